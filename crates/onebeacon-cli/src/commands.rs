@@ -1,0 +1,107 @@
+//! The commands: scenarios, run, mc.
+
+use crate::output::Staging;
+use crate::{BadInput, plot, report};
+use anyhow::Result;
+use indicatif::{ProgressBar, ProgressStyle};
+use onebeacon_sim::montecarlo::monte_carlo;
+use onebeacon_sim::run::simulate;
+use onebeacon_sim::scenario::{self, BUILTINS};
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// `onebeacon scenarios [--show NAME]`
+pub fn scenarios(show: Option<&str>) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    match show {
+        Some(name) => {
+            let b = scenario::builtin(name).ok_or_else(|| {
+                let names: Vec<_> = BUILTINS.iter().map(|b| format!("`{}`", b.name)).collect();
+                BadInput(format!("--show {name}: no such built-in scenario; built-ins are {}", names.join(", ")))
+            })?;
+            out.write_all(b.toml.as_bytes())?;
+        }
+        None => {
+            for b in BUILTINS {
+                let s = scenario::parse(b.toml, b.name)?;
+                writeln!(out, "{:<12} {}", b.name, s.description)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `onebeacon run SCENARIO [--seed N] [--run I] [--out DIR]`
+pub fn run(name: &str, seed: Option<u64>, run: u64, out: Option<PathBuf>) -> Result<()> {
+    let s = scenario::load(name)?;
+    let seed = seed.unwrap_or(s.seed);
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name)));
+    let staging = Staging::new(&dir)?;
+    let cell = s.base_cell();
+    let result = simulate(&s, &cell, seed, run, true);
+
+    staging.write("trajectory.csv", &report::trajectory_csv(&s, &result)?)?;
+    staging.write("summary.json", report::run_summary_json(&s, seed, run, &cell, &result).as_bytes())?;
+    plot::top_view(&staging.file("top_view.png"), &s, &result)?;
+    plot::error_vs_time(&staging.file("error.png"), &s, &result)?;
+    let files = staging.commit()?;
+
+    print!("{}", report::run_table(&s, seed, run, &cell, &result));
+    println!("wrote:");
+    for f in files {
+        println!("  {}", f.display());
+    }
+    Ok(())
+}
+
+/// `onebeacon mc SCENARIO [--runs N] [--seed N] [--threads N] [--out DIR] [--json]`
+pub fn mc(
+    name: &str,
+    runs: Option<usize>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+    out: Option<PathBuf>,
+    json: bool,
+) -> Result<()> {
+    let s = scenario::load(name)?;
+    let runs = runs.unwrap_or(s.runs);
+    let seed = seed.unwrap_or(s.seed);
+    let staging = out.as_deref().map(Staging::new).transpose()?;
+
+    let total = (runs * s.cells().len()) as u64;
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new(total);
+        bar.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} runs, {elapsed} (eta {eta})")
+                .expect("static template")
+                .progress_chars("=> "),
+        );
+        bar.set_message(format!("mc {}", s.name));
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let start = Instant::now();
+    let result = monte_carlo(&s, runs, seed, threads, &|| bar.inc(1))?;
+    let wall_s = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    let json_text = report::mc_json(&s, &result, wall_s);
+    if let Some(staging) = staging {
+        staging.write("mc.json", json_text.as_bytes())?;
+        plot::mc_errors(&staging.file("mc_error.png"), &s, &result)?;
+        let files = staging.commit()?;
+        if !json {
+            for f in files {
+                eprintln!("wrote {}", f.display());
+            }
+        }
+    }
+    if json {
+        println!("{json_text}");
+    } else {
+        print!("{}", report::mc_table(&s, &result, wall_s));
+    }
+    Ok(())
+}

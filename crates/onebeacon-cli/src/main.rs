@@ -1,0 +1,107 @@
+//! `onebeacon`: single-beacon underwater navigation, from scenario to table and plot.
+
+mod commands;
+mod output;
+mod plot;
+mod report;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Navigation of underwater vehicles from one acoustic beacon: simulate, estimate,
+/// compare.
+#[derive(Debug, Parser)]
+#[command(name = "onebeacon", version)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// List the built-in scenarios, or print one (`--show NAME`) to copy and edit.
+    Scenarios {
+        /// Print this built-in scenario's TOML.
+        #[arg(long, value_name = "NAME")]
+        show: Option<String>,
+    },
+    /// One run of a scenario: trajectory.csv, summary.json and plots in DIR.
+    Run {
+        /// Built-in scenario name or path of a TOML file.
+        scenario: String,
+        /// Base seed (default: the scenario's `seed`).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Which run of the seed to simulate (run i of `mc`).
+        #[arg(long, default_value_t = 0)]
+        run: u64,
+        /// Output directory (default: out/<scenario>-run).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+    /// Monte Carlo over the scenario's sweep: a table per estimator, or JSON.
+    Mc {
+        /// Built-in scenario name or path of a TOML file.
+        scenario: String,
+        /// Runs per sweep cell (default: the scenario's `runs`).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+        runs: Option<u32>,
+        /// Base seed (default: the scenario's `seed`).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Worker threads (default: one per core). Results do not depend on it.
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+        threads: Option<u16>,
+        /// Also write mc.json and plots to this directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Print one JSON object on stdout instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Input the user can fix (flags, scenario, output path): exit status 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind::*;
+            if matches!(e.kind(), DisplayHelp | DisplayVersion | DisplayHelpOnMissingArgumentOrSubcommand) {
+                let _ = e.print();
+                return if e.kind() == DisplayHelpOnMissingArgumentOrSubcommand {
+                    ExitCode::from(2)
+                } else {
+                    ExitCode::SUCCESS
+                };
+            }
+            // one line: clap's first line names the flag and what is allowed
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
+            eprintln!("error: {first} (see `onebeacon --help`)");
+            return ExitCode::from(2);
+        }
+    };
+    let result = match cli.command {
+        Command::Scenarios { show } => commands::scenarios(show.as_deref()),
+        Command::Run { scenario, seed, run, out } => commands::run(&scenario, seed, run, out),
+        Command::Mc { scenario, runs, seed, threads, out, json } => {
+            commands::mc(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), out, json)
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let msg = format!("{e:#}").replace('\n', " ");
+            eprintln!("error: {msg}");
+            let input =
+                e.downcast_ref::<onebeacon_sim::ScenarioError>().is_some() || e.downcast_ref::<BadInput>().is_some();
+            ExitCode::from(if input { 2 } else { 1 })
+        }
+    }
+}

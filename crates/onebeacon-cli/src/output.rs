@@ -1,0 +1,72 @@
+//! Output directories that are never left half-written: files are written to a
+//! staging directory beside the target and moved in only when all of them are done.
+
+use crate::BadInput;
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+
+/// A staging directory for the files of one output directory.
+pub struct Staging {
+    target: PathBuf,
+    staging: PathBuf,
+    committed: bool,
+}
+
+impl Staging {
+    /// Prepares to write into `target`. Fails (as bad input) if `target` exists and is
+    /// not a directory, or its parent cannot be created.
+    pub fn new(target: &Path) -> Result<Self> {
+        if target.exists() && !target.is_dir() {
+            return Err(BadInput(format!("--out {}: exists and is not a directory", target.display())).into());
+        }
+        let parent = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&parent)
+            .map_err(|e| BadInput(format!("--out {}: cannot create {}: {e}", target.display(), parent.display())))?;
+        let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+        let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&staging);
+        std::fs::create_dir(&staging)
+            .map_err(|e| BadInput(format!("--out {}: cannot write in {}: {e}", target.display(), parent.display())))?;
+        Ok(Self { target: target.to_path_buf(), staging, committed: false })
+    }
+
+    /// Where to write file `name` for now.
+    pub fn file(&self, name: &str) -> PathBuf {
+        self.staging.join(name)
+    }
+
+    /// Writes `contents` as file `name`.
+    pub fn write(&self, name: &str, contents: &[u8]) -> Result<()> {
+        std::fs::write(self.file(name), contents).with_context(|| format!("cannot write {name}"))
+    }
+
+    /// Moves every staged file into the target directory; returns their final paths.
+    pub fn commit(mut self) -> Result<Vec<PathBuf>> {
+        let mut names: Vec<_> =
+            std::fs::read_dir(&self.staging)?.map(|e| e.map(|e| e.file_name())).collect::<std::io::Result<_>>()?;
+        names.sort();
+        if !self.target.exists() {
+            std::fs::rename(&self.staging, &self.target)
+                .with_context(|| format!("cannot create {}", self.target.display()))?;
+        } else {
+            for n in &names {
+                std::fs::rename(self.staging.join(n), self.target.join(n))
+                    .with_context(|| format!("cannot write into {}", self.target.display()))?;
+            }
+            std::fs::remove_dir(&self.staging)?;
+        }
+        self.committed = true;
+        Ok(names.iter().map(|n| self.target.join(n)).collect())
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}

@@ -1,0 +1,206 @@
+//! End-to-end tests of the `onebeacon` binary: outputs, determinism, bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_onebeacon"))
+}
+
+/// A fresh, empty scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("onebeacon-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("binary runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+const SHORT: &str = r#"
+name = "short"
+description = "two minutes of the garin2024 mission"
+[mission]
+duration_s = 120.0
+[sweep]
+t_com_s = [3.0, 9.0]
+"#;
+
+fn short_scenario(dir: &Path) -> String {
+    let p = dir.join("short.toml");
+    std::fs::write(&p, SHORT).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+#[test]
+fn scenarios_lists_and_shows_builtins() {
+    let out = run(&["scenarios"]);
+    assert!(out.status.success());
+    assert!(text(&out.stdout).starts_with("garin2024 "));
+    let out = run(&["scenarios", "--show", "garin2024"]);
+    assert!(out.status.success());
+    // what --show prints is a scenario file that runs
+    let dir = scratch("show");
+    let p = dir.join("copy.toml");
+    std::fs::write(&p, text(&out.stdout).replace("# duration_s = 1567", "duration_s = 30")).unwrap();
+    let out = run(&["mc", p.to_str().unwrap(), "--runs", "2", "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+#[test]
+fn run_writes_trajectory_summary_and_plots() {
+    let dir = scratch("run");
+    let scenario = short_scenario(&dir);
+    let out_dir = dir.join("out");
+    let out = run(&["run", &scenario, "--seed", "4", "--out", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("range+doppler") && stdout.contains("trajectory.csv"), "{stdout}");
+
+    let csv = std::fs::read_to_string(out_dir.join("trajectory.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for col in [
+        "t_s",
+        "truth_north_m",
+        "truth_east_m",
+        "range+doppler_north_m",
+        "range+doppler_error_m",
+        "rosb_error_m",
+        "rosb_nees",
+    ] {
+        assert!(header.contains(&col), "missing column {col}");
+    }
+    assert_eq!(lines.count(), 481); // 120 s at 0.25 s, plus t = 0
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["scenario"], "short");
+    assert_eq!(summary["seed"], 4);
+    let err = summary["estimators"][0]["mean_error_m"].as_f64().unwrap();
+    assert!(err > 0.0 && err < 20.0, "{err}");
+
+    for png in ["top_view.png", "error.png"] {
+        let bytes = std::fs::read(out_dir.join(png)).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000, "{png}");
+    }
+    // no staging directory left behind
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
+    assert!(leftovers.is_empty());
+}
+
+#[test]
+fn mc_json_has_the_contract_fields_and_ignores_thread_count() {
+    let dir = scratch("mc");
+    let scenario = short_scenario(&dir);
+    let cells = |threads: &str| {
+        let out = run(&["mc", &scenario, "--runs", "6", "--seed", "9", "--threads", threads, "--json"]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let v: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+        assert_eq!(v["scenario"], "short");
+        assert_eq!(v["runs"], 6);
+        assert_eq!(v["seed"], 9);
+        assert!(v["wall_s"].as_f64().unwrap() > 0.0);
+        v["cells"].clone()
+    };
+    let one = cells("1");
+    let cells_arr = one.as_array().unwrap();
+    assert_eq!(cells_arr.len(), 4); // 2 T_com x 2 estimators
+    for c in cells_arr {
+        for key in [
+            "sweep",
+            "estimator",
+            "mean_error_m",
+            "error_variance_m2",
+            "rmse_m",
+            "outliers",
+            "etd_max_pct",
+            "etd_mean_pct",
+            "nees_mean",
+            "nees_band",
+        ] {
+            assert!(!c[key].is_null(), "missing {key} in {c}");
+        }
+        assert!(c["sweep"]["t_com_s"].as_f64().is_some());
+    }
+    assert_eq!(one, cells("2"));
+}
+
+#[test]
+fn mc_out_writes_json_and_plot() {
+    let dir = scratch("mcout");
+    let scenario = short_scenario(&dir);
+    let out_dir = dir.join("mc");
+    let out = run(&["mc", &scenario, "--runs", "3", "--out", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("Mean positioning error"));
+    assert!(std::fs::read(out_dir.join("mc_error.png")).unwrap().starts_with(b"\x89PNG"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("mc.json")).unwrap()).unwrap();
+    assert_eq!(v["cells"].as_array().unwrap().len(), 4);
+}
+
+/// Each bad input: exit status 2, one line on stderr naming the problem, no panic, no
+/// output directory.
+#[test]
+fn bad_input_exits_2_with_one_line_naming_the_key() {
+    let dir = scratch("bad");
+    let write = |name: &str, body: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, body).unwrap();
+        p.to_string_lossy().into_owned()
+    };
+    let missing = dir.join("nope.toml").to_string_lossy().into_owned();
+    let malformed = write("malformed.toml", "name = \"m\"\n[comms\nt_com_s = 3\n");
+    let unknown = write("unknown.toml", "name = \"u\"\n[comms]\nt_comm_s = 3.0\n");
+    let wrong_type = write("type.toml", "name = \"t\"\n[sensors]\nrange_noise_m = \"big\"\n");
+    let t_com = write("tcom.toml", "name = \"c\"\n[comms]\nt_com_s = 0.0\n");
+    let runs0 = write("runs.toml", "name = \"r\"\nruns = 0\n");
+    let nan = write("nan.toml", "name = \"n\"\n[mission]\ndt_s = nan\n");
+    let negative = write("neg.toml", "name = \"g\"\n[sensors]\ndoppler_noise_m_s = -0.1\n");
+    let sweep = write("sweep.toml", "name = \"s\"\n[sweep]\nt_com_s = [3.0, -6.0]\n");
+    let not_a_dir = write("file.txt", "x");
+    let out_dir = dir.join("should-not-exist");
+    let out = out_dir.to_str().unwrap();
+
+    let cases: Vec<(Vec<&str>, &[&str])> = vec![
+        (vec!["run", "garin2025", "--out", out], &["garin2025", "garin2024"]),
+        (vec!["mc", &missing, "--out", out], &["nope.toml", "cannot read"]),
+        (vec!["mc", &malformed, "--out", out], &["malformed.toml", "line 2"]),
+        (vec!["mc", &unknown, "--out", out], &["unknown.toml", "t_comm_s", "t_com_s"]),
+        (vec!["mc", &wrong_type, "--out", out], &["type.toml", "sensors.range_noise_m", "line 3"]),
+        (vec!["run", &t_com, "--out", out], &["tcom.toml", "comms.t_com_s", "> 0"]),
+        (vec!["mc", &runs0, "--out", out], &["runs.toml", "runs", "from 1"]),
+        (vec!["mc", &nan, "--out", out], &["nan.toml", "mission.dt_s", "NaN"]),
+        (vec!["mc", &negative, "--out", out], &["neg.toml", "sensors.doppler_noise_m_s", ">= 0"]),
+        (vec!["mc", &sweep, "--out", out], &["sweep.toml", "sweep.t_com_s[1]"]),
+        (vec!["mc", "garin2024", "--runs", "0", "--out", out], &["--runs", "0"]),
+        (vec!["mc", "garin2024", "--threads", "0", "--out", out], &["--threads"]),
+        (vec!["mc", "garin2024", "--seed", "abc", "--out", out], &["--seed", "abc"]),
+        (vec!["run", "garin2024", "--out", &not_a_dir], &["file.txt", "not a directory"]),
+        (vec!["scenarios", "--show", "nothing"], &["nothing", "garin2024"]),
+        (vec!["fly"], &["fly"]),
+    ];
+    for (args, needles) in cases {
+        let o = run(&args);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: not one line: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{args:?}: `{n}` not in: {err}");
+        }
+        assert!(o.stdout.is_empty(), "{args:?}: wrote to stdout");
+        assert!(!out_dir.exists(), "{args:?}: left an output directory");
+    }
+}

@@ -1,0 +1,18 @@
+//! onebeacon-sim: the world around the onboard library.
+//!
+//! - [`vehicles`]: truth dynamics, paths and their controllers;
+//! - [`sensors`]: what the vehicle's sensors and modem report, with their errors;
+//! - [`scenario`]: the TOML scenario schema, its validation and the built-in scenarios;
+//! - [`run`]: one simulated run, a pure function of (scenario, sweep cell, seed, run);
+//! - [`metrics`]: per-run error statistics and their Monte Carlo aggregation;
+//! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count.
+
+pub mod metrics;
+pub mod montecarlo;
+pub mod run;
+pub mod scenario;
+pub mod seed;
+pub mod sensors;
+pub mod vehicles;
+
+pub use scenario::{Scenario, ScenarioError};

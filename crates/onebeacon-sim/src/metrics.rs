@@ -1,0 +1,219 @@
+//! Error statistics of one run and their aggregation over Monte Carlo runs
+//! (garin2024 section 4.1: mean error, its variance, outliers, %etd).
+
+use serde::Serialize;
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// Statistics of one estimator over one run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RunMetrics {
+    /// Mean horizontal position error over the run, m (infinite if the filter diverged
+    /// to non-finite numbers).
+    pub mean_error_m: f64,
+    /// Variance of the error over the run, m^2.
+    pub error_variance_m2: f64,
+    /// Mean squared error, m^2.
+    pub mse_m2: f64,
+    pub max_error_m: f64,
+    pub final_error_m: f64,
+    /// Error in percent of the distance travelled in the whole run ("%etd"): max, mean.
+    pub etd_max_pct: f64,
+    pub etd_mean_pct: f64,
+    /// Mean NEES of the horizontal position (2 degrees of freedom).
+    pub nees_mean: f64,
+    /// Filter updates refused (innovation covariance not positive definite).
+    pub failed_updates: u64,
+}
+
+/// Accumulates one estimator's errors step by step.
+#[derive(Debug, Clone, Default)]
+pub struct ErrorAccumulator {
+    n: u64,
+    sum: f64,
+    sum2: f64,
+    max: f64,
+    last: f64,
+    nees_sum: f64,
+    nees_n: u64,
+    failed_updates: u64,
+    diverged: bool,
+}
+
+impl ErrorAccumulator {
+    /// Adds the error of one step and its position NEES (None if P was not positive
+    /// definite).
+    pub fn push(&mut self, error_m: f64, nees: Option<f64>) {
+        if !error_m.is_finite() {
+            self.diverged = true;
+            return;
+        }
+        self.n += 1;
+        self.sum += error_m;
+        self.sum2 += error_m * error_m;
+        self.max = self.max.max(error_m);
+        self.last = error_m;
+        if let Some(v) = nees.filter(|v| v.is_finite()) {
+            self.nees_sum += v;
+            self.nees_n += 1;
+        }
+    }
+
+    pub fn failed_update(&mut self) {
+        self.failed_updates += 1;
+    }
+
+    /// The run's statistics; `distance_m` is the distance travelled in the run.
+    pub fn finish(&self, distance_m: f64) -> RunMetrics {
+        let n = self.n.max(1) as f64;
+        let mean = self.sum / n;
+        let mse = self.sum2 / n;
+        let pct = 100.0 / distance_m.max(f64::MIN_POSITIVE);
+        let bad = self.diverged || self.n == 0;
+        RunMetrics {
+            mean_error_m: if bad { f64::INFINITY } else { mean },
+            error_variance_m2: if bad { f64::INFINITY } else { (mse - mean * mean).max(0.0) },
+            mse_m2: if bad { f64::INFINITY } else { mse },
+            max_error_m: if bad { f64::INFINITY } else { self.max },
+            final_error_m: if bad { f64::INFINITY } else { self.last },
+            etd_max_pct: if bad { f64::INFINITY } else { self.max * pct },
+            etd_mean_pct: if bad { f64::INFINITY } else { mean * pct },
+            nees_mean: if self.nees_n == 0 { f64::NAN } else { self.nees_sum / self.nees_n as f64 },
+            failed_updates: self.failed_updates,
+        }
+    }
+}
+
+/// Statistics of one estimator over the runs of one sweep cell, as in garin2024 Tables
+/// 3 and 4. Outliers are runs whose mean error lies beyond q1 - 1.5 IQR or q3 + 1.5 IQR
+/// of all runs' mean errors (section 4.1.1); they are counted and left out of the
+/// error statistics, NEES included; `nees_mean_all_runs` keeps them, since a diverged
+/// run is exactly what a consistency check must also see.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CellSummary {
+    pub runs: usize,
+    pub outliers: usize,
+    /// Mean over inlier runs of the run's mean error, m.
+    pub mean_error_m: f64,
+    /// Mean over inlier runs of the run's error variance, m^2.
+    pub error_variance_m2: f64,
+    /// Root of the mean squared error over inlier runs and steps, m.
+    pub rmse_m: f64,
+    pub etd_max_pct: f64,
+    pub etd_mean_pct: f64,
+    /// Mean position NEES over the inlier runs and their steps.
+    pub nees_mean: f64,
+    /// 95 % band of the run-averaged NEES of a consistent filter over the inlier runs:
+    /// chi2(2N)/N quantiles.
+    pub nees_band: [f64; 2],
+    /// Mean position NEES over all runs, outliers included (infinite if a filter's
+    /// covariance broke down).
+    pub nees_mean_all_runs: f64,
+    pub failed_updates: u64,
+}
+
+/// Quantile by linear interpolation between order statistics (type 7); `sorted` must
+/// be sorted ascending and non-empty.
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let h = (sorted.len() - 1) as f64 * q;
+    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
+    if lo == hi || !sorted[hi].is_finite() {
+        sorted[lo]
+    } else {
+        sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+    }
+}
+
+/// 95 % band for the average of `runs` independent chi-square(`dof`) variables.
+pub fn nees_band(runs: usize, dof: usize) -> [f64; 2] {
+    let n = (runs * dof) as f64;
+    match ChiSquared::new(n) {
+        Ok(chi) => [chi.inverse_cdf(0.025) / runs as f64, chi.inverse_cdf(0.975) / runs as f64],
+        Err(_) => [f64::NAN, f64::NAN],
+    }
+}
+
+/// Aggregates runs (in run order) into a cell summary.
+pub fn summarise(runs: &[RunMetrics]) -> CellSummary {
+    assert!(!runs.is_empty(), "a cell has at least one run");
+    let mut means: Vec<f64> = runs.iter().map(|r| r.mean_error_m).collect();
+    means.sort_by(f64::total_cmp);
+    let (q1, q3) = (quantile(&means, 0.25), quantile(&means, 0.75));
+    let iqr = q3 - q1;
+    let (lo, hi) = (q1 - 1.5 * iqr, q3 + 1.5 * iqr);
+    let inliers: Vec<&RunMetrics> =
+        runs.iter().filter(|r| r.mean_error_m.is_finite() && r.mean_error_m >= lo && r.mean_error_m <= hi).collect();
+    let avg = |f: &dyn Fn(&RunMetrics) -> f64| {
+        if inliers.is_empty() { f64::NAN } else { inliers.iter().map(|r| f(r)).sum::<f64>() / inliers.len() as f64 }
+    };
+    let nees_all = if runs.iter().all(|r| r.nees_mean.is_finite()) {
+        runs.iter().map(|r| r.nees_mean).sum::<f64>() / runs.len() as f64
+    } else {
+        f64::INFINITY
+    };
+    CellSummary {
+        runs: runs.len(),
+        outliers: runs.len() - inliers.len(),
+        mean_error_m: avg(&|r| r.mean_error_m),
+        error_variance_m2: avg(&|r| r.error_variance_m2),
+        rmse_m: avg(&|r| r.mse_m2).sqrt(),
+        etd_max_pct: avg(&|r| r.etd_max_pct),
+        etd_mean_pct: avg(&|r| r.etd_mean_pct),
+        nees_mean: avg(&|r| r.nees_mean),
+        nees_band: nees_band(inliers.len(), 2),
+        nees_mean_all_runs: nees_all,
+        failed_updates: runs.iter().map(|r| r.failed_updates).sum(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn run(mean: f64) -> RunMetrics {
+        let mut a = ErrorAccumulator::default();
+        a.push(mean - 1.0, Some(1.0));
+        a.push(mean + 1.0, Some(3.0));
+        a.finish(1000.0)
+    }
+
+    #[test]
+    fn accumulator_statistics() {
+        let m = run(5.0);
+        assert_relative_eq!(m.mean_error_m, 5.0);
+        assert_relative_eq!(m.error_variance_m2, 1.0, max_relative = 1e-12);
+        assert_relative_eq!(m.mse_m2, 26.0);
+        assert_relative_eq!(m.etd_max_pct, 0.6);
+        assert_relative_eq!(m.etd_mean_pct, 0.5);
+        assert_relative_eq!(m.nees_mean, 2.0);
+        assert_eq!(m.final_error_m, 6.0);
+    }
+
+    #[test]
+    fn tukey_outliers_are_counted_and_excluded() {
+        // 1..=9 and one far run: q1 = 3.25, q3 = 7.75 over the ten, fence 14.5
+        let mut runs: Vec<RunMetrics> = (1..=9).map(|i| run(i as f64 + 1.0)).collect();
+        runs.push(run(40.0));
+        let s = summarise(&runs);
+        assert_eq!(s.outliers, 1);
+        assert_relative_eq!(s.mean_error_m, 6.0); // mean of 2..=10
+        assert_relative_eq!(s.nees_mean, 2.0);
+        assert_eq!(s.nees_band, nees_band(9, 2));
+        // a diverged run is an outlier; NEES over all runs sees it
+        let mut acc = ErrorAccumulator::default();
+        acc.push(f64::NAN, None);
+        runs.push(acc.finish(1000.0));
+        let s = summarise(&runs);
+        assert_eq!(s.outliers, 2);
+        assert!(s.nees_mean.is_finite() && s.nees_mean_all_runs.is_infinite());
+    }
+
+    #[test]
+    fn nees_band_matches_acoustics_md() {
+        // ../shared/acoustics.md: N = 50, n = 2: [1.48, 2.59]; N = 100, n = 2: [1.63, 2.41]
+        let b = nees_band(50, 2);
+        assert!((b[0] - 1.48).abs() < 0.01 && (b[1] - 2.59).abs() < 0.01, "{b:?}");
+        let b = nees_band(100, 2);
+        assert!((b[0] - 1.63).abs() < 0.01 && (b[1] - 2.41).abs() < 0.01, "{b:?}");
+    }
+}

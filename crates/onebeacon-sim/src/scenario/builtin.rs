@@ -1,0 +1,31 @@
+//! Built-in scenarios: the TOML files of `scenarios/`, embedded in the binary.
+
+/// A built-in scenario file.
+#[derive(Debug, Clone, Copy)]
+pub struct Builtin {
+    pub name: &'static str,
+    pub toml: &'static str,
+}
+
+/// All built-in scenarios.
+pub const BUILTINS: &[Builtin] =
+    &[Builtin { name: "garin2024", toml: include_str!("../../../../scenarios/garin2024.toml") }];
+
+/// The built-in scenario called `name`.
+pub fn builtin(name: &str) -> Option<&'static Builtin> {
+    BUILTINS.iter().find(|b| b.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_parses_and_is_named_after_its_file() {
+        for b in BUILTINS {
+            let s = crate::scenario::parse(b.toml, b.name).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(s.name, b.name);
+            assert!(!s.description.is_empty() && !s.description.contains('\n'));
+        }
+    }
+}

@@ -1,0 +1,124 @@
+//! Loading a scenario from a built-in name or a file, with one-line errors that name
+//! the source, the key and what is allowed.
+
+use super::{Scenario, builtin, validate};
+use std::path::Path;
+
+/// Why a scenario could not be loaded. Each message is one line naming the source (file
+/// or built-in), the key and what is allowed.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    #[error("unknown scenario `{name}`: built-in scenarios are {available}; or give the path of a .toml file")]
+    UnknownBuiltin { name: String, available: String },
+    #[error("{source_name}: cannot read: {message}")]
+    Io { source_name: String, message: String },
+    #[error("{source_name}: line {line}: {message}")]
+    Syntax { source_name: String, line: usize, message: String },
+    #[error("{source_name}: line {line}: key `{key}`: {message}")]
+    Key { source_name: String, line: usize, key: String, message: String },
+    #[error("{source_name}: key `{key}` = {value}: {allowed}")]
+    Invalid { source_name: String, key: String, value: String, allowed: String },
+}
+
+/// Loads `name_or_path`: a built-in scenario name, or the path of a TOML file.
+pub fn load(name_or_path: &str) -> Result<Scenario, ScenarioError> {
+    if let Some(b) = builtin(name_or_path) {
+        return parse(b.toml, &format!("built-in scenario `{}`", b.name));
+    }
+    let path = Path::new(name_or_path);
+    let looks_like_path = name_or_path.ends_with(".toml") || name_or_path.contains(['/', '\\']);
+    if !looks_like_path && !path.exists() {
+        return Err(ScenarioError::UnknownBuiltin {
+            name: name_or_path.to_string(),
+            available: super::BUILTINS.iter().map(|b| format!("`{}`", b.name)).collect::<Vec<_>>().join(", "),
+        });
+    }
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ScenarioError::Io { source_name: name_or_path.to_string(), message: e.to_string() })?;
+    parse(&text, name_or_path)
+}
+
+/// Parses and validates scenario TOML; `source_name` names it in errors.
+pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
+    let line_of = |span: Option<std::ops::Range<usize>>| {
+        span.map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1).unwrap_or(0)
+    };
+    let one_line = |m: &str| m.trim().replace('\n', "; ");
+    let de = toml::Deserializer::parse(text).map_err(|e| ScenarioError::Syntax {
+        source_name: source_name.to_string(),
+        line: line_of(e.span()),
+        message: one_line(e.message()),
+    })?;
+    let scenario: Scenario = serde_path_to_error::deserialize(de).map_err(|e| {
+        let key = e.path().to_string();
+        let inner = e.into_inner();
+        let (line, message) = (line_of(inner.span()), one_line(inner.message()));
+        if key == "." {
+            ScenarioError::Syntax { source_name: source_name.to_string(), line, message }
+        } else {
+            ScenarioError::Key { source_name: source_name.to_string(), line, key, message }
+        }
+    })?;
+    validate::validate(&scenario).map_err(|v| ScenarioError::Invalid {
+        source_name: source_name.to_string(),
+        key: v.key,
+        value: v.value,
+        allowed: v.allowed,
+    })?;
+    Ok(scenario)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        parse(text, "test.toml").unwrap_err().to_string()
+    }
+
+    #[test]
+    fn minimal_scenario_takes_defaults() {
+        let s = parse("name = \"x\"\n", "test.toml").unwrap();
+        assert_eq!(s.runs, 300);
+        assert_eq!(s.comms.t_com_s, 3.0);
+        assert_eq!(s.estimators.len(), 2);
+    }
+
+    #[test]
+    fn errors_name_the_key_and_what_is_allowed() {
+        let e = err("name = \"x\"\n[comms]\nt_comm_s = 3.0\n");
+        assert!(e.contains("test.toml") && e.contains("t_comm_s") && e.contains("t_com_s"), "{e}");
+        assert!(e.contains("line 3"), "{e}");
+
+        let e = err("name = \"x\"\n[comms]\nt_com_s = \"fast\"\n");
+        assert!(e.contains("comms.t_com_s") && e.contains("line 3"), "{e}");
+
+        let e = err("name = \"x\"\n[comms]\nt_com_s = -1.0\n");
+        assert!(e.contains("comms.t_com_s") && e.contains("-1") && e.contains("> 0"), "{e}");
+
+        let e = err("name = \"x\"\n[sensors]\nrange_noise_m = nan\n");
+        assert!(e.contains("sensors.range_noise_m") && e.contains("NaN"), "{e}");
+
+        let e = err("name = \"x\"\n[sensors]\ndoppler_noise_m_s = -0.1\n");
+        assert!(e.contains("sensors.doppler_noise_m_s") && e.contains(">= 0"), "{e}");
+
+        let e = err("name = \"x\"\nruns = 0\n");
+        assert!(e.contains("`runs`") && e.contains("from 1 to"), "{e}");
+
+        let e = err("name = \"x\"\n[sweep]\nt_com_s = [3.0, 0.0]\n");
+        assert!(e.contains("sweep.t_com_s[1]"), "{e}");
+
+        let e = err("name = \"x\"\n[[estimators]]\nkind = \"kalman\"\n");
+        assert!(e.contains("estimators[0].kind") && e.contains("range+doppler"), "{e}");
+
+        let e = err("name = \"x\"\n[comms\n");
+        assert!(e.contains("test.toml: line 2"), "{e}");
+
+        let e = err("description = \"no name\"\n");
+        assert!(e.contains("name"), "{e}");
+
+        for e in [err("name = 1\n"), err("name=\"x\"\n[mission]\ndt_s = inf\n")] {
+            assert!(!e.contains('\n'), "{e}");
+        }
+    }
+}

@@ -1,0 +1,375 @@
+//! The scenario schema with its defaults. Unknown keys are errors.
+
+use onebeacon::nav::{Aiding, EkfTuning};
+use serde::{Deserialize, Serialize};
+
+/// A complete scenario: the world, the vehicle, its sensors, the estimators compared on
+/// the same runs, and the Monte Carlo sweep.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name, used in outputs.
+    pub name: String,
+    /// One line shown by `onebeacon scenarios`.
+    #[serde(default)]
+    pub description: String,
+    /// Base seed of the runs (the CLI's `--seed` overrides it).
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Monte Carlo runs per sweep cell (the CLI's `--runs` overrides it).
+    #[serde(default = "default_runs")]
+    pub runs: usize,
+    #[serde(default)]
+    pub mission: Mission,
+    #[serde(default)]
+    pub path: PathSpec,
+    #[serde(default)]
+    pub beacon: Beacon,
+    #[serde(default)]
+    pub comms: Comms,
+    #[serde(default)]
+    pub sensors: Sensors,
+    #[serde(default)]
+    pub initial: Initial,
+    #[serde(default = "default_estimators")]
+    pub estimators: Vec<EstimatorSpec>,
+    #[serde(default)]
+    pub sweep: Sweep,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+fn default_runs() -> usize {
+    300
+}
+fn default_estimators() -> Vec<EstimatorSpec> {
+    vec![EstimatorSpec::new(EstimatorKind::RangeDoppler), EstimatorSpec::new(EstimatorKind::Rosb)]
+}
+
+/// Time step, speed and duration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Mission {
+    /// Simulation and filter time step, s (garin2024 Table 2: 250 ms).
+    pub dt_s: f64,
+    /// Speed along the path, m/s (garin2024 section 4.1.1: about 1 m/s).
+    pub speed_m_s: f64,
+    /// Mission duration, s; absent: the time to travel the whole path.
+    pub duration_s: Option<f64>,
+}
+
+impl Default for Mission {
+    fn default() -> Self {
+        Self { dt_s: 0.25, speed_m_s: 1.0, duration_s: None }
+    }
+}
+
+/// Boustrophedon survey path.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PathSpec {
+    pub start_north_m: f64,
+    pub start_east_m: f64,
+    /// Direction of the first leg, deg from north toward east.
+    pub leg_heading_deg: f64,
+    /// Length of each straight leg, m.
+    pub leg_length_m: f64,
+    /// Distance between legs (diameter of the half-circle turns), m.
+    pub leg_spacing_m: f64,
+    /// Number of legs.
+    pub legs: usize,
+    /// Side the legs advance to, seen along the first leg.
+    pub turn: Turn,
+}
+
+impl Default for PathSpec {
+    fn default() -> Self {
+        // 6 legs of 235 m, 20 m apart: 1567 m, inside about 100 m x 255 m (garin2024 4.1.1)
+        Self {
+            start_north_m: 0.0,
+            start_east_m: 0.0,
+            leg_heading_deg: 90.0,
+            leg_length_m: 235.0,
+            leg_spacing_m: 20.0,
+            legs: 6,
+            turn: Turn::Left,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Turn {
+    Left,
+    Right,
+}
+
+/// The fixed beacon.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Beacon {
+    pub north_m: f64,
+    pub east_m: f64,
+}
+
+impl Default for Beacon {
+    fn default() -> Self {
+        Self { north_m: 50.0, east_m: 100.0 } // garin2024 Table 2
+    }
+}
+
+/// The acoustic communication schedule.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Comms {
+    /// Period between communication frames, s.
+    pub t_com_s: f64,
+    /// Probability that a frame is not decoded, in [0, 1].
+    pub frame_loss_prob: f64,
+}
+
+impl Default for Comms {
+    fn default() -> Self {
+        Self { t_com_s: 3.0, frame_loss_prob: 0.0 }
+    }
+}
+
+/// Sensor errors of the simulated vehicle (standard deviations).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Sensors {
+    /// OWTT range noise, m.
+    pub range_noise_m: f64,
+    /// Doppler radial speed noise, m/s.
+    pub doppler_noise_m_s: f64,
+    /// AHRS heading white noise, deg.
+    pub heading_noise_deg: f64,
+    /// Standard deviation of the heading bias at the start, deg.
+    pub heading_bias_deg: f64,
+    /// Standard deviation of the heading bias drift rate, deg/h (constant in a run).
+    pub heading_bias_drift_deg_per_h: f64,
+    /// Gyro (yaw rate) white noise, rad/s.
+    pub gyro_noise_rad_s: f64,
+    /// Accelerometer (forward) white noise, m/s^2.
+    pub accel_noise_m_s2: f64,
+}
+
+impl Default for Sensors {
+    fn default() -> Self {
+        Self {
+            range_noise_m: 3.464,
+            doppler_noise_m_s: 0.447,
+            heading_noise_deg: 2.0,
+            heading_bias_deg: 0.0,
+            heading_bias_drift_deg_per_h: 5.0,
+            gyro_noise_rad_s: 0.05,
+            accel_noise_m_s2: 0.05,
+        }
+    }
+}
+
+impl Sensors {
+    /// All errors zero: a noise-free world.
+    pub fn noise_free() -> Self {
+        Self {
+            range_noise_m: 0.0,
+            doppler_noise_m_s: 0.0,
+            heading_noise_deg: 0.0,
+            heading_bias_deg: 0.0,
+            heading_bias_drift_deg_per_h: 0.0,
+            gyro_noise_rad_s: 0.0,
+            accel_noise_m_s2: 0.0,
+        }
+    }
+}
+
+/// Initial uncertainty: the filters start at the truth plus an error drawn with these
+/// standard deviations (the same draw for every estimator), with the matching
+/// covariance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Initial {
+    pub position_sigma_m: f64,
+    pub heading_sigma_deg: f64,
+    pub speed_sigma_m_s: f64,
+    pub yaw_rate_sigma_rad_s: f64,
+    pub accel_sigma_m_s2: f64,
+}
+
+impl Default for Initial {
+    fn default() -> Self {
+        Self {
+            position_sigma_m: 0.5,
+            heading_sigma_deg: 2.0,
+            speed_sigma_m_s: 0.05,
+            yaw_rate_sigma_rad_s: 0.01,
+            accel_sigma_m_s2: 0.01,
+        }
+    }
+}
+
+/// Which estimator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum EstimatorKind {
+    /// garin2024's EKF with range and Doppler speed.
+    #[serde(rename = "range+doppler")]
+    RangeDoppler,
+    /// Range-only single beacon EKF (ROSB).
+    #[serde(rename = "rosb")]
+    Rosb,
+}
+
+impl EstimatorKind {
+    pub fn aiding(self) -> Aiding {
+        match self {
+            EstimatorKind::RangeDoppler => Aiding::RangeDoppler,
+            EstimatorKind::Rosb => Aiding::RangeOnly,
+        }
+    }
+    pub fn label(self) -> &'static str {
+        match self {
+            EstimatorKind::RangeDoppler => "range+doppler",
+            EstimatorKind::Rosb => "rosb",
+        }
+    }
+}
+
+/// One estimator to run. Noise defaults are garin2024 eq. 25.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EstimatorSpec {
+    pub kind: EstimatorKind,
+    /// Name in outputs; default: the kind.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Diagonal of Q per step, state order [x, y, psi, v, Omega, a].
+    #[serde(default = "default_q")]
+    pub q_diag: [f64; 6],
+    #[serde(default = "default_r_range")]
+    pub r_range_m2: f64,
+    #[serde(default = "default_r_doppler")]
+    pub r_doppler_m2_s2: f64,
+    #[serde(default = "default_r_heading")]
+    pub r_heading_rad2: f64,
+    #[serde(default = "default_r_yaw_rate")]
+    pub r_yaw_rate_rad2_s2: f64,
+    #[serde(default = "default_r_accel")]
+    pub r_accel_m2_s4: f64,
+}
+
+fn default_q() -> [f64; 6] {
+    EkfTuning::default().q_diag
+}
+fn default_r_range() -> f64 {
+    EkfTuning::default().r_range_m2
+}
+fn default_r_doppler() -> f64 {
+    EkfTuning::default().r_doppler_m2_s2
+}
+fn default_r_heading() -> f64 {
+    EkfTuning::default().r_heading_rad2
+}
+fn default_r_yaw_rate() -> f64 {
+    EkfTuning::default().r_yaw_rate_rad2_s2
+}
+fn default_r_accel() -> f64 {
+    EkfTuning::default().r_accel_m2_s4
+}
+
+impl EstimatorSpec {
+    /// An estimator of `kind` with the default (eq. 25) tuning.
+    pub fn new(kind: EstimatorKind) -> Self {
+        let t = EkfTuning::default();
+        Self {
+            kind,
+            name: None,
+            q_diag: t.q_diag,
+            r_range_m2: t.r_range_m2,
+            r_doppler_m2_s2: t.r_doppler_m2_s2,
+            r_heading_rad2: t.r_heading_rad2,
+            r_yaw_rate_rad2_s2: t.r_yaw_rate_rad2_s2,
+            r_accel_m2_s4: t.r_accel_m2_s4,
+        }
+    }
+
+    pub fn name(&self) -> &str {
+        self.name.as_deref().unwrap_or(self.kind.label())
+    }
+
+    pub fn tuning(&self) -> EkfTuning {
+        EkfTuning {
+            q_diag: self.q_diag,
+            r_range_m2: self.r_range_m2,
+            r_doppler_m2_s2: self.r_doppler_m2_s2,
+            r_heading_rad2: self.r_heading_rad2,
+            r_yaw_rate_rad2_s2: self.r_yaw_rate_rad2_s2,
+            r_accel_m2_s4: self.r_accel_m2_s4,
+        }
+    }
+}
+
+/// Values swept by `mc`; each combination is one cell. An absent key keeps the
+/// scenario's value.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Sweep {
+    /// Communication periods, s.
+    pub t_com_s: Option<Vec<f64>>,
+}
+
+/// One sweep cell: the swept values that differ from the base scenario.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cell {
+    pub t_com_s: f64,
+}
+
+impl Cell {
+    /// The swept keys and values, for tables and JSON.
+    pub fn values(&self) -> Vec<(&'static str, f64)> {
+        vec![("t_com_s", self.t_com_s)]
+    }
+}
+
+impl Scenario {
+    /// The cell of the base scenario (no sweep).
+    pub fn base_cell(&self) -> Cell {
+        Cell { t_com_s: self.comms.t_com_s }
+    }
+
+    /// All sweep cells, in order.
+    pub fn cells(&self) -> Vec<Cell> {
+        match &self.sweep.t_com_s {
+            Some(v) => v.iter().map(|&t_com_s| Cell { t_com_s }).collect(),
+            None => vec![self.base_cell()],
+        }
+    }
+
+    /// Mission duration, s.
+    pub fn duration_s(&self) -> f64 {
+        self.mission.duration_s.unwrap_or_else(|| self.path().length() / self.mission.speed_m_s)
+    }
+
+    /// Number of filter steps after the initial one.
+    pub fn steps(&self) -> usize {
+        (self.duration_s() / self.mission.dt_s).round() as usize
+    }
+
+    /// The reference path.
+    pub fn path(&self) -> crate::vehicles::Path {
+        let p = &self.path;
+        crate::vehicles::Path::boustrophedon(
+            nalgebra::Vector2::new(p.start_north_m, p.start_east_m),
+            p.leg_heading_deg.to_radians(),
+            p.leg_length_m,
+            p.leg_spacing_m,
+            p.legs,
+            p.turn == Turn::Left,
+        )
+    }
+
+    /// Beacon position, NED m.
+    pub fn beacon_ned_m(&self) -> nalgebra::Vector2<f64> {
+        nalgebra::Vector2::new(self.beacon.north_m, self.beacon.east_m)
+    }
+}

@@ -1,0 +1,115 @@
+//! What the vehicle's sensors and modem report: the truth plus errors, drawn from the
+//! run's seeded random streams (garin2024 sections 3.5, 4.1.1).
+
+use crate::scenario::Sensors;
+use crate::seed::{Stream, rng};
+use crate::vehicles::TruthState;
+use nalgebra::Vector2;
+use onebeacon::geo::wrap_angle;
+use onebeacon::nav::{CommFrame, Proprioceptive};
+use rand::RngExt;
+use rand_distr::StandardNormal;
+use rand_pcg::Pcg64Mcg;
+
+/// The sensor suite of one run.
+pub struct SensorSuite {
+    noise: Sensors,
+    frame_loss_prob: f64,
+    imu: Pcg64Mcg,
+    heading: Pcg64Mcg,
+    acoustic: Pcg64Mcg,
+    bias0_rad: f64,
+    bias_rate_rad_s: f64,
+}
+
+fn gauss(rng: &mut Pcg64Mcg, sigma: f64) -> f64 {
+    sigma * rng.sample::<f64, _>(StandardNormal)
+}
+
+impl SensorSuite {
+    pub fn new(noise: &Sensors, frame_loss_prob: f64, seed: u64, run: u64) -> Self {
+        let mut heading = rng(seed, run, Stream::Heading);
+        let bias0_rad = gauss(&mut heading, noise.heading_bias_deg.to_radians());
+        let bias_rate_rad_s = gauss(&mut heading, noise.heading_bias_drift_deg_per_h.to_radians() / 3600.0);
+        Self {
+            noise: noise.clone(),
+            frame_loss_prob,
+            imu: rng(seed, run, Stream::Imu),
+            heading,
+            acoustic: rng(seed, run, Stream::Acoustic),
+            bias0_rad,
+            bias_rate_rad_s,
+        }
+    }
+
+    /// AHRS heading with white noise and a linearly drifting bias (3.5.3), and IMU yaw
+    /// rate and forward acceleration with white noise (4.1.1), at time `t`, given the
+    /// commanded (true) yaw rate and acceleration.
+    pub fn proprioceptive(&mut self, t: f64, truth: &TruthState, omega: f64, accel: f64) -> Proprioceptive {
+        let bias = self.bias0_rad + self.bias_rate_rad_s * t;
+        let heading_noise = gauss(&mut self.heading, self.noise.heading_noise_deg.to_radians());
+        Proprioceptive {
+            heading_rad: wrap_angle(truth.psi + bias + heading_noise),
+            yaw_rate_rad_s: omega + gauss(&mut self.imu, self.noise.gyro_noise_rad_s),
+            accel_m_s2: accel + gauss(&mut self.imu, self.noise.accel_noise_m_s2),
+        }
+    }
+
+    /// A communication frame from `beacon` (None if lost): OWTT range (eq. 19) and
+    /// Doppler radial speed (eq. 13-14), each with white noise.
+    pub fn comm_frame(&mut self, truth: &TruthState, beacon: Vector2<f64>) -> Option<CommFrame> {
+        // always draw all three numbers so that a loss does not shift later draws
+        let lost = self.acoustic.random::<f64>() < self.frame_loss_prob;
+        let range_noise = gauss(&mut self.acoustic, self.noise.range_noise_m);
+        let doppler_noise = gauss(&mut self.acoustic, self.noise.doppler_noise_m_s);
+        if lost {
+            return None;
+        }
+        let d = truth.pos - beacon;
+        let bearing_to_beacon = d.y.atan2(d.x) + std::f64::consts::PI; // eq. 14
+        Some(CommFrame {
+            beacon_ned_m: beacon,
+            range_m: d.norm() + range_noise,
+            radial_speed_m_s: truth.v * (bearing_to_beacon - truth.psi).cos() + doppler_noise, // eq. 13
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    #[test]
+    fn noise_free_measurements_equal_the_truth() {
+        let mut s = SensorSuite::new(&Sensors::noise_free(), 0.0, 3, 0);
+        let truth = TruthState { pos: Vector2::new(10.0, 0.0), psi: std::f64::consts::PI, v: 1.5 };
+        let f = s.comm_frame(&truth, Vector2::zeros()).unwrap();
+        assert_abs_diff_eq!(f.range_m, 10.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(f.radial_speed_m_s, 1.5, epsilon = 1e-12); // heading at the beacon
+        let p = s.proprioceptive(100.0, &truth, 0.02, -0.01);
+        assert_abs_diff_eq!(p.heading_rad.abs(), std::f64::consts::PI, epsilon = 1e-12);
+        assert_eq!((p.yaw_rate_rad_s, p.accel_m_s2), (0.02, -0.01));
+    }
+
+    #[test]
+    fn noise_has_the_configured_spread_and_losses_their_rate() {
+        let noise = Sensors { range_noise_m: 2.0, ..Sensors::noise_free() };
+        let mut s = SensorSuite::new(&noise, 0.25, 9, 4);
+        let truth = TruthState { pos: Vector2::new(30.0, 40.0), psi: 0.0, v: 1.0 };
+        let (mut n, mut sum2, mut lost) = (0, 0.0, 0);
+        for _ in 0..20_000 {
+            match s.comm_frame(&truth, Vector2::zeros()) {
+                Some(f) => {
+                    n += 1;
+                    sum2 += (f.range_m - 50.0).powi(2);
+                }
+                None => lost += 1,
+            }
+        }
+        let sigma = (sum2 / n as f64).sqrt();
+        assert!((sigma - 2.0).abs() < 0.05, "sigma {sigma}");
+        let rate = lost as f64 / 20_000.0;
+        assert!((rate - 0.25).abs() < 0.015, "loss rate {rate}");
+    }
+}

@@ -1,0 +1,7 @@
+//! Truth vehicles: paths to follow, controllers, and the dynamics that move them.
+
+pub mod path;
+pub mod unicycle;
+
+pub use path::{Path, Reference};
+pub use unicycle::{TruthState, feedback_linearising_control};

@@ -1,0 +1,18 @@
+//! onebeacon: the onboard part of single-beacon underwater navigation.
+//!
+//! What runs on a vehicle lives here, with lean dependencies (nalgebra, thiserror):
+//!
+//! - [`geo`]: NED frame conventions and angle wrapping;
+//! - [`models`]: process models used by the estimators;
+//! - [`measure`]: measurement models `h(x)` with their Jacobians;
+//! - [`filter`]: the generic extended Kalman filter and consistency statistics;
+//! - [`nav`]: navigators that put a model, measurements and a filter together.
+//!
+//! Conventions: NED frame (x north, y east, z down), SI units, radians, heading from
+//! north toward east. Equation numbers in comments refer to the source papers.
+
+pub mod filter;
+pub mod geo;
+pub mod measure;
+pub mod models;
+pub mod nav;

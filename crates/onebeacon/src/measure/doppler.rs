@@ -1,0 +1,79 @@
+//! Relative (radial) speed toward a beacon from the Doppler shift of a communication
+//! frame (garin2024 eq. 13-15, 20).
+//!
+//! Sign: positive when the vehicle closes on the beacon. The vehicle moves along its
+//! heading at its forward speed (no sideslip): v_r = v cos(omega_b - psi) with
+//! omega_b = atan2(y - y_ref, x - x_ref) + pi the bearing from the vehicle to the beacon.
+
+use super::ScalarModel;
+use crate::models::unicycle::idx;
+use nalgebra::{SMatrix, SVector, Vector2};
+
+/// Radial speed of the vehicle toward `beacon` (NED, m), read from the unicycle state
+/// layout (position, heading, forward speed).
+#[derive(Debug, Clone, Copy)]
+pub struct RadialSpeed2d {
+    pub beacon: Vector2<f64>,
+}
+
+impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
+    fn predict(&self, x: &SVector<f64, N>) -> f64 {
+        let (dx, dy) = (x[idx::X] - self.beacon.x, x[idx::Y] - self.beacon.y);
+        let c = dy.atan2(dx) - x[idx::PSI]; // C of eq. 23
+        -x[idx::V] * c.cos() // eq. 20, second row; equals eq. 13 with eq. 14
+    }
+
+    fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
+        let (dx, dy) = (x[idx::X] - self.beacon.x, x[idx::Y] - self.beacon.y);
+        let r2 = dx * dx + dy * dy;
+        let v = x[idx::V];
+        let c = dy.atan2(dx) - x[idx::PSI];
+        let mut h = SMatrix::<f64, 1, N>::zeros();
+        if r2 > 1e-18 {
+            let b = v * c.sin() / r2; // B of eq. 23
+            h[idx::X] = -b * dy; // eq. 22, last row
+            h[idx::Y] = b * dx;
+        }
+        h[idx::PSI] = -v * c.sin();
+        h[idx::V] = -c.cos();
+        h
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::finite_difference;
+    use approx::assert_abs_diff_eq;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    fn state(x: f64, y: f64, psi: f64, v: f64) -> SVector<f64, 6> {
+        SVector::<f64, 6>::from([x, y, psi, v, 0.0, 0.0])
+    }
+
+    #[test]
+    fn sign_is_positive_when_closing() {
+        let m = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0) };
+        // vehicle 10 m north of the beacon heading south at 1.5 m/s: closing at 1.5
+        assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &state(10.0, 0.0, PI, 1.5)), 1.5, epsilon = 1e-12);
+        // heading north: opening
+        assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &state(10.0, 0.0, 0.0, 1.5)), -1.5, epsilon = 1e-12);
+        // heading east, abeam: zero
+        assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &state(10.0, 0.0, FRAC_PI_2, 1.5)), 0.0, epsilon = 1e-12);
+        // 45 deg off the line of sight
+        let v = ScalarModel::<6>::predict(&m, &state(10.0, 10.0, -FRAC_PI_2, 2.0));
+        assert_abs_diff_eq!(v, 2.0 * (PI / 4.0).cos(), epsilon = 1e-12);
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let m = RadialSpeed2d { beacon: Vector2::new(50.0, 100.0) };
+        for x in [state(10.0, 20.0, 0.4, 1.1), state(80.0, 230.0, -2.5, 0.9), state(49.0, 101.0, 3.0, -1.2)] {
+            let h = ScalarModel::<6>::jacobian(&m, &x);
+            let fd = finite_difference::<6>(&m, &x);
+            for j in 0..6 {
+                assert_abs_diff_eq!(h[j], fd[j], epsilon = 1e-7);
+            }
+        }
+    }
+}

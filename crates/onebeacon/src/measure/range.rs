@@ -1,0 +1,49 @@
+//! Horizontal range to a beacon at a known position (garin2024 eq. 19).
+
+use super::ScalarModel;
+use nalgebra::{SMatrix, SVector, Vector2};
+
+/// Range from the state's position (components 0, 1) to `beacon` (NED, m).
+#[derive(Debug, Clone, Copy)]
+pub struct Range2d {
+    pub beacon: Vector2<f64>,
+}
+
+impl<const N: usize> ScalarModel<N> for Range2d {
+    fn predict(&self, x: &SVector<f64, N>) -> f64 {
+        (x[0] - self.beacon.x).hypot(x[1] - self.beacon.y) // eq. 19
+    }
+
+    fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
+        let (dx, dy) = (x[0] - self.beacon.x, x[1] - self.beacon.y);
+        let r = dx.hypot(dy);
+        let mut h = SMatrix::<f64, 1, N>::zeros();
+        if r > 1e-9 {
+            // eq. 22, row of d: A (x - x_ref), A (y - y_ref) with A = 1 / d (eq. 23)
+            h[0] = dx / r;
+            h[1] = dy / r;
+        }
+        h
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::finite_difference;
+    use approx::assert_abs_diff_eq;
+
+    #[test]
+    fn range_and_jacobian() {
+        let m = Range2d { beacon: Vector2::new(50.0, 100.0) };
+        let x = SVector::<f64, 6>::from([53.0, 104.0, 0.3, 1.0, 0.0, 0.0]);
+        assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &x), 5.0, epsilon = 1e-12);
+        for x in [x, SVector::<f64, 6>::from([-20.0, 240.0, -2.0, 1.3, 0.1, 0.0])] {
+            let h = ScalarModel::<6>::jacobian(&m, &x);
+            let fd = finite_difference::<6>(&m, &x);
+            for j in 0..6 {
+                assert_abs_diff_eq!(h[j], fd[j], epsilon = 1e-7);
+            }
+        }
+    }
+}

@@ -1,0 +1,58 @@
+//! Direct observation of one state component: heading from the AHRS, yaw rate and
+//! acceleration from the IMU (garin2024 eq. 18, 24).
+
+use super::ScalarModel;
+use nalgebra::{SMatrix, SVector};
+
+/// Measures state component `index`; `angle` wraps its innovation.
+#[derive(Debug, Clone, Copy)]
+pub struct StateComponent {
+    pub index: usize,
+    pub angle: bool,
+}
+
+impl StateComponent {
+    /// A non-angular component.
+    pub const fn value(index: usize) -> Self {
+        Self { index, angle: false }
+    }
+    /// An angular component (heading).
+    pub const fn angle(index: usize) -> Self {
+        Self { index, angle: true }
+    }
+}
+
+impl<const N: usize> ScalarModel<N> for StateComponent {
+    fn predict(&self, x: &SVector<f64, N>) -> f64 {
+        x[self.index]
+    }
+    fn jacobian(&self, _x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
+        let mut h = SMatrix::<f64, 1, N>::zeros();
+        h[self.index] = 1.0; // eq. 24
+        h
+    }
+    fn is_angle(&self) -> bool {
+        self.angle
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::finite_difference;
+    use approx::assert_abs_diff_eq;
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let x = SVector::<f64, 6>::from([1.0, 2.0, 0.3, 1.1, 0.02, -0.1]);
+        for i in 0..6 {
+            let m = StateComponent::value(i);
+            let h = ScalarModel::<6>::jacobian(&m, &x);
+            let fd = finite_difference::<6>(&m, &x);
+            for j in 0..6 {
+                assert_abs_diff_eq!(h[j], fd[j], epsilon = 1e-9);
+            }
+            assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &x), x[i]);
+        }
+    }
+}

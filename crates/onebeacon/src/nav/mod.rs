@@ -1,0 +1,6 @@
+//! Navigators: a process model, measurement models and a filter put together, fed with
+//! sensor samples as they arrive on the vehicle.
+
+pub mod single_beacon;
+
+pub use single_beacon::{Aiding, CommFrame, EkfTuning, Proprioceptive, SingleBeaconEkf};
