@@ -2,7 +2,7 @@
 
 use crate::output::Staging;
 use crate::{BadInput, plot, report};
-use anyhow::Result;
+use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::run::simulate;
@@ -43,8 +43,9 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, out: Option<PathBuf>) -> Res
 
     staging.write("trajectory.csv", &report::trajectory_csv(&s, &result)?)?;
     staging.write("summary.json", report::run_summary_json(&s, seed, run, &cell, &result).as_bytes())?;
-    plot::top_view(&staging.file("top_view.png"), &s, &result)?;
-    plot::error_vs_time(&staging.file("error.png"), &s, &result)?;
+    let title = format!("{} seed {seed} run {run}, T_com {} s", s.name, cell.t_com_s);
+    plot::top_view(&staging.file("top_view.png"), &s, &title, &result).context("cannot draw top_view.png")?;
+    plot::error_vs_time(&staging.file("error.png"), &s, &title, &result).context("cannot draw error.png")?;
     let files = staging.commit()?;
 
     print!("{}", report::run_table(&s, seed, run, &cell, &result));
@@ -73,7 +74,7 @@ pub fn mc(
     let bar = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::new(total);
         bar.set_style(
-            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} runs, {elapsed} (eta {eta})")
+            ProgressStyle::with_template("{msg} {pos}/{len} runs [{wide_bar}] eta {eta}")
                 .expect("static template")
                 .progress_chars("=> "),
         );
@@ -90,7 +91,7 @@ pub fn mc(
     let json_text = report::mc_json(&s, &result, wall_s);
     if let Some(staging) = staging {
         staging.write("mc.json", json_text.as_bytes())?;
-        plot::mc_errors(&staging.file("mc_error.png"), &s, &result)?;
+        plot::mc_errors(&staging.file("mc_error.png"), &s, &result).context("cannot draw mc_error.png")?;
         let files = staging.commit()?;
         if !json {
             for f in files {

@@ -9,7 +9,7 @@ use crate::sensors::SensorSuite;
 use crate::vehicles::{TruthState, feedback_linearising_control};
 use nalgebra::{SVector, Vector2};
 use onebeacon::filter::consistency::nees;
-use onebeacon::models::unicycle::{Cov, State};
+use onebeacon::models::unicycle::{Cov, State, idx};
 use onebeacon::nav::SingleBeaconEkf;
 use rand::RngExt;
 use rand_distr::StandardNormal;
@@ -92,8 +92,8 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
             if record {
                 estimates.push(Estimate {
                     pos: f.position(),
-                    psi: onebeacon::geo::wrap_angle(f.state()[2]),
-                    v: f.state()[3],
+                    psi: onebeacon::geo::wrap_angle(f.state()[idx::PSI]),
+                    v: f.state()[idx::V],
                     sigma_pos: Vector2::new(p[(0, 0)].max(0.0).sqrt(), p[(1, 1)].max(0.0).sqrt()),
                     error_m: e.norm(),
                     nees: n.unwrap_or(f64::NAN),
