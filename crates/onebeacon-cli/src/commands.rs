@@ -4,6 +4,7 @@ use crate::output::Staging;
 use crate::{BadInput, plot, report};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use onebeacon::guidance::{PolarGrid, best_standoff};
 use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::run::simulate;
 use onebeacon_sim::scenario::{self, BUILTINS};
@@ -103,6 +104,30 @@ pub fn mc(
         println!("{json_text}");
     } else {
         print!("{}", report::mc_table(&s, &result, wall_s));
+    }
+    Ok(())
+}
+
+/// `onebeacon guidance standoff --speed-m-s V --depths-m D1,D2,... [--period-s T] [--json]`
+pub fn standoff(speed_m_s: f64, depths_m: &[f64], period_s: f64, json: bool) -> Result<()> {
+    let reach = speed_m_s * period_s;
+    let rows: Vec<_> = depths_m.iter().map(|&d| best_standoff(d, reach, PolarGrid::default())).collect();
+    if json {
+        let v = serde_json::json!({
+            "speed_m_s": speed_m_s,
+            "period_s": period_s,
+            "reach_m": reach,
+            "standoffs": rows.iter().map(|s| serde_json::json!({
+                "depth_m": s.depth_m, "distance_m": s.distance_m, "det_fim": s.det_fim,
+            })).collect::<Vec<_>>(),
+        });
+        println!("{v}");
+    } else {
+        println!("ASV at {speed_m_s} m/s, ping every {period_s} s: reach {reach} m (range noise 1 m)");
+        println!("{:>9} {:>12} {:>14}", "depth_m", "standoff_m", "det_fim_1/m4");
+        for s in rows {
+            println!("{:>9.2} {:>12.2} {:>14.5}", s.depth_m, s.distance_m, s.det_fim);
+        }
     }
     Ok(())
 }

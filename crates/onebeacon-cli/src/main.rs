@@ -60,6 +60,44 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Beacon-vehicle guidance tools.
+    Guidance {
+        #[command(subcommand)]
+        command: GuidanceCommand,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+enum GuidanceCommand {
+    /// Best initial horizontal distance between a surface beacon and a target at each
+    /// depth (sousa Fig. 4.7-4.8): the distance whose best second ping, within the
+    /// ASV's reach (speed x period), carries the most Fisher information.
+    Standoff {
+        /// ASV maximum speed, m/s.
+        #[arg(long, value_parser = positive_f64)]
+        speed_m_s: f64,
+        /// Target depths, m, comma-separated.
+        #[arg(long, value_delimiter = ',', required = true, value_parser = non_negative_f64)]
+        depths_m: Vec<f64>,
+        /// Time between pings, s.
+        #[arg(long, default_value_t = 10.0, value_parser = positive_f64)]
+        period_s: f64,
+        /// Print one JSON object on stdout instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn parse_finite(s: &str) -> Result<f64, String> {
+    s.trim().parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| format!("`{s}` is not a finite number"))
+}
+
+fn positive_f64(s: &str) -> Result<f64, String> {
+    parse_finite(s).and_then(|v| if v > 0.0 { Ok(v) } else { Err(format!("{v} must be > 0")) })
+}
+
+fn non_negative_f64(s: &str) -> Result<f64, String> {
+    parse_finite(s).and_then(|v| if v >= 0.0 { Ok(v) } else { Err(format!("{v} must be >= 0")) })
 }
 
 /// Input the user can fix (flags, scenario, output path): exit status 2.
@@ -80,10 +118,13 @@ fn main() -> ExitCode {
                     ExitCode::SUCCESS
                 };
             }
-            // one line: clap's first line names the flag and what is allowed
+            // one line: clap's message up to its usage block, which names the flag and
+            // what is allowed
             let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
-            eprintln!("error: {first} (see `onebeacon --help`)");
+            let message: Vec<&str> =
+                text.lines().map(str::trim).take_while(|l| !l.is_empty() && !l.starts_with("Usage:")).collect();
+            let message = message.join(" ");
+            eprintln!("error: {} (see `onebeacon --help`)", message.trim_start_matches("error: "));
             return ExitCode::from(2);
         }
     };
@@ -92,6 +133,9 @@ fn main() -> ExitCode {
         Command::Run { scenario, seed, run, out } => commands::run(&scenario, seed, run, out),
         Command::Mc { scenario, runs, seed, threads, out, json } => {
             commands::mc(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), out, json)
+        }
+        Command::Guidance { command: GuidanceCommand::Standoff { speed_m_s, depths_m, period_s, json } } => {
+            commands::standoff(speed_m_s, &depths_m, period_s, json)
         }
     };
     match result {

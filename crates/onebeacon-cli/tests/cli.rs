@@ -189,6 +189,9 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["mc", "garin2024", "--seed", "abc", "--out", out], &["--seed", "abc"]),
         (vec!["run", "garin2024", "--out", &not_a_dir], &["file.txt", "not a directory"]),
         (vec!["scenarios", "--show", "nothing"], &["nothing", "garin2024"]),
+        (vec!["guidance", "standoff", "--speed-m-s", "0", "--depths-m", "5"], &["--speed-m-s", "> 0"]),
+        (vec!["guidance", "standoff", "--speed-m-s", "2", "--depths-m", "5,nan"], &["--depths-m", "nan"]),
+        (vec!["guidance", "standoff", "--speed-m-s", "2"], &["--depths-m"]),
         (vec!["fly"], &["fly"]),
     ];
     for (args, needles) in cases {
@@ -203,4 +206,15 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         assert!(o.stdout.is_empty(), "{args:?}: wrote to stdout");
         assert!(!out_dir.exists(), "{args:?}: left an output directory");
     }
+}
+
+#[test]
+fn standoff_distance_grows_with_depth() {
+    let out = run(&["guidance", "standoff", "--speed-m-s", "2", "--depths-m", "1,5,20,50", "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+    assert_eq!(v["reach_m"], 20.0);
+    let d: Vec<f64> = v["standoffs"].as_array().unwrap().iter().map(|s| s["distance_m"].as_f64().unwrap()).collect();
+    assert_eq!(d.len(), 4);
+    assert!(d.windows(2).all(|w| w[1] > w[0]), "{d:?}");
 }

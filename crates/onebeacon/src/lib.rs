@@ -6,6 +6,7 @@
 //! - [`models`]: process models used by the estimators;
 //! - [`measure`]: measurement models `h(x)` with their Jacobians;
 //! - [`filter`]: the generic extended Kalman filter and consistency statistics;
+//! - [`guidance`]: where a beacon vehicle should go next (Fisher information);
 //! - [`nav`]: navigators that put a model, measurements and a filter together.
 //!
 //! Conventions: NED frame (x north, y east, z down), SI units, radians, heading from
@@ -13,6 +14,7 @@
 
 pub mod filter;
 pub mod geo;
+pub mod guidance;
 pub mod measure;
 pub mod models;
 pub mod nav;

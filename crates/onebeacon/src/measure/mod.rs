@@ -5,15 +5,15 @@
 //! [`MeasurementModel`]), as garin2024 eq. 18 and 20 stack range, Doppler speed, heading,
 //! yaw rate and acceleration when a communication frame arrives.
 //!
-//! The models here read the planar state layout of [`crate::models::unicycle`]
-//! (position first, then heading and forward speed).
+//! States put the NED position first; the Doppler model also reads the heading and
+//! forward speed of [`crate::models::unicycle`].
 
 pub mod doppler;
 pub mod range;
 pub mod state;
 
 pub use doppler::RadialSpeed2d;
-pub use range::Range2d;
+pub use range::{Range2d, Range3d};
 pub use state::StateComponent;
 
 use crate::filter::MeasurementModel;

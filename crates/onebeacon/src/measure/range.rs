@@ -1,7 +1,8 @@
-//! Horizontal range to a beacon at a known position (garin2024 eq. 19).
+//! Range to a beacon at a known position: horizontal (garin2024 eq. 19) or slant
+//! (sousa eq. 3.7, 3.11).
 
 use super::ScalarModel;
-use nalgebra::{SMatrix, SVector, Vector2};
+use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
 /// Range from the state's position (components 0, 1) to `beacon` (NED, m).
 #[derive(Debug, Clone, Copy)]
@@ -27,6 +28,31 @@ impl<const N: usize> ScalarModel<N> for Range2d {
     }
 }
 
+/// Slant range from the state's position (components 0, 1, 2: N, E, D) to `beacon`
+/// (NED, m), e.g. an ASV's transducer at its position when it transmitted.
+#[derive(Debug, Clone, Copy)]
+pub struct Range3d {
+    pub beacon: Vector3<f64>,
+}
+
+impl<const N: usize> ScalarModel<N> for Range3d {
+    fn predict(&self, x: &SVector<f64, N>) -> f64 {
+        (Vector3::new(x[0], x[1], x[2]) - self.beacon).norm() // eq. 3.7
+    }
+
+    fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
+        let d = Vector3::new(x[0], x[1], x[2]) - self.beacon;
+        let r = d.norm();
+        let mut h = SMatrix::<f64, 1, N>::zeros();
+        if r > 1e-9 {
+            for i in 0..3 {
+                h[i] = d[i] / r; // eq. 3.13, with the depth row
+            }
+        }
+        h
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -36,6 +62,11 @@ mod tests {
     #[test]
     fn range_and_jacobian() {
         let m = Range2d { beacon: Vector2::new(50.0, 100.0) };
+        let m3 = Range3d { beacon: Vector3::new(50.0, 100.0, 0.5) };
+        let x3 = SVector::<f64, 6>::from([53.0, 104.0, 12.5, 0.1, -0.1, 2.0]);
+        assert_abs_diff_eq!(ScalarModel::<6>::predict(&m3, &x3), 13.0, epsilon = 1e-12); // 3-4-12
+        let (h, fd) = (ScalarModel::<6>::jacobian(&m3, &x3), finite_difference::<6>(&m3, &x3));
+        assert_abs_diff_eq!(h, fd, epsilon = 1e-7);
         let x = SVector::<f64, 6>::from([53.0, 104.0, 0.3, 1.0, 0.0, 0.0]);
         assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &x), 5.0, epsilon = 1e-12);
         for x in [x, SVector::<f64, 6>::from([-20.0, 240.0, -2.0, 1.3, 0.1, 0.0])] {

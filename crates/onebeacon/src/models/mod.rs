@@ -1,5 +1,7 @@
 //! Process models used by the estimators.
 
+pub mod kinematic6dof;
 pub mod unicycle;
 
+pub use kinematic6dof::Kinematic6Dof;
 pub use unicycle::UnicycleAccel;

@@ -1,0 +1,18 @@
+//! Guidance of the beacon vehicle: where an ASV carrying the beacon should be at the
+//! next ping so that the ranges tell the underwater vehicle the most.
+//!
+//! - [`fim`]: Fisher information of range measurements about the target's horizontal
+//!   position (sousa eq. 3.11-3.15);
+//! - [`planner`]: the next waypoint inside the ASV's reaching set, by approach A (one
+//!   target position, eq. 3.15) or B (current and predicted target, eq. 3.16-3.19),
+//!   searched on a polar grid and refined locally;
+//! - [`standoff`]: the best initial horizontal distance for a target depth and ASV reach
+//!   (sousa Fig. 4.7-4.8), answered with the same planner.
+
+pub mod fim;
+pub mod planner;
+pub mod standoff;
+
+pub use fim::{det2, range_fim};
+pub use planner::{Decision, FimPlanner, Metric, PolarGrid, ReachingSet};
+pub use standoff::{Standoff, best_standoff};
