@@ -26,7 +26,7 @@ pub fn scenarios(show: Option<&str>) -> Result<()> {
         None => {
             for b in BUILTINS {
                 let s = scenario::parse(b.toml, b.name)?;
-                writeln!(out, "{:<12} {}", b.name, s.description)?;
+                writeln!(out, "{:<12} {}", b.name, s.description())?;
             }
         }
     }
@@ -36,15 +36,15 @@ pub fn scenarios(show: Option<&str>) -> Result<()> {
 /// `onebeacon run SCENARIO [--seed N] [--run I] [--out DIR]`
 pub fn run(name: &str, seed: Option<u64>, run: u64, out: Option<PathBuf>) -> Result<()> {
     let s = scenario::load(name)?;
-    let seed = seed.unwrap_or(s.seed);
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name)));
+    let seed = seed.unwrap_or(s.seed());
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name())));
     let staging = Staging::new(&dir)?;
     let cell = s.base_cell();
     let result = simulate(&s, &cell, seed, run, true);
 
     staging.write("trajectory.csv", &report::trajectory_csv(&s, &result)?)?;
     staging.write("summary.json", report::run_summary_json(&s, seed, run, &cell, &result).as_bytes())?;
-    let title = format!("{} seed {seed} run {run}, T_com {} s", s.name, cell.t_com_s);
+    let title = format!("{} seed {seed} run {run}, {}", s.name(), cell.label());
     plot::top_view(&staging.file("top_view.png"), &s, &title, &result).context("cannot draw top_view.png")?;
     plot::error_vs_time(&staging.file("error.png"), &s, &title, &result).context("cannot draw error.png")?;
     let files = staging.commit()?;
@@ -67,8 +67,8 @@ pub fn mc(
     json: bool,
 ) -> Result<()> {
     let s = scenario::load(name)?;
-    let runs = runs.unwrap_or(s.runs);
-    let seed = seed.unwrap_or(s.seed);
+    let runs = runs.unwrap_or(s.runs());
+    let seed = seed.unwrap_or(s.seed());
     let staging = out.as_deref().map(Staging::new).transpose()?;
 
     let total = (runs * s.cells().len()) as u64;
@@ -79,7 +79,7 @@ pub fn mc(
                 .expect("static template")
                 .progress_chars("=> "),
         );
-        bar.set_message(format!("mc {}", s.name));
+        bar.set_message(format!("mc {}", s.name()));
         bar
     } else {
         ProgressBar::hidden()

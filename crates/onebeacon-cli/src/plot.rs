@@ -2,8 +2,9 @@
 
 use anyhow::Result;
 use onebeacon_sim::Scenario;
-use onebeacon_sim::montecarlo::McResult;
+use onebeacon_sim::montecarlo::{CellResult, McResult};
 use onebeacon_sim::run::{Estimate, RunOutput};
+use onebeacon_sim::scenario::SweepValue;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
@@ -90,15 +91,14 @@ fn line(
     Ok(())
 }
 
-/// Top view: truth, every estimate, the beacon. East to the right, north up, equal
-/// scales.
+/// Top view: truth, every estimate, the beacon (its track when it moves). East to the
+/// right, north up, equal scales.
 pub fn top_view(path: &Path, s: &Scenario, title: &str, out: &RunOutput) -> Result<()> {
     register_fonts();
-    let beacon = s.beacon_ned_m();
     let traj = &out.trajectory;
-    let all = || traj.iter().flat_map(|r| std::iter::once(r.truth.pos).chain(r.estimates.iter().map(|e| e.pos)));
-    let (n0, n1) = span(all().map(|p| p.x).chain([beacon.x]), 0.05);
-    let (e0, e1) = span(all().map(|p| p.y).chain([beacon.y]), 0.05);
+    let all = || traj.iter().flat_map(|r| [r.truth_pos, r.beacon].into_iter().chain(r.estimates.iter().map(|e| e.pos)));
+    let (n0, n1) = span(all().map(|p| p.x), 0.05);
+    let (e0, e1) = span(all().map(|p| p.y), 0.05);
     let (w, h) = (1200u32, 800u32);
     let scale = ((e1 - e0) / (w - 120) as f64).max((n1 - n0) / (h - 120) as f64);
     let (ec, nc) = ((e0 + e1) / 2.0, (n0 + n1) / 2.0);
@@ -107,18 +107,27 @@ pub fn top_view(path: &Path, s: &Scenario, title: &str, out: &RunOutput) -> Resu
     let root = BitMapBackend::new(path, (w, h)).into_drawing_area();
     let mut chart =
         chart(&root, &format!("{title}: top view"), ec - he..ec + he, nc - hn..nc + hn, ("east (m)", "north (m)"))?;
-    line(&mut chart, traj.iter().map(|r| (r.truth.pos.y, r.truth.pos.x)), BLACK.stroke_width(2), Some("truth"))?;
-    for (i, e) in s.estimators.iter().enumerate() {
-        let points = traj.iter().map(|r| (r.estimates[i].pos.y, r.estimates[i].pos.x));
-        line(&mut chart, points, colour(i).stroke_width(1), Some(e.name()))?;
+    let moving = traj.windows(2).any(|w| (w[1].beacon - w[0].beacon).norm() > 1e-9);
+    if moving {
+        line(
+            &mut chart,
+            traj.iter().map(|r| (r.beacon.y, r.beacon.x)),
+            BLUE.mix(0.5).stroke_width(1),
+            Some("beacon (ASV)"),
+        )?;
     }
-    chart
-        .draw_series(std::iter::once(TriangleMarker::new((beacon.y, beacon.x), 9, BLUE.filled())))?
-        .label("beacon")
-        .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLUE.filled()));
+    line(&mut chart, traj.iter().map(|r| (r.truth_pos.y, r.truth_pos.x)), BLACK.stroke_width(2), Some("truth"))?;
+    for (i, name) in s.estimator_names().iter().enumerate() {
+        let points = traj.iter().map(|r| (r.estimates[i].pos.y, r.estimates[i].pos.x));
+        line(&mut chart, points, colour(i).stroke_width(1), Some(name))?;
+    }
     if let Some(first) = traj.first() {
         chart
-            .draw_series(std::iter::once(Circle::new((first.truth.pos.y, first.truth.pos.x), 5, BLACK.filled())))?
+            .draw_series(std::iter::once(TriangleMarker::new((first.beacon.y, first.beacon.x), 9, BLUE.filled())))?
+            .label(if moving { "beacon start" } else { "beacon" })
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLUE.filled()));
+        chart
+            .draw_series(std::iter::once(Circle::new((first.truth_pos.y, first.truth_pos.x), 5, BLACK.filled())))?
             .label("start")
             .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
     }
@@ -138,9 +147,9 @@ pub fn error_vs_time(path: &Path, s: &Scenario, title: &str, out: &RunOutput) ->
     let root = BitMapBackend::new(path, (1200, 600)).into_drawing_area();
     let caption = format!("{title}: position error (thick), 2-sigma bound (thin)");
     let mut chart = chart(&root, &caption, 0.0..t1, 0.0..ymax.max(0.01), ("time (s)", "horizontal error (m)"))?;
-    for (i, e) in s.estimators.iter().enumerate() {
+    for (i, name) in s.estimator_names().iter().enumerate() {
         let c = colour(i);
-        line(&mut chart, traj.iter().map(|r| (r.t_s, r.estimates[i].error_m)), c.stroke_width(2), Some(e.name()))?;
+        line(&mut chart, traj.iter().map(|r| (r.t_s, r.estimates[i].error_m)), c.stroke_width(2), Some(name))?;
         line(&mut chart, traj.iter().map(|r| (r.t_s, sigma2(&r.estimates[i]))), c.mix(0.5).stroke_width(1), None)?;
     }
     legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
@@ -148,27 +157,81 @@ pub fn error_vs_time(path: &Path, s: &Scenario, title: &str, out: &RunOutput) ->
     Ok(())
 }
 
-/// Monte Carlo: mean error (inliers) and RMSE versus the first swept value.
+/// Monte Carlo: mean error (inliers) and RMSE versus the first numeric swept key. With
+/// text keys too (path, guidance), one panel per value of the first text key and one
+/// line per value of the others, for the first estimator, with the PCRB dashed where
+/// known; otherwise one line per estimator.
 pub fn mc_errors(path: &Path, s: &Scenario, r: &McResult) -> Result<()> {
     register_fonts();
-    let xs: Vec<f64> = r.cells.iter().map(|c| c.cell.values()[0].1).collect();
-    let key = r.cells.first().map(|c| c.cell.values()[0].0).unwrap_or("cell");
-    let (x0, x1) = span(xs.iter().copied(), 0.05);
-    let stats = r.cells.iter().flat_map(|c| c.estimators.iter().flat_map(|(_, m)| [m.mean_error_m, m.rmse_m]));
-    let (_, ymax) = span(stats, 0.1);
-    let root = BitMapBackend::new(path, (1000, 600)).into_drawing_area();
-    let caption = format!("{}: {} runs per cell, mean error (thick) and RMSE (thin)", s.name, r.runs);
-    let mut chart = chart(&root, &caption, x0..x1, 0.0..ymax.max(0.01), (key, "horizontal error (m)"))?;
-    for (i, e) in s.estimators.iter().enumerate() {
-        let c = colour(i);
-        let mean: Vec<(f64, f64)> =
-            xs.iter().zip(&r.cells).map(|(&x, cell)| (x, cell.estimators[i].1.mean_error_m)).collect();
-        let rmse = xs.iter().zip(&r.cells).map(|(&x, cell)| (x, cell.estimators[i].1.rmse_m));
-        line(&mut chart, mean.iter().copied(), c.stroke_width(2), Some(e.name()))?;
-        chart.draw_series(mean.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
-        line(&mut chart, rmse, c.mix(0.6).stroke_width(1), None)?;
+    let Some(first) = r.cells.first() else { return Ok(()) };
+    let values = first.cell.values();
+    let x_key = values.iter().position(|(_, v)| matches!(v, SweepValue::Number(_))).unwrap_or(0);
+    let text_keys: Vec<usize> = (0..values.len()).filter(|&k| matches!(values[k].1, SweepValue::Text(_))).collect();
+    let x_of = |c: &CellResult| match c.cell.values()[x_key].1 {
+        SweepValue::Number(x) => x,
+        SweepValue::Text(_) => 0.0,
+    };
+    let text_of = |c: &CellResult, keys: &[usize]| {
+        let v = c.cell.values();
+        keys.iter().map(|&k| v[k].1.to_string()).collect::<Vec<_>>().join(" ")
+    };
+    // panels by the first text key
+    let mut panels: Vec<String> = Vec::new();
+    for c in &r.cells {
+        let p = text_of(c, &text_keys[..text_keys.len().min(1)]);
+        if !panels.contains(&p) {
+            panels.push(p);
+        }
     }
-    legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+    let (x0, x1) = span(r.cells.iter().map(x_of), 0.05);
+    let stats = r.cells.iter().flat_map(|c| c.estimators.iter().flat_map(|(_, m)| [m.mean_error_m, m.rmse_m]));
+    let (_, ymax) = span(stats.chain(r.cells.iter().filter_map(|c| c.pcrb_rmse_m)), 0.1);
+    let cols = if panels.len() > 1 { 2 } else { 1 };
+    let rows = panels.len().div_ceil(cols);
+    let root = BitMapBackend::new(path, (1000 * cols as u32, 600 * rows as u32)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let areas = root.split_evenly((rows, cols));
+    let names = s.estimator_names();
+    for (panel, area) in panels.iter().zip(areas.iter()) {
+        let cells: Vec<&CellResult> =
+            r.cells.iter().filter(|c| text_of(c, &text_keys[..text_keys.len().min(1)]) == *panel).collect();
+        let caption = if panel.is_empty() {
+            format!("{}: {} runs per cell, mean error (thick), RMSE (thin)", s.name(), r.runs)
+        } else {
+            format!("{} {panel}: {} mean error (thick), RMSE (thin), PCRB (dashed)", s.name(), names[0])
+        };
+        let mut chart = chart(area, &caption, x0..x1, 0.0..ymax.max(0.01), (values[x_key].0, "horizontal error (m)"))?;
+        // series: the remaining text keys, or the estimators
+        let series: Vec<(String, usize)> = if text_keys.len() > 1 {
+            let mut v: Vec<String> = Vec::new();
+            for c in &cells {
+                let t = text_of(c, &text_keys[1..]);
+                if !v.contains(&t) {
+                    v.push(t);
+                }
+            }
+            v.into_iter().map(|t| (t, 0)).collect()
+        } else {
+            names.iter().enumerate().map(|(i, n)| (n.clone(), i)).collect()
+        };
+        for (i, (label, est)) in series.iter().enumerate() {
+            let c = colour(i);
+            let mine: Vec<&&CellResult> =
+                cells.iter().filter(|cell| text_keys.len() <= 1 || text_of(cell, &text_keys[1..]) == *label).collect();
+            let mean: Vec<(f64, f64)> =
+                mine.iter().map(|cell| (x_of(cell), cell.estimators[*est].1.mean_error_m)).collect();
+            let rmse = mine.iter().map(|cell| (x_of(cell), cell.estimators[*est].1.rmse_m));
+            line(&mut chart, mean.iter().copied(), c.stroke_width(2), Some(label))?;
+            chart.draw_series(mean.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
+            line(&mut chart, rmse, c.mix(0.6).stroke_width(1), None)?;
+            let pcrb: Vec<(f64, f64)> =
+                mine.iter().filter_map(|cell| cell.pcrb_rmse_m.map(|p| (x_of(cell), p))).collect();
+            if pcrb.len() > 1 {
+                chart.draw_series(DashedLineSeries::new(pcrb, 6, 4, c.mix(0.8).stroke_width(1)))?;
+            }
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+    }
     root.present()?;
     Ok(())
 }

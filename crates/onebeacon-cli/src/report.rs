@@ -4,7 +4,7 @@ use anyhow::Result;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::montecarlo::McResult;
 use onebeacon_sim::run::RunOutput;
-use onebeacon_sim::scenario::Cell;
+use onebeacon_sim::scenario::{Cell, SweepValue};
 use serde_json::{Value, json};
 use std::fmt::Write;
 
@@ -14,44 +14,60 @@ fn num(v: f64) -> Value {
 }
 
 fn sweep_json(cell: &Cell) -> Value {
-    Value::Object(cell.values().into_iter().map(|(k, v)| (k.to_string(), num(v))).collect())
+    let value = |v: SweepValue| match v {
+        SweepValue::Number(x) => num(x),
+        SweepValue::Text(t) => json!(t),
+    };
+    Value::Object(cell.values().into_iter().map(|(k, v)| (k.to_string(), value(v))).collect())
 }
 
 /// trajectory.csv: one row per step with the truth and every estimator's estimate,
 /// standard deviations, error and NEES.
 pub fn trajectory_csv(s: &Scenario, out: &RunOutput) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> =
-        ["t_s", "truth_north_m", "truth_east_m", "truth_heading_deg", "truth_speed_m_s", "frame"]
-            .map(String::from)
-            .to_vec();
-    for e in &s.estimators {
-        for col in ["north_m", "east_m", "heading_deg", "speed_m_s", "sigma_north_m", "sigma_east_m", "error_m", "nees"]
-        {
-            header.push(format!("{}_{col}", e.name()));
+    let mut header: Vec<String> = [
+        "t_s",
+        "truth_north_m",
+        "truth_east_m",
+        "truth_down_m",
+        "truth_heading_deg",
+        "truth_speed_m_s",
+        "beacon_north_m",
+        "beacon_east_m",
+        "beacon_down_m",
+        "frame",
+    ]
+    .map(String::from)
+    .to_vec();
+    for name in s.estimator_names() {
+        for col in [
+            "north_m",
+            "east_m",
+            "down_m",
+            "heading_deg",
+            "speed_m_s",
+            "sigma_north_m",
+            "sigma_east_m",
+            "error_m",
+            "nees",
+        ] {
+            header.push(format!("{name}_{col}"));
         }
     }
     w.write_record(&header)?;
+    let f = |v: f64| format!("{v:.4}");
     for r in &out.trajectory {
-        let mut row = vec![
-            format!("{:.2}", r.t_s),
-            format!("{:.4}", r.truth.pos.x),
-            format!("{:.4}", r.truth.pos.y),
-            format!("{:.3}", onebeacon::geo::wrap_angle(r.truth.psi).to_degrees()),
-            format!("{:.4}", r.truth.v),
-            u8::from(r.frame).to_string(),
-        ];
+        let mut row = vec![format!("{:.2}", r.t_s)];
+        row.extend([r.truth_pos.x, r.truth_pos.y, r.truth_pos.z].map(f));
+        row.push(format!("{:.3}", onebeacon::geo::wrap_angle(r.truth_heading).to_degrees()));
+        row.push(f(r.truth_speed));
+        row.extend([r.beacon.x, r.beacon.y, r.beacon.z].map(f));
+        row.push(u8::from(r.frame).to_string());
         for e in &r.estimates {
-            row.extend([
-                format!("{:.4}", e.pos.x),
-                format!("{:.4}", e.pos.y),
-                format!("{:.3}", e.psi.to_degrees()),
-                format!("{:.4}", e.v),
-                format!("{:.4}", e.sigma_pos.x),
-                format!("{:.4}", e.sigma_pos.y),
-                format!("{:.4}", e.error_m),
-                format!("{:.4}", e.nees),
-            ]);
+            row.extend([e.pos.x, e.pos.y, e.pos.z].map(f));
+            row.push(format!("{:.3}", e.psi.to_degrees()));
+            row.push(e.speed.map(f).unwrap_or_default());
+            row.extend([e.sigma_pos.x, e.sigma_pos.y, e.error_m, e.nees].map(f));
         }
         w.write_record(&row)?;
     }
@@ -61,12 +77,12 @@ pub fn trajectory_csv(s: &Scenario, out: &RunOutput) -> Result<Vec<u8>> {
 /// summary.json of one run.
 pub fn run_summary_json(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutput) -> String {
     let estimators: Vec<Value> = s
-        .estimators
+        .estimator_names()
         .iter()
         .zip(&out.metrics)
-        .map(|(e, m)| {
+        .map(|(name, m)| {
             json!({
-                "estimator": e.name(),
+                "estimator": name,
                 "mean_error_m": num(m.mean_error_m),
                 "error_variance_m2": num(m.error_variance_m2),
                 "rmse_m": num(m.mse_m2.sqrt()),
@@ -80,7 +96,7 @@ pub fn run_summary_json(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &Ru
         })
         .collect();
     let v = json!({
-        "scenario": s.name,
+        "scenario": s.name(),
         "seed": seed,
         "run": run,
         "sweep": sweep_json(cell),
@@ -97,9 +113,9 @@ pub fn run_table(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutput
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "{}: seed {seed}, run {run}, T_com {} s, {:.0} m in {:.0} s, {} frames decoded",
-        s.name,
-        cell.t_com_s,
+        "{}: seed {seed}, run {run}, {}: {:.0} m in {:.0} s, {} acoustic measurements",
+        s.name(),
+        cell.label(),
         out.distance_m,
         s.duration_s(),
         out.frames_decoded
@@ -109,11 +125,11 @@ pub fn run_table(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutput
         "{:<16} {:>10} {:>9} {:>9} {:>10} {:>9}",
         "estimator", "mean_err_m", "rmse_m", "max_m", "final_m", "nees"
     );
-    for (e, m) in s.estimators.iter().zip(&out.metrics) {
+    for (name, m) in s.estimator_names().iter().zip(&out.metrics) {
         let _ = writeln!(
             t,
             "{:<16} {:>10.3} {:>9.3} {:>9.3} {:>10.3} {:>9.2}",
-            e.name(),
+            name,
             m.mean_error_m,
             m.mse_m2.sqrt(),
             m.max_error_m,
@@ -144,37 +160,37 @@ pub fn mc_json(s: &Scenario, r: &McResult, wall_s: f64) -> String {
                     "nees_mean": num(m.nees_mean),
                     "nees_band": [num(m.nees_band[0]), num(m.nees_band[1])],
                     "nees_mean_all_runs": num(m.nees_mean_all_runs),
+                    "pcrb_rmse_m": c.pcrb_rmse_m.map(num).unwrap_or(Value::Null),
+                    "mean_error_first_half_m": num(m.mean_error_first_half_m),
+                    "mean_error_second_half_m": num(m.mean_error_second_half_m),
                     "failed_updates": m.failed_updates,
                 })
             })
         })
         .collect();
-    let v = json!({ "scenario": s.name, "runs": r.runs, "seed": r.seed, "cells": cells, "wall_s": wall_s });
+    let v = json!({ "scenario": s.name(), "runs": r.runs, "seed": r.seed, "cells": cells, "wall_s": wall_s });
     serde_json::to_string(&v).expect("serialisable")
-}
-
-fn sweep_label(cell: &Cell) -> String {
-    cell.values().iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ")
 }
 
 /// The `mc` tables: mean error (outliers) of every estimator side by side, as
 /// garin2024 Table 4, then every statistic per estimator, as Table 3.
 pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
     let mut t = String::new();
-    let _ = writeln!(t, "{}: {} runs per cell, seed {}, {:.2} s", s.name, r.runs, r.seed, wall_s);
+    let _ = writeln!(t, "{}: {} runs per cell, seed {}, {:.2} s", s.name(), r.runs, r.seed, wall_s);
     let _ = writeln!(
         t,
         "(outliers: runs whose mean error is beyond 1.5 IQR of the quartiles; left out of every statistic but nees_all)"
     );
     let _ = writeln!(t);
     let _ = writeln!(t, "Mean positioning error in m (outliers)");
-    let _ = write!(t, "{:<14}", "sweep");
-    for e in &s.estimators {
-        let _ = write!(t, " {:>18}", e.name());
+    let width = r.cells.iter().map(|c| c.cell.label().len()).max().unwrap_or(5).max(5);
+    let _ = write!(t, "{:<width$}", "sweep");
+    for name in s.estimator_names() {
+        let _ = write!(t, " {:>18}", name);
     }
     let _ = writeln!(t);
     for c in &r.cells {
-        let _ = write!(t, "{:<14}", sweep_label(&c.cell));
+        let _ = write!(t, "{:<width$}", c.cell.label());
         for (_, m) in &c.estimators {
             let _ = write!(t, " {:>18}", format!("{:.4} ({})", m.mean_error_m, m.outliers));
         }
@@ -200,8 +216,8 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
         for (name, m) in &c.estimators {
             let _ = writeln!(
                 t,
-                "{:<14} {:<16} {:>10.4} {:>5} {:>10.4} {:>8.3} {:>9.4} {:>10.4} {:>8.2} {:>15} {:>10.1}",
-                sweep_label(&c.cell),
+                "{:<width$} {:<16} {:>10.4} {:>5} {:>10.4} {:>8.3} {:>9.4} {:>10.4} {:>8.2} {:>15} {:>10.1} {:>9}",
+                c.cell.label(),
                 name,
                 m.mean_error_m,
                 m.outliers,
@@ -212,6 +228,7 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
                 m.nees_mean,
                 format!("[{:.2}, {:.2}]", m.nees_band[0], m.nees_band[1]),
                 m.nees_mean_all_runs,
+                c.pcrb_rmse_m.map(|p| format!("{p:.3}")).unwrap_or_else(|| "-".into()),
             );
         }
     }

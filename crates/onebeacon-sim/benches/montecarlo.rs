@@ -5,12 +5,15 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::run::simulate;
-use onebeacon_sim::scenario::{builtin, parse};
+use onebeacon_sim::scenario::{Scenario, builtin, parse};
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {
     let s = parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap();
     let cell = s.base_cell();
+    let Scenario::FixedBeacon(mut one_cell) = s.clone() else { unreachable!() };
+    one_cell.sweep.t_com_s = Some(vec![3.0]);
+    let one_cell = Scenario::FixedBeacon(one_cell);
     let mut run = 0u64;
     c.bench_function("garin2024 one run (6269 steps, 2 estimators)", |b| {
         b.iter(|| {
@@ -18,8 +21,6 @@ fn bench(c: &mut Criterion) {
             black_box(simulate(&s, &cell, 1, run, false))
         })
     });
-    let mut one_cell = s.clone();
-    one_cell.sweep.t_com_s = Some(vec![3.0]);
     let mut group = c.benchmark_group("garin2024 monte carlo");
     group.sample_size(10);
     group.bench_function("20 runs, 1 cell, all cores", |b| {

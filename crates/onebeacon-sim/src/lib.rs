@@ -2,13 +2,17 @@
 //!
 //! - [`vehicles`]: truth dynamics, paths and their controllers;
 //! - [`sensors`]: what the vehicle's sensors and modem report, with their errors;
+//! - [`acoustics`]: pings propagating between moving ends;
+//! - [`pcrb`]: the posterior Cramer-Rao bound of the range-only moving-beacon case;
 //! - [`scenario`]: the TOML scenario schema, its validation and the built-in scenarios;
 //! - [`run`]: one simulated run, a pure function of (scenario, sweep cell, seed, run);
 //! - [`metrics`]: per-run error statistics and their Monte Carlo aggregation;
 //! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count.
 
+pub mod acoustics;
 pub mod metrics;
 pub mod montecarlo;
+pub mod pcrb;
 pub mod run;
 pub mod scenario;
 pub mod seed;

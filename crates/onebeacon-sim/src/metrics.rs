@@ -23,11 +23,18 @@ pub struct RunMetrics {
     pub nees_mean: f64,
     /// Filter updates refused (innovation covariance not positive definite).
     pub failed_updates: u64,
+    /// Mean error over the first and the second half of the steps, m: whether the error
+    /// stays bounded.
+    pub mean_error_first_half_m: f64,
+    pub mean_error_second_half_m: f64,
 }
 
 /// Accumulates one estimator's errors step by step.
 #[derive(Debug, Clone, Default)]
 pub struct ErrorAccumulator {
+    /// Steps pushed before this one count in the first half.
+    half: u64,
+    first_half_sum: f64,
     n: u64,
     sum: f64,
     sum2: f64,
@@ -40,12 +47,20 @@ pub struct ErrorAccumulator {
 }
 
 impl ErrorAccumulator {
+    /// An accumulator for a run of `steps` steps.
+    pub fn new(steps: usize) -> Self {
+        Self { half: (steps / 2) as u64, ..Self::default() }
+    }
+
     /// Adds the error of one step and its position NEES (None if P was not positive
     /// definite).
     pub fn push(&mut self, error_m: f64, nees: Option<f64>) {
         if !error_m.is_finite() {
             self.diverged = true;
             return;
+        }
+        if self.n < self.half {
+            self.first_half_sum += error_m;
         }
         self.n += 1;
         self.sum += error_m;
@@ -67,8 +82,11 @@ impl ErrorAccumulator {
         let n = self.n.max(1) as f64;
         let mean = self.sum / n;
         let mse = self.sum2 / n;
-        let pct = 100.0 / distance_m.max(f64::MIN_POSITIVE);
+        // %etd is undefined for a vehicle that does not move
+        let pct = if distance_m > 1e-6 { 100.0 / distance_m } else { f64::NAN };
         let bad = self.diverged || self.n == 0;
+        let first = self.half.min(self.n);
+        let second = self.n - first;
         RunMetrics {
             mean_error_m: if bad { f64::INFINITY } else { mean },
             error_variance_m2: if bad { f64::INFINITY } else { (mse - mean * mean).max(0.0) },
@@ -79,6 +97,12 @@ impl ErrorAccumulator {
             etd_mean_pct: if bad { f64::INFINITY } else { mean * pct },
             nees_mean: if self.nees_n == 0 { f64::NAN } else { self.nees_sum / self.nees_n as f64 },
             failed_updates: self.failed_updates,
+            mean_error_first_half_m: if bad || first == 0 { f64::INFINITY } else { self.first_half_sum / first as f64 },
+            mean_error_second_half_m: if bad || second == 0 {
+                f64::INFINITY
+            } else {
+                (self.sum - self.first_half_sum) / second as f64
+            },
         }
     }
 }
@@ -109,6 +133,9 @@ pub struct CellSummary {
     /// covariance broke down).
     pub nees_mean_all_runs: f64,
     pub failed_updates: u64,
+    /// Mean over inlier runs of the mean error in the first and second half, m.
+    pub mean_error_first_half_m: f64,
+    pub mean_error_second_half_m: f64,
 }
 
 /// Quantile by linear interpolation between order statistics (type 7); `sorted` must
@@ -162,6 +189,8 @@ pub fn summarise(runs: &[RunMetrics]) -> CellSummary {
         nees_band: nees_band(inliers.len(), 2),
         nees_mean_all_runs: nees_all,
         failed_updates: runs.iter().map(|r| r.failed_updates).sum(),
+        mean_error_first_half_m: avg(&|r| r.mean_error_first_half_m),
+        mean_error_second_half_m: avg(&|r| r.mean_error_second_half_m),
     }
 }
 
@@ -171,7 +200,7 @@ mod tests {
     use approx::assert_relative_eq;
 
     fn run(mean: f64) -> RunMetrics {
-        let mut a = ErrorAccumulator::default();
+        let mut a = ErrorAccumulator::new(2);
         a.push(mean - 1.0, Some(1.0));
         a.push(mean + 1.0, Some(3.0));
         a.finish(1000.0)
@@ -187,6 +216,11 @@ mod tests {
         assert_relative_eq!(m.etd_mean_pct, 0.5);
         assert_relative_eq!(m.nees_mean, 2.0);
         assert_eq!(m.final_error_m, 6.0);
+        assert_relative_eq!(m.mean_error_first_half_m, 4.0);
+        assert_relative_eq!(m.mean_error_second_half_m, 6.0);
+        let mut still = ErrorAccumulator::new(2);
+        still.push(1.0, None);
+        assert!(still.finish(0.0).etd_mean_pct.is_nan());
     }
 
     #[test]
@@ -200,7 +234,7 @@ mod tests {
         assert_relative_eq!(s.nees_mean, 2.0);
         assert_eq!(s.nees_band, nees_band(9, 2));
         // a diverged run is an outlier; NEES over all runs sees it
-        let mut acc = ErrorAccumulator::default();
+        let mut acc = ErrorAccumulator::new(2);
         acc.push(f64::NAN, None);
         runs.push(acc.finish(1000.0));
         let s = summarise(&runs);

@@ -1,10 +1,14 @@
 //! Monte Carlo: `runs` runs of every sweep cell, in parallel with rayon. Run i of every
 //! cell is seeded from (seed, i), results are collected in run order and aggregated
-//! sequentially, so the output is bit-identical for any number of threads.
+//! sequentially, so the output is bit-identical for any number of threads. Cells are
+//! done one after the other (their runs in parallel) so that only one cell's per-run
+//! data is held at a time.
 
-use crate::metrics::{CellSummary, summarise};
+use crate::metrics::{CellSummary, RunMetrics, summarise};
+use crate::pcrb::horizontal_rmse_bound;
 use crate::run::simulate;
 use crate::scenario::{Cell, Scenario};
+use nalgebra::Matrix6;
 use rayon::prelude::*;
 
 /// The results of one sweep cell: one summary per estimator, in scenario order.
@@ -12,6 +16,8 @@ use rayon::prelude::*;
 pub struct CellResult {
     pub cell: Cell,
     pub estimators: Vec<(String, CellSummary)>,
+    /// Posterior Cramer-Rao bound on the horizontal RMSE (moving-beacon cells).
+    pub pcrb_rmse_m: Option<f64>,
 }
 
 /// The results of a Monte Carlo sweep.
@@ -40,18 +46,8 @@ pub fn monte_carlo(
     threads: Option<usize>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<McResult, ThreadPoolError> {
-    let cells = scenario.cells();
-    let work = || {
-        let jobs: Vec<(usize, u64)> = (0..cells.len()).flat_map(|c| (0..runs as u64).map(move |r| (c, r))).collect();
-        jobs.par_iter()
-            .map(|&(c, r)| {
-                let out = simulate(scenario, &cells[c], seed, r, false);
-                progress();
-                out.metrics
-            })
-            .collect::<Vec<_>>()
-    };
-    let per_run = match threads {
+    let work = || scenario.cells().iter().map(|cell| run_cell(scenario, cell, runs, seed, progress)).collect();
+    let cells = match threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
@@ -59,24 +55,43 @@ pub fn monte_carlo(
             .install(work),
         None => work(),
     };
-    let cells = cells
-        .iter()
-        .enumerate()
-        .map(|(c, cell)| {
-            let cell_runs = &per_run[c * runs..(c + 1) * runs];
-            let estimators = scenario
-                .estimators
-                .iter()
-                .enumerate()
-                .map(|(e, spec)| {
-                    let metrics: Vec<_> = cell_runs.iter().map(|m| m[e]).collect();
-                    (spec.name().to_string(), summarise(&metrics))
-                })
-                .collect();
-            CellResult { cell: *cell, estimators }
+    Ok(McResult { runs, seed, cells })
+}
+
+/// What the aggregation keeps of one run: its metrics and its range information.
+type RunSummary = (Vec<RunMetrics>, Vec<(usize, Matrix6<f64>)>);
+
+fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: &(dyn Fn() + Sync)) -> CellResult {
+    let per_run: Vec<RunSummary> = (0..runs as u64)
+        .into_par_iter()
+        .map(|r| {
+            let out = simulate(scenario, cell, seed, r, false);
+            progress();
+            (out.metrics, out.range_information)
         })
         .collect();
-    Ok(McResult { runs, seed, cells })
+    let estimators = scenario
+        .estimator_names()
+        .into_iter()
+        .enumerate()
+        .map(|(e, name)| {
+            let metrics: Vec<_> = per_run.iter().map(|(m, _)| m[e]).collect();
+            (name, summarise(&metrics))
+        })
+        .collect();
+    let pcrb_rmse_m = match (scenario, cell) {
+        (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
+            let mut sum = vec![Matrix6::zeros(); s.steps() + 1];
+            for (_, info) in &per_run {
+                for (k, m) in info {
+                    sum[*k] += m;
+                }
+            }
+            Some(horizontal_rmse_bound(s, c, &sum, runs))
+        }
+        _ => None,
+    };
+    CellResult { cell: *cell, estimators, pcrb_rmse_m }
 }
 
 #[cfg(test)]
@@ -85,10 +100,12 @@ mod tests {
     use crate::scenario::{builtin, parse};
 
     fn short_garin() -> Scenario {
-        let mut s = parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap();
+        let Scenario::FixedBeacon(mut s) = parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap() else {
+            unreachable!()
+        };
         s.mission.duration_s = Some(400.0);
         s.sweep.t_com_s = Some(vec![3.0, 15.0]);
-        s
+        Scenario::FixedBeacon(s)
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! What the vehicle's sensors and modem report: the truth plus errors, drawn from the
 //! run's seeded random streams (garin2024 sections 3.5, 4.1.1).
 
-use crate::scenario::Sensors;
+use crate::scenario::fixed_beacon::Sensors;
 use crate::seed::{Stream, rng};
 use crate::vehicles::TruthState;
 use nalgebra::Vector2;

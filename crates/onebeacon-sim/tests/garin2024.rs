@@ -6,9 +6,11 @@ use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::scenario::{Scenario, builtin, parse};
 
 fn garin(t_com: &[f64]) -> Scenario {
-    let mut s = parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap();
+    let Scenario::FixedBeacon(mut s) = parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap() else {
+        unreachable!()
+    };
     s.sweep.t_com_s = Some(t_com.to_vec());
-    s
+    Scenario::FixedBeacon(s)
 }
 
 fn cell<'a>(r: &'a onebeacon_sim::montecarlo::McResult, cell: usize, name: &str) -> &'a CellSummary {

@@ -8,8 +8,10 @@ pub struct Builtin {
 }
 
 /// All built-in scenarios.
-pub const BUILTINS: &[Builtin] =
-    &[Builtin { name: "garin2024", toml: include_str!("../../../../scenarios/garin2024.toml") }];
+pub const BUILTINS: &[Builtin] = &[
+    Builtin { name: "garin2024", toml: include_str!("../../../../scenarios/garin2024.toml") },
+    Builtin { name: "sousa", toml: include_str!("../../../../scenarios/sousa.toml") },
+];
 
 /// The built-in scenario called `name`.
 pub fn builtin(name: &str) -> Option<&'static Builtin> {
@@ -24,8 +26,8 @@ mod tests {
     fn every_builtin_parses_and_is_named_after_its_file() {
         for b in BUILTINS {
             let s = crate::scenario::parse(b.toml, b.name).unwrap_or_else(|e| panic!("{e}"));
-            assert_eq!(s.name, b.name);
-            assert!(!s.description.is_empty() && !s.description.contains('\n'));
+            assert_eq!(s.name(), b.name);
+            assert!(!s.description().is_empty() && !s.description().contains('\n'));
         }
     }
 }

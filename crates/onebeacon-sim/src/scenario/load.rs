@@ -1,7 +1,7 @@
 //! Loading a scenario from a built-in name or a file, with one-line errors that name
 //! the source, the key and what is allowed.
 
-use super::{Scenario, builtin, validate};
+use super::{FixedBeacon, MovingBeacon, Scenario, builtin, validate};
 use std::path::Path;
 
 /// Why a scenario could not be loaded. Each message is one line naming the source (file
@@ -44,12 +44,12 @@ pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
         span.map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1).unwrap_or(0)
     };
     let one_line = |m: &str| m.trim().replace('\n', "; ");
-    let de = toml::Deserializer::parse(text).map_err(|e| ScenarioError::Syntax {
+    let syntax = |e: toml::de::Error| ScenarioError::Syntax {
         source_name: source_name.to_string(),
         line: line_of(e.span()),
         message: one_line(e.message()),
-    })?;
-    let scenario: Scenario = serde_path_to_error::deserialize(de).map_err(|e| {
+    };
+    let keyed = |e: serde_path_to_error::Error<toml::de::Error>| {
         let key = e.path().to_string();
         let inner = e.into_inner();
         let (line, message) = (line_of(inner.span()), one_line(inner.message()));
@@ -58,7 +58,16 @@ pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
         } else {
             ScenarioError::Key { source_name: source_name.to_string(), line, key, message }
         }
-    })?;
+    };
+    // the world's kind decides the schema; a bad `kind` is reported by the default one
+    let kind =
+        toml::from_str::<toml::Table>(text).ok().and_then(|t| t.get("kind").and_then(|k| k.as_str().map(String::from)));
+    let de = toml::Deserializer::parse(text).map_err(syntax)?;
+    let scenario = if kind.as_deref() == Some("moving_beacon") {
+        Scenario::MovingBeacon(serde_path_to_error::deserialize::<_, MovingBeacon>(de).map_err(keyed)?)
+    } else {
+        Scenario::FixedBeacon(serde_path_to_error::deserialize::<_, FixedBeacon>(de).map_err(keyed)?)
+    };
     validate::validate(&scenario).map_err(|v| ScenarioError::Invalid {
         source_name: source_name.to_string(),
         key: v.key,
@@ -78,7 +87,7 @@ mod tests {
 
     #[test]
     fn minimal_scenario_takes_defaults() {
-        let s = parse("name = \"x\"\n", "test.toml").unwrap();
+        let Scenario::FixedBeacon(s) = parse("name = \"x\"\n", "test.toml").unwrap() else { panic!() };
         assert_eq!(s.runs, 300);
         assert_eq!(s.comms.t_com_s, 3.0);
         assert_eq!(s.estimators.len(), 2);
@@ -113,6 +122,15 @@ mod tests {
 
         let e = err("name = \"x\"\n[comms\n");
         assert!(e.contains("test.toml: line 2"), "{e}");
+
+        let e = err("name = \"x\"\nkind = \"floating\"\n");
+        assert!(e.contains("kind") && e.contains("moving_beacon"), "{e}");
+
+        let e = err("name = \"x\"\nkind = \"moving_beacon\"\n[sweep]\npath = [\"zigzag\"]\n");
+        assert!(e.contains("sweep.path[0]") && e.contains("circular"), "{e}");
+
+        let e = err("name = \"x\"\nkind = \"moving_beacon\"\n[acoustics]\nsound_speed_m_s = 0\n");
+        assert!(e.contains("acoustics.sound_speed_m_s") && e.contains("> 0"), "{e}");
 
         let e = err("description = \"no name\"\n");
         assert!(e.contains("name"), "{e}");

@@ -1,15 +1,142 @@
 //! Scenario files: schema, defaults, loading, validation and the built-in scenarios.
 //!
-//! A scenario is a TOML file; every key is optional except `name` and has a documented
-//! default (see the built-in `scenarios/garin2024.toml`, which spells every key out with
-//! where its value comes from). Keys carry their unit in their name; angles in config
-//! are degrees (`*_deg`), radians inside.
+//! A scenario is a TOML file whose `kind` names the world it describes:
+//! `fixed_beacon` (the default; garin2024) or `moving_beacon` (sousa). Every key is
+//! optional except `name` and has a documented default (the built-in files in
+//! `scenarios/` spell every key out with where its value comes from). Keys carry their
+//! unit in their name; angles in config are degrees (`*_deg`), radians inside.
 
 mod builtin;
+pub mod fixed_beacon;
 mod load;
-mod schema;
+pub mod moving_beacon;
 mod validate;
 
 pub use builtin::{BUILTINS, Builtin, builtin};
+pub use fixed_beacon::{FixedBeacon, FixedBeaconCell};
 pub use load::{ScenarioError, load, parse};
-pub use schema::*;
+pub use moving_beacon::{MovingBeacon, MovingBeaconCell};
+
+use serde::{Deserialize, Serialize};
+
+/// Which world a scenario describes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum World {
+    /// An AUV and a fixed beacon (garin2024).
+    #[default]
+    FixedBeacon,
+    /// An underwater vehicle and a beacon on a guided surface vehicle (sousa).
+    MovingBeacon,
+}
+
+pub(crate) fn default_seed() -> u64 {
+    1
+}
+pub(crate) fn default_runs<const N: usize>() -> usize {
+    N
+}
+
+/// A parsed, validated scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Scenario {
+    FixedBeacon(FixedBeacon),
+    MovingBeacon(MovingBeacon),
+}
+
+/// One value of a swept key.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SweepValue {
+    Number(f64),
+    Text(&'static str),
+}
+
+impl std::fmt::Display for SweepValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SweepValue::Number(v) => write!(f, "{v}"),
+            SweepValue::Text(t) => f.write_str(t),
+        }
+    }
+}
+
+/// One sweep cell: the values the cell's runs use for the swept keys.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Cell {
+    FixedBeacon(FixedBeaconCell),
+    MovingBeacon(MovingBeaconCell),
+}
+
+impl Cell {
+    /// The swept keys and values, for tables and JSON.
+    pub fn values(&self) -> Vec<(&'static str, SweepValue)> {
+        match self {
+            Cell::FixedBeacon(c) => vec![("t_com_s", SweepValue::Number(c.t_com_s))],
+            Cell::MovingBeacon(c) => vec![
+                ("path", SweepValue::Text(c.path.label())),
+                ("depth_m", SweepValue::Number(c.depth_m)),
+                ("guidance", SweepValue::Text(c.guidance.label())),
+            ],
+        }
+    }
+
+    /// `key=value` pairs joined by spaces.
+    pub fn label(&self) -> String {
+        self.values().iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ")
+    }
+}
+
+impl Scenario {
+    pub fn name(&self) -> &str {
+        match self {
+            Scenario::FixedBeacon(s) => &s.name,
+            Scenario::MovingBeacon(s) => &s.name,
+        }
+    }
+    pub fn description(&self) -> &str {
+        match self {
+            Scenario::FixedBeacon(s) => &s.description,
+            Scenario::MovingBeacon(s) => &s.description,
+        }
+    }
+    pub fn seed(&self) -> u64 {
+        match self {
+            Scenario::FixedBeacon(s) => s.seed,
+            Scenario::MovingBeacon(s) => s.seed,
+        }
+    }
+    pub fn runs(&self) -> usize {
+        match self {
+            Scenario::FixedBeacon(s) => s.runs,
+            Scenario::MovingBeacon(s) => s.runs,
+        }
+    }
+    /// The estimators' names, in the order of every run's metrics.
+    pub fn estimator_names(&self) -> Vec<String> {
+        match self {
+            Scenario::FixedBeacon(s) => s.estimators.iter().map(|e| e.name().to_string()).collect(),
+            Scenario::MovingBeacon(s) => s.estimators.iter().map(|e| e.name().to_string()).collect(),
+        }
+    }
+    /// The cell `run` simulates: the scenario's own values, no sweep.
+    pub fn base_cell(&self) -> Cell {
+        match self {
+            Scenario::FixedBeacon(s) => Cell::FixedBeacon(s.base_cell()),
+            Scenario::MovingBeacon(s) => Cell::MovingBeacon(s.base_cell()),
+        }
+    }
+    /// The sweep cells of `mc`, in order.
+    pub fn cells(&self) -> Vec<Cell> {
+        match self {
+            Scenario::FixedBeacon(s) => s.cells().into_iter().map(Cell::FixedBeacon).collect(),
+            Scenario::MovingBeacon(s) => s.cells().into_iter().map(Cell::MovingBeacon).collect(),
+        }
+    }
+    /// Mission duration, s.
+    pub fn duration_s(&self) -> f64 {
+        match self {
+            Scenario::FixedBeacon(s) => s.duration_s(),
+            Scenario::MovingBeacon(s) => s.mission.duration_s,
+        }
+    }
+}

@@ -1,6 +1,6 @@
 //! Range checks on a parsed scenario. The first violation is reported with its key.
 
-use super::Scenario;
+use super::{FixedBeacon, MovingBeacon, Scenario};
 
 pub(super) struct Violation {
     pub key: String,
@@ -44,6 +44,111 @@ fn check_count(key: &str, value: usize, min: usize, max: usize) -> Result<(), Vi
 }
 
 pub(super) fn validate(s: &Scenario) -> Result<(), Violation> {
+    match s {
+        Scenario::FixedBeacon(s) => validate_fixed(s),
+        Scenario::MovingBeacon(s) => validate_moving(s),
+    }
+}
+
+fn check_steps(duration_s: f64, dt_s: f64) -> Result<(), Violation> {
+    let steps = duration_s / dt_s;
+    if steps > 1e8 {
+        return Err(Violation {
+            key: "mission.dt_s".into(),
+            value: format!("{dt_s:?}"),
+            allowed: format!("gives {steps:.0} steps; at most 1e8 steps per run"),
+        });
+    }
+    Ok(())
+}
+
+fn check_name(key: String, name: &str, taken: bool) -> Result<(), Violation> {
+    let ok = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || "+-_.".contains(c));
+    if !ok {
+        return Err(Violation {
+            key,
+            value: format!("{name:?}"),
+            allowed: "must be non-empty ASCII letters, digits and + - _ .".into(),
+        });
+    }
+    if taken {
+        return Err(Violation {
+            key,
+            value: format!("{name:?}"),
+            allowed: "must differ from the other estimators' names (set `name`)".into(),
+        });
+    }
+    Ok(())
+}
+
+fn check_list_nonempty<T>(key: &str, v: &Option<Vec<T>>) -> Result<(), Violation> {
+    match v {
+        Some(v) if v.is_empty() => Err(Violation {
+            key: key.into(),
+            value: "[]".into(),
+            allowed: "must list at least one value, or be left out".into(),
+        }),
+        _ => Ok(()),
+    }
+}
+
+fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
+    use Rule::*;
+    check_count("runs", s.runs, 1, 1_000_000)?;
+    check("mission.dt_s", s.mission.dt_s, Positive)?;
+    check("mission.duration_s", s.mission.duration_s, Positive)?;
+    let v = &s.vehicle;
+    check("vehicle.depth_m", v.depth_m, NonNegative)?;
+    check("vehicle.start_north_m", v.start_north_m, Finite)?;
+    check("vehicle.start_east_m", v.start_east_m, Finite)?;
+    check("vehicle.heading_deg", v.heading_deg, Finite)?;
+    check("vehicle.speed_m_s", v.speed_m_s, NonNegative)?;
+    check("vehicle.circle_radius_m", v.circle_radius_m, Positive)?;
+    check("vehicle.spiral_descent_m_s", v.spiral_descent_m_s, NonNegative)?;
+    check("vehicle.leg_length_m", v.leg_length_m, Positive)?;
+    check("vehicle.leg_spacing_m", v.leg_spacing_m, Positive)?;
+    let n = &s.sensors;
+    check("sensors.velocity_noise_m_s", n.velocity_noise_m_s, Positive)?;
+    check("sensors.rate_noise_rad_s", n.rate_noise_rad_s, Positive)?;
+    check("sensors.depth_noise_m", n.depth_noise_m, Positive)?;
+    check("sensors.attitude_noise_deg", n.attitude_noise_deg, Positive)?;
+    let a = &s.asv;
+    check("asv.max_speed_m_s", a.max_speed_m_s, Positive)?;
+    check("asv.max_turn_rate_deg_s", a.max_turn_rate_deg_s, Positive)?;
+    check("asv.gps_noise_m", a.gps_noise_m, NonNegative)?;
+    check("asv.transducer_depth_m", a.transducer_depth_m, NonNegative)?;
+    check("asv.start_bearing_deg", a.start_bearing_deg, Finite)?;
+    let c = &s.acoustics;
+    check("acoustics.ping_period_s", c.ping_period_s, Positive)?;
+    check("acoustics.sound_speed_m_s", c.sound_speed_m_s, Positive)?;
+    check("acoustics.range_noise_m", c.range_noise_m, Positive)?;
+    check_count("guidance.grid_radial", s.guidance.grid_radial, 1, 10_000)?;
+    check_count("guidance.grid_angular", s.guidance.grid_angular, 1, 10_000)?;
+    check("guidance.circle_radius_m", s.guidance.circle_radius_m, Positive)?;
+    let i = &s.initial;
+    check("initial.position_sigma_m", i.position_sigma_m, Positive)?;
+    check("initial.depth_sigma_m", i.depth_sigma_m, Positive)?;
+    check("initial.attitude_sigma_deg", i.attitude_sigma_deg, Positive)?;
+    if s.estimators.is_empty() {
+        return Err(Violation {
+            key: "estimators".into(),
+            value: "[]".into(),
+            allowed: "at least one estimator is needed".into(),
+        });
+    }
+    for (k, e) in s.estimators.iter().enumerate() {
+        check_name(format!("estimators[{k}].name"), e.name(), s.estimators[..k].iter().any(|o| o.name() == e.name()))?;
+    }
+    check_list_nonempty("sweep.path", &s.sweep.path)?;
+    check_list_nonempty("sweep.guidance", &s.sweep.guidance)?;
+    check_list_nonempty("sweep.depth_m", &s.sweep.depth_m)?;
+    for (j, &d) in s.sweep.depth_m.iter().flatten().enumerate() {
+        check(&format!("sweep.depth_m[{j}]"), d, NonNegative)?;
+    }
+    check_steps(s.mission.duration_s, s.mission.dt_s)
+}
+
+fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
     use Rule::*;
     check_count("runs", s.runs, 1, 1_000_000)?;
 

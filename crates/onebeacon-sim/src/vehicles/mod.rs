@@ -1,6 +1,8 @@
 //! Truth vehicles: paths to follow, controllers, and the dynamics that move them.
 
+pub mod asv;
 pub mod path;
+pub mod rov;
 pub mod unicycle;
 
 pub use path::{Path, Reference};

@@ -1,13 +1,18 @@
-//! The scenario schema with its defaults. Unknown keys are errors.
+//! Scenarios of kind `fixed_beacon` (garin2024): an AUV on a boustrophedon, a fixed
+//! beacon, range and Doppler from communication frames. Unknown keys are errors.
 
+use super::{World, default_runs, default_seed};
 use onebeacon::nav::{Aiding, EkfTuning};
 use serde::{Deserialize, Serialize};
 
-/// A complete scenario: the world, the vehicle, its sensors, the estimators compared on
-/// the same runs, and the Monte Carlo sweep.
+/// A complete fixed-beacon scenario: the world, the vehicle, its sensors, the
+/// estimators compared on the same runs, and the Monte Carlo sweep.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Scenario {
+pub struct FixedBeacon {
+    /// `fixed_beacon` (the default).
+    #[serde(default)]
+    pub kind: World,
     /// Short name, used in outputs.
     pub name: String,
     /// One line shown by `onebeacon scenarios`.
@@ -17,7 +22,7 @@ pub struct Scenario {
     #[serde(default = "default_seed")]
     pub seed: u64,
     /// Monte Carlo runs per sweep cell (the CLI's `--runs` overrides it).
-    #[serde(default = "default_runs")]
+    #[serde(default = "default_runs::<300>")]
     pub runs: usize,
     #[serde(default)]
     pub mission: Mission,
@@ -37,12 +42,6 @@ pub struct Scenario {
     pub sweep: Sweep,
 }
 
-fn default_seed() -> u64 {
-    1
-}
-fn default_runs() -> usize {
-    300
-}
 fn default_estimators() -> Vec<EstimatorSpec> {
     vec![EstimatorSpec::new(EstimatorKind::RangeDoppler), EstimatorSpec::new(EstimatorKind::Rosb)]
 }
@@ -318,29 +317,22 @@ pub struct Sweep {
     pub t_com_s: Option<Vec<f64>>,
 }
 
-/// One sweep cell: the swept values that differ from the base scenario.
+/// One sweep cell of a fixed-beacon scenario.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Cell {
+pub struct FixedBeaconCell {
     pub t_com_s: f64,
 }
 
-impl Cell {
-    /// The swept keys and values, for tables and JSON.
-    pub fn values(&self) -> Vec<(&'static str, f64)> {
-        vec![("t_com_s", self.t_com_s)]
-    }
-}
-
-impl Scenario {
+impl FixedBeacon {
     /// The cell of the base scenario (no sweep).
-    pub fn base_cell(&self) -> Cell {
-        Cell { t_com_s: self.comms.t_com_s }
+    pub fn base_cell(&self) -> FixedBeaconCell {
+        FixedBeaconCell { t_com_s: self.comms.t_com_s }
     }
 
     /// All sweep cells, in order.
-    pub fn cells(&self) -> Vec<Cell> {
+    pub fn cells(&self) -> Vec<FixedBeaconCell> {
         match &self.sweep.t_com_s {
-            Some(v) => v.iter().map(|&t_com_s| Cell { t_com_s }).collect(),
+            Some(v) => v.iter().map(|&t_com_s| FixedBeaconCell { t_com_s }).collect(),
             None => vec![self.base_cell()],
         }
     }

@@ -1,54 +1,21 @@
-//! One simulated run: truth, sensors and every estimator of the scenario on the same
-//! truth and the same measurement draws (a paired comparison). A pure function of
-//! (scenario, cell, seed, run index).
+//! The fixed-beacon world (garin2024): an AUV following a boustrophedon under the
+//! feedback-linearising controller, a fixed beacon, communication frames every T_com.
 
-use crate::metrics::{ErrorAccumulator, RunMetrics};
-use crate::scenario::{Cell, Scenario};
+use super::{Estimate, RunOutput, StepRecord};
+use crate::metrics::ErrorAccumulator;
+use crate::scenario::{FixedBeacon, FixedBeaconCell};
 use crate::seed::{Stream, rng};
 use crate::sensors::SensorSuite;
 use crate::vehicles::{TruthState, feedback_linearising_control};
-use nalgebra::{SVector, Vector2};
+use nalgebra::{SVector, Vector2, Vector3};
 use onebeacon::filter::consistency::nees;
 use onebeacon::models::unicycle::{Cov, State, idx};
 use onebeacon::nav::SingleBeaconEkf;
 use rand::RngExt;
 use rand_distr::StandardNormal;
 
-/// One estimator's estimate at one step.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Estimate {
-    pub pos: Vector2<f64>,
-    pub psi: f64,
-    pub v: f64,
-    /// Standard deviations of north and east, m.
-    pub sigma_pos: Vector2<f64>,
-    pub error_m: f64,
-    pub nees: f64,
-}
-
-/// Truth and all estimates at one step.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StepRecord {
-    pub t_s: f64,
-    pub truth: TruthState,
-    /// Whether a communication frame was decoded at this step.
-    pub frame: bool,
-    pub estimates: Vec<Estimate>,
-}
-
-/// The outcome of one run.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunOutput {
-    /// One entry per estimator, in scenario order.
-    pub metrics: Vec<RunMetrics>,
-    /// Every step, when recording was asked for; empty otherwise.
-    pub trajectory: Vec<StepRecord>,
-    pub distance_m: f64,
-    pub frames_decoded: u64,
-}
-
 /// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
-pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) -> RunOutput {
+pub(super) fn simulate(s: &FixedBeacon, cell: &FixedBeaconCell, seed: u64, run: u64, record: bool) -> RunOutput {
     let dt = s.mission.dt_s;
     let speed = s.mission.speed_m_s;
     let path = s.path();
@@ -77,7 +44,7 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
     let mut filters: Vec<SingleBeaconEkf> =
         s.estimators.iter().map(|e| SingleBeaconEkf::new(e.kind.aiding(), e.tuning(), z0, p0)).collect();
 
-    let mut acc = vec![ErrorAccumulator::default(); filters.len()];
+    let mut acc = vec![ErrorAccumulator::new(steps + 1); filters.len()];
     let mut trajectory = Vec::with_capacity(if record { steps + 1 } else { 0 });
     let mut distance = 0.0;
     let mut frames_decoded = 0;
@@ -91,9 +58,9 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
             a.push(e.norm(), n);
             if record {
                 estimates.push(Estimate {
-                    pos: f.position(),
+                    pos: Vector3::new(f.position().x, f.position().y, 0.0),
                     psi: onebeacon::geo::wrap_angle(f.state()[idx::PSI]),
-                    v: f.state()[idx::V],
+                    speed: Some(f.state()[idx::V]),
                     sigma_pos: Vector2::new(p[(0, 0)].max(0.0).sqrt(), p[(1, 1)].max(0.0).sqrt()),
                     error_m: e.norm(),
                     nees: n.unwrap_or(f64::NAN),
@@ -104,7 +71,7 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
     };
     let estimates = observe(&filters, &mut acc, &truth, record);
     if record {
-        trajectory.push(StepRecord { t_s: 0.0, truth, frame: false, estimates });
+        trajectory.push(step_record(0.0, &truth, beacon, false, estimates));
     }
 
     let mut frame_index = 0u64;
@@ -133,7 +100,7 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
         }
         let estimates = observe(&filters, &mut acc, &truth, record);
         if record {
-            trajectory.push(StepRecord { t_s: t, truth, frame: frame.is_some(), estimates });
+            trajectory.push(step_record(t, &truth, beacon, frame.is_some(), estimates));
         }
     }
 
@@ -142,16 +109,39 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
         trajectory,
         distance_m: distance,
         frames_decoded,
+        range_information: Vec::new(),
+    }
+}
+
+fn step_record(
+    t_s: f64,
+    truth: &TruthState,
+    beacon: Vector2<f64>,
+    frame: bool,
+    estimates: Vec<Estimate>,
+) -> StepRecord {
+    StepRecord {
+        t_s,
+        truth_pos: Vector3::new(truth.pos.x, truth.pos.y, 0.0),
+        truth_heading: truth.psi,
+        truth_speed: truth.v,
+        beacon: Vector3::new(beacon.x, beacon.y, 0.0),
+        frame,
+        estimates,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scenario::{Sensors, builtin, parse};
+    use crate::scenario::fixed_beacon::Sensors;
+    use crate::scenario::{Scenario, builtin, parse};
 
-    fn garin() -> Scenario {
-        parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap()
+    fn garin() -> FixedBeacon {
+        match parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap() {
+            Scenario::FixedBeacon(s) => s,
+            _ => unreachable!(),
+        }
     }
 
     #[test]

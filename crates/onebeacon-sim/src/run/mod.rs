@@ -1,0 +1,69 @@
+//! One simulated run: truth, sensors and every estimator of the scenario on the same
+//! truth and the same measurement draws (a paired comparison). A pure function of
+//! (scenario, cell, seed, run index).
+
+mod fixed_beacon;
+mod moving_beacon;
+
+use crate::metrics::RunMetrics;
+use crate::scenario::{Cell, Scenario};
+use nalgebra::{Matrix6, Vector2, Vector3};
+
+/// One estimator's estimate at one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// NED position, m.
+    pub pos: Vector3<f64>,
+    /// Heading, rad in (-pi, pi].
+    pub psi: f64,
+    /// Forward speed, m/s, when the estimator has it as a state.
+    pub speed: Option<f64>,
+    /// Standard deviations of north and east, m.
+    pub sigma_pos: Vector2<f64>,
+    /// Horizontal position error, m.
+    pub error_m: f64,
+    /// NEES of the horizontal position.
+    pub nees: f64,
+}
+
+/// Truth and all estimates at one step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepRecord {
+    pub t_s: f64,
+    /// The vehicle's true NED position, heading and forward speed.
+    pub truth_pos: Vector3<f64>,
+    pub truth_heading: f64,
+    pub truth_speed: f64,
+    /// The beacon's true position (fixed, or on the surface vehicle).
+    pub beacon: Vector3<f64>,
+    /// Whether an acoustic measurement was used in this step.
+    pub frame: bool,
+    pub estimates: Vec<Estimate>,
+}
+
+/// The outcome of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutput {
+    /// One entry per estimator, in scenario order.
+    pub metrics: Vec<RunMetrics>,
+    /// Every step, when recording was asked for; empty otherwise.
+    pub trajectory: Vec<StepRecord>,
+    pub distance_m: f64,
+    /// Acoustic measurements received (frames decoded, ranges heard).
+    pub frames_decoded: u64,
+    /// For bounds: the Fisher information H' R^-1 H of each range received, with the
+    /// step it was received in (moving-beacon runs; empty otherwise).
+    pub range_information: Vec<(usize, Matrix6<f64>)>,
+}
+
+/// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
+/// A cell of another world than the scenario's is a programming error.
+pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) -> RunOutput {
+    match (s, cell) {
+        (Scenario::FixedBeacon(s), Cell::FixedBeacon(c)) => fixed_beacon::simulate(s, c, seed, run, record),
+        (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => moving_beacon::simulate(s, c, seed, run, record),
+        _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),
+    }
+}
+
+pub use moving_beacon::{initial_asv_position, truth_trajectory};

@@ -1,0 +1,322 @@
+//! Scenarios of kind `moving_beacon` (sousa): an underwater vehicle (ROV/AUV) with
+//! 6-DOF kinematics and dead reckoning, a surface vehicle (ASV) carrying the beacon and
+//! steered by a guidance law, one-way travel-time ranges propagating at the speed of
+//! sound between moving ends. Unknown keys are errors.
+
+use super::{World, default_runs, default_seed};
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MovingBeacon {
+    /// `moving_beacon`.
+    pub kind: World,
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    #[serde(default = "default_runs::<20>")]
+    pub runs: usize,
+    #[serde(default)]
+    pub mission: Mission,
+    #[serde(default)]
+    pub vehicle: Vehicle,
+    #[serde(default)]
+    pub sensors: Sensors,
+    #[serde(default)]
+    pub asv: Asv,
+    #[serde(default)]
+    pub acoustics: Acoustics,
+    #[serde(default)]
+    pub guidance: Guidance,
+    #[serde(default)]
+    pub initial: Initial,
+    #[serde(default = "default_estimators")]
+    pub estimators: Vec<EstimatorSpec>,
+    #[serde(default)]
+    pub sweep: Sweep,
+}
+
+fn default_estimators() -> Vec<EstimatorSpec> {
+    vec![
+        EstimatorSpec { kind: EstimatorKind::RangeEkf, name: None },
+        EstimatorSpec { kind: EstimatorKind::DeadReckoning, name: None },
+    ]
+}
+
+/// Time step and duration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Mission {
+    /// Truth integration (RK4) and filter step, s.
+    pub dt_s: f64,
+    pub duration_s: f64,
+}
+
+impl Default for Mission {
+    fn default() -> Self {
+        Self { dt_s: 0.1, duration_s: 7200.0 } // sousa 4.2: two-hour missions; 10 Hz
+    }
+}
+
+/// The underwater vehicle's path, defined by its body velocities (sousa 4.1.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PathKind {
+    Stationary,
+    Lawnmower,
+    Circular,
+    Spiral,
+}
+
+impl PathKind {
+    pub fn label(self) -> &'static str {
+        match self {
+            PathKind::Stationary => "stationary",
+            PathKind::Lawnmower => "lawnmower",
+            PathKind::Circular => "circular",
+            PathKind::Spiral => "spiral",
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Vehicle {
+    pub path: PathKind,
+    /// Start depth, m (positive down).
+    pub depth_m: f64,
+    pub start_north_m: f64,
+    pub start_east_m: f64,
+    pub heading_deg: f64,
+    /// Surge speed on moving paths, m/s.
+    pub speed_m_s: f64,
+    /// Radius of the circular and spiral paths, m.
+    pub circle_radius_m: f64,
+    /// Descent rate of the spiral, m/s.
+    pub spiral_descent_m_s: f64,
+    /// Lawnmower leg length and spacing (diameter of the turns), m.
+    pub leg_length_m: f64,
+    pub leg_spacing_m: f64,
+}
+
+impl Default for Vehicle {
+    fn default() -> Self {
+        Self {
+            path: PathKind::Circular,
+            depth_m: 5.0,
+            start_north_m: 0.0,
+            start_east_m: 0.0,
+            heading_deg: 0.0,
+            speed_m_s: 0.5,
+            circle_radius_m: 25.0,
+            spiral_descent_m_s: 0.005,
+            leg_length_m: 100.0,
+            leg_spacing_m: 20.0,
+        }
+    }
+}
+
+/// The underwater vehicle's sensors (standard deviations).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Sensors {
+    /// Body linear velocity (u, v, w) noise, m/s (DVL-class).
+    pub velocity_noise_m_s: f64,
+    /// Body angular rate (p, q, r) noise, rad/s.
+    pub rate_noise_rad_s: f64,
+    /// Depth sensor noise, m.
+    pub depth_noise_m: f64,
+    /// Roll, pitch and heading noise, deg.
+    pub attitude_noise_deg: f64,
+}
+
+impl Default for Sensors {
+    fn default() -> Self {
+        Self { velocity_noise_m_s: 0.05, rate_noise_rad_s: 0.002, depth_noise_m: 0.05, attitude_noise_deg: 1.0 }
+    }
+}
+
+/// The surface vehicle carrying the beacon.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Asv {
+    pub max_speed_m_s: f64,
+    pub max_turn_rate_deg_s: f64,
+    /// GPS position noise (each horizontal axis), m (sousa eq. 4.3).
+    pub gps_noise_m: f64,
+    /// Transducer depth, m.
+    pub transducer_depth_m: f64,
+    /// Direction from the vehicle to the ASV at the start, deg; the distance is the
+    /// best standoff for the vehicle's depth (sousa Fig. 4.7).
+    pub start_bearing_deg: f64,
+}
+
+impl Default for Asv {
+    fn default() -> Self {
+        Self {
+            max_speed_m_s: 2.0,
+            max_turn_rate_deg_s: 30.0,
+            gps_noise_m: 0.5,
+            transducer_depth_m: 0.0,
+            start_bearing_deg: 0.0,
+        }
+    }
+}
+
+/// One-way travel-time ranging.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Acoustics {
+    /// Time between pings, s.
+    pub ping_period_s: f64,
+    pub sound_speed_m_s: f64,
+    /// Range noise (travel-time error times sound speed), m.
+    pub range_noise_m: f64,
+}
+
+impl Default for Acoustics {
+    fn default() -> Self {
+        Self { ping_period_s: 10.0, sound_speed_m_s: 1500.0, range_noise_m: 0.5 }
+    }
+}
+
+/// How the ASV chooses where to be at the next ping.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum GuidanceKind {
+    /// Maximise det FIM of the previous and next range (sousa approach A, eq. 3.15).
+    #[serde(rename = "A")]
+    ApproachA,
+    /// Maximise det FIM(now) + det FIM(predicted next) (sousa approach B, eq. 3.19).
+    #[serde(rename = "B")]
+    ApproachB,
+    /// Stay at the start point (baseline).
+    #[serde(rename = "static")]
+    Static,
+    /// Circle the vehicle's estimate at a fixed radius (baseline).
+    #[serde(rename = "circle")]
+    Circle,
+}
+
+impl GuidanceKind {
+    pub fn label(self) -> &'static str {
+        match self {
+            GuidanceKind::ApproachA => "A",
+            GuidanceKind::ApproachB => "B",
+            GuidanceKind::Static => "static",
+            GuidanceKind::Circle => "circle",
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Guidance {
+    pub kind: GuidanceKind,
+    /// Polar search grid over the reaching set: rings and directions.
+    pub grid_radial: usize,
+    pub grid_angular: usize,
+    /// Radius of the circling baseline, m.
+    pub circle_radius_m: f64,
+}
+
+impl Default for Guidance {
+    fn default() -> Self {
+        Self { kind: GuidanceKind::ApproachA, grid_radial: 100, grid_angular: 72, circle_radius_m: 30.0 }
+    }
+}
+
+/// Initial uncertainty of the vehicle's filter (standard deviations; the estimate
+/// starts at the truth plus one draw of these).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Initial {
+    pub position_sigma_m: f64,
+    pub depth_sigma_m: f64,
+    pub attitude_sigma_deg: f64,
+}
+
+impl Default for Initial {
+    fn default() -> Self {
+        Self { position_sigma_m: 1.0, depth_sigma_m: 0.1, attitude_sigma_deg: 1.0 }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum EstimatorKind {
+    /// EKF with attitude, depth and OWTT ranges (sousa section 3.2).
+    #[serde(rename = "range-ekf")]
+    RangeEkf,
+    /// The same filter without ranges.
+    #[serde(rename = "dead-reckoning")]
+    DeadReckoning,
+}
+
+impl EstimatorKind {
+    pub fn label(self) -> &'static str {
+        match self {
+            EstimatorKind::RangeEkf => "range-ekf",
+            EstimatorKind::DeadReckoning => "dead-reckoning",
+        }
+    }
+}
+
+/// One estimator. Its noise model is the sensors' (a matched filter).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EstimatorSpec {
+    pub kind: EstimatorKind,
+    #[serde(default)]
+    pub name: Option<String>,
+}
+
+impl EstimatorSpec {
+    pub fn name(&self) -> &str {
+        self.name.as_deref().unwrap_or(self.kind.label())
+    }
+}
+
+/// Values swept by `mc`: the cells are every combination.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Sweep {
+    pub path: Option<Vec<PathKind>>,
+    pub depth_m: Option<Vec<f64>>,
+    pub guidance: Option<Vec<GuidanceKind>>,
+}
+
+/// One sweep cell of a moving-beacon scenario.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MovingBeaconCell {
+    pub path: PathKind,
+    pub depth_m: f64,
+    pub guidance: GuidanceKind,
+}
+
+impl MovingBeacon {
+    pub fn base_cell(&self) -> MovingBeaconCell {
+        MovingBeaconCell { path: self.vehicle.path, depth_m: self.vehicle.depth_m, guidance: self.guidance.kind }
+    }
+
+    /// Every combination of the swept values, path outermost, guidance innermost.
+    pub fn cells(&self) -> Vec<MovingBeaconCell> {
+        let b = self.base_cell();
+        let paths = self.sweep.path.clone().unwrap_or_else(|| vec![b.path]);
+        let depths = self.sweep.depth_m.clone().unwrap_or_else(|| vec![b.depth_m]);
+        let guidances = self.sweep.guidance.clone().unwrap_or_else(|| vec![b.guidance]);
+        let mut cells = Vec::new();
+        for &path in &paths {
+            for &depth_m in &depths {
+                for &guidance in &guidances {
+                    cells.push(MovingBeaconCell { path, depth_m, guidance });
+                }
+            }
+        }
+        cells
+    }
+
+    pub fn steps(&self) -> usize {
+        (self.mission.duration_s / self.mission.dt_s).round() as usize
+    }
+}
