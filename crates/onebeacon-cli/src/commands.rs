@@ -33,8 +33,8 @@ pub fn scenarios(show: Option<&str>) -> Result<()> {
     Ok(())
 }
 
-/// `onebeacon run SCENARIO [--seed N] [--run I] [--out DIR]`
-pub fn run(name: &str, seed: Option<u64>, run: u64, out: Option<PathBuf>) -> Result<()> {
+/// `onebeacon run SCENARIO [--seed N] [--run I] [--ping K] [--out DIR]`
+pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, out: Option<PathBuf>) -> Result<()> {
     let s = scenario::load(name)?;
     let seed = seed.unwrap_or(s.seed());
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name())));
@@ -47,6 +47,13 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, out: Option<PathBuf>) -> Res
     let title = format!("{} seed {seed} run {run}, {}", s.name(), cell.label());
     plot::top_view(&staging.file("top_view.png"), &s, &title, &result).context("cannot draw top_view.png")?;
     plot::error_vs_time(&staging.file("error.png"), &s, &title, &result).context("cannot draw error.png")?;
+    if !result.guidance.is_empty() {
+        let snapshot = result
+            .guidance
+            .get(ping)
+            .ok_or_else(|| BadInput(format!("--ping {ping}: the run has pings 0 to {}", result.guidance.len() - 1)))?;
+        plot::guidance_map(&staging.file("guidance.png"), snapshot).context("cannot draw guidance.png")?;
+    }
     let files = staging.commit()?;
 
     print!("{}", report::run_table(&s, seed, run, &cell, &result));

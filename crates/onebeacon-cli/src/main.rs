@@ -36,6 +36,10 @@ enum Command {
         /// Which run of the seed to simulate (run i of `mc`).
         #[arg(long, default_value_t = 0)]
         run: u64,
+        /// Moving-beacon scenarios: the ping whose guidance metric is mapped in
+        /// guidance.png (0 is the first).
+        #[arg(long, default_value_t = 1)]
+        ping: usize,
         /// Output directory (default: out/<scenario>-run).
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
@@ -130,7 +134,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Scenarios { show } => commands::scenarios(show.as_deref()),
-        Command::Run { scenario, seed, run, out } => commands::run(&scenario, seed, run, out),
+        Command::Run { scenario, seed, run, ping, out } => commands::run(&scenario, seed, run, ping, out),
         Command::Mc { scenario, runs, seed, threads, out, json } => {
             commands::mc(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), out, json)
         }

@@ -1,9 +1,10 @@
 //! PNG plots with plotters and an embedded font (no system font libraries needed).
 
 use anyhow::Result;
+use onebeacon::guidance::Metric;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::montecarlo::{CellResult, McResult};
-use onebeacon_sim::run::{Estimate, RunOutput};
+use onebeacon_sim::run::{Estimate, GuidanceSnapshot, RunOutput};
 use onebeacon_sim::scenario::SweepValue;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -232,6 +233,75 @@ pub fn mc_errors(path: &Path, s: &Scenario, r: &McResult) -> Result<()> {
         }
         legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     }
+    root.present()?;
+    Ok(())
+}
+
+/// A viridis-like colour for `v` in [0, 1].
+fn viridis(v: f64) -> RGBColor {
+    const STOPS: [(f64, f64, f64); 5] =
+        [(68.0, 1.0, 84.0), (59.0, 82.0, 139.0), (33.0, 145.0, 140.0), (94.0, 201.0, 98.0), (253.0, 231.0, 37.0)];
+    let x = v.clamp(0.0, 1.0) * (STOPS.len() - 1) as f64;
+    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    let f = x - i as f64;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * f).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// The guidance metric as a function of the beacon's next position at one ping (sousa
+/// Fig. 3.5 and 3.7): colour from low (dark) to high (yellow), the reaching set as a
+/// circle, the beacon's position, the vehicle's estimate (and its prediction for
+/// approach B) and the chosen waypoint.
+pub fn guidance_map(path: &Path, g: &GuidanceSnapshot) -> Result<()> {
+    register_fonts();
+    let centre = g.target.xy();
+    let half = ((g.previous - centre).norm() + g.reach_m).max(2.0 * g.reach_m) * 1.2;
+    let (n0, e0) = (centre.x - half, centre.y - half);
+    let cells = 160usize;
+    let size = 2.0 * half / cells as f64;
+    let mut values = vec![0.0; cells * cells];
+    for i in 0..cells {
+        for j in 0..cells {
+            let p = nalgebra::Vector2::new(n0 + (i as f64 + 0.5) * size, e0 + (j as f64 + 0.5) * size);
+            values[i * cells + j] = g.planner.metric_at(p, g.previous, &g.target, &g.target_next);
+        }
+    }
+    let vmax = values.iter().cloned().fold(f64::MIN_POSITIVE, f64::max);
+    let root = BitMapBackend::new(path, (900, 860)).into_drawing_area();
+    let caption = format!("{:?} metric at the ping of t = {:.0} s (max {:.3e})", g.planner.metric, g.t_s, vmax);
+    let mut chart = chart(&root, &caption, e0..e0 + 2.0 * half, n0..n0 + 2.0 * half, ("east (m)", "north (m)"))?;
+    chart.draw_series((0..cells).flat_map(|i| {
+        let values = &values;
+        (0..cells).map(move |j| {
+            let (n, e) = (n0 + i as f64 * size, e0 + j as f64 * size);
+            Rectangle::new([(e, n), (e + size, n + size)], viridis(values[i * cells + j] / vmax).filled())
+        })
+    }))?;
+    let circle = (0..=180).map(|k| {
+        let a = std::f64::consts::TAU * k as f64 / 180.0;
+        (g.previous.y + g.reach_m * a.sin(), g.previous.x + g.reach_m * a.cos())
+    });
+    line(&mut chart, circle, WHITE.stroke_width(2), Some("reaching set"))?;
+    chart
+        .draw_series(std::iter::once(TriangleMarker::new((g.previous.y, g.previous.x), 9, WHITE.filled())))?
+        .label("beacon now")
+        .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.filled()));
+    chart
+        .draw_series(std::iter::once(Circle::new((g.target.y, g.target.x), 6, RED.filled())))?
+        .label("vehicle estimate")
+        .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.filled()));
+    if g.planner.metric == Metric::ApproachB {
+        chart
+            .draw_series(std::iter::once(Circle::new((g.target_next.y, g.target_next.x), 6, RED.stroke_width(2))))?
+            .label("vehicle predicted")
+            .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.stroke_width(2)));
+    }
+    chart
+        .draw_series(std::iter::once(Cross::new((g.waypoint.y, g.waypoint.x), 8, WHITE.stroke_width(3))))?
+        .label("chosen waypoint")
+        .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     root.present()?;
     Ok(())
 }

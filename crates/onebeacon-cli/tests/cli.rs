@@ -218,3 +218,50 @@ fn standoff_distance_grows_with_depth() {
     assert_eq!(d.len(), 4);
     assert!(d.windows(2).all(|w| w[1] > w[0]), "{d:?}");
 }
+
+const SHORT_SOUSA: &str = r#"
+kind = "moving_beacon"
+name = "short-sousa"
+description = "five minutes of the sousa mission"
+runs = 2
+[mission]
+duration_s = 300.0
+[sweep]
+path = ["stationary", "circular"]
+depth_m = [5.0]
+guidance = ["A", "static"]
+"#;
+
+#[test]
+fn moving_beacon_run_and_mc() {
+    let dir = scratch("sousa");
+    let p = dir.join("short-sousa.toml");
+    std::fs::write(&p, SHORT_SOUSA).unwrap();
+    let scenario = p.to_str().unwrap();
+    let out_dir = dir.join("run");
+    let out = run(&["run", scenario, "--ping", "3", "--out", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for png in ["top_view.png", "error.png", "guidance.png"] {
+        assert!(std::fs::read(out_dir.join(png)).unwrap().starts_with(b"\x89PNG"), "{png}");
+    }
+    let csv = std::fs::read_to_string(out_dir.join("trajectory.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(header.contains("beacon_north_m") && header.contains("range-ekf_down_m"), "{header}");
+    assert_eq!(csv.lines().count(), 3002);
+
+    let out = run(&["mc", scenario, "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+    let cells = v["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 8); // 2 paths x 2 guidance x 2 estimators
+    assert_eq!(cells[0]["sweep"]["path"], "stationary");
+    assert_eq!(cells[0]["sweep"]["guidance"], "A");
+    assert_eq!(cells[0]["sweep"]["depth_m"], 5.0);
+    assert!(cells[0]["pcrb_rmse_m"].as_f64().unwrap() > 0.0);
+    assert!(cells[0]["etd_mean_pct"].is_null()); // a stationary vehicle travels no distance
+
+    let o = run(&["run", scenario, "--ping", "500", "--out", dir.join("none").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("--ping 500"));
+    assert!(!dir.join("none").exists());
+}

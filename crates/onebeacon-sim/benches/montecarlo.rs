@@ -1,6 +1,8 @@
 //! One full garin2024 run (1567 s at 4 Hz, both estimators on the same draws), and a
-//! 20-run Monte Carlo cell. The 300-run, 6-cell sweep is 3600 such runs (target for
-//! the sweep: under 5 s on 2 cores, i.e. about 2.8 ms per run).
+//! 20-run Monte Carlo cell. The 300-run, 6-cell sweep is 1800 such runs (target for
+//! the sweep: under 5 s on 2 cores, i.e. about 5.5 ms per run).
+//! One sousa mission: 2 h at 10 Hz with ASV guidance (approach A) every 10 s (target:
+//! under 1 s).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use onebeacon_sim::montecarlo::monte_carlo;
@@ -25,6 +27,19 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("20 runs, 1 cell, all cores", |b| {
         b.iter(|| black_box(monte_carlo(&one_cell, 20, 1, None, &|| {})))
+    });
+    group.finish();
+
+    let sousa = parse(builtin("sousa").unwrap().toml, "sousa").unwrap();
+    let cell = sousa.base_cell();
+    let mut group = c.benchmark_group("sousa");
+    group.sample_size(10);
+    let mut run = 0u64;
+    group.bench_function("one 2 h mission at 10 Hz, approach A, 2 estimators", |b| {
+        b.iter(|| {
+            run += 1;
+            black_box(simulate(&sousa, &cell, 1, run, false))
+        })
     });
     group.finish();
 }

@@ -110,6 +110,7 @@ pub(super) fn simulate(s: &FixedBeacon, cell: &FixedBeaconCell, seed: u64, run: 
         distance_m: distance,
         frames_decoded,
         range_information: Vec::new(),
+        guidance: Vec::new(),
     }
 }
 

@@ -8,6 +8,7 @@ mod moving_beacon;
 use crate::metrics::RunMetrics;
 use crate::scenario::{Cell, Scenario};
 use nalgebra::{Matrix6, Vector2, Vector3};
+use onebeacon::guidance::FimPlanner;
 
 /// One estimator's estimate at one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,6 +42,23 @@ pub struct StepRecord {
     pub estimates: Vec<Estimate>,
 }
 
+/// What the beacon vehicle's guidance knew and chose at one ping (recorded runs), so
+/// that its metric can be mapped over the reaching set (sousa Fig. 3.5, 3.7).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GuidanceSnapshot {
+    pub t_s: f64,
+    /// The planner whose metric is mapped (approach A for the baselines).
+    pub planner: FimPlanner,
+    /// The beacon's position estimate at this ping, the centre of its reaching set.
+    pub previous: Vector2<f64>,
+    pub reach_m: f64,
+    /// The vehicle's estimate now and predicted at the next ping.
+    pub target: Vector3<f64>,
+    pub target_next: Vector3<f64>,
+    /// The waypoint the guidance chose.
+    pub waypoint: Vector2<f64>,
+}
+
 /// The outcome of one run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutput {
@@ -54,6 +72,8 @@ pub struct RunOutput {
     /// For bounds: the Fisher information H' R^-1 H of each range received, with the
     /// step it was received in (moving-beacon runs; empty otherwise).
     pub range_information: Vec<(usize, Matrix6<f64>)>,
+    /// The guidance decisions of a recorded moving-beacon run, one per ping.
+    pub guidance: Vec<GuidanceSnapshot>,
 }
 
 /// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.

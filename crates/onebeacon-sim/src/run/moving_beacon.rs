@@ -4,7 +4,7 @@
 //! when the wavefront meets it. Every estimator runs on the same truth and draws; the
 //! first estimator's estimate is what the vehicle reports to the ASV's guidance.
 
-use super::{Estimate, RunOutput, StepRecord};
+use super::{Estimate, GuidanceSnapshot, RunOutput, StepRecord};
 use crate::acoustics::Ping;
 use crate::metrics::ErrorAccumulator;
 use crate::scenario::moving_beacon::{EstimatorKind, GuidanceKind};
@@ -104,6 +104,7 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
     let mut acc = vec![ErrorAccumulator::new(steps + 1); filters.len()];
     let mut trajectory = Vec::with_capacity(if record { steps + 1 } else { 0 });
     let mut range_information = Vec::new();
+    let mut guidance = Vec::new();
     let (mut distance, mut heard) = (0.0, 0u64);
 
     let observe = |filters: &[Range6DofEkf], acc: &mut [ErrorAccumulator], eta: &State| {
@@ -149,10 +150,10 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
             let st = est.state();
             let target_next = target + rotation(st[idx::ROLL], st[idx::PITCH], st[idx::YAW]) * lin * period;
             let here = gps.xy();
+            // the baselines' snapshots map approach A's metric
+            let metric = if cell.guidance == GuidanceKind::ApproachB { Metric::ApproachB } else { Metric::ApproachA };
             waypoint = match cell.guidance {
                 GuidanceKind::ApproachA | GuidanceKind::ApproachB => {
-                    let metric =
-                        if cell.guidance == GuidanceKind::ApproachA { Metric::ApproachA } else { Metric::ApproachB };
                     planner(metric)
                         .next_waypoint(&ReachingSet { center: here, radius: reach }, here, &target, &target_next)
                         .waypoint
@@ -165,6 +166,17 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
                     target.xy() + Vector2::new(angle.cos(), angle.sin()) * r
                 }
             };
+            if record {
+                guidance.push(GuidanceSnapshot {
+                    t_s: t0,
+                    planner: planner(metric),
+                    previous: here,
+                    reach_m: reach,
+                    target,
+                    target_next,
+                    waypoint,
+                });
+            }
             arrive_at = t0 + period;
             next_ping += period;
         }
@@ -246,6 +258,7 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
         distance_m: distance,
         frames_decoded: heard,
         range_information,
+        guidance,
     }
 }
 

@@ -134,7 +134,7 @@ pub struct Sensors {
 
 impl Default for Sensors {
     fn default() -> Self {
-        Self { velocity_noise_m_s: 0.05, rate_noise_rad_s: 0.002, depth_noise_m: 0.05, attitude_noise_deg: 1.0 }
+        Self { velocity_noise_m_s: 0.2, rate_noise_rad_s: 0.002, depth_noise_m: 0.05, attitude_noise_deg: 1.0 }
     }
 }
 
@@ -158,7 +158,7 @@ impl Default for Asv {
         Self {
             max_speed_m_s: 2.0,
             max_turn_rate_deg_s: 30.0,
-            gps_noise_m: 0.5,
+            gps_noise_m: 1.0,
             transducer_depth_m: 0.0,
             start_bearing_deg: 0.0,
         }
@@ -178,7 +178,7 @@ pub struct Acoustics {
 
 impl Default for Acoustics {
     fn default() -> Self {
-        Self { ping_period_s: 10.0, sound_speed_m_s: 1500.0, range_noise_m: 0.5 }
+        Self { ping_period_s: 10.0, sound_speed_m_s: 1500.0, range_noise_m: 1.0 }
     }
 }
 

@@ -1,0 +1,106 @@
+//! Properties of the moving-beacon (sousa) world at Monte Carlo counts and mission
+//! lengths small enough for CI. The full reproduction is `onebeacon mc sousa`.
+
+use onebeacon_sim::montecarlo::{CellResult, monte_carlo};
+use onebeacon_sim::run::simulate;
+use onebeacon_sim::scenario::moving_beacon::{GuidanceKind, PathKind};
+use onebeacon_sim::scenario::{Cell, MovingBeacon, Scenario, builtin, parse};
+
+fn sousa() -> MovingBeacon {
+    match parse(builtin("sousa").unwrap().toml, "sousa").unwrap() {
+        Scenario::MovingBeacon(s) => s,
+        _ => unreachable!(),
+    }
+}
+
+fn with_sweep(
+    mut s: MovingBeacon,
+    paths: &[PathKind],
+    depths: &[f64],
+    guidance: &[GuidanceKind],
+    seconds: f64,
+) -> Scenario {
+    s.mission.duration_s = seconds;
+    s.sweep.path = Some(paths.to_vec());
+    s.sweep.depth_m = Some(depths.to_vec());
+    s.sweep.guidance = Some(guidance.to_vec());
+    Scenario::MovingBeacon(s)
+}
+
+fn range_ekf(c: &CellResult) -> &onebeacon_sim::metrics::CellSummary {
+    &c.estimators[0].1
+}
+
+/// With (nearly) exact sensors and ranges, a stationary vehicle's position converges
+/// to the truth from its 1 m initial error.
+#[test]
+fn nearly_noise_free_stationary_vehicle_converges() {
+    let mut s = sousa();
+    s.sensors.velocity_noise_m_s = 1e-5;
+    s.sensors.rate_noise_rad_s = 1e-7;
+    s.sensors.depth_noise_m = 1e-4;
+    s.sensors.attitude_noise_deg = 1e-4;
+    s.acoustics.range_noise_m = 1e-3;
+    s.asv.gps_noise_m = 0.0;
+    s.mission.duration_s = 600.0;
+    let scenario = Scenario::MovingBeacon(s);
+    let cell = match scenario.base_cell() {
+        Cell::MovingBeacon(mut c) => {
+            c.path = PathKind::Stationary;
+            c.depth_m = 20.0;
+            Cell::MovingBeacon(c)
+        }
+        _ => unreachable!(),
+    };
+    let out = simulate(&scenario, &cell, 3, 0, false);
+    assert!(out.frames_decoded >= 59, "{} ranges", out.frames_decoded);
+    let ekf = &out.metrics[0];
+    assert!(ekf.final_error_m < 0.01, "final error {}", ekf.final_error_m);
+    // dead reckoning keeps its initial error
+    assert!(out.metrics[1].final_error_m > 0.05, "{}", out.metrics[1].final_error_m);
+}
+
+#[test]
+fn results_do_not_depend_on_thread_count() {
+    let s = with_sweep(sousa(), &[PathKind::Circular], &[5.0], &[GuidanceKind::ApproachA, GuidanceKind::Circle], 300.0);
+    let one = monte_carlo(&s, 3, 5, Some(1), &|| {}).unwrap();
+    let two = monte_carlo(&s, 3, 5, Some(2), &|| {}).unwrap();
+    assert_eq!(one, two);
+    assert_eq!(one.cells.len(), 2);
+}
+
+/// sousa Tables 4.1/4.2 properties at CI scale: FIM guidance beats a static beacon on
+/// moving paths; on the circle the error stays bounded (second half within 1.5x the
+/// first); ranges beat dead reckoning; the EKF's RMSE stays above and near its PCRB.
+#[test]
+fn fim_guidance_beats_a_static_beacon_and_stays_bounded() {
+    let s = with_sweep(
+        sousa(),
+        &[PathKind::Lawnmower, PathKind::Circular],
+        &[20.0],
+        &[GuidanceKind::ApproachA, GuidanceKind::ApproachB, GuidanceKind::Static],
+        1800.0,
+    );
+    let r = monte_carlo(&s, 4, 11, None, &|| {}).unwrap();
+    for path in r.cells.chunks(3) {
+        let (a, b, st) = (range_ekf(&path[0]), range_ekf(&path[1]), range_ekf(&path[2]));
+        eprintln!(
+            "{}: A {:.3} B {:.3} static {:.3}",
+            path[0].cell.label(),
+            a.mean_error_m,
+            b.mean_error_m,
+            st.mean_error_m
+        );
+        assert!(a.mean_error_m < st.mean_error_m && b.mean_error_m < st.mean_error_m);
+        for c in path {
+            let e = range_ekf(c);
+            let dr = &c.estimators[1].1;
+            assert!(e.mean_error_m < dr.mean_error_m, "{}", c.cell.label());
+            let ratio = e.rmse_m / c.pcrb_rmse_m.unwrap();
+            // a floor up to sampling: 4 runs, inliers only
+            assert!((0.7..3.0).contains(&ratio), "{}: RMSE/PCRB {ratio}", c.cell.label());
+        }
+    }
+    let circle_a = range_ekf(&r.cells[3]);
+    assert!(circle_a.mean_error_second_half_m < 1.5 * circle_a.mean_error_first_half_m, "{circle_a:?}");
+}
