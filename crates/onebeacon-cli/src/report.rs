@@ -4,7 +4,7 @@ use anyhow::Result;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::montecarlo::McResult;
 use onebeacon_sim::run::RunOutput;
-use onebeacon_sim::scenario::{Cell, SweepValue};
+use onebeacon_sim::scenario::{Cell, MovingBeaconCell, SweepValue};
 use serde_json::{Value, json};
 use std::fmt::Write;
 
@@ -172,8 +172,64 @@ pub fn mc_json(s: &Scenario, r: &McResult, wall_s: f64) -> String {
     serde_json::to_string(&v).expect("serialisable")
 }
 
+/// For moving-beacon sweeps, sousa's layout (Tables 4.1, 4.2): per guidance, rows of
+/// depth, columns of path, "mean (variance) [RMSE/PCRB]" of the first estimator.
+fn depth_by_path_tables(s: &Scenario, r: &McResult) -> String {
+    let mut t = String::new();
+    let cells: Vec<(&MovingBeaconCell, &onebeacon_sim::montecarlo::CellResult)> = r
+        .cells
+        .iter()
+        .filter_map(|c| match &c.cell {
+            Cell::MovingBeacon(m) => Some((m, c)),
+            _ => None,
+        })
+        .collect();
+    let mut paths = Vec::new();
+    let mut depths: Vec<f64> = Vec::new();
+    let mut guidances = Vec::new();
+    for (m, _) in &cells {
+        if !paths.contains(&m.path) {
+            paths.push(m.path);
+        }
+        if !depths.contains(&m.depth_m) {
+            depths.push(m.depth_m);
+        }
+        if !guidances.contains(&m.guidance) {
+            guidances.push(m.guidance);
+        }
+    }
+    let names = s.estimator_names();
+    for g in guidances {
+        let _ = writeln!(t);
+        let _ = writeln!(t, "guidance {}: {} mean error m (variance m^2) [RMSE/PCRB]", g.label(), names[0]);
+        let _ = write!(t, "{:>8}", "depth_m");
+        for p in &paths {
+            let _ = write!(t, " {:>26}", p.label());
+        }
+        let _ = writeln!(t);
+        for &d in &depths {
+            let _ = write!(t, "{d:>8}");
+            for p in &paths {
+                let found = cells.iter().find(|(m, _)| m.path == *p && m.depth_m == d && m.guidance == g);
+                let text = match found {
+                    Some((_, c)) => {
+                        let e = &c.estimators[0].1;
+                        let ratio = c.pcrb_rmse_m.map(|b| format!("{:.2}", e.rmse_m / b)).unwrap_or_else(|| "-".into());
+                        format!("{:.3} ({:.3}) [{ratio}]", e.mean_error_m, e.error_variance_m2)
+                    }
+                    None => "-".into(),
+                };
+                let _ = write!(t, " {text:>26}");
+            }
+            let _ = writeln!(t);
+        }
+    }
+    t
+}
+
 /// The `mc` tables: mean error (outliers) of every estimator side by side, as
-/// garin2024 Table 4, then every statistic per estimator, as Table 3.
+/// garin2024 Table 4, then every statistic per estimator, as Table 3; for moving-beacon
+/// sweeps also sousa's depth-by-path layout.
 pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
     let mut t = String::new();
     let _ = writeln!(t, "{}: {} runs per cell, seed {}, {:.2} s", s.name(), r.runs, r.seed, wall_s);
@@ -231,6 +287,9 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
                 c.pcrb_rmse_m.map(|p| format!("{p:.3}")).unwrap_or_else(|| "-".into()),
             );
         }
+    }
+    if matches!(s, Scenario::MovingBeacon(_)) {
+        t.push_str(&depth_by_path_tables(s, r));
     }
     t
 }
