@@ -31,6 +31,14 @@ fn check(key: &str, value: f64, rule: Rule) -> Result<(), Violation> {
     }
 }
 
+/// Checks fields of one section; the key is built from the section and the field
+/// name, so it cannot drift from the schema.
+macro_rules! check_fields {
+    ($section:literal, $obj:expr, { $($field:ident: $rule:ident),* $(,)? }) => {
+        $( check(concat!($section, ".", stringify!($field)), $obj.$field, $rule)?; )*
+    };
+}
+
 fn check_count(key: &str, value: usize, min: usize, max: usize) -> Result<(), Violation> {
     if (min..=max).contains(&value) {
         Ok(())
@@ -95,40 +103,54 @@ fn check_list_nonempty<T>(key: &str, v: &Option<Vec<T>>) -> Result<(), Violation
 fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
     use Rule::*;
     check_count("runs", s.runs, 1, 1_000_000)?;
-    check("mission.dt_s", s.mission.dt_s, Positive)?;
-    check("mission.duration_s", s.mission.duration_s, Positive)?;
+    check_fields!("mission", s.mission, {
+        dt_s: Positive,
+        duration_s: Positive,
+    });
     let v = &s.vehicle;
-    check("vehicle.depth_m", v.depth_m, NonNegative)?;
-    check("vehicle.start_north_m", v.start_north_m, Finite)?;
-    check("vehicle.start_east_m", v.start_east_m, Finite)?;
-    check("vehicle.heading_deg", v.heading_deg, Finite)?;
-    check("vehicle.speed_m_s", v.speed_m_s, NonNegative)?;
-    check("vehicle.circle_radius_m", v.circle_radius_m, Positive)?;
-    check("vehicle.spiral_descent_m_s", v.spiral_descent_m_s, NonNegative)?;
-    check("vehicle.leg_length_m", v.leg_length_m, Positive)?;
-    check("vehicle.leg_spacing_m", v.leg_spacing_m, Positive)?;
+    check_fields!("vehicle", v, {
+        depth_m: NonNegative,
+        start_north_m: Finite,
+        start_east_m: Finite,
+        heading_deg: Finite,
+        speed_m_s: NonNegative,
+        circle_radius_m: Positive,
+        spiral_descent_m_s: NonNegative,
+        leg_length_m: Positive,
+        leg_spacing_m: Positive,
+    });
     let n = &s.sensors;
-    check("sensors.velocity_noise_m_s", n.velocity_noise_m_s, Positive)?;
-    check("sensors.rate_noise_rad_s", n.rate_noise_rad_s, Positive)?;
-    check("sensors.depth_noise_m", n.depth_noise_m, Positive)?;
-    check("sensors.attitude_noise_deg", n.attitude_noise_deg, Positive)?;
+    check_fields!("sensors", n, {
+        velocity_noise_m_s: Positive,
+        rate_noise_rad_s: Positive,
+        depth_noise_m: Positive,
+        attitude_noise_deg: Positive,
+    });
     let a = &s.asv;
-    check("asv.max_speed_m_s", a.max_speed_m_s, Positive)?;
-    check("asv.max_turn_rate_deg_s", a.max_turn_rate_deg_s, Positive)?;
-    check("asv.gps_noise_m", a.gps_noise_m, NonNegative)?;
-    check("asv.transducer_depth_m", a.transducer_depth_m, NonNegative)?;
-    check("asv.start_bearing_deg", a.start_bearing_deg, Finite)?;
+    check_fields!("asv", a, {
+        max_speed_m_s: Positive,
+        max_turn_rate_deg_s: Positive,
+        gps_noise_m: NonNegative,
+        transducer_depth_m: NonNegative,
+        start_bearing_deg: Finite,
+    });
     let c = &s.acoustics;
-    check("acoustics.ping_period_s", c.ping_period_s, Positive)?;
-    check("acoustics.sound_speed_m_s", c.sound_speed_m_s, Positive)?;
-    check("acoustics.range_noise_m", c.range_noise_m, Positive)?;
+    check_fields!("acoustics", c, {
+        ping_period_s: Positive,
+        sound_speed_m_s: Positive,
+        range_noise_m: Positive,
+    });
     check_count("guidance.grid_radial", s.guidance.grid_radial, 1, 10_000)?;
     check_count("guidance.grid_angular", s.guidance.grid_angular, 1, 10_000)?;
-    check("guidance.circle_radius_m", s.guidance.circle_radius_m, Positive)?;
+    check_fields!("guidance", s.guidance, {
+        circle_radius_m: Positive,
+    });
     let i = &s.initial;
-    check("initial.position_sigma_m", i.position_sigma_m, Positive)?;
-    check("initial.depth_sigma_m", i.depth_sigma_m, Positive)?;
-    check("initial.attitude_sigma_deg", i.attitude_sigma_deg, Positive)?;
+    check_fields!("initial", i, {
+        position_sigma_m: Positive,
+        depth_sigma_m: Positive,
+        attitude_sigma_deg: Positive,
+    });
     if s.estimators.is_empty() {
         return Err(Violation {
             key: "estimators".into(),
@@ -153,41 +175,53 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
     check_count("runs", s.runs, 1, 1_000_000)?;
 
     let m = &s.mission;
-    check("mission.dt_s", m.dt_s, Positive)?;
-    check("mission.speed_m_s", m.speed_m_s, Positive)?;
+    check_fields!("mission", m, {
+        dt_s: Positive,
+        speed_m_s: Positive,
+    });
     if let Some(d) = m.duration_s {
         check("mission.duration_s", d, Positive)?;
     }
 
     let p = &s.path;
-    check("path.start_north_m", p.start_north_m, Finite)?;
-    check("path.start_east_m", p.start_east_m, Finite)?;
-    check("path.leg_heading_deg", p.leg_heading_deg, Finite)?;
-    check("path.leg_length_m", p.leg_length_m, Positive)?;
-    check("path.leg_spacing_m", p.leg_spacing_m, Positive)?;
+    check_fields!("path", p, {
+        start_north_m: Finite,
+        start_east_m: Finite,
+        leg_heading_deg: Finite,
+        leg_length_m: Positive,
+        leg_spacing_m: Positive,
+    });
     check_count("path.legs", p.legs, 1, 10_000)?;
 
-    check("beacon.north_m", s.beacon.north_m, Finite)?;
-    check("beacon.east_m", s.beacon.east_m, Finite)?;
+    check_fields!("beacon", s.beacon, {
+        north_m: Finite,
+        east_m: Finite,
+    });
 
-    check("comms.t_com_s", s.comms.t_com_s, Positive)?;
-    check("comms.frame_loss_prob", s.comms.frame_loss_prob, Probability)?;
+    check_fields!("comms", s.comms, {
+        t_com_s: Positive,
+        frame_loss_prob: Probability,
+    });
 
     let n = &s.sensors;
-    check("sensors.range_noise_m", n.range_noise_m, NonNegative)?;
-    check("sensors.doppler_noise_m_s", n.doppler_noise_m_s, NonNegative)?;
-    check("sensors.heading_noise_deg", n.heading_noise_deg, NonNegative)?;
-    check("sensors.heading_bias_deg", n.heading_bias_deg, NonNegative)?;
-    check("sensors.heading_bias_drift_deg_per_h", n.heading_bias_drift_deg_per_h, NonNegative)?;
-    check("sensors.gyro_noise_rad_s", n.gyro_noise_rad_s, NonNegative)?;
-    check("sensors.accel_noise_m_s2", n.accel_noise_m_s2, NonNegative)?;
+    check_fields!("sensors", n, {
+        range_noise_m: NonNegative,
+        doppler_noise_m_s: NonNegative,
+        heading_noise_deg: NonNegative,
+        heading_bias_deg: NonNegative,
+        heading_bias_drift_deg_per_h: NonNegative,
+        gyro_noise_rad_s: NonNegative,
+        accel_noise_m_s2: NonNegative,
+    });
 
     let i = &s.initial;
-    check("initial.position_sigma_m", i.position_sigma_m, Positive)?;
-    check("initial.heading_sigma_deg", i.heading_sigma_deg, Positive)?;
-    check("initial.speed_sigma_m_s", i.speed_sigma_m_s, Positive)?;
-    check("initial.yaw_rate_sigma_rad_s", i.yaw_rate_sigma_rad_s, Positive)?;
-    check("initial.accel_sigma_m_s2", i.accel_sigma_m_s2, Positive)?;
+    check_fields!("initial", i, {
+        position_sigma_m: Positive,
+        heading_sigma_deg: Positive,
+        speed_sigma_m_s: Positive,
+        yaw_rate_sigma_rad_s: Positive,
+        accel_sigma_m_s2: Positive,
+    });
 
     if s.estimators.is_empty() {
         return Err(Violation {
