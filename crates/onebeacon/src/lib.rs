@@ -3,6 +3,7 @@
 //! What runs on a vehicle lives here, with lean dependencies (nalgebra, thiserror):
 //!
 //! - [`geo`]: NED frame conventions and angle wrapping;
+//! - [`dsp`]: receiver signal processing: matched filter, beamforming, modes;
 //! - [`models`]: process models used by the estimators;
 //! - [`measure`]: measurement models `h(x)` with their Jacobians;
 //! - [`filter`]: the generic extended Kalman filter and consistency statistics;
@@ -12,6 +13,7 @@
 //! Conventions: NED frame (x north, y east, z down), SI units, radians, heading from
 //! north toward east. Equation numbers in comments refer to the source papers.
 
+pub mod dsp;
 pub mod filter;
 pub mod geo;
 pub mod guidance;

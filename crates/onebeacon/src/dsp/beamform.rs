@@ -1,0 +1,318 @@
+//! Direction of arrival by wideband beamforming (rypkema eq. 9-11) and by sensor-pair
+//! decomposition beamforming, SPD-BF (Rypkema, Fischell, Schmidt, JASA 2020;
+//! ../shared/acoustics.md, "Beamforming: CBF and SPD-BF").
+//!
+//! Directions are unit vectors `u` toward the source in the array frame (x forward,
+//! y starboard, z down). Element m at `r_m` hears the wave `tau_m = -r_m . u / c` after
+//! the array centre: elements nearer the source hear it first.
+
+use super::Complex;
+use nalgebra::Vector3;
+use realfft::RealFftPlanner;
+use std::f64::consts::{PI, TAU};
+
+/// Unit vector toward the source from azimuth (from x toward y) and inclination (from
+/// +z, down: 0 straight down, pi/2 level, pi straight up), radians.
+pub fn direction(azimuth: f64, inclination: f64) -> Vector3<f64> {
+    let (sa, ca) = azimuth.sin_cos();
+    let (si, ci) = inclination.sin_cos();
+    Vector3::new(si * ca, si * sa, ci)
+}
+
+/// Azimuth in [0, 2 pi) and inclination in [0, pi] of a direction.
+pub fn azimuth_inclination(u: &Vector3<f64>) -> (f64, f64) {
+    let u = u.normalize();
+    (u.y.atan2(u.x).rem_euclid(TAU), u.z.clamp(-1.0, 1.0).acos())
+}
+
+/// Angle between two directions, rad.
+pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.normalize().dot(&b.normalize()).clamp(-1.0, 1.0).acos()
+}
+
+/// The in-band spectra of every element over one segment of the capture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Snapshot {
+    pub freqs_hz: Vec<f64>,
+    /// `spectra[m][k]`: element m, frequency k.
+    pub spectra: Vec<Vec<Complex>>,
+}
+
+impl Snapshot {
+    /// FFT of `len` samples from `start` of each element's capture, keeping the bins in
+    /// `band_hz`.
+    pub fn from_segment(captures: &[Vec<f64>], start: usize, len: usize, band_hz: (f64, f64), fs: f64) -> Self {
+        let n = len.max(2);
+        let r2c = RealFftPlanner::<f64>::new().plan_fft_forward(n);
+        let df = fs / n as f64;
+        let lo = (band_hz.0 / df).ceil() as usize;
+        let hi = ((band_hz.1 / df).floor() as usize).min(n / 2);
+        let freqs_hz = (lo..=hi).map(|k| k as f64 * df).collect();
+        let spectra = captures
+            .iter()
+            .map(|x| {
+                let mut seg: Vec<f64> = (start..start + n).map(|i| x.get(i).copied().unwrap_or(0.0)).collect();
+                let mut out = r2c.make_output_vec();
+                r2c.process(&mut seg, &mut out).expect("sizes match the plan");
+                out[lo..=hi].to_vec()
+            })
+            .collect();
+        Self { freqs_hz, spectra }
+    }
+
+    /// Total in-band energy of each element, sum over k of |X_m(f_k)|^2.
+    pub fn energies(&self) -> Vec<f64> {
+        self.spectra.iter().map(|s| s.iter().map(|c| c.norm_sqr()).sum()).collect()
+    }
+}
+
+/// Conventional wideband beamformer (eq. 10-11, without the 1/M): P(u) = sum over k of
+/// |sum over m of X_m(f_k) exp(+j 2 pi f_k tau_m(u))|^2.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cbf {
+    pub elements: Vec<Vector3<f64>>,
+    pub sound_speed_m_s: f64,
+}
+
+impl Cbf {
+    pub fn power(&self, snap: &Snapshot, u: &Vector3<f64>) -> f64 {
+        let (f0, df) = (snap.freqs_hz.first().copied().unwrap_or(0.0), freq_step(&snap.freqs_hz));
+        let k = snap.freqs_hz.len();
+        let mut sum = vec![Complex::new(0.0, 0.0); k];
+        for (r, x) in self.elements.iter().zip(&snap.spectra) {
+            let tau = -r.dot(u) / self.sound_speed_m_s;
+            // exp(+j 2 pi f tau) for f = f0 + i df, by recurrence
+            let mut w = Complex::from_polar(1.0, TAU * f0 * tau);
+            let step = Complex::from_polar(1.0, TAU * df * tau);
+            for (s, xi) in sum.iter_mut().zip(x) {
+                *s += xi * w;
+                w *= step;
+            }
+        }
+        sum.iter().map(|c| c.norm_sqr()).sum()
+    }
+}
+
+fn freq_step(f: &[f64]) -> f64 {
+    if f.len() > 1 { f[1] - f[0] } else { 0.0 }
+}
+
+/// One element pair of SPD-BF: its axis and length.
+#[derive(Debug, Clone, PartialEq)]
+struct Pair {
+    i: usize,
+    j: usize,
+    axis: Vector3<f64>,
+    length: f64,
+}
+
+/// Sensor-pair decomposition beamforming: each of the M(M-1)/2 element pairs is
+/// beamformed over one conical angle zeta (the angle between the direction and the pair
+/// axis), on a grid uniform in cos zeta; the power in a direction is the sum over pairs
+/// of the pair power at its cos zeta = axis . u (linear interpolation). The sum equals
+/// the CBF power plus (M - 2) times the total element energy, so both peak together.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpdBf {
+    pairs: Vec<Pair>,
+    sound_speed_m_s: f64,
+    n_cos: usize,
+    /// `tables[p][g]`: pair p at cos zeta = -1 + 2 g / (n_cos - 1).
+    tables: Vec<Vec<f64>>,
+}
+
+impl SpdBf {
+    /// An SPD beamformer whose conical grid is no coarser than `resolution_rad` at
+    /// broadside (the grid is uniform in cos zeta).
+    pub fn new(elements: &[Vector3<f64>], sound_speed_m_s: f64, resolution_rad: f64) -> Self {
+        let mut pairs = Vec::new();
+        for i in 0..elements.len() {
+            for j in i + 1..elements.len() {
+                let d = elements[j] - elements[i];
+                pairs.push(Pair { i, j, axis: d.normalize(), length: d.norm() });
+            }
+        }
+        let n_cos = (2.0 / resolution_rad).ceil() as usize + 1;
+        Self { tables: vec![vec![0.0; n_cos]; pairs.len()], pairs, sound_speed_m_s, n_cos }
+    }
+
+    /// Number of conical grid points per pair and of pairs (memory: their product).
+    pub fn size(&self) -> (usize, usize) {
+        (self.n_cos, self.pairs.len())
+    }
+
+    /// Power of pair `p` at cos zeta = `cz` straight from the snapshot.
+    fn pair_power(&self, p: &Pair, snap: &Snapshot, cz: f64) -> f64 {
+        let (xi, xj) = (&snap.spectra[p.i], &snap.spectra[p.j]);
+        let delay = p.length * cz / self.sound_speed_m_s;
+        let (f0, df) = (snap.freqs_hz.first().copied().unwrap_or(0.0), freq_step(&snap.freqs_hz));
+        let mut w = Complex::from_polar(1.0, -TAU * f0 * delay);
+        let step = Complex::from_polar(1.0, -TAU * df * delay);
+        let mut sum = 0.0;
+        for (a, b) in xi.iter().zip(xj) {
+            sum += (a + b * w).norm_sqr();
+            w *= step;
+        }
+        sum
+    }
+
+    /// Beamforms every pair over its conical grid for this snapshot.
+    pub fn compute(&mut self, snap: &Snapshot) {
+        let n = self.n_cos;
+        let tables: Vec<Vec<f64>> = self
+            .pairs
+            .iter()
+            .map(|p| (0..n).map(|g| self.pair_power(p, snap, -1.0 + 2.0 * g as f64 / (n - 1) as f64)).collect())
+            .collect();
+        self.tables = tables;
+    }
+
+    /// The SPD power toward `u` from the computed tables (one dot product and one
+    /// interpolation per pair).
+    pub fn power(&self, u: &Vector3<f64>) -> f64 {
+        let scale = (self.n_cos - 1) as f64 / 2.0;
+        self.pairs
+            .iter()
+            .zip(&self.tables)
+            .map(|(p, t)| {
+                let x = ((p.axis.dot(u) + 1.0) * scale).clamp(0.0, (self.n_cos - 1) as f64);
+                let g = (x.floor() as usize).min(self.n_cos - 2);
+                let f = x - g as f64;
+                t[g] * (1.0 - f) + t[g + 1] * f
+            })
+            .sum()
+    }
+
+    /// The SPD power toward `u` evaluated exactly (no grid), for reference.
+    pub fn power_exact(&self, snap: &Snapshot, u: &Vector3<f64>) -> f64 {
+        self.pairs.iter().map(|p| self.pair_power(p, snap, p.axis.dot(u))).sum()
+    }
+}
+
+/// The best direction of `power`: the maximum over an azimuth x inclination grid of
+/// `step_rad`, refined by a pattern search down to `step_rad / 1024`.
+pub fn search(power: impl Fn(&Vector3<f64>) -> f64, step_rad: f64) -> (Vector3<f64>, f64) {
+    let (na, ni) = ((TAU / step_rad).round() as usize, (PI / step_rad).round() as usize);
+    let mut best = (0.0, 0.0, f64::MIN);
+    for a in 0..na {
+        for i in 0..=ni {
+            let (az, inc) = (a as f64 * TAU / na as f64, i as f64 * PI / ni as f64);
+            let p = power(&direction(az, inc));
+            if p > best.2 {
+                best = (az, inc, p);
+            }
+        }
+    }
+    let mut step = step_rad / 2.0;
+    while step > step_rad / 1024.0 {
+        let mut moved = true;
+        while moved {
+            moved = false;
+            for (da, di) in [(step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)] {
+                let (az, inc) = (best.0 + da, (best.1 + di).clamp(0.0, PI));
+                let p = power(&direction(az, inc));
+                if p > best.2 {
+                    best = (az, inc, p);
+                    moved = true;
+                }
+            }
+        }
+        step /= 2.0;
+    }
+    (direction(best.0, best.1), best.2)
+}
+
+/// rypkema's array: a pyramid with 8 cm edges, four base elements at (+-4, +-4, 0) cm
+/// and the apex 5.657 cm above their plane (toward -z, up), positions relative to the
+/// centroid (../shared/acoustics.md).
+pub fn pyramid_8cm() -> Vec<Vector3<f64>> {
+    let h = 0.08 / 2f64.sqrt();
+    let raw = [
+        Vector3::new(0.04, 0.04, 0.0),
+        Vector3::new(0.04, -0.04, 0.0),
+        Vector3::new(-0.04, -0.04, 0.0),
+        Vector3::new(-0.04, 0.04, 0.0),
+        Vector3::new(0.0, 0.0, -h),
+    ];
+    let centroid = raw.iter().sum::<Vector3<f64>>() / raw.len() as f64;
+    raw.iter().map(|r| r - centroid).collect()
+}
+
+/// A regular tetrahedron of edge `edge_m`, centred.
+pub fn tetrahedron(edge_m: f64) -> Vec<Vector3<f64>> {
+    let a = edge_m / (2.0 * 2f64.sqrt());
+    [Vector3::new(a, a, a), Vector3::new(a, -a, -a), Vector3::new(-a, a, -a), Vector3::new(-a, -a, a)].to_vec()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dsp::waveform::Lfm;
+    use approx::assert_relative_eq;
+
+    /// Noise-free plane-wave captures of a chirp from direction `u`.
+    fn captures(elements: &[Vector3<f64>], u: &Vector3<f64>, fs: f64, chirp: &Lfm, t0: f64) -> Vec<Vec<f64>> {
+        elements
+            .iter()
+            .map(|r| {
+                let tau = -r.dot(u) / 1500.0;
+                (0..2048).map(|n| chirp.value(n as f64 / fs - t0 - tau)).collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn geometry_helpers() {
+        let e = pyramid_8cm();
+        assert_relative_eq!((e[0] - e[1]).norm(), 0.08, epsilon = 1e-12);
+        assert_relative_eq!((e[4] - e[0]).norm(), 0.08, epsilon = 1e-12);
+        assert_relative_eq!(e.iter().sum::<Vector3<f64>>().norm(), 0.0, epsilon = 1e-15);
+        let t = tetrahedron(0.1);
+        assert_relative_eq!((t[0] - t[3]).norm(), 0.1, epsilon = 1e-12);
+        let u = direction(1.0, 2.0);
+        let (a, i) = azimuth_inclination(&u);
+        assert_relative_eq!(a, 1.0, epsilon = 1e-12);
+        assert_relative_eq!(i, 2.0, epsilon = 1e-12);
+    }
+
+    /// The exact identity P_SPD = P_CBF + (M - 2) sum E_m (acoustics.md), at arbitrary
+    /// directions: CBF is the reference for SPD, as a naive DFT is for an FFT.
+    #[test]
+    fn spd_equals_cbf_plus_constant() {
+        let fs = 37_500.0;
+        let chirp = Lfm::new(7e3, 9e3, 0.02);
+        let el = pyramid_8cm();
+        let truth = direction(0.7, 2.2);
+        let snap = Snapshot::from_segment(&captures(&el, &truth, fs, &chirp, 0.005), 0, 1024, chirp.band(), fs);
+        let cbf = Cbf { elements: el.clone(), sound_speed_m_s: 1500.0 };
+        let spd = SpdBf::new(&el, 1500.0, 0.25f64.to_radians());
+        let extra: f64 = (el.len() - 2) as f64 * snap.energies().iter().sum::<f64>();
+        for (a, i) in [(0.0, 0.0), (1.0, 1.0), (3.0, 2.5), (5.5, 1.7), (0.7, 2.2)] {
+            let u = direction(a, i);
+            assert_relative_eq!(spd.power_exact(&snap, &u), cbf.power(&snap, &u) + extra, max_relative = 1e-10);
+        }
+    }
+
+    /// Noise-free pings over a grid of directions: both beamformers peak within 1 deg of
+    /// the truth and of each other.
+    #[test]
+    fn noise_free_peaks_agree_with_the_truth() {
+        let fs = 37_500.0;
+        let chirp = Lfm::new(7e3, 9e3, 0.02);
+        let el = pyramid_8cm();
+        let cbf = Cbf { elements: el.clone(), sound_speed_m_s: 1500.0 };
+        let mut spd = SpdBf::new(&el, 1500.0, 0.25f64.to_radians());
+        for az in [10.0f64, 100.0, 200.0, 300.0] {
+            for inc in [100.0f64, 130.0, 160.0] {
+                let truth = direction(az.to_radians(), inc.to_radians());
+                let snap = Snapshot::from_segment(&captures(&el, &truth, fs, &chirp, 0.005), 0, 1024, chirp.band(), fs);
+                spd.compute(&snap);
+                let (uc, _) = search(|u| cbf.power(&snap, u), 4f64.to_radians());
+                let (us, _) = search(|u| spd.power(u), 4f64.to_radians());
+                let deg = |a: &Vector3<f64>, b: &Vector3<f64>| angle_between(a, b).to_degrees();
+                assert!(deg(&uc, &truth) < 1.0, "CBF {az} {inc}: {}", deg(&uc, &truth));
+                assert!(deg(&us, &truth) < 1.0, "SPD {az} {inc}: {}", deg(&us, &truth));
+                assert!(deg(&uc, &us) < 1.0);
+            }
+        }
+    }
+}
