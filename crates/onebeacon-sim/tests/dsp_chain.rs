@@ -108,7 +108,7 @@ fn mode_accuracy(n: usize, snr_db: f64, seed: u64) -> f64 {
         let src = Vector3::new(range, 0.0, 1.0);
         let caps =
             simulate_ping(&modes[mode], &src, &Vector3::new(0.0, 0.0, 3.0), &Matrix3::identity(), &el, &ch, &mut noise);
-        right += usize::from(bank.identify(&caps) == mode);
+        right += usize::from(bank.identify(&bank.spectra(&caps)) == mode);
     }
     right as f64 / n as f64
 }

@@ -28,8 +28,9 @@ fn bench(c: &mut Criterion) {
     let mut rx = Receiver::new(modes[0], &el, ReceiverConfig::default());
     c.bench_function("ping: 4-template mode id + PHAT range + SPD-BF 0.25 deg", |b| {
         b.iter(|| {
-            let mode = bank.identify(black_box(&captures));
-            black_box((mode, rx.process(black_box(&captures))))
+            let spectra = bank.spectra(black_box(&captures));
+            let mode = bank.identify(&spectra);
+            black_box((mode, rx.process_spectra(black_box(&captures), &spectra)))
         })
     });
     c.bench_function("ping: PHAT range + SPD-BF 0.25 deg only", |b| {

@@ -188,37 +188,64 @@ impl SpdBf {
     }
 }
 
-/// The best direction of `power`: the maximum over an azimuth x inclination grid of
-/// `step_rad`, refined by a pattern search down to `step_rad / 1024`.
-pub fn search(power: impl Fn(&Vector3<f64>) -> f64, step_rad: f64) -> (Vector3<f64>, f64) {
-    let (na, ni) = ((TAU / step_rad).round() as usize, (PI / step_rad).round() as usize);
-    let mut best = (0.0, 0.0, f64::MIN);
-    for a in 0..na {
-        for i in 0..=ni {
-            let (az, inc) = (a as f64 * TAU / na as f64, i as f64 * PI / ni as f64);
-            let p = power(&direction(az, inc));
-            if p > best.2 {
-                best = (az, inc, p);
+/// An azimuth x inclination grid of look directions, computed once, and the search
+/// of a power function over it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectionGrid {
+    step_rad: f64,
+    dirs: Vec<(f64, f64, Vector3<f64>)>,
+}
+
+impl DirectionGrid {
+    /// Azimuths 0..2 pi and inclinations 0..pi every `step_rad` (rounded to divide both).
+    pub fn new(step_rad: f64) -> Self {
+        let (na, ni) = ((TAU / step_rad).round().max(1.0) as usize, (PI / step_rad).round().max(1.0) as usize);
+        let mut dirs = Vec::with_capacity(na * (ni + 1));
+        for a in 0..na {
+            for i in 0..=ni {
+                let (az, inc) = (a as f64 * TAU / na as f64, i as f64 * PI / ni as f64);
+                dirs.push((az, inc, direction(az, inc)));
             }
         }
+        Self { step_rad, dirs }
     }
-    let mut step = step_rad / 2.0;
-    while step > step_rad / 1024.0 {
-        let mut moved = true;
-        while moved {
-            moved = false;
-            for (da, di) in [(step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)] {
-                let (az, inc) = (best.0 + da, (best.1 + di).clamp(0.0, PI));
-                let p = power(&direction(az, inc));
-                if p > best.2 {
-                    best = (az, inc, p);
-                    moved = true;
+
+    pub fn len(&self) -> usize {
+        self.dirs.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.dirs.is_empty()
+    }
+
+    /// The best direction of `power`: the grid maximum (the first on ties), refined by a
+    /// pattern search in azimuth and inclination down to 1/1024 of the grid step.
+    pub fn search(&self, power: impl Fn(&Vector3<f64>) -> f64) -> (Vector3<f64>, f64) {
+        let mut best = (0.0, 0.0, f64::MIN);
+        for (az, inc, u) in &self.dirs {
+            let p = power(u);
+            if p > best.2 {
+                best = (*az, *inc, p);
+            }
+        }
+        let mut step = self.step_rad / 2.0;
+        while step > self.step_rad / 1024.0 {
+            let mut moved = true;
+            while moved {
+                moved = false;
+                for (da, di) in [(step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)] {
+                    let (az, inc) = (best.0 + da, (best.1 + di).clamp(0.0, PI));
+                    let p = power(&direction(az, inc));
+                    if p > best.2 {
+                        best = (az, inc, p);
+                        moved = true;
+                    }
                 }
             }
+            step /= 2.0;
         }
-        step /= 2.0;
+        (direction(best.0, best.1), best.2)
     }
-    (direction(best.0, best.1), best.2)
 }
 
 /// rypkema's array: a pyramid with 8 cm edges, four base elements at (+-4, +-4, 0) cm
@@ -306,8 +333,9 @@ mod tests {
                 let truth = direction(az.to_radians(), inc.to_radians());
                 let snap = Snapshot::from_segment(&captures(&el, &truth, fs, &chirp, 0.005), 0, 1024, chirp.band(), fs);
                 spd.compute(&snap);
-                let (uc, _) = search(|u| cbf.power(&snap, u), 4f64.to_radians());
-                let (us, _) = search(|u| spd.power(u), 4f64.to_radians());
+                let grid = DirectionGrid::new(4f64.to_radians());
+                let (uc, _) = grid.search(|u| cbf.power(&snap, u));
+                let (us, _) = grid.search(|u| spd.power(u));
                 let deg = |a: &Vector3<f64>, b: &Vector3<f64>| angle_between(a, b).to_degrees();
                 assert!(deg(&uc, &truth) < 1.0, "CBF {az} {inc}: {}", deg(&uc, &truth));
                 assert!(deg(&us, &truth) < 1.0, "SPD {az} {inc}: {}", deg(&us, &truth));

@@ -43,7 +43,7 @@ impl MatchedFilter {
     }
 
     fn build(template: &[f64], band_hz: (f64, f64), fs: f64, capture_len: usize, phat: bool) -> Self {
-        let n = (capture_len + template.len()).next_power_of_two();
+        let n = fast_len(capture_len + template.len());
         let mut planner = RealFftPlanner::<f64>::new();
         let r2c = planner.plan_fft_forward(n);
         let ifft = FftPlanner::<f64>::new().plan_fft_inverse(n);
@@ -63,15 +63,32 @@ impl MatchedFilter {
         self.capture_len
     }
 
-    /// The analytic envelope |y[n]| of the PHAT-whitened correlation of `x` with the
-    /// template (eq. 2-3 with acoustics.md's whitening of X S*), for lags 0..capture_len:
-    /// lag n is the template starting at sample n.
-    pub fn envelope(&self, x: &[f64]) -> Vec<f64> {
+    /// FFT length; filters of equal length can share [`MatchedFilter::spectrum`]s.
+    pub fn fft_len(&self) -> usize {
+        self.n
+    }
+
+    /// The zero-padded spectrum of one capture, to be shared by every filter of the
+    /// same FFT length.
+    pub fn spectrum(&self, x: &[f64]) -> Vec<Complex> {
         let mut padded = vec![0.0; self.n];
         let m = x.len().min(self.capture_len);
         padded[..m].copy_from_slice(&x[..m]);
         let mut spectrum = self.r2c.make_output_vec();
         self.r2c.process(&mut padded, &mut spectrum).expect("sizes match the plan");
+        spectrum
+    }
+
+    /// The analytic envelope |y[n]| of the PHAT-whitened correlation of `x` with the
+    /// template (eq. 2-3 with acoustics.md's whitening of X S*), for lags 0..capture_len:
+    /// lag n is the template starting at sample n.
+    pub fn envelope(&self, x: &[f64]) -> Vec<f64> {
+        self.envelope_of(&self.spectrum(x))
+    }
+
+    /// [`MatchedFilter::envelope`] from a capture's spectrum.
+    pub fn envelope_of(&self, spectrum: &[Complex]) -> Vec<f64> {
+        assert_eq!(spectrum.len(), self.n / 2 + 1, "spectrum of another FFT length");
         // one-sided (analytic) spectrum of the whitened cross-spectrum, in band only
         let mut y = vec![Complex::new(0.0, 0.0); self.n];
         for (k, s) in (self.lo..self.hi).zip(&self.template_conj) {
@@ -80,14 +97,34 @@ impl MatchedFilter {
                 y[k] = p * 2.0;
                 continue;
             }
-            let mag = p.norm();
+            let mag = p.norm_sqr().sqrt();
             if mag > 0.0 {
                 y[k] = p * (2.0 / mag); // eq. 2: keep the phase only
             }
         }
         self.ifft.process(&mut y);
-        y.iter().take(self.capture_len).map(|c| c.norm() / self.n as f64).collect()
+        y.iter().take(self.capture_len).map(|c| c.norm_sqr().sqrt() / self.n as f64).collect()
     }
+}
+
+/// The smallest length of the form 2^a 3^b 5^c that is at least `n`: fast for
+/// rustfft, and up to twice shorter than the next power of two.
+pub fn fast_len(n: usize) -> usize {
+    let mut best = n.next_power_of_two();
+    let mut p5 = 1;
+    while p5 < best {
+        let mut p35 = p5;
+        while p35 < best {
+            let mut m = p35;
+            while m < n {
+                m *= 2;
+            }
+            best = best.min(m);
+            p35 *= 3;
+        }
+        p5 *= 5;
+    }
+    best
 }
 
 /// Range from the envelopes of all elements.
@@ -192,6 +229,24 @@ mod tests {
         let mut c = vec![0.0; 100];
         c[30] = 1.0;
         assert!(estimate_range(&[a, c], 15, 1.0, 1.0).consistent);
+    }
+
+    #[test]
+    fn fast_lengths() {
+        assert_eq!(fast_len(8750), 9000); // 2^3 3^2 5^3
+        assert_eq!(fast_len(1024), 1024);
+        assert_eq!(fast_len(1025), 1080); // 2^3 3^3 5
+        for n in 1..2000 {
+            let m = fast_len(n);
+            assert!(m >= n);
+            let mut r = m;
+            for p in [2, 3, 5] {
+                while r % p == 0 {
+                    r /= p;
+                }
+            }
+            assert_eq!(r, 1, "{m}");
+        }
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! bank of templates; the one with the largest response is this ping's mode; a mode is
 //! confirmed after the same identification `confirmations` times in a row (3).
 
+use super::Complex;
 use super::matched_filter::MatchedFilter;
 
 /// A bank of matched filters, one per mode.
@@ -11,20 +12,32 @@ pub struct ModeBank {
 }
 
 impl ModeBank {
+    /// A bank of filters of one FFT length (equal template and capture lengths), so that
+    /// every capture is transformed once.
     pub fn new(filters: Vec<MatchedFilter>) -> Self {
+        assert!(filters.windows(2).all(|w| w[0].fft_len() == w[1].fft_len()), "filters of one FFT length");
         Self { filters }
+    }
+
+    /// The spectra of the captures, shared by every filter of the bank (and by a
+    /// [`crate::dsp::receiver::Receiver`] of the same lengths).
+    pub fn spectra(&self, captures: &[Vec<f64>]) -> Vec<Vec<Complex>> {
+        match self.filters.first() {
+            Some(f) => captures.iter().map(|x| f.spectrum(x)).collect(),
+            None => Vec::new(),
+        }
     }
 
     /// Each mode's response: the peak over lags of the sum over elements of the squared
     /// envelopes (build the bank with [`MatchedFilter::classical`] filters for a
     /// statistic comparable across templates).
-    pub fn responses(&self, captures: &[Vec<f64>]) -> Vec<f64> {
+    pub fn responses(&self, spectra: &[Vec<Complex>]) -> Vec<f64> {
         self.filters
             .iter()
             .map(|f| {
                 let mut sum = vec![0.0; f.capture_len()];
-                for x in captures {
-                    for (s, e) in sum.iter_mut().zip(f.envelope(x)) {
+                for x in spectra {
+                    for (s, e) in sum.iter_mut().zip(f.envelope_of(x)) {
                         *s += e * e;
                     }
                 }
@@ -33,9 +46,10 @@ impl ModeBank {
             .collect()
     }
 
-    /// The mode (index into the bank) with the largest response.
-    pub fn identify(&self, captures: &[Vec<f64>]) -> usize {
-        super::matched_filter::argmax(&self.responses(captures))
+    /// The mode (index into the bank) with the largest response, from the spectra of
+    /// the captures ([`ModeBank::spectra`]).
+    pub fn identify(&self, spectra: &[Vec<Complex>]) -> usize {
+        super::matched_filter::argmax(&self.responses(spectra))
     }
 }
 

@@ -2,7 +2,7 @@
 //! from the combined envelopes, then SPD-BF on the direct-path segment for the
 //! direction (rypkema section 3.2).
 
-use super::beamform::{Snapshot, SpdBf, azimuth_inclination, search};
+use super::beamform::{DirectionGrid, Snapshot, SpdBf, azimuth_inclination};
 use super::matched_filter::{MatchedFilter, RangeEstimate, estimate_range};
 use super::waveform::Lfm;
 use nalgebra::Vector3;
@@ -51,6 +51,7 @@ pub struct Receiver {
     waveform: Lfm,
     filter: MatchedFilter,
     spd: SpdBf,
+    grid: DirectionGrid,
 }
 
 impl Receiver {
@@ -58,13 +59,21 @@ impl Receiver {
         let filter =
             MatchedFilter::new(&waveform.samples(config.fs_hz), waveform.band(), config.fs_hz, config.capture_len);
         let spd = SpdBf::new(elements, config.sound_speed_m_s, config.conical_resolution_rad);
-        Self { config, waveform, filter, spd }
+        let grid = DirectionGrid::new(config.search_step_rad);
+        Self { config, waveform, filter, spd, grid }
     }
 
     /// Range and direction from one capture per element.
     pub fn process(&mut self, captures: &[Vec<f64>]) -> PingEstimate {
+        let spectra: Vec<_> = captures.iter().map(|x| self.filter.spectrum(x)).collect();
+        self.process_spectra(captures, &spectra)
+    }
+
+    /// [`Receiver::process`] with the captures' spectra already computed (by a
+    /// [`crate::dsp::modes::ModeBank`] of the same lengths, say).
+    pub fn process_spectra(&mut self, captures: &[Vec<f64>], spectra: &[Vec<super::Complex>]) -> PingEstimate {
         let c = &self.config;
-        let envelopes: Vec<Vec<f64>> = captures.iter().map(|x| self.filter.envelope(x)).collect();
+        let envelopes: Vec<Vec<f64>> = spectra.iter().map(|x| self.filter.envelope_of(x)).collect();
         let range = estimate_range(&envelopes, c.gate_samples, c.fs_hz, c.sound_speed_m_s);
         // the direct-path segment: the pulse from a little before the detected onset
         let pulse = (self.waveform.duration_s * c.fs_hz).ceil() as usize;
@@ -72,7 +81,8 @@ impl Receiver {
         let start = (range.lag.round() as usize).saturating_sub(pulse / 8);
         let snap = Snapshot::from_segment(captures, start, len, self.waveform.band(), c.fs_hz);
         self.spd.compute(&snap);
-        let (direction, _) = search(|u| self.spd.power(u), c.search_step_rad);
+        let spd = &self.spd;
+        let (direction, _) = self.grid.search(|u| spd.power(u));
         let (azimuth, inclination) = azimuth_inclination(&direction);
         PingEstimate { range, direction, azimuth, inclination }
     }
