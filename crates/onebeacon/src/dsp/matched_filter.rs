@@ -241,7 +241,7 @@ mod tests {
             assert!(m >= n);
             let mut r = m;
             for p in [2, 3, 5] {
-                while r % p == 0 {
+                while r.is_multiple_of(p) {
                     r /= p;
                 }
             }
