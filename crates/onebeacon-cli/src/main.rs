@@ -1,6 +1,7 @@
 //! `onebeacon`: single-beacon underwater navigation, from scenario to table and plot.
 
 mod commands;
+mod dsp;
 mod output;
 mod plot;
 mod report;
@@ -64,10 +65,44 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Acoustic signal chain: simulate one ping as a WAV, or process a WAV.
+    Dsp {
+        #[command(subcommand)]
+        command: DspCommand,
+    },
     /// Beacon-vehicle guidance tools.
     Guidance {
         #[command(subcommand)]
         command: GuidanceCommand,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+enum DspCommand {
+    /// Simulate one ping on every element of the array: a multichannel float WAV and a
+    /// JSON sidecar with the truth (range_m, azimuth_deg, inclination_deg, mode, ...).
+    Simulate {
+        /// Ping configuration (TOML; every key optional; see README).
+        #[arg(long, value_name = "FILE")]
+        config: Option<String>,
+        /// The WAV to write; the sidecar gets the same name with .json.
+        #[arg(long, value_name = "FILE.wav")]
+        out: PathBuf,
+    },
+    /// Run the receiver on a multichannel WAV (simulated or recorded): mode, range,
+    /// azimuth and inclination.
+    Process {
+        /// The WAV: one channel per array element, starting at the transmit epoch.
+        wav: PathBuf,
+        /// Ping configuration: array, sample rate, sound speed (defaults as simulate).
+        #[arg(long, value_name = "FILE")]
+        config: Option<String>,
+        /// Also write range.csv, range.png, beam.png and estimate.json here.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Print one JSON object with the estimates.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -137,6 +172,10 @@ fn main() -> ExitCode {
         Command::Run { scenario, seed, run, ping, out } => commands::run(&scenario, seed, run, ping, out),
         Command::Mc { scenario, runs, seed, threads, out, json } => {
             commands::mc(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), out, json)
+        }
+        Command::Dsp { command: DspCommand::Simulate { config, out } } => dsp::simulate(config.as_deref(), &out),
+        Command::Dsp { command: DspCommand::Process { wav, config, out, json } } => {
+            dsp::process(&wav, config.as_deref(), out, json)
         }
         Command::Guidance { command: GuidanceCommand::Standoff { speed_m_s, depths_m, period_s, json } } => {
             commands::standoff(speed_m_s, &depths_m, period_s, json)

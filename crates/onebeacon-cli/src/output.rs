@@ -33,6 +33,16 @@ impl Staging {
         Ok(Self { target: target.to_path_buf(), staging, committed: false })
     }
 
+    /// A staging directory for files that will be moved into the existing directory
+    /// `dir` (beside other files) with [`Staging::move_files_to`].
+    pub fn beside(dir: &Path, name: &str) -> Result<Self> {
+        std::fs::create_dir_all(dir).map_err(|e| BadInput(format!("cannot create {}: {e}", dir.display())))?;
+        let staging = dir.join(format!(".{name}.partial-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&staging);
+        std::fs::create_dir(&staging).map_err(|e| BadInput(format!("cannot write in {}: {e}", dir.display())))?;
+        Ok(Self { target: dir.to_path_buf(), staging, committed: false })
+    }
+
     /// Where to write file `name` for now.
     pub fn file(&self, name: &str) -> PathBuf {
         self.staging.join(name)
@@ -43,23 +53,36 @@ impl Staging {
         std::fs::write(self.file(name), contents).with_context(|| format!("cannot write {name}"))
     }
 
-    /// Moves every staged file into the target directory; returns their final paths.
-    pub fn commit(mut self) -> Result<Vec<PathBuf>> {
+    fn staged_names(&self) -> Result<Vec<std::ffi::OsString>> {
         let mut names: Vec<_> =
             std::fs::read_dir(&self.staging)?.map(|e| e.map(|e| e.file_name())).collect::<std::io::Result<_>>()?;
         names.sort();
-        if !self.target.exists() {
-            std::fs::rename(&self.staging, &self.target)
-                .with_context(|| format!("cannot create {}", self.target.display()))?;
-        } else {
-            for n in &names {
-                std::fs::rename(self.staging.join(n), self.target.join(n))
-                    .with_context(|| format!("cannot write into {}", self.target.display()))?;
-            }
-            std::fs::remove_dir(&self.staging)?;
+        Ok(names)
+    }
+
+    /// Moves every staged file into the target directory; returns their final paths.
+    pub fn commit(mut self) -> Result<Vec<PathBuf>> {
+        if self.target.exists() {
+            let target = self.target.clone();
+            return self.move_files_to(&target);
         }
+        let names = self.staged_names()?;
+        std::fs::rename(&self.staging, &self.target)
+            .with_context(|| format!("cannot create {}", self.target.display()))?;
         self.committed = true;
         Ok(names.iter().map(|n| self.target.join(n)).collect())
+    }
+
+    /// Moves every staged file into the existing directory `dir`.
+    pub fn move_files_to(mut self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let names = self.staged_names()?;
+        for n in &names {
+            std::fs::rename(self.staging.join(n), dir.join(n))
+                .with_context(|| format!("cannot write into {}", dir.display()))?;
+        }
+        std::fs::remove_dir(&self.staging)?;
+        self.committed = true;
+        Ok(names.iter().map(|n| dir.join(n)).collect())
     }
 }
 

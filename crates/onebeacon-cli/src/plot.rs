@@ -305,3 +305,66 @@ pub fn guidance_map(path: &Path, g: &GuidanceSnapshot) -> Result<()> {
     root.present()?;
     Ok(())
 }
+
+/// The range pseudo-distribution of one ping (rypkema eq. 5, Fig. 3 top), with the
+/// estimate marked.
+pub fn range_distribution(path: &Path, distribution: &[f64], metres_per_sample: f64, estimate_m: f64) -> Result<()> {
+    register_fonts();
+    let r1 = distribution.len() as f64 * metres_per_sample;
+    let (_, ymax) = span(distribution.iter().copied(), 0.05);
+    let root = BitMapBackend::new(path, (1000, 500)).into_drawing_area();
+    let caption = format!("range pseudo-distribution, estimate {estimate_m:.2} m");
+    let mut chart = chart(&root, &caption, 0.0..r1, 0.0..ymax.max(1e-9), ("range (m)", "pseudo-probability"))?;
+    let points = distribution.iter().enumerate().map(|(i, v)| (i as f64 * metres_per_sample, *v));
+    line(&mut chart, points, BLUE.stroke_width(1), None)?;
+    line(&mut chart, [(estimate_m, 0.0), (estimate_m, ymax)], RED.stroke_width(1), Some("estimate"))?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    root.present()?;
+    Ok(())
+}
+
+/// The beamformer's power over azimuth x inclination (rypkema Fig. 3 bottom), with the
+/// estimate marked.
+pub fn beam_map(
+    path: &Path,
+    power: impl Fn(&nalgebra::Vector3<f64>) -> f64,
+    azimuth: f64,
+    inclination: f64,
+) -> Result<()> {
+    register_fonts();
+    let (na, ni) = (360usize, 180usize);
+    let mut values = vec![0.0; na * ni];
+    for a in 0..na {
+        for i in 0..ni {
+            let u =
+                onebeacon::dsp::beamform::direction(((a as f64) + 0.5).to_radians(), ((i as f64) + 0.5).to_radians());
+            values[a * ni + i] = power(&u);
+        }
+    }
+    let (lo, hi) = values.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    let root = BitMapBackend::new(path, (1000, 560)).into_drawing_area();
+    let caption = format!(
+        "beam map (SPD-BF): azimuth {:.1} deg, inclination {:.1} deg",
+        azimuth.to_degrees(),
+        inclination.to_degrees()
+    );
+    let mut chart = chart(&root, &caption, 0.0..360.0, 0.0..180.0, ("azimuth (deg)", "inclination (deg from down)"))?;
+    chart.draw_series((0..na).flat_map(|a| {
+        let values = &values;
+        (0..ni).map(move |i| {
+            let v = (values[a * ni + i] - lo) / (hi - lo).max(f64::MIN_POSITIVE);
+            Rectangle::new([(a as f64, i as f64), (a as f64 + 1.0, i as f64 + 1.0)], viridis(v).filled())
+        })
+    }))?;
+    chart
+        .draw_series(std::iter::once(Cross::new(
+            (azimuth.to_degrees(), inclination.to_degrees()),
+            8,
+            WHITE.stroke_width(3),
+        )))?
+        .label("estimate")
+        .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    root.present()?;
+    Ok(())
+}

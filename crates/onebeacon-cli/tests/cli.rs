@@ -265,3 +265,86 @@ fn moving_beacon_run_and_mc() {
     assert!(text(&o.stderr).contains("--ping 500"));
     assert!(!dir.join("none").exists());
 }
+
+fn write_wav(path: &Path, channels: u16, rate: u32, samples: &[f32]) {
+    let spec =
+        hound::WavSpec { channels, sample_rate: rate, bits_per_sample: 32, sample_format: hound::SampleFormat::Float };
+    let mut w = hound::WavWriter::create(path, spec).unwrap();
+    for s in samples {
+        w.write_sample(*s).unwrap();
+    }
+    w.finalize().unwrap();
+}
+
+#[test]
+fn dsp_simulate_then_process_recovers_the_truth() {
+    let dir = scratch("dsp");
+    let wav = dir.join("ping.wav");
+    let out = run(&["dsp", "simulate", "--out", wav.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("ping.json")).unwrap()).unwrap();
+    let res_dir = dir.join("res");
+    let out = run(&["dsp", "process", wav.to_str().unwrap(), "--json", "--out", res_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let est: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+    for key in ["range_m", "azimuth_deg", "inclination_deg", "mode"] {
+        assert!(!est[key].is_null() && !truth[key].is_null(), "{key}");
+    }
+    assert_eq!(est["mode"], truth["mode"]);
+    let d = |k: &str| (est[k].as_f64().unwrap() - truth[k].as_f64().unwrap()).abs();
+    assert!(d("range_m") < 0.2, "{est} vs {truth}");
+    assert!(d("azimuth_deg") < 5.0 && d("inclination_deg") < 5.0, "{est} vs {truth}");
+    for f in ["range.csv", "range.png", "beam.png", "estimate.json"] {
+        assert!(res_dir.join(f).exists(), "{f}");
+    }
+}
+
+#[test]
+fn bad_wav_input_exits_2_with_one_line() {
+    let dir = scratch("badwav");
+    let good = dir.join("good.wav");
+    assert!(run(&["dsp", "simulate", "--out", good.to_str().unwrap()]).status.success());
+    let bytes = std::fs::read(&good).unwrap();
+    let truncated = dir.join("truncated.wav");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2 + 3]).unwrap();
+    let empty = dir.join("empty.wav");
+    write_wav(&empty, 5, 37_500, &[]);
+    let nan = dir.join("nan.wav");
+    let mut s = vec![0.01f32; 5 * 2000];
+    s[777] = f32::NAN;
+    write_wav(&nan, 5, 37_500, &s);
+    let clipped = dir.join("clipped.wav");
+    let mut s = vec![0.01f32; 5 * 2000];
+    s[10] = 1.0;
+    s[11] = -1.0;
+    write_wav(&clipped, 5, 37_500, &s);
+    let rate = dir.join("rate.wav");
+    write_wav(&rate, 5, 48_000, &vec![0.01f32; 5 * 2000]);
+    let four = dir.join("four.wav");
+    write_wav(&four, 4, 37_500, &vec![0.01f32; 4 * 2000]);
+    let notwav = dir.join("notwav.wav");
+    std::fs::write(&notwav, "hello").unwrap();
+    let out_dir = dir.join("nothing");
+    let cases: Vec<(&Path, &[&str])> = vec![
+        (&truncated, &["truncated.wav", "truncated"]),
+        (&empty, &["empty.wav", "no samples"]),
+        (&nan, &["nan.wav", "not a number"]),
+        (&clipped, &["clipped.wav", "2 samples at full scale"]),
+        (&rate, &["rate.wav", "48000", "37500"]),
+        (&four, &["four.wav", "4 channels", "5 elements"]),
+        (&notwav, &["notwav.wav", "not a readable WAV"]),
+    ];
+    for (wav, needles) in cases {
+        let o = run(&["dsp", "process", wav.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{wav:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        for n in needles {
+            assert!(err.contains(n), "`{n}` not in {err}");
+        }
+        assert!(!out_dir.exists());
+    }
+    let o = run(&["dsp", "simulate", "--out", dir.join("ping.mp3").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+}

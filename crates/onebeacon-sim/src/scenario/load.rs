@@ -38,8 +38,8 @@ pub fn load(name_or_path: &str) -> Result<Scenario, ScenarioError> {
     parse(&text, name_or_path)
 }
 
-/// Parses and validates scenario TOML; `source_name` names it in errors.
-pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
+/// Deserializes TOML into `T` with errors naming the source, line and key.
+pub(crate) fn deserialize<T: serde::de::DeserializeOwned>(text: &str, source_name: &str) -> Result<T, ScenarioError> {
     let line_of = |span: Option<std::ops::Range<usize>>| {
         span.map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1).unwrap_or(0)
     };
@@ -59,21 +59,26 @@ pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
             ScenarioError::Key { source_name: source_name.to_string(), line, key, message }
         }
     };
+    let de = toml::Deserializer::parse(text).map_err(syntax)?;
+    serde_path_to_error::deserialize(de).map_err(keyed)
+}
+
+/// Turns a validation failure into the error naming the source.
+pub(crate) fn invalid(source_name: &str, v: validate::Violation) -> ScenarioError {
+    ScenarioError::Invalid { source_name: source_name.to_string(), key: v.key, value: v.value, allowed: v.allowed }
+}
+
+/// Parses and validates scenario TOML; `source_name` names it in errors.
+pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
     // the world's kind decides the schema; a bad `kind` is reported by the default one
     let kind =
         toml::from_str::<toml::Table>(text).ok().and_then(|t| t.get("kind").and_then(|k| k.as_str().map(String::from)));
-    let de = toml::Deserializer::parse(text).map_err(syntax)?;
     let scenario = if kind.as_deref() == Some("moving_beacon") {
-        Scenario::MovingBeacon(serde_path_to_error::deserialize::<_, MovingBeacon>(de).map_err(keyed)?)
+        Scenario::MovingBeacon(deserialize::<MovingBeacon>(text, source_name)?)
     } else {
-        Scenario::FixedBeacon(serde_path_to_error::deserialize::<_, FixedBeacon>(de).map_err(keyed)?)
+        Scenario::FixedBeacon(deserialize::<FixedBeacon>(text, source_name)?)
     };
-    validate::validate(&scenario).map_err(|v| ScenarioError::Invalid {
-        source_name: source_name.to_string(),
-        key: v.key,
-        value: v.value,
-        allowed: v.allowed,
-    })?;
+    validate::validate(&scenario).map_err(|v| invalid(source_name, v))?;
     Ok(scenario)
 }
 

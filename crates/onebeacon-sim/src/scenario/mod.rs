@@ -10,7 +10,8 @@ mod builtin;
 pub mod fixed_beacon;
 mod load;
 pub mod moving_beacon;
-mod validate;
+pub mod ping;
+pub(crate) mod validate;
 
 pub use builtin::{BUILTINS, Builtin, builtin};
 pub use fixed_beacon::{FixedBeacon, FixedBeaconCell};

@@ -2,7 +2,7 @@
 
 use super::{FixedBeacon, MovingBeacon, Scenario};
 
-pub(super) struct Violation {
+pub(crate) struct Violation {
     pub key: String,
     pub value: String,
     pub allowed: String,
@@ -10,14 +10,14 @@ pub(super) struct Violation {
 
 /// Rules for one number.
 #[derive(Clone, Copy)]
-enum Rule {
+pub(crate) enum Rule {
     Positive,
     NonNegative,
     Probability,
     Finite,
 }
 
-fn check(key: &str, value: f64, rule: Rule) -> Result<(), Violation> {
+pub(crate) fn check(key: &str, value: f64, rule: Rule) -> Result<(), Violation> {
     let (ok, allowed) = match rule {
         Rule::Positive => (value > 0.0, "must be a finite number > 0"),
         Rule::NonNegative => (value >= 0.0, "must be a finite number >= 0"),
@@ -33,13 +33,14 @@ fn check(key: &str, value: f64, rule: Rule) -> Result<(), Violation> {
 
 /// Checks fields of one section; the key is built from the section and the field
 /// name, so it cannot drift from the schema.
-macro_rules! check_fields {
+macro_rules! check_fields_impl {
     ($section:literal, $obj:expr, { $($field:ident: $rule:ident),* $(,)? }) => {
-        $( check(concat!($section, ".", stringify!($field)), $obj.$field, $rule)?; )*
+        $( $crate::scenario::validate::check(concat!($section, ".", stringify!($field)), $obj.$field, $crate::scenario::validate::Rule::$rule)?; )*
     };
 }
+pub(crate) use check_fields_impl as check_fields;
 
-fn check_count(key: &str, value: usize, min: usize, max: usize) -> Result<(), Violation> {
+pub(crate) fn check_count(key: &str, value: usize, min: usize, max: usize) -> Result<(), Violation> {
     if (min..=max).contains(&value) {
         Ok(())
     } else {

@@ -86,4 +86,9 @@ impl Receiver {
         let (azimuth, inclination) = azimuth_inclination(&direction);
         PingEstimate { range, direction, azimuth, inclination }
     }
+
+    /// The SPD-BF power toward `u` for the last processed ping (the beam map).
+    pub fn beam_power(&self, u: &Vector3<f64>) -> f64 {
+        self.spd.power(u)
+    }
 }

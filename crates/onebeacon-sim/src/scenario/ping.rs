@@ -1,0 +1,297 @@
+//! Configuration of one simulated or recorded ping (`onebeacon dsp simulate|process
+//! --config FILE`): waveform, capture, array, geometry, water, noise and clock. Every
+//! key is optional; the defaults are rypkema's receiver (5-element pyramid with 8 cm
+//! edges, 8000 samples at 37.5 kS/s, mode-1 chirp) 120 m from the beacon.
+
+use super::load::{ScenarioError, deserialize, invalid};
+use super::validate::{Rule, Violation, check, check_count, check_fields};
+use crate::acoustics::channel::{Boundaries, Channel};
+use nalgebra::{Matrix3, Rotation3, Vector3};
+use onebeacon::dsp::beamform::{pyramid_8cm, tetrahedron};
+use onebeacon::dsp::sound_speed::mackenzie;
+use onebeacon::dsp::waveform::{Lfm, rypkema_modes};
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PingConfig {
+    pub seed: u64,
+    pub waveform: Waveform,
+    pub capture: Capture,
+    pub array: Array,
+    pub geometry: Geometry,
+    pub water: Water,
+    pub noise: Noise,
+    pub clock: Clock,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Waveform {
+    /// rypkema's command mode, 1-4: 7->9, 10->8, 8->6, 9->11 kHz, 20 ms.
+    pub mode: usize,
+}
+impl Default for Waveform {
+    fn default() -> Self {
+        Self { mode: 1 }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Capture {
+    pub fs_hz: f64,
+    /// Samples per element from the PPS.
+    pub samples: usize,
+}
+impl Default for Capture {
+    fn default() -> Self {
+        Self { fs_hz: 37_500.0, samples: 8000 }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ArrayKind {
+    Pyramid,
+    Tetrahedron,
+    Custom,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Array {
+    /// `pyramid` (rypkema, 8 cm edges), `tetrahedron` (of `edge_m`) or `custom`.
+    pub kind: ArrayKind,
+    pub edge_m: f64,
+    /// Element positions (x forward, y starboard, z down), m, for `custom`.
+    pub elements_m: Vec<[f64; 3]>,
+}
+impl Default for Array {
+    fn default() -> Self {
+        Self { kind: ArrayKind::Pyramid, edge_m: 0.08, elements_m: Vec::new() }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Geometry {
+    pub source_north_m: f64,
+    pub source_east_m: f64,
+    pub source_depth_m: f64,
+    pub receiver_north_m: f64,
+    pub receiver_east_m: f64,
+    pub receiver_depth_m: f64,
+    pub receiver_roll_deg: f64,
+    pub receiver_pitch_deg: f64,
+    pub receiver_heading_deg: f64,
+    /// Closing speed, m/s (Doppler).
+    pub radial_speed_m_s: f64,
+}
+impl Default for Geometry {
+    fn default() -> Self {
+        Self {
+            source_north_m: 100.0,
+            source_east_m: 60.0,
+            source_depth_m: 1.0,
+            receiver_north_m: 0.0,
+            receiver_east_m: 0.0,
+            receiver_depth_m: 30.0,
+            receiver_roll_deg: 0.0,
+            receiver_pitch_deg: 0.0,
+            receiver_heading_deg: 0.0,
+            radial_speed_m_s: 0.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Water {
+    /// Sound speed, m/s; absent: Mackenzie (1981) from temperature and salinity at the
+    /// mean depth of source and receiver.
+    pub sound_speed_m_s: Option<f64>,
+    pub temperature_c: f64,
+    pub salinity_ppt: f64,
+    /// Water depth for surface and bottom reflections; absent: free field.
+    pub depth_m: Option<f64>,
+    pub surface_coef: f64,
+    pub bottom_coef: f64,
+    /// A vertical wall at this east coordinate (the river's stone wall), if any.
+    pub wall_east_m: Option<f64>,
+    pub wall_coef: f64,
+}
+impl Default for Water {
+    fn default() -> Self {
+        Self {
+            sound_speed_m_s: None,
+            temperature_c: 10.0,
+            salinity_ppt: 35.0,
+            depth_m: None,
+            surface_coef: -1.0,
+            bottom_coef: 0.5,
+            wall_east_m: None,
+            wall_coef: 0.8,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Noise {
+    /// Direct-path 2E/N0 per element, dB.
+    pub snr_db: f64,
+    /// Set false for a noise-free ping.
+    pub enabled: bool,
+}
+impl Default for Noise {
+    fn default() -> Self {
+        Self { snr_db: 20.0, enabled: true }
+    }
+}
+
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Clock {
+    pub offset_s: f64,
+    pub drift_ppm: f64,
+}
+
+impl PingConfig {
+    /// Reads `path`, or the defaults.
+    pub fn load(path: Option<&str>) -> Result<Self, ScenarioError> {
+        let Some(path) = path else { return Ok(Self::default()) };
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ScenarioError::Io { source_name: path.to_string(), message: e.to_string() })?;
+        Self::parse(&text, path)
+    }
+
+    pub fn parse(text: &str, source_name: &str) -> Result<Self, ScenarioError> {
+        let c: Self = deserialize(text, source_name)?;
+        c.validate().map_err(|v| invalid(source_name, v))?;
+        Ok(c)
+    }
+
+    fn validate(&self) -> Result<(), Violation> {
+        check_count("waveform.mode", self.waveform.mode, 1, 4)?;
+        check_fields!("capture", self.capture, { fs_hz: Positive });
+        check_count("capture.samples", self.capture.samples, 1, 10_000_000)?;
+        check_fields!("array", self.array, { edge_m: Positive });
+        if self.array.kind == ArrayKind::Custom {
+            check_count("array.elements_m (count)", self.array.elements_m.len(), 2, 64)?;
+            for (i, e) in self.array.elements_m.iter().enumerate() {
+                for (j, v) in e.iter().enumerate() {
+                    check(&format!("array.elements_m[{i}][{j}]"), *v, Rule::Finite)?;
+                }
+            }
+        }
+        check_fields!("geometry", self.geometry, {
+            source_north_m: Finite,
+            source_east_m: Finite,
+            source_depth_m: NonNegative,
+            receiver_north_m: Finite,
+            receiver_east_m: Finite,
+            receiver_depth_m: NonNegative,
+            receiver_roll_deg: Finite,
+            receiver_pitch_deg: Finite,
+            receiver_heading_deg: Finite,
+            radial_speed_m_s: Finite,
+        });
+        if let Some(c) = self.water.sound_speed_m_s {
+            check("water.sound_speed_m_s", c, Rule::Positive)?;
+        }
+        check_fields!("water", self.water, { temperature_c: Finite, salinity_ppt: NonNegative, surface_coef: Finite, bottom_coef: Finite, wall_coef: Finite });
+        if let Some(d) = self.water.depth_m {
+            check("water.depth_m", d, Rule::Positive)?;
+        }
+        if let Some(w) = self.water.wall_east_m {
+            check("water.wall_east_m", w, Rule::Finite)?;
+        }
+        check_fields!("noise", self.noise, { snr_db: Finite });
+        check_fields!("clock", self.clock, { offset_s: Finite, drift_ppm: Finite });
+        Ok(())
+    }
+
+    pub fn waveform(&self) -> Lfm {
+        rypkema_modes()[self.waveform.mode - 1]
+    }
+
+    /// Element positions in the array (body) frame, m.
+    pub fn elements(&self) -> Vec<Vector3<f64>> {
+        match self.array.kind {
+            ArrayKind::Pyramid => pyramid_8cm().iter().map(|e| e * (self.array.edge_m / 0.08)).collect(),
+            ArrayKind::Tetrahedron => tetrahedron(self.array.edge_m),
+            ArrayKind::Custom => self.array.elements_m.iter().map(|e| Vector3::new(e[0], e[1], e[2])).collect(),
+        }
+    }
+
+    pub fn source(&self) -> Vector3<f64> {
+        let g = &self.geometry;
+        Vector3::new(g.source_north_m, g.source_east_m, g.source_depth_m)
+    }
+
+    pub fn receiver(&self) -> Vector3<f64> {
+        let g = &self.geometry;
+        Vector3::new(g.receiver_north_m, g.receiver_east_m, g.receiver_depth_m)
+    }
+
+    /// Body-to-NED rotation of the receiving array.
+    pub fn attitude(&self) -> Matrix3<f64> {
+        let g = &self.geometry;
+        Rotation3::from_euler_angles(
+            g.receiver_roll_deg.to_radians(),
+            g.receiver_pitch_deg.to_radians(),
+            g.receiver_heading_deg.to_radians(),
+        )
+        .into_inner()
+    }
+
+    pub fn sound_speed_m_s(&self) -> f64 {
+        let w = &self.water;
+        w.sound_speed_m_s.unwrap_or_else(|| {
+            mackenzie(
+                w.temperature_c,
+                w.salinity_ppt,
+                (self.geometry.source_depth_m + self.geometry.receiver_depth_m) / 2.0,
+            )
+        })
+    }
+
+    pub fn channel(&self) -> Channel {
+        let w = &self.water;
+        Channel {
+            fs_hz: self.capture.fs_hz,
+            capture_len: self.capture.samples,
+            sound_speed_m_s: self.sound_speed_m_s(),
+            snr_db: self.noise.enabled.then_some(self.noise.snr_db),
+            boundaries: w.depth_m.map(|d| Boundaries {
+                water_depth_m: d,
+                surface_coef: w.surface_coef,
+                bottom_coef: w.bottom_coef,
+                wall_east_m: w.wall_east_m,
+                wall_coef: w.wall_coef,
+            }),
+            clock_offset_s: self.clock.offset_s,
+            clock_drift_ppm: self.clock.drift_ppm,
+            radial_speed_m_s: self.geometry.radial_speed_m_s,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_and_errors() {
+        let c = PingConfig::parse("", "ping.toml").unwrap();
+        assert_eq!(c.elements().len(), 5);
+        assert!((c.sound_speed_m_s() - 1490.0).abs() < 5.0);
+        let e = PingConfig::parse("[waveform]\nmode = 5\n", "ping.toml").unwrap_err().to_string();
+        assert!(e.contains("waveform.mode") && e.contains("1 to 4"), "{e}");
+        let e = PingConfig::parse("[array]\nkind = \"ring\"\n", "ping.toml").unwrap_err().to_string();
+        assert!(e.contains("array.kind") && e.contains("pyramid"), "{e}");
+        let e = PingConfig::parse("[water]\ndepth_m = -5\n", "ping.toml").unwrap_err().to_string();
+        assert!(e.contains("water.depth_m"), "{e}");
+    }
+}
