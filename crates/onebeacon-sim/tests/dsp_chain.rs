@@ -129,3 +129,61 @@ fn measure_mode_identification() {
         eprintln!("mode identification at {snr} dB over 1000 pings: {:.2} %", 100.0 * mode_accuracy(1000, snr, 6));
     }
 }
+
+/// garin2024's pure tone (f_pt = 20 kHz, fs = 96.153 kHz, Table 5) over a 300 ms frame
+/// at 2E/N0 = 20 dB, |v_r| <= 3 m/s: Doppler speed RMSE of the periodogram (ML)
+/// estimator on the baseband decimated to 400 Hz and of eq. 9 (single lag) on the
+/// oversampled baseband (4 kHz), with the bound. Returns (ML, eq. 9, bound), m/s.
+fn tone_doppler(trials: usize, seed: u64) -> (f64, f64, f64) {
+    use onebeacon::dsp::doppler::{
+        baseband, frequency_crlb_hz, periodogram_frequency, pulse_pair_frequency, radial_speed,
+    };
+    let (fs, f_pt, c, t_d) = (96_153.0, 20_000.0, 1500.0, 0.3);
+    let n = (t_d * fs) as usize;
+    let snr = 100.0; // 2E/N0 = 20 dB
+    let eta = snr / n as f64; // per sample, real tone of unit amplitude: power 1/2
+    let sigma = (0.5 / eta).sqrt();
+    let mut g = rng(seed, 0, Stream::Acoustic);
+    let (mut se_kay, mut se_pp) = (0.0, 0.0);
+    for _ in 0..trials {
+        let v = 6.0 * g.random::<f64>() - 3.0;
+        let alpha = 1.0 + v / c;
+        let phi = TAU * g.random::<f64>();
+        let x: Vec<f64> = (0..n)
+            .map(|i| {
+                (TAU * f_pt * alpha * i as f64 / fs + phi).cos()
+                    + sigma * g.sample::<f64, _>(rand_distr::StandardNormal)
+            })
+            .collect();
+        let (d_kay, d_pp) = (240, 24);
+        let kay = radial_speed(periodogram_frequency(&baseband(&x, f_pt, fs, d_kay), fs / d_kay as f64, 60.0), f_pt, c);
+        let pp = radial_speed(pulse_pair_frequency(&baseband(&x, f_pt, fs, d_pp), fs / d_pp as f64), f_pt, c);
+        se_kay += (kay - v).powi(2);
+        se_pp += (pp - v).powi(2);
+    }
+    // the bound on the decimated complex baseband: eta_d N_d = (2E/N0) / 2
+    let d = 240usize;
+    let n_d = n / d;
+    let eta_d = snr / 2.0 / n_d as f64;
+    let bound = radial_speed(frequency_crlb_hz(eta_d, n_d, d as f64 / fs), f_pt, c);
+    ((se_kay / trials as f64).sqrt(), (se_pp / trials as f64).sqrt(), bound)
+}
+
+#[test]
+fn tone_doppler_speed_at_20_db() {
+    let (kay, pp, bound) = tone_doppler(60, 8);
+    eprintln!("Doppler speed RMSE at 20 dB: ML {kay:.4} m/s, eq. 9 {pp:.4} m/s, bound {bound:.4} m/s");
+    assert!(kay < 0.05, "{kay}");
+    assert!(kay < 1.5 * bound, "ML {kay} vs bound {bound}");
+}
+
+#[test]
+#[ignore]
+fn measure_tone_doppler() {
+    let (kay, pp, bound) = tone_doppler(2000, 9);
+    eprintln!(
+        "Doppler speed RMSE at 20 dB over 2000 frames: ML {kay:.4} m/s ({:.2} x bound), eq. 9 {pp:.4} m/s ({:.2} x bound), bound {bound:.4} m/s",
+        kay / bound,
+        pp / bound
+    );
+}

@@ -6,11 +6,13 @@
 //!   consistency gate, their combination and the range pseudo-distribution (eq. 2-5);
 //! - [`beamform`]: conventional wideband beamforming (eq. 9-11) and sensor-pair
 //!   decomposition beamforming (SPD-BF), on grids or at any direction;
+//! - [`doppler`]: Doppler speed from a pure tone (garin eq. 9, Kay's estimator);
 //! - [`modes`]: command-mode identification against a template bank;
 //! - [`receiver`]: one ping through the chain, to range and direction;
 //! - [`sound_speed`]: Mackenzie (1981).
 
 pub mod beamform;
+pub mod doppler;
 pub mod matched_filter;
 pub mod modes;
 pub mod receiver;
