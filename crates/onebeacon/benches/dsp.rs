@@ -3,7 +3,7 @@
 //! direction search and refinement (target: under 5 ms on one core).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use onebeacon::dsp::beamform::{direction, pyramid_8cm};
+use onebeacon::dsp::beamform::{Cbf, DirectionGrid, Snapshot, SpdBf, direction, pyramid_8cm};
 use onebeacon::dsp::matched_filter::MatchedFilter;
 use onebeacon::dsp::modes::ModeBank;
 use onebeacon::dsp::receiver::{Receiver, ReceiverConfig};
@@ -36,6 +36,33 @@ fn bench(c: &mut Criterion) {
     c.bench_function("ping: PHAT range + SPD-BF 0.25 deg only", |b| {
         b.iter(|| black_box(rx.process(black_box(&captures))))
     });
+
+    // CBF against SPD-BF over the same 1 deg azimuth x inclination grid (65 160 looks)
+    let snap = Snapshot::from_segment(&captures, 3100, 1024, modes[0].band(), fs);
+    let grid = DirectionGrid::new(1f64.to_radians());
+    let cbf = Cbf { elements: el.clone(), sound_speed_m_s: 1500.0 };
+    let mut spd = SpdBf::new(&el, 1500.0, 0.25f64.to_radians());
+    let mut group = c.benchmark_group("1 deg direction grid");
+    group.sample_size(10);
+    group.bench_function("CBF (steering computed on the fly)", |b| {
+        b.iter(|| black_box(grid.search(|u| cbf.power(&snap, u))))
+    });
+    group.bench_function("SPD-BF (pair tables at 0.25 deg + lookups)", |b| {
+        b.iter(|| {
+            spd.compute(black_box(&snap));
+            black_box(grid.search(|u| spd.power(u)))
+        })
+    });
+    group.finish();
+    let (n_cos, pairs) = spd.size();
+    eprintln!(
+        "memory: SPD tables {pairs} x {n_cos} x 8 B = {} kB; a stored CBF steering table: {} looks x {} elements x {} bins x 16 B = {:.0} MB",
+        pairs * n_cos * 8 / 1000,
+        grid.len(),
+        el.len(),
+        snap.freqs_hz.len(),
+        (grid.len() * el.len() * snap.freqs_hz.len() * 16) as f64 / 1e6
+    );
 }
 
 criterion_group!(benches, bench);

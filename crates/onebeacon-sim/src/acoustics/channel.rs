@@ -5,7 +5,7 @@
 //! at a given per-element 2E/N0 (../shared/acoustics.md).
 
 use nalgebra::{Matrix3, Vector3};
-use onebeacon::dsp::waveform::Lfm;
+use onebeacon::dsp::waveform::Waveform;
 use rand::RngExt;
 use rand_distr::StandardNormal;
 
@@ -76,8 +76,8 @@ pub fn images(source: &Vector3<f64>, b: &Option<Boundaries>) -> Vec<(Vector3<f64
 /// The captures of one ping transmitted at t = 0 (the PPS both ends share) by a source
 /// at `source` (NED) and received by an array centred at `receiver` with body-to-NED
 /// rotation `attitude` and element positions `elements` (body frame).
-pub fn simulate_ping<R: rand::Rng>(
-    waveform: &Lfm,
+pub fn simulate_ping<W: Waveform + ?Sized, R: rand::Rng>(
+    waveform: &W,
     source: &Vector3<f64>,
     receiver: &Vector3<f64>,
     attitude: &Matrix3<f64>,
@@ -129,6 +129,7 @@ pub fn simulate_ping<R: rand::Rng>(
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use onebeacon::dsp::waveform::Lfm;
 
     #[test]
     fn image_sources_mirror_the_boundaries() {

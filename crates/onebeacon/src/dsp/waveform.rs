@@ -1,6 +1,19 @@
 //! Transmitted waveforms (../shared/acoustics.md, "Waveforms and reception").
 
-use std::f64::consts::PI;
+use super::Complex;
+use std::f64::consts::{PI, TAU};
+
+/// A transmitted waveform, evaluated in continuous time (zero outside the signal), so
+/// that a channel can sample it at exact fractional delays and Doppler-scaled times.
+pub trait Waveform {
+    fn value(&self, t: f64) -> f64;
+}
+
+impl Waveform for Lfm {
+    fn value(&self, t: f64) -> f64 {
+        Lfm::value(self, t)
+    }
+}
 
 /// Amplitude taper over the pulse.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,6 +89,133 @@ pub fn rypkema_modes() -> [Lfm; 4] {
     [Lfm::new(7e3, 9e3, 0.02), Lfm::new(10e3, 8e3, 0.02), Lfm::new(8e3, 6e3, 0.02), Lfm::new(9e3, 11e3, 0.02)]
 }
 
+/// Square-root raised-cosine pulse of symbol period `t_sym` and roll-off `beta`, peak
+/// 1 - beta + 4 beta / pi at t = 0.
+pub fn srrc(t: f64, t_sym: f64, beta: f64) -> f64 {
+    let x = t / t_sym;
+    if x.abs() < 1e-12 {
+        return 1.0 - beta + 4.0 * beta / PI;
+    }
+    if beta > 0.0 && (x.abs() - 1.0 / (4.0 * beta)).abs() < 1e-9 {
+        let a = PI / (4.0 * beta);
+        return beta / 2f64.sqrt() * ((1.0 + 2.0 / PI) * a.sin() + (1.0 - 2.0 / PI) * a.cos());
+    }
+    ((PI * x * (1.0 - beta)).sin() + 4.0 * beta * x * (PI * x * (1.0 + beta)).cos())
+        / (PI * x * (1.0 - (4.0 * beta * x).powi(2)))
+}
+
+/// garin2024's communication frame (eq. 8): a pure tone at `f_pt_hz` over the frame plus
+/// PSK symbols with SRRC pulses at `f0_hz`: `guard` null symbols, the known `pilots`
+/// (BPSK), the `data` symbols, `guard` null symbols. Defaults of Table 5: f_pt 20 kHz,
+/// f0 28 kHz, 6.4 kBd, bandwidth 8.96 kHz (roll-off 0.4).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PskFrame {
+    pub f_pt_hz: f64,
+    pub f0_hz: f64,
+    pub symbol_rate_hz: f64,
+    pub rolloff: f64,
+    pub guard: usize,
+    pub pilots: Vec<f64>,
+    pub data: Vec<Complex>,
+    /// Pulses are truncated at this many symbols each side.
+    pub span: usize,
+}
+
+/// A maximal-length +-1 sequence of 2^7 - 1 = 127 chips (x^7 + x^6 + 1).
+pub fn m_sequence_127() -> Vec<f64> {
+    let mut state = 0x7fu8;
+    (0..127)
+        .map(|_| {
+            let bit = ((state >> 6) ^ (state >> 5)) & 1;
+            state = ((state << 1) | bit) & 0x7f;
+            if bit == 1 { 1.0 } else { -1.0 }
+        })
+        .collect()
+}
+
+impl PskFrame {
+    /// Table 5's frame with 127 pilots, `data` symbols and 16 guard symbols each end.
+    pub fn garin(data: Vec<Complex>) -> Self {
+        Self {
+            f_pt_hz: 20e3,
+            f0_hz: 28e3,
+            symbol_rate_hz: 6.4e3,
+            rolloff: 0.4,
+            guard: 16,
+            pilots: m_sequence_127(),
+            data,
+            span: 6,
+        }
+    }
+
+    pub fn symbol_period_s(&self) -> f64 {
+        1.0 / self.symbol_rate_hz
+    }
+
+    /// Frame duration, s.
+    pub fn duration_s(&self) -> f64 {
+        (2 * self.guard + self.pilots.len() + self.data.len()) as f64 * self.symbol_period_s()
+    }
+
+    /// Occupied band of the PSK part, Hz.
+    pub fn band(&self) -> (f64, f64) {
+        let half = self.symbol_rate_hz * (1.0 + self.rolloff) / 2.0;
+        (self.f0_hz - half, self.f0_hz + half)
+    }
+
+    /// Time of the first pilot symbol's centre, s (t0 of eq. 12 at zero range).
+    pub fn first_pilot_s(&self) -> f64 {
+        self.guard as f64 * self.symbol_period_s()
+    }
+
+    fn symbols_at(&self, t: f64, pilots_only: bool) -> Complex {
+        let ts = self.symbol_period_s();
+        let k = (t / ts).round() as i64;
+        let mut sum = Complex::new(0.0, 0.0);
+        for j in (k - self.span as i64)..=(k + self.span as i64) {
+            let Ok(j) = usize::try_from(j) else { continue };
+            let Some(idx) = j.checked_sub(self.guard) else { continue };
+            let sym = if idx < self.pilots.len() {
+                Complex::new(self.pilots[idx], 0.0)
+            } else if !pilots_only {
+                match self.data.get(idx - self.pilots.len()) {
+                    Some(d) => *d,
+                    None => continue,
+                }
+            } else {
+                continue;
+            };
+            sum += sym * srrc(t - j as f64 * ts, ts, self.rolloff);
+        }
+        sum
+    }
+
+    /// The pilot section alone (passband, no tone, no data), sampled at `fs` from
+    /// `start_s` for `len` samples: the template of frame synchronisation.
+    pub fn pilot_template(&self, fs: f64) -> (Vec<f64>, f64) {
+        let ts = self.symbol_period_s();
+        let start = self.first_pilot_s() - self.span as f64 * ts;
+        let len = ((self.pilots.len() + 2 * self.span) as f64 * ts * fs).ceil() as usize;
+        let v = (0..len)
+            .map(|n| {
+                let t = start + n as f64 / fs;
+                (self.symbols_at(t, true) * Complex::from_polar(1.0, TAU * self.f0_hz * t)).re
+            })
+            .collect();
+        (v, start)
+    }
+}
+
+impl Waveform for PskFrame {
+    /// eq. 8: Re[exp(j 2 pi f_pt t) + sum x[k] g(t - kT) exp(j 2 pi f0 t)] over the frame.
+    fn value(&self, t: f64) -> f64 {
+        if !(0.0..self.duration_s()).contains(&t) {
+            return 0.0;
+        }
+        (TAU * self.f_pt_hz * t).cos() + (self.symbols_at(t, false) * Complex::from_polar(1.0, TAU * self.f0_hz * t)).re
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,6 +245,36 @@ mod tests {
         assert_eq!(c.value(0.02), 0.0);
         assert_abs_diff_eq!(c.value(0.0), 1.0);
         assert_eq!(rypkema_modes()[1].band(), (8e3, 10e3));
+    }
+
+    #[test]
+    fn srrc_and_frame() {
+        // the raised cosine (SRRC convolved with itself) has zeros at the other symbols:
+        // check numerically that sum g(t) g(t - kT) dt is ~0 for k != 0
+        let (ts, beta) = (1.0, 0.4);
+        let dt = 1e-3;
+        let corr = |k: f64| {
+            (-8000..8000).map(|i| srrc(i as f64 * dt, ts, beta) * srrc(i as f64 * dt - k, ts, beta)).sum::<f64>() * dt
+        };
+        let c0 = corr(0.0);
+        for k in [1.0, 2.0, 3.0] {
+            assert!((corr(k) / c0).abs() < 0.01, "k {k}: {}", corr(k) / c0);
+        }
+        // the limits at 0 and at T / (4 beta) are continuous
+        assert!((srrc(1e-7, ts, beta) - srrc(0.0, ts, beta)).abs() < 1e-5);
+        let edge = 1.0 / (4.0 * beta);
+        assert!((srrc(edge + 1e-7, ts, beta) - srrc(edge, ts, beta)).abs() < 1e-5);
+        // the m-sequence is balanced and its cyclic autocorrelation is two-valued
+        let m = m_sequence_127();
+        assert_eq!(m.iter().sum::<f64>().abs(), 1.0);
+        for lag in 1..127 {
+            let r: f64 = (0..127).map(|i| m[i] * m[(i + lag) % 127]).sum();
+            assert_eq!(r, -1.0);
+        }
+        let f = PskFrame::garin(vec![Complex::new(1.0, 0.0); 1740]);
+        assert!((f.duration_s() - 0.297).abs() < 1e-3);
+        assert!((f.band().1 - f.band().0 - 8960.0).abs() < 1e-6);
+        assert_eq!(f.value(-0.1), 0.0);
     }
 
     #[test]
