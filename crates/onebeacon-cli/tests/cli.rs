@@ -348,3 +348,31 @@ fn bad_wav_input_exits_2_with_one_line() {
     let o = run(&["dsp", "simulate", "--out", dir.join("ping.mp3").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn dsp_garin_frame_gives_range_and_doppler_speed() {
+    let dir = scratch("garin-frame");
+    let cfg = dir.join("frame.toml");
+    std::fs::write(
+        &cfg,
+        "[waveform]\nkind = \"garin_frame\"\n[capture]\nfs_hz = 96153\nsamples = 52000\n[geometry]\nradial_speed_m_s = -2.0\n[noise]\nsnr_db = 40\n",
+    )
+    .unwrap();
+    let wav = dir.join("frame.wav");
+    let out = run(&["dsp", "simulate", "--config", cfg.to_str().unwrap(), "--out", wav.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("frame.json")).unwrap()).unwrap();
+    let out = run(&["dsp", "process", wav.to_str().unwrap(), "--config", cfg.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let est: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+    assert!(est["mode"].is_null());
+    let d = |k: &str| (est[k].as_f64().unwrap() - truth[k].as_f64().unwrap()).abs();
+    assert!(d("range_m") < 0.1, "{est} vs {truth}");
+    assert!(d("radial_speed_m_s") < 0.05, "{est} vs {truth}");
+    // a chirp rate cannot carry the frame
+    std::fs::write(&cfg, "[waveform]\nkind = \"garin_frame\"\n").unwrap();
+    let o = run(&["dsp", "simulate", "--config", cfg.to_str().unwrap(), "--out", wav.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("capture.fs_hz"));
+}

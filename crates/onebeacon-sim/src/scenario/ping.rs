@@ -7,9 +7,11 @@ use super::load::{ScenarioError, deserialize, invalid};
 use super::validate::{Rule, Violation, check, check_count, check_fields};
 use crate::acoustics::channel::{Boundaries, Channel};
 use nalgebra::{Matrix3, Rotation3, Vector3};
+use onebeacon::dsp::Complex;
 use onebeacon::dsp::beamform::{pyramid_8cm, tetrahedron};
 use onebeacon::dsp::sound_speed::mackenzie;
-use onebeacon::dsp::waveform::{Lfm, rypkema_modes};
+use onebeacon::dsp::waveform::{Lfm, PskFrame, rypkema_modes};
+use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -25,15 +27,45 @@ pub struct PingConfig {
     pub clock: Clock,
 }
 
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WaveformKind {
+    /// One of rypkema's command chirps.
+    Chirp,
+    /// garin2024's communication frame: tone at 20 kHz plus PSK at 28 kHz (Table 5).
+    GarinFrame,
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Waveform {
-    /// rypkema's command mode, 1-4: 7->9, 10->8, 8->6, 9->11 kHz, 20 ms.
+    /// `chirp` or `garin_frame`.
+    pub kind: WaveformKind,
+    /// rypkema's command mode, 1-4: 7->9, 10->8, 8->6, 9->11 kHz, 20 ms (chirps).
     pub mode: usize,
+    /// Data symbols of a garin frame (QPSK, drawn from `seed`): 1740 make Table 5's
+    /// 300 ms frame with 127 pilots and 2 x 16 guard symbols.
+    pub data_symbols: usize,
 }
 impl Default for Waveform {
     fn default() -> Self {
-        Self { mode: 1 }
+        Self { kind: WaveformKind::Chirp, mode: 1, data_symbols: 1740 }
+    }
+}
+
+/// The waveform of a ping configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Signal {
+    Chirp(Lfm),
+    Frame(PskFrame),
+}
+
+impl onebeacon::dsp::waveform::Waveform for Signal {
+    fn value(&self, t: f64) -> f64 {
+        match self {
+            Signal::Chirp(c) => c.value(t),
+            Signal::Frame(f) => onebeacon::dsp::waveform::Waveform::value(f, t),
+        }
     }
 }
 
@@ -174,7 +206,15 @@ impl PingConfig {
 
     fn validate(&self) -> Result<(), Violation> {
         check_count("waveform.mode", self.waveform.mode, 1, 4)?;
+        check_count("waveform.data_symbols", self.waveform.data_symbols, 0, 1_000_000)?;
         check_fields!("capture", self.capture, { fs_hz: Positive });
+        if self.waveform.kind == WaveformKind::GarinFrame && self.capture.fs_hz < 65_000.0 {
+            return Err(Violation {
+                key: "capture.fs_hz".into(),
+                value: format!("{:?}", self.capture.fs_hz),
+                allowed: "a garin frame reaches 32.5 kHz: needs a rate over 65 kHz (Table 5: 96153)".into(),
+            });
+        }
         check_count("capture.samples", self.capture.samples, 1, 10_000_000)?;
         check_fields!("array", self.array, { edge_m: Positive });
         if self.array.kind == ArrayKind::Custom {
@@ -212,8 +252,28 @@ impl PingConfig {
         Ok(())
     }
 
-    pub fn waveform(&self) -> Lfm {
+    /// The configured chirp (the command mode's), used by chirp pings.
+    pub fn chirp(&self) -> Lfm {
         rypkema_modes()[self.waveform.mode - 1]
+    }
+
+    /// The garin frame with its data symbols drawn from `seed`.
+    pub fn frame(&self) -> PskFrame {
+        let mut g = crate::seed::rng(self.seed, 0, crate::seed::Stream::Initial);
+        let data = (0..self.waveform.data_symbols)
+            .map(|_| {
+                let (a, b): (bool, bool) = (g.random(), g.random());
+                Complex::new(if a { 1.0 } else { -1.0 }, if b { 1.0 } else { -1.0 }) / 2f64.sqrt()
+            })
+            .collect();
+        PskFrame::garin(data)
+    }
+
+    pub fn signal(&self) -> Signal {
+        match self.waveform.kind {
+            WaveformKind::Chirp => Signal::Chirp(self.chirp()),
+            WaveformKind::GarinFrame => Signal::Frame(self.frame()),
+        }
     }
 
     /// Element positions in the array (body) frame, m.
@@ -291,6 +351,8 @@ mod tests {
         assert!(e.contains("waveform.mode") && e.contains("1 to 4"), "{e}");
         let e = PingConfig::parse("[array]\nkind = \"ring\"\n", "ping.toml").unwrap_err().to_string();
         assert!(e.contains("array.kind") && e.contains("pyramid"), "{e}");
+        let e = PingConfig::parse("[waveform]\nkind = \"garin_frame\"\n", "ping.toml").unwrap_err().to_string();
+        assert!(e.contains("capture.fs_hz") && e.contains("65 kHz"), "{e}");
         let e = PingConfig::parse("[water]\ndepth_m = -5\n", "ping.toml").unwrap_err().to_string();
         assert!(e.contains("water.depth_m"), "{e}");
     }

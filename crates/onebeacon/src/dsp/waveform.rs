@@ -190,15 +190,23 @@ impl PskFrame {
         sum
     }
 
-    /// The pilot section alone (passband, no tone, no data), sampled at `fs` from
-    /// `start_s` for `len` samples: the template of frame synchronisation.
+    /// The pilot section alone (passband, no tone, no data), sampled at `fs`: the
+    /// template of frame synchronisation, and the frame time of its first sample.
     pub fn pilot_template(&self, fs: f64) -> (Vec<f64>, f64) {
+        self.pilot_template_scaled(fs, 1.0)
+    }
+
+    /// The pilot template as received with Doppler time scale `alpha` = 1 + v / c
+    /// (closing speed v): sample n is the pilot section at frame time start + alpha n /
+    /// fs. A receiver at x(t) = s(alpha t - tau) then peaks at lag L with tau =
+    /// alpha L / fs - start (garin eq. 10-12: compensate the Doppler, then synchronise).
+    pub fn pilot_template_scaled(&self, fs: f64, alpha: f64) -> (Vec<f64>, f64) {
         let ts = self.symbol_period_s();
         let start = self.first_pilot_s() - self.span as f64 * ts;
-        let len = ((self.pilots.len() + 2 * self.span) as f64 * ts * fs).ceil() as usize;
+        let len = ((self.pilots.len() + 2 * self.span) as f64 * ts * fs / alpha).ceil() as usize;
         let v = (0..len)
             .map(|n| {
-                let t = start + n as f64 / fs;
+                let t = start + alpha * n as f64 / fs;
                 (self.symbols_at(t, true) * Complex::from_polar(1.0, TAU * self.f0_hz * t)).re
             })
             .collect();
