@@ -159,14 +159,7 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     });
     if let Some(staging) = staging {
         let c_fs = c.sound_speed_m_s() / fs;
-        let mut csv = String::from("range_m,pseudo_probability\n");
-        for (i, v) in est.range.distribution.iter().enumerate() {
-            csv.push_str(&format!("{:.4},{v:.6e}\n", i as f64 * c_fs));
-        }
-        staging.write("range.csv", csv.as_bytes())?;
-        staging.write("estimate.json", (serde_json::to_string_pretty(&result)? + "\n").as_bytes())?;
-        plot::range_distribution(&staging.file("range.png"), &est.range.distribution, c_fs, est.range.range_m)
-            .context("cannot draw range.png")?;
+        write_range_outputs(&staging, &est.range.distribution, c_fs, 0.0, est.range.range_m, &result)?;
         plot::beam_map(&staging.file("beam.png"), |u: &Vector3<f64>| rx.beam_power(u), est.azimuth, est.inclination)
             .context("cannot draw beam.png")?;
         for f in staging.commit()? {
@@ -231,15 +224,8 @@ fn process_frame(c: &PingConfig, captures: &[Vec<f64>], staging: Option<Staging>
         "consistent": sync.consistent,
     });
     if let Some(staging) = staging {
-        let c_fs = sound / fs;
-        let mut csv = String::from("range_m,pseudo_probability\n");
-        for (i, p) in sync.distribution.iter().enumerate() {
-            csv.push_str(&format!("{:.4},{p:.6e}\n", i as f64 * c_fs - sound * t_start));
-        }
-        staging.write("range.csv", csv.as_bytes())?;
-        staging.write("estimate.json", (serde_json::to_string_pretty(&result)? + "\n").as_bytes())?;
-        plot::range_distribution(&staging.file("range.png"), &sync.distribution, c_fs, sync.lag * c_fs)
-            .context("cannot draw range.png")?;
+        // lags in metres, scaled by the Doppler compensation, less the pilots' offset
+        write_range_outputs(&staging, &sync.distribution, alpha * sound / fs, sound * t_start, range_m, &result)?;
         for f in staging.commit()? {
             eprintln!("wrote {}", f.display());
         }
@@ -257,4 +243,24 @@ fn process_frame(c: &PingConfig, captures: &[Vec<f64>], staging: Option<Staging>
         );
     }
     Ok(())
+}
+
+/// The range pseudo-distribution as CSV and PNG (range = lag x `metres_per_sample` -
+/// `offset_m`) and the estimates as JSON.
+fn write_range_outputs(
+    staging: &Staging,
+    distribution: &[f64],
+    metres_per_sample: f64,
+    offset_m: f64,
+    estimate_m: f64,
+    result: &serde_json::Value,
+) -> Result<()> {
+    let mut csv = String::from("range_m,pseudo_probability\n");
+    for (i, p) in distribution.iter().enumerate() {
+        csv.push_str(&format!("{:.4},{p:.6e}\n", i as f64 * metres_per_sample - offset_m));
+    }
+    staging.write("range.csv", csv.as_bytes())?;
+    staging.write("estimate.json", (serde_json::to_string_pretty(result)? + "\n").as_bytes())?;
+    plot::range_distribution(&staging.file("range.png"), distribution, metres_per_sample, offset_m, estimate_m)
+        .context("cannot draw range.png")
 }

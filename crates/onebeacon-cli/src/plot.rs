@@ -308,14 +308,21 @@ pub fn guidance_map(path: &Path, g: &GuidanceSnapshot) -> Result<()> {
 
 /// The range pseudo-distribution of one ping (rypkema eq. 5, Fig. 3 top), with the
 /// estimate marked.
-pub fn range_distribution(path: &Path, distribution: &[f64], metres_per_sample: f64, estimate_m: f64) -> Result<()> {
+pub fn range_distribution(
+    path: &Path,
+    distribution: &[f64],
+    metres_per_sample: f64,
+    offset_m: f64,
+    estimate_m: f64,
+) -> Result<()> {
     register_fonts();
-    let r1 = distribution.len() as f64 * metres_per_sample;
+    let r0 = -offset_m;
+    let r1 = distribution.len() as f64 * metres_per_sample - offset_m;
     let (_, ymax) = span(distribution.iter().copied(), 0.05);
     let root = BitMapBackend::new(path, (1000, 500)).into_drawing_area();
     let caption = format!("range pseudo-distribution, estimate {estimate_m:.2} m");
-    let mut chart = chart(&root, &caption, 0.0..r1, 0.0..ymax.max(1e-9), ("range (m)", "pseudo-probability"))?;
-    let points = distribution.iter().enumerate().map(|(i, v)| (i as f64 * metres_per_sample, *v));
+    let mut chart = chart(&root, &caption, r0..r1, 0.0..ymax.max(1e-9), ("range (m)", "pseudo-probability"))?;
+    let points = distribution.iter().enumerate().map(|(i, v)| (i as f64 * metres_per_sample - offset_m, *v));
     line(&mut chart, points, BLUE.stroke_width(1), None)?;
     line(&mut chart, [(estimate_m, 0.0), (estimate_m, ymax)], RED.stroke_width(1), Some("estimate"))?;
     legend(&mut chart, SeriesLabelPosition::UpperRight)?;

@@ -20,3 +20,4 @@ pub mod guidance;
 pub mod measure;
 pub mod models;
 pub mod nav;
+pub mod optim;

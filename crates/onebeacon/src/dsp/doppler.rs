@@ -88,22 +88,7 @@ pub fn periodogram_frequency(z: &[Complex], fs: f64, max_abs_hz: f64) -> f64 {
         }
     }
     // golden section on [f - df, f + df]
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (best.0 - df, best.0 + df);
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut pc, mut pd) = (power(c), power(d));
-    for _ in 0..40 {
-        if pc > pd {
-            (b, d, pd) = (d, c, pc);
-            c = b - g * (b - a);
-            pc = power(c);
-        } else {
-            (a, c, pc) = (c, d, pd);
-            d = a + g * (b - a);
-            pd = power(d);
-        }
-    }
-    (a + b) / 2.0
+    crate::optim::golden_section_max(power, best.0 - df, best.0 + df, 40).0
 }
 
 /// Cramer-Rao bound (standard deviation, Hz) on the frequency of a complex tone in

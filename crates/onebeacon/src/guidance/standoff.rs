@@ -38,22 +38,7 @@ pub fn best_standoff(depth_m: f64, reach_m: f64, grid: PolarGrid) -> Standoff {
         }
     }
     // golden section on [best - step, best + step]
-    let (mut a, mut b) = ((best_d - step).max(0.0), best_d + step);
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (value(c), value(d));
-    for _ in 0..30 {
-        if fc > fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - g * (b - a);
-            fc = value(c);
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + g * (b - a);
-            fd = value(d);
-        }
-    }
-    let (d_opt, v_opt) = if fc > fd { (c, fc) } else { (d, fd) };
+    let (d_opt, v_opt) = crate::optim::golden_section_max(value, (best_d - step).max(0.0), best_d + step, 30);
     if v_opt > best_v {
         Standoff { depth_m, distance_m: d_opt, det_fim: v_opt }
     } else {
