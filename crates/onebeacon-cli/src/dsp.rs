@@ -142,7 +142,9 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     if c.waveform.kind == WaveformKind::GarinFrame {
         return process_frame(&c, &captures, staging, as_json);
     }
-    let bank = ModeBank::new(modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, n)).collect());
+    let filters = modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, n)).collect();
+    let centres = modes.iter().map(|m| (m.f0_hz + m.f1_hz) / 2.0).collect();
+    let bank = ModeBank::with_array(filters, centres, elements.clone(), c.sound_speed_m_s());
     let spectra = bank.spectra(&captures);
     let mode = bank.identify(&spectra);
     let cfg =

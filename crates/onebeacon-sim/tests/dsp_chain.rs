@@ -95,9 +95,10 @@ fn measure_free_field_and_multipath() {
 fn mode_accuracy(n: usize, snr_db: f64, seed: u64) -> f64 {
     let fs = 37_500.0;
     let modes = rypkema_modes();
-    let bank =
-        ModeBank::new(modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, 8000)).collect());
     let el = pyramid_8cm();
+    let filters = modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, 8000)).collect();
+    let centres = modes.iter().map(|m| (m.f0_hz + m.f1_hz) / 2.0).collect();
+    let bank = ModeBank::with_array(filters, centres, el.clone(), 1500.0);
     let ch = Channel { snr_db: Some(snr_db), ..Channel::default() };
     let mut g = rng(seed, 0, Stream::Initial);
     let mut noise = rng(seed, 0, Stream::Acoustic);
@@ -113,8 +114,9 @@ fn mode_accuracy(n: usize, snr_db: f64, seed: u64) -> f64 {
     right as f64 / n as f64
 }
 
-/// Over 1000 pings at 10 dB the classical matched-filter bank is right on 96.7 % (the
-/// issue asks 99 %); CI checks a smaller count against 95 %.
+/// Over 1000 pings at 10 dB the bank (classical matched filters, coherent combination
+/// across elements at the strongest lags) is right on 98.1 % (incoherent only: 96.7 %;
+/// the issue asks 99 %); CI checks a smaller count against 95 %.
 #[test]
 fn modes_are_identified_at_10_db() {
     let acc = mode_accuracy(60, 10.0, 5);

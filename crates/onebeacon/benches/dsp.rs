@@ -23,8 +23,9 @@ fn bench(c: &mut Criterion) {
             (0..8000).map(|n| modes[0].value(n as f64 / fs - tau) + 1e-3 * ((n * 7919) % 13) as f64).collect()
         })
         .collect();
-    let bank =
-        ModeBank::new(modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, 8000)).collect());
+    let filters = modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, 8000)).collect();
+    let centres = modes.iter().map(|m| (m.f0_hz + m.f1_hz) / 2.0).collect();
+    let bank = ModeBank::with_array(filters, centres, el.clone(), 1500.0);
     let mut rx = Receiver::new(modes[0], &el, ReceiverConfig::default());
     c.bench_function("ping: 4-template mode id + PHAT range + SPD-BF 0.25 deg", |b| {
         b.iter(|| {

@@ -214,6 +214,11 @@ impl DirectionGrid {
         self.dirs.len()
     }
 
+    /// The look directions.
+    pub fn directions(&self) -> Vec<Vector3<f64>> {
+        self.dirs.iter().map(|d| d.2).collect()
+    }
+
     pub fn is_empty(&self) -> bool {
         self.dirs.is_empty()
     }

@@ -88,6 +88,13 @@ impl MatchedFilter {
 
     /// [`MatchedFilter::envelope`] from a capture's spectrum.
     pub fn envelope_of(&self, spectrum: &[Complex]) -> Vec<f64> {
+        self.analytic_of(spectrum).iter().map(|c| c.norm_sqr().sqrt()).collect()
+    }
+
+    /// The complex analytic correlation from a capture's spectrum, lags 0..capture_len
+    /// (its modulus is the envelope; its phase carries the carrier, for coherent
+    /// combination across elements).
+    pub fn analytic_of(&self, spectrum: &[Complex]) -> Vec<Complex> {
         assert_eq!(spectrum.len(), self.n / 2 + 1, "spectrum of another FFT length");
         // one-sided (analytic) spectrum of the whitened cross-spectrum, in band only
         let mut y = vec![Complex::new(0.0, 0.0); self.n];
@@ -103,7 +110,9 @@ impl MatchedFilter {
             }
         }
         self.ifft.process(&mut y);
-        y.iter().take(self.capture_len).map(|c| c.norm_sqr().sqrt() / self.n as f64).collect()
+        y.truncate(self.capture_len);
+        y.iter_mut().for_each(|c| *c /= self.n as f64);
+        y
     }
 }
 
