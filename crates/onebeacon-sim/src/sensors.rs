@@ -2,13 +2,12 @@
 //! run's seeded random streams (garin2024 sections 3.5, 4.1.1).
 
 use crate::scenario::fixed_beacon::Sensors;
-use crate::seed::{Stream, rng};
+use crate::seed::{Stream, gauss, rng};
 use crate::vehicles::TruthState;
 use nalgebra::Vector2;
 use onebeacon::geo::wrap_angle;
 use onebeacon::nav::{CommFrame, Proprioceptive};
 use rand::RngExt;
-use rand_distr::StandardNormal;
 use rand_pcg::Pcg64Mcg;
 
 /// The sensor suite of one run.
@@ -20,10 +19,6 @@ pub struct SensorSuite {
     acoustic: Pcg64Mcg,
     bias0_rad: f64,
     bias_rate_rad_s: f64,
-}
-
-fn gauss(rng: &mut Pcg64Mcg, sigma: f64) -> f64 {
-    sigma * rng.sample::<f64, _>(StandardNormal)
 }
 
 impl SensorSuite {

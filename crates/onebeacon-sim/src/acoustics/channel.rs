@@ -6,8 +6,6 @@
 
 use nalgebra::{Matrix3, Vector3};
 use onebeacon::dsp::waveform::Waveform;
-use rand::RngExt;
-use rand_distr::StandardNormal;
 
 /// Reflecting boundaries. Depth positive down; the surface is z = 0.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -119,7 +117,7 @@ pub fn simulate_ping<W: Waveform + ?Sized, R: rand::Rng>(
         let e = direct_energy / elements.len().max(1) as f64;
         let sigma = (e / 10f64.powf(snr_db / 10.0)).sqrt();
         for x in captures.iter_mut().flatten() {
-            *x += sigma * rng.sample::<f64, _>(StandardNormal);
+            *x += crate::seed::gauss(rng, sigma);
         }
     }
     captures

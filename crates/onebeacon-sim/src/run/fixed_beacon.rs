@@ -4,15 +4,13 @@
 use super::{Estimate, RunOutput, StepRecord};
 use crate::metrics::ErrorAccumulator;
 use crate::scenario::{FixedBeacon, FixedBeaconCell};
-use crate::seed::{Stream, rng};
+use crate::seed::{Stream, gauss, rng};
 use crate::sensors::SensorSuite;
 use crate::vehicles::{TruthState, feedback_linearising_control};
 use nalgebra::{SVector, Vector2, Vector3};
 use onebeacon::filter::consistency::nees;
 use onebeacon::models::unicycle::{Cov, State, idx};
 use onebeacon::nav::SingleBeaconEkf;
-use rand::RngExt;
-use rand_distr::StandardNormal;
 
 /// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
 pub(super) fn simulate(s: &FixedBeacon, cell: &FixedBeaconCell, seed: u64, run: u64, record: bool) -> RunOutput {
@@ -39,7 +37,7 @@ pub(super) fn simulate(s: &FixedBeacon, cell: &FixedBeaconCell, seed: u64, run: 
     ]);
     let mut init_rng = rng(seed, run, Stream::Initial);
     let z_true = State::from([truth.pos.x, truth.pos.y, truth.psi, truth.v, omega, accel]);
-    let z0 = z_true + sigma0.map(|sd| sd * init_rng.sample::<f64, _>(StandardNormal));
+    let z0 = z_true + sigma0.map(|sd| gauss(&mut init_rng, sd));
     let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
     let mut filters: Vec<SingleBeaconEkf> =
         s.estimators.iter().map(|e| SingleBeaconEkf::new(e.kind.aiding(), e.tuning(), z0, p0)).collect();

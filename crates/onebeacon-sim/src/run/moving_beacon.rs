@@ -9,7 +9,7 @@ use crate::acoustics::Ping;
 use crate::metrics::ErrorAccumulator;
 use crate::scenario::moving_beacon::{EstimatorKind, GuidanceKind};
 use crate::scenario::{MovingBeacon, MovingBeaconCell};
-use crate::seed::{Stream, rng};
+use crate::seed::{Stream, gauss, rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::rov::{body_velocity, rk4_step};
 use nalgebra::{SVector, Vector2, Vector3, Vector4};
@@ -18,13 +18,6 @@ use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, ReachingSet, best_stand
 use onebeacon::measure::{Range3d, ScalarModel};
 use onebeacon::models::kinematic6dof::{BodyVelocity, Cov, State, idx, rotation};
 use onebeacon::nav::{OwttRange, Range6DofEkf, SensorNoise};
-use rand::RngExt;
-use rand_distr::StandardNormal;
-use rand_pcg::Pcg64Mcg;
-
-fn gauss(rng: &mut Pcg64Mcg, sigma: f64) -> f64 {
-    sigma * rng.sample::<f64, _>(StandardNormal)
-}
 
 /// The vehicle's true state at every step (it does not depend on the draws).
 pub fn truth_trajectory(s: &MovingBeacon, cell: &MovingBeaconCell) -> Vec<State> {

@@ -71,21 +71,27 @@ fn check_steps(duration_s: f64, dt_s: f64) -> Result<(), Violation> {
     Ok(())
 }
 
-fn check_name(key: String, name: &str, taken: bool) -> Result<(), Violation> {
-    let ok = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || "+-_.".contains(c));
-    if !ok {
+/// At least one estimator; names of ASCII letters, digits and + - _ . , all different.
+fn check_estimator_names(names: &[&str]) -> Result<(), Violation> {
+    if names.is_empty() {
         return Err(Violation {
-            key,
-            value: format!("{name:?}"),
-            allowed: "must be non-empty ASCII letters, digits and + - _ .".into(),
+            key: "estimators".into(),
+            value: "[]".into(),
+            allowed: "at least one estimator is needed".into(),
         });
     }
-    if taken {
-        return Err(Violation {
-            key,
+    for (k, name) in names.iter().enumerate() {
+        let violation = |allowed: &str| Violation {
+            key: format!("estimators[{k}].name"),
             value: format!("{name:?}"),
-            allowed: "must differ from the other estimators' names (set `name`)".into(),
-        });
+            allowed: allowed.into(),
+        };
+        if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || "+-_.".contains(c)) {
+            return Err(violation("must be non-empty ASCII letters, digits and + - _ ."));
+        }
+        if names[..k].contains(name) {
+            return Err(violation("must differ from the other estimators' names (set `name`)"));
+        }
     }
     Ok(())
 }
@@ -152,16 +158,7 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
         depth_sigma_m: Positive,
         attitude_sigma_deg: Positive,
     });
-    if s.estimators.is_empty() {
-        return Err(Violation {
-            key: "estimators".into(),
-            value: "[]".into(),
-            allowed: "at least one estimator is needed".into(),
-        });
-    }
-    for (k, e) in s.estimators.iter().enumerate() {
-        check_name(format!("estimators[{k}].name"), e.name(), s.estimators[..k].iter().any(|o| o.name() == e.name()))?;
-    }
+    check_estimator_names(&s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
     check_list_nonempty("sweep.path", &s.sweep.path)?;
     check_list_nonempty("sweep.guidance", &s.sweep.guidance)?;
     check_list_nonempty("sweep.depth_m", &s.sweep.depth_m)?;
@@ -224,13 +221,7 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
         accel_sigma_m_s2: Positive,
     });
 
-    if s.estimators.is_empty() {
-        return Err(Violation {
-            key: "estimators".into(),
-            value: "[]".into(),
-            allowed: "at least one estimator is needed".into(),
-        });
-    }
+    check_estimator_names(&s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
     for (k, e) in s.estimators.iter().enumerate() {
         let key = |f: &str| format!("estimators[{k}].{f}");
         for (j, &q) in e.q_diag.iter().enumerate() {
@@ -241,22 +232,6 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
         check(&key("r_heading_rad2"), e.r_heading_rad2, Positive)?;
         check(&key("r_yaw_rate_rad2_s2"), e.r_yaw_rate_rad2_s2, Positive)?;
         check(&key("r_accel_m2_s4"), e.r_accel_m2_s4, Positive)?;
-        let name = e.name();
-        let name_ok = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || "+-_.".contains(c));
-        if !name_ok {
-            return Err(Violation {
-                key: key("name"),
-                value: format!("{name:?}"),
-                allowed: "must be non-empty ASCII letters, digits and + - _ .".into(),
-            });
-        }
-        if s.estimators[..k].iter().any(|o| o.name() == name) {
-            return Err(Violation {
-                key: key("name"),
-                value: format!("{name:?}"),
-                allowed: "must differ from the other estimators' names (set `name`)".into(),
-            });
-        }
     }
 
     if let Some(v) = &s.sweep.t_com_s {
