@@ -3,13 +3,13 @@
 //! `cargo test --release -p onebeacon-sim --test dsp_chain -- --ignored --nocapture`.
 
 use nalgebra::{Matrix3, Vector3};
-use onebeacon::dsp::beamform::{angle_between, azimuth_inclination, direction, pyramid_8cm};
+use onebeacon::dsp::beamform::{angle_between, azimuth_inclination, direction, doa_crb, pyramid_8cm};
 use onebeacon::dsp::matched_filter::MatchedFilter;
 use onebeacon::dsp::modes::ModeBank;
 use onebeacon::dsp::receiver::{Receiver, ReceiverConfig};
 use onebeacon::dsp::waveform::{Lfm, rypkema_modes};
 use onebeacon_sim::acoustics::channel::{Boundaries, Channel, simulate_ping};
-use onebeacon_sim::seed::{Stream, rng};
+use onebeacon_sim::seed::{Stream, gauss, rng};
 use rand::RngExt;
 use std::f64::consts::{PI, TAU};
 
@@ -17,6 +17,8 @@ struct Errors {
     range_m: Vec<f64>,
     azimuth_deg: Vec<f64>,
     direction_deg: Vec<f64>,
+    /// |azimuth error| / the CRB's sigma for that direction (`doa_crb`).
+    azimuth_over_crb: Vec<f64>,
 }
 
 fn percentile(v: &[f64], q: f64) -> f64 {
@@ -33,7 +35,8 @@ fn run(n: usize, channel: &Channel, multipath: bool, seed: u64) -> Errors {
     let mut rx = Receiver::new(chirp, &el, ReceiverConfig::default());
     let mut geo = rng(seed, 0, Stream::Initial);
     let mut noise = rng(seed, 0, Stream::Acoustic);
-    let mut e = Errors { range_m: vec![], azimuth_deg: vec![], direction_deg: vec![] };
+    let mut e = Errors { range_m: vec![], azimuth_deg: vec![], direction_deg: vec![], azimuth_over_crb: vec![] };
+    let two_e_over_n0 = 10f64.powf(channel.snr_db.unwrap_or(f64::INFINITY) / 10.0);
     for _ in 0..n {
         let range = 30.0 + 260.0 * geo.random::<f64>();
         let (receiver, source) = if multipath {
@@ -49,36 +52,40 @@ fn run(n: usize, channel: &Channel, multipath: bool, seed: u64) -> Errors {
         let caps = simulate_ping(&chirp, &source, &receiver, &Matrix3::identity(), &el, channel, &mut noise);
         let est = rx.process(&caps);
         let truth = (source - receiver).normalize();
-        let (az_true, _) = azimuth_inclination(&truth);
+        let (az_true, incl_true) = azimuth_inclination(&truth);
+        let crb = doa_crb(&el, az_true, incl_true, chirp.rms_frequency_hz(), two_e_over_n0, channel.sound_speed_m_s)
+            .expect("elevations within +-45 deg");
         let daz = (est.azimuth - az_true + PI).rem_euclid(TAU) - PI;
         e.range_m.push((est.range.range_m - (source - receiver).norm()).abs());
         e.azimuth_deg.push(daz.abs().to_degrees());
         e.direction_deg.push(angle_between(&est.direction, &truth).to_degrees());
+        e.azimuth_over_crb.push(daz.abs() / crb[(0, 0)].sqrt());
     }
     e
 }
 
 fn report(label: &str, e: &Errors) {
     eprintln!(
-        "{label}: {} pings; 68 % range error {:.3} m, 68 % azimuth error {:.2} deg, 68 % direction error {:.2} deg",
+        "{label}: {} pings; 68 % range error {:.3} m, 68 % azimuth error {:.2} deg (68 % of error / CRB sigma: {:.2}, \
+         0.99 at the bound), 68 % direction error {:.2} deg",
         e.range_m.len(),
         percentile(&e.range_m, 0.68),
         percentile(&e.azimuth_deg, 0.68),
+        percentile(&e.azimuth_over_crb, 0.68),
         percentile(&e.direction_deg, 0.68)
     );
 }
 
 /// 20 dB per element, no multipath: 68 % of range errors under 0.2 m (the CRLB for five
-/// elements is about 1.8 cm); azimuth within 1.5x the array's CRB (2.1 deg at zero
-/// elevation, growing as 1 / cos(elevation); acoustics.md). Over 1000 pings the 68 %
-/// azimuth error is 2.7 deg for elevations within +-45 deg: the issue's 2 deg is below
-/// the bound there.
+/// elements is about 1.8 cm); azimuth errors within 1.5x the array's CRB per ping (2.1
+/// deg level, growing as 1 / cos(elevation); `doa_crb`). The issue's 2 deg is below the
+/// bound at every elevation: no unbiased estimator reaches it at 20 dB.
 #[test]
 fn twenty_db_free_field_range_and_azimuth() {
     let e = run(30, &Channel::default(), false, 1);
     report("20 dB free field", &e);
     assert!(percentile(&e.range_m, 0.68) < 0.2);
-    assert!(percentile(&e.azimuth_deg, 0.68) < 1.5 * 2.1 / (22.5f64.to_radians().cos()));
+    assert!(percentile(&e.azimuth_over_crb, 0.68) < 1.5);
 }
 
 #[test]
@@ -92,13 +99,17 @@ fn measure_free_field_and_multipath() {
     );
 }
 
-fn mode_accuracy(n: usize, snr_db: f64, seed: u64) -> f64 {
+/// The share of `n` pings at `snr_db` whose mode the bank identifies. With `gate_m`, the
+/// search is gated to +-`gate_m` around a predicted range that is off by a Gaussian error
+/// of sigma `gate_m / 3` (a navigation filter's prediction).
+fn mode_accuracy(n: usize, snr_db: f64, seed: u64, gate_m: Option<f64>) -> f64 {
     let fs = 37_500.0;
+    let c = 1500.0;
     let modes = rypkema_modes();
     let el = pyramid_8cm();
     let filters = modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, 8000)).collect();
     let centres = modes.iter().map(|m| (m.f0_hz + m.f1_hz) / 2.0).collect();
-    let bank = ModeBank::with_array(filters, centres, el.clone(), 1500.0);
+    let bank = ModeBank::with_array(filters, centres, el.clone(), c);
     let ch = Channel { snr_db: Some(snr_db), ..Channel::default() };
     let mut g = rng(seed, 0, Stream::Initial);
     let mut noise = rng(seed, 0, Stream::Acoustic);
@@ -106,29 +117,47 @@ fn mode_accuracy(n: usize, snr_db: f64, seed: u64) -> f64 {
     for _ in 0..n {
         let mode = (g.random::<f64>() * 4.0) as usize % 4;
         let range = 30.0 + 260.0 * g.random::<f64>();
+        let receiver = Vector3::new(0.0, 0.0, 3.0);
         let src = Vector3::new(range, 0.0, 1.0);
-        let caps =
-            simulate_ping(&modes[mode], &src, &Vector3::new(0.0, 0.0, 3.0), &Matrix3::identity(), &el, &ch, &mut noise);
-        right += usize::from(bank.identify(&bank.spectra(&caps)) == mode);
+        let caps = simulate_ping(&modes[mode], &src, &receiver, &Matrix3::identity(), &el, &ch, &mut noise);
+        let spectra = bank.spectra(&caps);
+        let found = match gate_m {
+            None => bank.identify(&spectra),
+            Some(w) => {
+                let predicted = (src - receiver).norm() + gauss(&mut g, w / 3.0);
+                let lag = |r: f64| (r.max(0.0) / c * fs).round() as usize;
+                bank.identify_within(&spectra, lag(predicted - w)..lag(predicted + w))
+            }
+        };
+        right += usize::from(found == mode);
     }
     right as f64 / n as f64
 }
 
 /// Over 1000 pings at 10 dB the bank (classical matched filters, coherent combination
-/// across elements at the strongest lags) is right on 98.1 % (incoherent only: 96.7 %;
-/// the issue asks 99 %); CI checks a smaller count against 95 %.
+/// across elements at the strongest lags) is right on 98.1 % searching the whole
+/// capture (incoherent only: 96.7 %), and on 99.8 % with the search gated to +-15 m
+/// around a prediction (99.3 % over 7 x 300 pings of other seeds); CI checks smaller
+/// counts against 95 % and 97.5 %.
 #[test]
 fn modes_are_identified_at_10_db() {
-    let acc = mode_accuracy(60, 10.0, 5);
-    eprintln!("mode identification at 10 dB: {:.1} %", 100.0 * acc);
+    let acc = mode_accuracy(60, 10.0, 5, None);
+    let gated = mode_accuracy(150, 10.0, 1, Some(15.0));
+    eprintln!("mode identification at 10 dB: {:.1} %, gated {:.1} %", 100.0 * acc, 100.0 * gated);
     assert!(acc >= 0.95);
+    assert!(gated >= 0.975);
 }
 
 #[test]
 #[ignore]
 fn measure_mode_identification() {
     for snr in [0.0, 5.0, 10.0] {
-        eprintln!("mode identification at {snr} dB over 1000 pings: {:.2} %", 100.0 * mode_accuracy(1000, snr, 6));
+        for gate in [None, Some(15.0), Some(5.0)] {
+            eprintln!(
+                "mode identification at {snr} dB over 1000 pings, gate {gate:?} m: {:.2} %",
+                100.0 * mode_accuracy(1000, snr, 6, gate)
+            );
+        }
     }
 }
 

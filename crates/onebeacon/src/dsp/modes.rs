@@ -4,6 +4,7 @@
 
 use super::Complex;
 use super::matched_filter::MatchedFilter;
+use std::ops::Range;
 
 /// A bank of matched filters, one per mode.
 #[derive(Debug)]
@@ -68,14 +69,15 @@ impl ModeBank {
         }
     }
 
-    /// Each mode's response: the peak over lags of the sum over elements of the squared
-    /// envelopes (build the bank with [`MatchedFilter::classical`] filters for a
-    /// statistic comparable across templates).
-    pub fn responses(&self, spectra: &[Vec<Complex>]) -> Vec<f64> {
+    /// Each mode's response: the peak over the lags in `lags` of the sum over elements of
+    /// the squared envelopes (build the bank with [`MatchedFilter::classical`] filters for
+    /// a statistic comparable across templates). Lags beyond the capture are ignored.
+    pub fn responses(&self, spectra: &[Vec<Complex>], lags: Range<usize>) -> Vec<f64> {
         self.filters
             .iter()
             .enumerate()
             .map(|(t, f)| {
+                let lags = lags.start.min(f.capture_len())..lags.end.min(f.capture_len());
                 let outputs: Vec<Vec<Complex>> = spectra.iter().map(|x| f.analytic_of(x)).collect();
                 let mut sum = vec![0.0; f.capture_len()];
                 for y in &outputs {
@@ -84,26 +86,33 @@ impl ModeBank {
                     }
                 }
                 match &self.coherent {
-                    None => sum.iter().cloned().fold(0.0, f64::max),
-                    Some(c) => c.best_alignment(&outputs, &sum, &c.steer[t]),
+                    None => sum[lags].iter().cloned().fold(0.0, f64::max),
+                    Some(c) => c.best_alignment(&outputs, &sum, lags, &c.steer[t]),
                 }
             })
             .collect()
     }
 
-    /// The mode (index into the bank) with the largest response, from the spectra of
-    /// the captures ([`ModeBank::spectra`]).
+    /// The mode (index into the bank) with the largest response anywhere in the
+    /// capture, from the spectra of the captures ([`ModeBank::spectra`]).
     pub fn identify(&self, spectra: &[Vec<Complex>]) -> usize {
-        super::matched_filter::argmax(&self.responses(spectra))
+        self.identify_within(spectra, 0..usize::MAX)
+    }
+
+    /// [`ModeBank::identify`] with the search gated to the lags `lags` (samples from the
+    /// capture start), e.g. around the arrival the navigation filter predicts: fewer
+    /// noise-only lags can outgrow the true peak (acoustics.md: gating buys dBs).
+    pub fn identify_within(&self, spectra: &[Vec<Complex>], lags: Range<usize>) -> usize {
+        super::matched_filter::argmax(&self.responses(spectra, lags))
     }
 }
 
 impl Coherent {
     /// The largest coherent power over the look directions at the 8 strongest local
-    /// maxima of the incoherent sum.
-    fn best_alignment(&self, outputs: &[Vec<Complex>], sum: &[f64], steer: &[Vec<Complex>]) -> f64 {
-        let mut peaks: Vec<usize> =
-            (1..sum.len().saturating_sub(1)).filter(|&n| sum[n] >= sum[n - 1] && sum[n] > sum[n + 1]).collect();
+    /// maxima of the incoherent sum within `lags`.
+    fn best_alignment(&self, outputs: &[Vec<Complex>], sum: &[f64], lags: Range<usize>, steer: &[Vec<Complex>]) -> f64 {
+        let inner = lags.start.max(1)..lags.end.min(sum.len().saturating_sub(1));
+        let mut peaks: Vec<usize> = inner.filter(|&n| sum[n] >= sum[n - 1] && sum[n] > sum[n + 1]).collect();
         peaks.sort_by(|a, b| sum[*b].total_cmp(&sum[*a]));
         peaks.truncate(8);
         let mut best = 0.0f64;

@@ -79,6 +79,19 @@ impl Lfm {
     }
 
     /// The swept band, low to high, Hz.
+    /// RMS frequency F (carrier included), Hz: F^2 = int s'^2 / ((2 pi)^2 int s^2) inside
+    /// the pulse (the edges of a rectangular pulse left out), from the waveform sampled
+    /// at 512 points per cycle of its highest frequency, so that windows count:
+    /// sqrt((f0^2 + f0 f1 + f1^2) / 3) for a rectangular chirp.
+    pub fn rms_frequency_hz(&self) -> f64 {
+        let dt = 1.0 / (512.0 * self.f0_hz.max(self.f1_hz));
+        let n = (self.duration_s / dt).ceil() as usize;
+        let s: Vec<f64> = (0..n).map(|i| self.value(i as f64 * dt)).collect();
+        let energy: f64 = s.iter().map(|x| x * x).sum();
+        let slope: f64 = s.windows(3).map(|w| ((w[2] - w[0]) / (2.0 * dt)).powi(2)).sum();
+        (slope / energy).sqrt() / std::f64::consts::TAU
+    }
+
     pub fn band(&self) -> (f64, f64) {
         (self.f0_hz.min(self.f1_hz), self.f0_hz.max(self.f1_hz))
     }
@@ -253,6 +266,12 @@ mod tests {
         assert_eq!(c.value(0.02), 0.0);
         assert_abs_diff_eq!(c.value(0.0), 1.0);
         assert_eq!(rypkema_modes()[1].band(), (8e3, 10e3));
+    }
+
+    #[test]
+    fn rms_frequency_of_a_rectangular_chirp() {
+        let f = Lfm::new(7e3, 9e3, 0.02).rms_frequency_hz();
+        assert!((f - ((49e6 + 63e6 + 81e6) / 3.0f64).sqrt()).abs() < 1.0, "{f}"); // 8020.8 Hz
     }
 
     #[test]
