@@ -4,6 +4,7 @@ mod commands;
 mod dsp;
 mod output;
 mod plot;
+mod replay;
 mod report;
 
 use clap::{Parser, Subcommand};
@@ -69,6 +70,34 @@ enum Command {
     Dsp {
         #[command(subcommand)]
         command: DspCommand,
+    },
+    /// Replay a real log (CSV files described by a TOML file) through every estimator it
+    /// configures, scored against its ground truth: trajectory.csv, summary.json,
+    /// rejected.csv, top_view.png and error.png in DIR, and a table (or --json).
+    Replay {
+        /// The log description (TOML; see README "Replaying logs").
+        log: PathBuf,
+        /// Output directory (default: out/<log>-replay[-beacons-...]).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Use only these beacons (ids, comma-separated), e.g. one at a time.
+        #[arg(long, value_delimiter = ',', value_name = "IDS")]
+        beacons: Option<Vec<u32>>,
+        /// Print one JSON object (per estimator: rmse_m, mean_error_m, final_error_m,
+        /// max_error_m, rejected, range_bias_m) instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Print the merged, time-ordered stream as JSON Lines (the input of `stream`)
+        /// and stop.
+        #[arg(long, conflicts_with_all = ["json", "out", "beacons"])]
+        print_stream: bool,
+    },
+    /// Run the estimators of CONFIG on JSON Lines measurements from stdin, writing one
+    /// JSON line of estimates per input line to stdout, flushed after each.
+    Stream {
+        /// Log description or stream configuration (TOML): frame, beacons, initial
+        /// state, estimators; its [[source]] tables are ignored.
+        config: PathBuf,
     },
     /// Beacon-vehicle guidance tools.
     Guidance {
@@ -177,6 +206,10 @@ fn main() -> ExitCode {
         Command::Dsp { command: DspCommand::Process { wav, config, out, json } } => {
             dsp::process(&wav, config.as_deref(), out, json)
         }
+        Command::Replay { log, out, beacons, json, print_stream } => {
+            replay::replay(&log, out, beacons, json, print_stream)
+        }
+        Command::Stream { config } => replay::stream(&config),
         Command::Guidance { command: GuidanceCommand::Standoff { speed_m_s, depths_m, period_s, json } } => {
             commands::standoff(speed_m_s, &depths_m, period_s, json)
         }
@@ -186,8 +219,9 @@ fn main() -> ExitCode {
         Err(e) => {
             let msg = format!("{e:#}").replace('\n', " ");
             eprintln!("error: {msg}");
-            let input =
-                e.downcast_ref::<onebeacon_sim::ScenarioError>().is_some() || e.downcast_ref::<BadInput>().is_some();
+            let input = e.downcast_ref::<onebeacon_sim::ScenarioError>().is_some()
+                || e.downcast_ref::<onebeacon_sim::replay::LogError>().is_some()
+                || e.downcast_ref::<BadInput>().is_some();
             ExitCode::from(if input { 2 } else { 1 })
         }
     }

@@ -1,10 +1,11 @@
 //! PNG plots with plotters and an embedded font (no system font libraries needed).
 
 use anyhow::Result;
+use nalgebra::Vector3;
 use onebeacon::guidance::Metric;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::montecarlo::{CellResult, McResult};
-use onebeacon_sim::run::{Estimate, GuidanceSnapshot, RunOutput};
+use onebeacon_sim::run::{Estimate, GuidanceSnapshot, StepRecord};
 use onebeacon_sim::scenario::SweepValue;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -92,12 +93,26 @@ fn line(
     Ok(())
 }
 
-/// Top view: truth, every estimate, the beacon (its track when it moves). East to the
-/// right, north up, equal scales.
-pub fn top_view(path: &Path, s: &Scenario, title: &str, out: &RunOutput) -> Result<()> {
+/// Top view: truth, every estimate (`names`, in the records' order), the beacons:
+/// `fixed_beacons` when given (replayed logs), else the records' beacon (its track when
+/// it moves). East to the right, north up, equal scales.
+pub fn top_view(
+    path: &Path,
+    names: &[String],
+    title: &str,
+    traj: &[StepRecord],
+    fixed_beacons: Option<&[Vector3<f64>]>,
+) -> Result<()> {
     register_fonts();
-    let traj = &out.trajectory;
-    let all = || traj.iter().flat_map(|r| [r.truth_pos, r.beacon].into_iter().chain(r.estimates.iter().map(|e| e.pos)));
+    let fixed = fixed_beacons.unwrap_or(&[]);
+    let all = || {
+        traj.iter()
+            .flat_map(|r| {
+                let beacon = if fixed_beacons.is_none() { Some(r.beacon) } else { None };
+                [Some(r.truth_pos), beacon].into_iter().flatten().chain(r.estimates.iter().map(|e| e.pos))
+            })
+            .chain(fixed.iter().copied())
+    };
     let (n0, n1) = span(all().map(|p| p.x), 0.05);
     let (e0, e1) = span(all().map(|p| p.y), 0.05);
     let (w, h) = (1200u32, 800u32);
@@ -108,7 +123,7 @@ pub fn top_view(path: &Path, s: &Scenario, title: &str, out: &RunOutput) -> Resu
     let root = BitMapBackend::new(path, (w, h)).into_drawing_area();
     let mut chart =
         chart(&root, &format!("{title}: top view"), ec - he..ec + he, nc - hn..nc + hn, ("east (m)", "north (m)"))?;
-    let moving = traj.windows(2).any(|w| (w[1].beacon - w[0].beacon).norm() > 1e-9);
+    let moving = fixed_beacons.is_none() && traj.windows(2).any(|w| (w[1].beacon - w[0].beacon).norm() > 1e-9);
     if moving {
         line(
             &mut chart,
@@ -117,16 +132,23 @@ pub fn top_view(path: &Path, s: &Scenario, title: &str, out: &RunOutput) -> Resu
             Some("beacon (ASV)"),
         )?;
     }
-    line(&mut chart, traj.iter().map(|r| (r.truth_pos.y, r.truth_pos.x)), BLACK.stroke_width(2), Some("truth"))?;
-    for (i, name) in s.estimator_names().iter().enumerate() {
+    let truth = traj.iter().filter(|r| r.truth_pos.x.is_finite());
+    line(&mut chart, truth.map(|r| (r.truth_pos.y, r.truth_pos.x)), BLACK.stroke_width(2), Some("truth"))?;
+    for (i, name) in names.iter().enumerate() {
         let points = traj.iter().map(|r| (r.estimates[i].pos.y, r.estimates[i].pos.x));
         line(&mut chart, points, colour(i).stroke_width(1), Some(name))?;
     }
-    if let Some(first) = traj.first() {
+    let beacons: Vec<Vector3<f64>> = match fixed_beacons {
+        Some(b) => b.to_vec(),
+        None => traj.first().map(|r| r.beacon).into_iter().collect(),
+    };
+    if !beacons.is_empty() {
         chart
-            .draw_series(std::iter::once(TriangleMarker::new((first.beacon.y, first.beacon.x), 9, BLUE.filled())))?
+            .draw_series(beacons.iter().map(|b| TriangleMarker::new((b.y, b.x), 9, BLUE.filled())))?
             .label(if moving { "beacon start" } else { "beacon" })
             .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLUE.filled()));
+    }
+    if let Some(first) = traj.iter().find(|r| r.truth_pos.x.is_finite()) {
         chart
             .draw_series(std::iter::once(Circle::new((first.truth_pos.y, first.truth_pos.x), 5, BLACK.filled())))?
             .label("start")
@@ -139,19 +161,20 @@ pub fn top_view(path: &Path, s: &Scenario, title: &str, out: &RunOutput) -> Resu
 
 /// Horizontal position error versus time, one line per estimator, with its 2-sigma
 /// bound (twice the root of the trace of the position covariance) as a thin line.
-pub fn error_vs_time(path: &Path, s: &Scenario, title: &str, out: &RunOutput) -> Result<()> {
+pub fn error_vs_time(path: &Path, names: &[String], title: &str, traj: &[StepRecord]) -> Result<()> {
     register_fonts();
-    let traj = &out.trajectory;
-    let t1 = traj.last().map(|r| r.t_s).unwrap_or(1.0).max(1e-3);
+    let t0 = traj.first().map(|r| r.t_s).unwrap_or(0.0);
+    let t1 = traj.last().map(|r| r.t_s - t0).unwrap_or(1.0).max(1e-3);
     let sigma2 = |e: &Estimate| 2.0 * e.sigma_pos.norm();
     let (_, ymax) = span(traj.iter().flat_map(|r| r.estimates.iter().flat_map(|e| [e.error_m, sigma2(e)])), 0.05);
     let root = BitMapBackend::new(path, (1200, 600)).into_drawing_area();
     let caption = format!("{title}: position error (thick), 2-sigma bound (thin)");
-    let mut chart = chart(&root, &caption, 0.0..t1, 0.0..ymax.max(0.01), ("time (s)", "horizontal error (m)"))?;
-    for (i, name) in s.estimator_names().iter().enumerate() {
+    let x_desc = if t0 == 0.0 { "time (s)".to_string() } else { format!("time since {t0:.1} s (s)") };
+    let mut chart = chart(&root, &caption, 0.0..t1, 0.0..ymax.max(0.01), (&x_desc, "horizontal error (m)"))?;
+    for (i, name) in names.iter().enumerate() {
         let c = colour(i);
-        line(&mut chart, traj.iter().map(|r| (r.t_s, r.estimates[i].error_m)), c.stroke_width(2), Some(name))?;
-        line(&mut chart, traj.iter().map(|r| (r.t_s, sigma2(&r.estimates[i]))), c.mix(0.5).stroke_width(1), None)?;
+        line(&mut chart, traj.iter().map(|r| (r.t_s - t0, r.estimates[i].error_m)), c.stroke_width(2), Some(name))?;
+        line(&mut chart, traj.iter().map(|r| (r.t_s - t0, sigma2(&r.estimates[i]))), c.mix(0.5).stroke_width(1), None)?;
     }
     legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     root.present()?;

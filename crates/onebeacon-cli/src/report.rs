@@ -3,7 +3,7 @@
 use anyhow::Result;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::montecarlo::McResult;
-use onebeacon_sim::run::RunOutput;
+use onebeacon_sim::run::{RunOutput, StepRecord};
 use onebeacon_sim::scenario::{Cell, MovingBeaconCell, SweepValue};
 use serde_json::{Value, json};
 use std::fmt::Write;
@@ -21,9 +21,9 @@ fn sweep_json(cell: &Cell) -> Value {
     Value::Object(cell.values().into_iter().map(|(k, v)| (k.to_string(), value(v))).collect())
 }
 
-/// trajectory.csv: one row per step with the truth and every estimator's estimate,
-/// standard deviations, error and NEES.
-pub fn trajectory_csv(s: &Scenario, out: &RunOutput) -> Result<Vec<u8>> {
+/// trajectory.csv: one row per step with the truth and every estimator's estimate
+/// (`names`, in the records' order), standard deviations, error and NEES.
+pub fn trajectory_csv(names: &[String], trajectory: &[StepRecord]) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header: Vec<String> = [
         "t_s",
@@ -39,7 +39,7 @@ pub fn trajectory_csv(s: &Scenario, out: &RunOutput) -> Result<Vec<u8>> {
     ]
     .map(String::from)
     .to_vec();
-    for name in s.estimator_names() {
+    for name in names {
         for col in [
             "north_m",
             "east_m",
@@ -56,7 +56,7 @@ pub fn trajectory_csv(s: &Scenario, out: &RunOutput) -> Result<Vec<u8>> {
     }
     w.write_record(&header)?;
     let f = |v: f64| format!("{v:.4}");
-    for r in &out.trajectory {
+    for r in trajectory {
         let mut row = vec![format!("{:.2}", r.t_s)];
         row.extend([r.truth_pos.x, r.truth_pos.y, r.truth_pos.z].map(f));
         row.push(format!("{:.3}", onebeacon::geo::wrap_angle(r.truth_heading).to_degrees()));

@@ -7,12 +7,14 @@
 //! - [`scenario`]: the TOML scenario schema, its validation and the built-in scenarios;
 //! - [`run`]: one simulated run, a pure function of (scenario, sweep cell, seed, run);
 //! - [`metrics`]: per-run error statistics and their Monte Carlo aggregation;
-//! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count.
+//! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count;
+//! - [`replay`]: real logs (CSV files described by a TOML file) through the estimators.
 
 pub mod acoustics;
 pub mod metrics;
 pub mod montecarlo;
 pub mod pcrb;
+pub mod replay;
 pub mod run;
 pub mod scenario;
 pub mod seed;

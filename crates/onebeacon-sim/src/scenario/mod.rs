@@ -8,7 +8,7 @@
 
 mod builtin;
 pub mod fixed_beacon;
-mod load;
+pub(crate) mod load;
 pub mod moving_beacon;
 pub mod ping;
 pub(crate) mod validate;

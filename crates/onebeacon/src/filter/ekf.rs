@@ -9,7 +9,7 @@ use crate::geo::wrap_angle;
 use nalgebra::{SMatrix, SVector};
 
 /// Errors of a filter step. The state is left unchanged when one is returned.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum FilterError {
     #[error("innovation covariance is not positive definite (measurement noise too small or state covariance broken)")]
     InnovationNotPositiveDefinite,
@@ -79,6 +79,19 @@ impl<const N: usize> Ekf<N> {
         z: &SVector<f64, M>,
         r: &SMatrix<f64, M, M>,
     ) -> Result<f64, FilterError> {
+        self.update_gated(model, z, r, f64::INFINITY).map(|g| g.nis())
+    }
+
+    /// [`Ekf::update`] with innovation gating: a measurement whose NIS exceeds `max_nis`
+    /// (a chi-square quantile with M degrees of freedom) is rejected and leaves the
+    /// state untouched.
+    pub fn update_gated<const M: usize, H: MeasurementModel<N, M>>(
+        &mut self,
+        model: &H,
+        z: &SVector<f64, M>,
+        r: &SMatrix<f64, M, M>,
+        max_nis: f64,
+    ) -> Result<Gated, FilterError> {
         let h = model.jacobian(&self.x);
         let mut nu = z - model.predict(&self.x);
         for i in 0..M {
@@ -95,15 +108,33 @@ impl<const N: usize> Ekf<N> {
         // matrices is several times faster than inverting through the factor.
         s.cholesky().ok_or(FilterError::InnovationNotPositiveDefinite)?;
         let s_inv = s.try_inverse().ok_or(FilterError::InnovationNotPositiveDefinite)?;
-        let k = pht * s_inv;
         let nis = nu.dot(&(s_inv * nu));
+        if nis > max_nis {
+            return Ok(Gated::Rejected(nis));
+        }
+        let k = pht * s_inv;
         self.x += k * nu;
         // Joseph form (I - K H) P (I - K H)' + K R K', with (I - K H) P = P - K (P H')'
         // and ((I - K H) P) (I - K H)' = A - (A H') K' for A = (I - K H) P.
         let a = self.p - k * pht.transpose();
         let p = a - (a * h.transpose()) * k.transpose() + k * r * k.transpose();
         self.p = (p + p.transpose()) * 0.5;
-        Ok(nis)
+        Ok(Gated::Accepted(nis))
+    }
+}
+
+/// What a gated update did, with the measurement's NIS.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Gated {
+    Accepted(f64),
+    Rejected(f64),
+}
+
+impl Gated {
+    pub fn nis(self) -> f64 {
+        match self {
+            Gated::Accepted(n) | Gated::Rejected(n) => n,
+        }
     }
 }
 
@@ -219,5 +250,17 @@ mod tests {
         let err = ekf.update(&PositionFix, &Vector1::new(f64::NAN), &nalgebra::Matrix1::new(1.0));
         assert_eq!(err, Err(FilterError::NonFinite));
         assert_eq!(ekf, before);
+    }
+
+    #[test]
+    fn gated_update_rejects_above_the_threshold_and_leaves_state() {
+        let mut ekf = Ekf::new(Vector2::new(0.0, 0.0), Matrix2::identity());
+        let r = nalgebra::Matrix1::new(1.0);
+        let before = ekf.clone();
+        // innovation 3, S = 1 + 1: NIS 4.5
+        assert_eq!(ekf.update_gated(&PositionFix, &Vector1::new(3.0), &r, 4.4), Ok(Gated::Rejected(4.5)));
+        assert_eq!(ekf, before);
+        assert_eq!(ekf.update_gated(&PositionFix, &Vector1::new(3.0), &r, 4.6), Ok(Gated::Accepted(4.5)));
+        assert_relative_eq!(ekf.x[0], 1.5, epsilon = 1e-12);
     }
 }

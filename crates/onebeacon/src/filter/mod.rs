@@ -3,4 +3,4 @@
 pub mod consistency;
 pub mod ekf;
 
-pub use ekf::{Ekf, FilterError, MeasurementModel, ProcessModel};
+pub use ekf::{Ekf, FilterError, Gated, MeasurementModel, ProcessModel};

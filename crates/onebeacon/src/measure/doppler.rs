@@ -10,23 +10,25 @@ use crate::models::unicycle::idx;
 use nalgebra::{SMatrix, SVector, Vector2};
 
 /// Radial speed of the vehicle toward `beacon` (NED, m), read from the unicycle state
-/// layout (position, heading, forward speed).
+/// layout (position, heading, forward speed), or with the forward speed a known input
+/// (`known_speed_m_s`: odometry, DVL), when only position and heading are states.
 #[derive(Debug, Clone, Copy)]
 pub struct RadialSpeed2d {
     pub beacon: Vector2<f64>,
+    pub known_speed_m_s: Option<f64>,
 }
 
 impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
     fn predict(&self, x: &SVector<f64, N>) -> f64 {
         let (dx, dy) = (x[idx::X] - self.beacon.x, x[idx::Y] - self.beacon.y);
         let c = dy.atan2(dx) - x[idx::PSI]; // C of eq. 23
-        -x[idx::V] * c.cos() // eq. 20, second row; equals eq. 13 with eq. 14
+        -self.speed(x) * c.cos() // eq. 20, second row; equals eq. 13 with eq. 14
     }
 
     fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
         let (dx, dy) = (x[idx::X] - self.beacon.x, x[idx::Y] - self.beacon.y);
         let r2 = dx * dx + dy * dy;
-        let v = x[idx::V];
+        let v = self.speed(x);
         let c = dy.atan2(dx) - x[idx::PSI];
         let mut h = SMatrix::<f64, 1, N>::zeros();
         if r2 > 1e-18 {
@@ -35,8 +37,16 @@ impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
             h[idx::Y] = b * dx;
         }
         h[idx::PSI] = -v * c.sin();
-        h[idx::V] = -c.cos();
+        if self.known_speed_m_s.is_none() {
+            h[idx::V] = -c.cos();
+        }
         h
+    }
+}
+
+impl RadialSpeed2d {
+    fn speed<const N: usize>(&self, x: &SVector<f64, N>) -> f64 {
+        self.known_speed_m_s.unwrap_or_else(|| x[idx::V])
     }
 }
 
@@ -53,7 +63,7 @@ mod tests {
 
     #[test]
     fn sign_is_positive_when_closing() {
-        let m = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0) };
+        let m = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None };
         // vehicle 10 m north of the beacon heading south at 1.5 m/s: closing at 1.5
         assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &state(10.0, 0.0, PI, 1.5)), 1.5, epsilon = 1e-12);
         // heading north: opening
@@ -67,13 +77,23 @@ mod tests {
 
     #[test]
     fn jacobian_matches_finite_differences() {
-        let m = RadialSpeed2d { beacon: Vector2::new(50.0, 100.0) };
+        let m = RadialSpeed2d { beacon: Vector2::new(50.0, 100.0), known_speed_m_s: None };
+        let known = RadialSpeed2d { known_speed_m_s: Some(1.3), ..m };
         for x in [state(10.0, 20.0, 0.4, 1.1), state(80.0, 230.0, -2.5, 0.9), state(49.0, 101.0, 3.0, -1.2)] {
-            let h = ScalarModel::<6>::jacobian(&m, &x);
-            let fd = finite_difference::<6>(&m, &x);
-            for j in 0..6 {
-                assert_abs_diff_eq!(h[j], fd[j], epsilon = 1e-7);
+            for m in [m, known] {
+                let h = ScalarModel::<6>::jacobian(&m, &x);
+                let fd = finite_difference::<6>(&m, &x);
+                for j in 0..6 {
+                    assert_abs_diff_eq!(h[j], fd[j], epsilon = 1e-7);
+                }
             }
         }
+        // a known speed is the input, whatever the state holds
+        let (x, x_at_known) = (state(10.0, 0.0, 0.7, 9.0), state(10.0, 0.0, 0.7, 1.3));
+        assert_abs_diff_eq!(
+            ScalarModel::<6>::predict(&known, &x),
+            ScalarModel::<6>::predict(&m, &x_at_known),
+            epsilon = 1e-12
+        );
     }
 }

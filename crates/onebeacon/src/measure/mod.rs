@@ -13,7 +13,7 @@ pub mod range;
 pub mod state;
 
 pub use doppler::RadialSpeed2d;
-pub use range::{Range2d, Range3d};
+pub use range::{Range2d, Range3d, SlantRange};
 pub use state::StateComponent;
 
 use crate::filter::MeasurementModel;

@@ -121,7 +121,7 @@ impl SingleBeaconEkf {
             }
             (Some(f), Aiding::RangeDoppler) => {
                 let range = Range2d { beacon: f.beacon_ned_m };
-                let doppler = RadialSpeed2d { beacon: f.beacon_ned_m };
+                let doppler = RadialSpeed2d { beacon: f.beacon_ned_m, known_speed_m_s: None };
                 self.update(
                     [&range, &doppler, &HEADING, &YAW_RATE, &ACCEL], // eq. 18, 20
                     [f.range_m, f.radial_speed_m_s, proprio[0], proprio[1], proprio[2]],
@@ -199,7 +199,7 @@ mod tests {
             let frame = (k % 12 == 0).then(|| CommFrame {
                 beacon_ned_m: beacon,
                 range_m: Range2d { beacon }.predict(&truth),
-                radial_speed_m_s: RadialSpeed2d { beacon }.predict(&truth),
+                radial_speed_m_s: RadialSpeed2d { beacon, known_speed_m_s: None }.predict(&truth),
             });
             for (f, e) in filters.iter_mut().zip(speed_err.iter_mut()) {
                 f.step(dt, &sample, frame.as_ref()).unwrap();

@@ -1,0 +1,346 @@
+//! `onebeacon replay` (a log through every estimator, scored against its ground truth)
+//! and `onebeacon stream` (JSON Lines in, one estimate line out per line, flushed).
+
+use crate::BadInput;
+use crate::output::Staging;
+use crate::{plot, report};
+use anyhow::{Context, Result};
+use onebeacon::nav::{Measurement, Outcome};
+use onebeacon_sim::replay::{Input, Item, Log, LogDescription, Session, Start, Step, TruthPose, replay as run_replay};
+use serde_json::{Map, Value, json};
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+
+/// One stream item as a JSON line (SI units, the log's frame).
+pub fn item_json(item: &Item) -> Value {
+    let t = item.t_s;
+    match item.input {
+        Input::Measurement(m) => match m {
+            Measurement::Odometry { distance_m, heading_change_rad } => {
+                json!({"t_s": t, "kind": "odometry", "distance_m": distance_m, "heading_change_rad": heading_change_rad})
+            }
+            Measurement::Speed { speed_m_s } => json!({"t_s": t, "kind": "speed", "speed_m_s": speed_m_s}),
+            Measurement::Heading { heading_rad } => json!({"t_s": t, "kind": "heading", "heading_rad": heading_rad}),
+            Measurement::Depth { depth_m } => json!({"t_s": t, "kind": "depth", "depth_m": depth_m}),
+            Measurement::Range { beacon_id, range_m, .. } => {
+                json!({"t_s": t, "kind": "range", "beacon": beacon_id, "range_m": range_m})
+            }
+            Measurement::Doppler { beacon_id, radial_speed_m_s, .. } => {
+                json!({"t_s": t, "kind": "doppler", "beacon": beacon_id, "radial_speed_m_s": radial_speed_m_s})
+            }
+        },
+        Input::BeaconPosition { beacon_id, position } => json!({"t_s": t, "kind": "beacon_position",
+            "beacon": beacon_id, "x_m": position.x, "y_m": position.y, "z_m": position.z}),
+        Input::Truth(p) => {
+            let mut v = json!({"t_s": t, "kind": "ground_truth", "x_m": p.north_m, "y_m": p.east_m});
+            if let Some(h) = p.heading_rad {
+                v["heading_rad"] = json!(h);
+            }
+            v
+        }
+    }
+}
+
+const KINDS: &str = "odometry, speed, heading, depth, range, doppler, beacon_position, ground_truth";
+
+/// Parses one JSON line into an item; fixed beacons resolve `beacon` ids, tracked ones
+/// (`beacon_position` lines seen so far) are resolved by the session.
+fn parse_item(
+    line: &str,
+    beacons: &BTreeMap<u32, nalgebra::Vector3<f64>>,
+    tracked: &mut BTreeSet<u32>,
+) -> Result<Item, String> {
+    let v: Map<String, Value> = serde_json::from_str(line).map_err(|e| format!("not a JSON object: {e}"))?;
+    let num = |key: &str| -> Result<f64, String> {
+        match v.get(key) {
+            None => Err(format!("missing key `{key}`")),
+            Some(x) => {
+                x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| format!("`{key}` = {x} is not a finite number"))
+            }
+        }
+    };
+    let kind = v.get("kind").and_then(Value::as_str).ok_or_else(|| format!("missing key `kind` (one of {KINDS})"))?;
+    let t_s = num("t_s")?;
+    let beacon = |tracked: &BTreeSet<u32>| -> Result<(u32, nalgebra::Vector3<f64>), String> {
+        let id = v.get("beacon").and_then(Value::as_u64).and_then(|b| u32::try_from(b).ok());
+        let id = id.ok_or_else(|| "`beacon` must be a beacon id (a non-negative integer)".to_string())?;
+        match beacons.get(&id) {
+            Some(p) => Ok((id, *p)),
+            None if tracked.contains(&id) => Ok((id, nalgebra::Vector3::repeat(f64::NAN))),
+            None => {
+                let known: Vec<String> = beacons.keys().chain(tracked.iter()).map(u32::to_string).collect();
+                Err(format!("beacon {id} is not among the beacons ({})", known.join(", ")))
+            }
+        }
+    };
+    let m = |m: Measurement| Input::Measurement(m);
+    let input = match kind {
+        "odometry" => {
+            m(Measurement::Odometry { distance_m: num("distance_m")?, heading_change_rad: num("heading_change_rad")? })
+        }
+        "speed" => m(Measurement::Speed { speed_m_s: num("speed_m_s")? }),
+        "heading" => m(Measurement::Heading { heading_rad: num("heading_rad")? }),
+        "depth" => m(Measurement::Depth { depth_m: num("depth_m")? }),
+        "range" => {
+            let (beacon_id, beacon) = beacon(tracked)?;
+            m(Measurement::Range { beacon_id, beacon, range_m: num("range_m")? })
+        }
+        "doppler" => {
+            let (beacon_id, beacon) = beacon(tracked)?;
+            m(Measurement::Doppler { beacon_id, beacon, radial_speed_m_s: num("radial_speed_m_s")? })
+        }
+        "beacon_position" => {
+            let id = v.get("beacon").and_then(Value::as_u64).and_then(|b| u32::try_from(b).ok());
+            let beacon_id = id.ok_or_else(|| "`beacon` must be a beacon id (a non-negative integer)".to_string())?;
+            tracked.insert(beacon_id);
+            let z = if v.contains_key("z_m") { num("z_m")? } else { 0.0 };
+            Input::BeaconPosition { beacon_id, position: nalgebra::Vector3::new(num("x_m")?, num("y_m")?, z) }
+        }
+        "ground_truth" => {
+            let heading_rad = if v.contains_key("heading_rad") { Some(num("heading_rad")?) } else { None };
+            Input::Truth(TruthPose { north_m: num("x_m")?, east_m: num("y_m")?, heading_rad })
+        }
+        other => return Err(format!("unknown kind `{other}` (one of {KINDS})")),
+    };
+    Ok(Item { t_s, input })
+}
+
+/// `--beacons` checked against the log's beacons.
+fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Option<BTreeSet<u32>>> {
+    let Some(ids) = ids else { return Ok(None) };
+    for id in &ids {
+        if !known.contains(id) {
+            let list: Vec<String> = known.iter().map(u32::to_string).collect();
+            return Err(
+                BadInput(format!("--beacons {id}: not a beacon of the log (beacons: {})", list.join(", "))).into()
+            );
+        }
+    }
+    Ok(Some(ids.into_iter().collect()))
+}
+
+/// `onebeacon replay LOG.toml [--out DIR] [--beacons 0,5] [--json] [--print-stream]`
+pub fn replay(
+    path: &Path,
+    out: Option<PathBuf>,
+    beacons: Option<Vec<u32>>,
+    as_json: bool,
+    print_stream: bool,
+) -> Result<()> {
+    let log = Log::load(path)?;
+    if print_stream {
+        let mut stdout = std::io::stdout().lock();
+        for item in &log.items {
+            writeln!(stdout, "{}", item_json(item))?;
+        }
+        return Ok(());
+    }
+    let mut known: BTreeSet<u32> = log.beacons.keys().copied().collect();
+    known.extend(log.items.iter().filter_map(|i| match i.input {
+        Input::BeaconPosition { beacon_id, .. } => Some(beacon_id),
+        _ => None,
+    }));
+    let filter = beacon_filter(beacons, &known)?;
+    let used: Vec<u32> = filter.clone().map_or_else(|| known.iter().copied().collect(), |f| f.into_iter().collect());
+    let suffix =
+        filter.as_ref().map(|f| format!("-beacons-{}", f.iter().map(u32::to_string).collect::<Vec<_>>().join("-")));
+    let name = &log.description.name;
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-replay{}", suffix.unwrap_or_default())));
+    let staging = Staging::new(&dir)?;
+
+    let started = std::time::Instant::now();
+    let r = run_replay(&log, filter)?;
+    let wall_s = started.elapsed().as_secs_f64();
+    let s = &r.session;
+    let summary = summary_json(&log, &used, s, wall_s);
+
+    staging.write("trajectory.csv", &report::trajectory_csv(&s.names, &r.trajectory)?)?;
+    staging.write("summary.json", serde_json::to_string_pretty(&summary)?.as_bytes())?;
+    staging.write("rejected.csv", &rejected_csv(s)?)?;
+    let fixed: Vec<_> =
+        used.iter().filter_map(|b| log.beacons.get(b)).map(|p| log.frame.to_ned(p.x, p.y, p.z)).collect();
+    let title = format!("{name}, beacons {}", used.iter().map(u32::to_string).collect::<Vec<_>>().join(", "));
+    plot::top_view(&staging.file("top_view.png"), &s.names, &title, &r.trajectory, Some(&fixed))
+        .context("cannot draw top_view.png")?;
+    plot::error_vs_time(&staging.file("error.png"), &s.names, &title, &r.trajectory)
+        .context("cannot draw error.png")?;
+    let files = staging.commit()?;
+
+    if as_json {
+        println!("{summary}");
+        return Ok(());
+    }
+    println!("{title}: {} measurements, replayed in {:.1} ms", log.items.len(), wall_s * 1e3);
+    println!(
+        "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9}",
+        "estimator", "rmse_m", "mean_m", "final_m", "max_m", "rejected", "bias_m"
+    );
+    for (e, st) in summary["estimators"].as_array().into_iter().flatten().zip(&s.stats) {
+        let f = |k: &str| e[k].as_f64().map_or("-".into(), |v| format!("{v:.3}"));
+        println!(
+            "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9}",
+            e["name"].as_str().unwrap_or(""),
+            f("rmse_m"),
+            f("mean_error_m"),
+            f("final_error_m"),
+            f("max_error_m"),
+            st.rejected,
+            f("range_bias_m")
+        );
+    }
+    println!("wrote:");
+    for f in files {
+        println!("  {}", f.display());
+    }
+    Ok(())
+}
+
+fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
+    let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+    let finals = s.final_estimates();
+    let estimators: Vec<Value> = s
+        .names
+        .iter()
+        .zip(&s.stats)
+        .zip(&finals)
+        .map(|((name, st), e)| {
+            let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m, e.east_m, 0.0));
+            json!({
+                "name": name,
+                "rmse_m": num(st.rmse_m()),
+                "mean_error_m": num(st.mean_m()),
+                "final_error_m": if st.count > 0 { num(st.final_m) } else { Value::Null },
+                "max_error_m": if st.count > 0 { num(st.max_m) } else { Value::Null },
+                "rejected": st.rejected,
+                "failed_updates": st.failed,
+                "range_bias_m": num(e.bias_m),
+                "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad)},
+            })
+        })
+        .collect();
+    json!({
+        "log": log.description.name,
+        "beacons": used,
+        "items": log.items.len(),
+        "skipped_before_start": s.before_start,
+        "left_out": s.left_out,
+        "wall_s": wall_s,
+        "estimators": estimators,
+    })
+}
+
+fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(["estimator", "t_s", "kind", "beacon", "value", "nis"])?;
+    for r in &s.rejected {
+        w.write_record([
+            s.names[r.estimator].clone(),
+            format!("{:.6}", r.t_s),
+            r.kind.to_string(),
+            r.beacon_id.to_string(),
+            format!("{:.6}", r.value),
+            format!("{:.3}", r.nis),
+        ])?;
+    }
+    Ok(w.into_inner()?)
+}
+
+/// One output line: every estimator's estimate after an input line (the log's frame).
+fn step_json(line: usize, step: &Step, s: &Session, frame: onebeacon::geo::Frame) -> Value {
+    let estimates: Vec<Value> = step
+        .estimates
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let (x, y, _) = frame.from_ned(&nalgebra::Vector3::new(e.north_m, e.east_m, 0.0));
+            let mut v = json!({
+                "name": s.names[i],
+                "x_m": x,
+                "y_m": y,
+                "heading_rad": frame.heading_from_ned(e.heading_rad),
+                "sigma_x_m": if frame == onebeacon::geo::Frame::Enu { e.sigma_east_m } else { e.sigma_north_m },
+                "sigma_y_m": if frame == onebeacon::geo::Frame::Enu { e.sigma_north_m } else { e.sigma_east_m },
+                "range_bias_m": e.bias_m,
+            });
+            if let Some(o) = step.outcomes[i] {
+                let (outcome, nis) = match o {
+                    Outcome::Applied => ("applied", None),
+                    Outcome::Accepted(n) => ("accepted", Some(n)),
+                    Outcome::Rejected(n) => ("rejected", Some(n)),
+                    Outcome::Skipped => ("skipped", None),
+                    Outcome::Failed(_) => ("failed", None),
+                };
+                v["outcome"] = json!(outcome);
+                if let Some(n) = nis {
+                    v["nis"] = json!(n);
+                }
+            }
+            if let Some(err) = step.errors_m.as_ref().map(|e| e[i]) {
+                v["error_m"] = json!(err);
+            }
+            v
+        })
+        .collect();
+    json!({"line": line, "t_s": step.t_s, "estimates": estimates})
+}
+
+/// `onebeacon stream CONFIG.toml`: JSON Lines on stdin, one JSON line per estimate on
+/// stdout, flushed after each; bad lines are reported on stderr and skipped.
+pub fn stream(config: &Path) -> Result<()> {
+    let d = LogDescription::load(config)?;
+    let base = config.parent().unwrap_or(Path::new("."));
+    let beacons = d.fixed_beacons(base)?;
+    let frame = onebeacon::geo::Frame::from(d.frame);
+    let init = &d.initial;
+    let start = match init.from {
+        onebeacon_sim::replay::log::InitialFrom::Given => {
+            let p = frame.to_ned(init.x_m.unwrap_or(0.0), init.y_m.unwrap_or(0.0), 0.0);
+            Start::At {
+                t0_s: None,
+                pose: (p.x, p.y, frame.heading_to_ned(init.heading_deg.unwrap_or(0.0).to_radians())),
+            }
+        }
+        onebeacon_sim::replay::log::InitialFrom::GroundTruth => {
+            if init.heading_from == onebeacon_sim::replay::log::HeadingFrom::Track {
+                return Err(BadInput(format!(
+                    "{}: key `initial.heading_from` = \"track\": needs the whole log; a stream starts from the first ground_truth line's heading (\"column\") or a given pose",
+                    config.display()
+                ))
+                .into());
+            }
+            Start::FirstTruth
+        }
+    };
+    let estimators = d.estimators.iter().map(|e| (e.name.clone(), e.config())).collect();
+    let mut session =
+        Session::new(frame, estimators, start, (init.sigma_position_m, init.sigma_heading_deg.to_radians()), None);
+    let mut tracked = BTreeSet::new();
+    let stdin = std::io::stdin().lock();
+    let mut stdout = std::io::stdout().lock();
+    let mut last_t = f64::NEG_INFINITY;
+    for (n, line) in stdin.lines().enumerate() {
+        let number = n + 1;
+        let line = line.context("cannot read stdin")?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let item = match parse_item(&line, &beacons, &mut tracked) {
+            Ok(item) if item.t_s < last_t => Err(format!("time {} is before {last_t} on an earlier line", item.t_s)),
+            other => other,
+        };
+        let item = match item {
+            Ok(item) => item,
+            Err(e) => {
+                eprintln!("stdin line {number}: {e}; skipped");
+                continue;
+            }
+        };
+        last_t = item.t_s;
+        if let Some(step) = session.push(&item) {
+            writeln!(stdout, "{}", step_json(number, &step, &session, frame))?;
+            stdout.flush()?;
+        }
+    }
+    Ok(())
+}

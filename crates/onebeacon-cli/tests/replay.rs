@@ -1,0 +1,241 @@
+//! `onebeacon replay` and `onebeacon stream` on the real plaza logs (data/plaza), and
+//! their bad input.
+
+use serde_json::Value;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_onebeacon"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("onebeacon-replay-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn plaza(n: u8) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../data/plaza/plaza{n}.toml")).display().to_string()
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("binary runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// `replay --json` (files into `out`): estimator name -> summary object.
+fn replay_json(log: &str, beacons: Option<&str>, out: &Path) -> Vec<Value> {
+    let out = out.display().to_string();
+    let mut args = vec!["replay", log, "--json", "--out", &out];
+    if let Some(b) = beacons {
+        args.extend(["--beacons", b]);
+    }
+    let o = run(&args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    v["estimators"].as_array().unwrap().clone()
+}
+
+fn rmse(estimators: &[Value], name: &str) -> f64 {
+    estimators.iter().find(|e| e["name"] == name).unwrap()["rmse_m"].as_f64().unwrap()
+}
+
+/// The issue's targets that the data allow (see the closing note for the table): all
+/// four beacons with bias estimation within 1.5 m RMSE on both logs; on plaza2, where
+/// dead reckoning drifts (32 m RMSE), single beacons 1 and 5 bring it under a quarter.
+#[test]
+fn plaza_all_beacons_and_single_beacons() {
+    let dir = scratch("plaza");
+    for n in [1, 2] {
+        let all = replay_json(&plaza(n), None, &dir.join(format!("all{n}")));
+        assert!(rmse(&all, "ekf-bias") <= 1.5, "plaza{n}: {all:?}");
+        assert!(rmse(&all, "ekf-bias-gated") <= 1.5);
+        // the estimated bias is near the data's +2.8 m
+        let bias = all.iter().find(|e| e["name"] == "ekf-bias").unwrap()["range_bias_m"].as_f64().unwrap();
+        assert!((1.5..4.0).contains(&bias), "plaza{n} bias {bias}");
+        // without the bias the gate rejects many true ranges; with it, next to none
+        let rejected = |name: &str| all.iter().find(|e| e["name"] == name).unwrap()["rejected"].as_u64().unwrap();
+        assert!(rejected("ekf-gated") > 10 * rejected("ekf-bias-gated").max(1));
+    }
+    let dr = rmse(&replay_json(&plaza(2), None, &dir.join("dr")), "dead-reckoning");
+    for b in ["1", "5"] {
+        let single = replay_json(&plaza(2), Some(b), &dir.join(format!("b{b}")));
+        assert!(rmse(&single, "ekf-bias") < dr / 4.0, "beacon {b}: {single:?} vs {dr}");
+    }
+    // the outputs are all there
+    for f in ["trajectory.csv", "summary.json", "rejected.csv", "top_view.png", "error.png"] {
+        assert!(dir.join("all1").join(f).is_file(), "{f}");
+    }
+}
+
+/// The merged stream of a log, piped through `stream`, gives the replay's estimates:
+/// the same final estimates to the bit, and the same RMSE from the per-line errors.
+#[test]
+fn streaming_equals_replay() {
+    let dir = scratch("stream");
+    let log = plaza(1);
+    let summary = replay_json(&log, None, &dir.join("out"));
+    let items = run(&["replay", &log, "--print-stream"]);
+    assert!(items.status.success());
+    let mut child = bin()
+        .args(["stream", &log])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let input = items.stdout.clone();
+    let writer = std::thread::spawn(move || stdin.write_all(&input).unwrap());
+    let o = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let lines: Vec<Value> = text(&o.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert!(lines.len() > 20_000);
+    let last = lines.last().unwrap()["estimates"].as_array().unwrap();
+    for (s, e) in summary.iter().zip(last) {
+        assert_eq!(s["name"], e["name"]);
+        for k in ["x_m", "y_m", "heading_rad"] {
+            assert_eq!(s["final"][k].as_f64(), e[k].as_f64(), "{} {k}", s["name"]);
+        }
+        let errors: Vec<f64> = lines
+            .iter()
+            .filter_map(|l| l["estimates"].as_array().unwrap().iter().find(|x| x["name"] == s["name"]))
+            .filter_map(|x| x["error_m"].as_f64())
+            .collect();
+        let r = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        assert!((r - s["rmse_m"].as_f64().unwrap()).abs() < 1e-9 * r, "{} {r}", s["name"]);
+    }
+}
+
+/// A log description in `dir/case` over a CSV of ranges `ranges` (and `extra` keys on
+/// its source), plus a clean odometry file.
+fn bad_log(dir: &Path, case: &str, ranges: &str, extra: &str) -> String {
+    let dir = &dir.join(case.replace(' ', "-"));
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join("odo.csv"), "t,d,dh\n1.0,0.1,0.0\n2.0,0.1,0.0\n").unwrap();
+    std::fs::write(dir.join("ranges.csv"), ranges).unwrap();
+    let toml = format!(
+        r#"name = "bad"
+frame = "enu"
+[[source]]
+kind = "odometry"
+file = "odo.csv"
+time = "t"
+distance = "d"
+heading_change = "dh"
+[[source]]
+kind = "range"
+file = "ranges.csv"
+time = "t"
+beacon = "id"
+range = "r"
+{extra}
+[[beacon]]
+id = 0
+x_m = 10.0
+y_m = 0.0
+[initial]
+from = "given"
+x_m = 0.0
+y_m = 0.0
+heading_deg = 0.0
+[[estimator]]
+name = "ekf"
+kind = "range_ekf"
+"#
+    );
+    let path = dir.join("log.toml");
+    std::fs::write(&path, toml).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn bad_logs_exit_2_with_one_line_naming_file_line_and_column() {
+    let dir = scratch("bad");
+    let good = "t,id,r\n1.5,0,10.0\n";
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("missing column", bad_log(&dir, "missing column", "t,beacon,r\n1.5,0,10.0\n", ""), "no column `id`"),
+        (
+            "not a number",
+            bad_log(&dir, "not a number", "t,id,r\n1.5,0,ten\n", ""),
+            "line 2, column `r`: `ten` is not a number",
+        ),
+        ("NaN cell", bad_log(&dir, "NaN cell", "t,id,r\n1.5,0,NaN\n", ""), "line 2, column `r`: `NaN` is not finite"),
+        (
+            "time backwards",
+            bad_log(&dir, "time backwards", "t,id,r\n1.5,0,10.0\n1.2,0,10.0\n", ""),
+            "line 3, column `t`: time 1.2 is before 1.5",
+        ),
+        (
+            "unknown beacon",
+            bad_log(&dir, "unknown beacon", "t,id,r\n1.5,7,10.0\n", ""),
+            "line 2, column `id`: beacon 7 is not among the beacons (0)",
+        ),
+        ("missing file", bad_log(&dir, "missing file", good, "").replace("log.toml", "nope.toml"), "nope.toml"),
+    ];
+    for (label, path, expected) in cases {
+        let o = run(&["replay", &path, "--out", &dir.join("out").display().to_string()]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{label}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{label}: {err}");
+        assert!(err.contains(expected), "{label}: {err}");
+        assert!(!dir.join("out").exists(), "{label}: nothing half-written");
+    }
+    // unknown measurement kind and a key of another kind, in the description
+    let path = bad_log(&dir, "kind", good, "");
+    let text_toml = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, text_toml.replace("kind = \"range\"", "kind = \"sonar\"")).unwrap();
+    let o = run(&["replay", &path]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("unknown variant `sonar`"), "{}", text(&o.stderr));
+    let path = bad_log(&dir, "key", good, "speed = \"v\"");
+    let o = run(&["replay", &path]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("source[1].speed"), "{}", text(&o.stderr));
+    // a beacon the log does not have
+    let o = run(&["replay", &plaza(1), "--beacons", "3"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("--beacons 3: not a beacon of the log (beacons: 0, 1, 5, 6)"));
+}
+
+#[test]
+fn stream_reports_bad_lines_and_goes_on() {
+    let dir = scratch("stream-bad");
+    let path = bad_log(&dir, "stream", "t,id,r\n1.5,0,10.0\n", "");
+    let input = [
+        r#"{"t_s": 1.0, "kind": "odometry", "distance_m": 0.5, "heading_change_rad": 0.0}"#,
+        r#"{"t_s": 1.1, "kind": "sonar"}"#,
+        r#"not json"#,
+        r#"{"t_s": 1.2, "kind": "range", "beacon": 4, "range_m": 9.0}"#,
+        r#"{"t_s": 0.5, "kind": "range", "beacon": 0, "range_m": 9.0}"#,
+        r#"{"t_s": 1.3, "kind": "range", "beacon": 0, "range_m": "x"}"#,
+        r#"{"t_s": 2.0, "kind": "range", "beacon": 0, "range_m": 9.6}"#,
+    ]
+    .join("\n");
+    let mut child = bin()
+        .args(["stream", &path])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input.as_bytes()).unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success());
+    let err = text(&o.stderr);
+    for (line, what) in
+        [(2, "unknown kind `sonar`"), (3, "not a JSON object"), (4, "beacon 4"), (5, "before"), (6, "`range_m`")]
+    {
+        assert!(err.contains(&format!("stdin line {line}: ")) && err.contains(what), "{line}: {err}");
+    }
+    let out: Vec<Value> = text(&o.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(out.iter().map(|l| l["line"].as_u64().unwrap()).collect::<Vec<_>>(), vec![1, 7]);
+    assert_eq!(out[1]["estimates"][0]["outcome"], "accepted");
+}

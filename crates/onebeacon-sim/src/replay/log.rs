@@ -1,0 +1,766 @@
+//! The log description (TOML) and the loading of its CSV files into one time-ordered
+//! stream. Every error is one line naming the file, the line, the column or key and
+//! what was expected.
+
+use crate::scenario::load::deserialize;
+use nalgebra::Vector3;
+use onebeacon::geo::Frame;
+use onebeacon::nav::{Measurement, PlanarConfig, PlanarNoise};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Why a log could not be loaded: one line each.
+#[derive(Debug, thiserror::Error)]
+pub enum LogError {
+    #[error(transparent)]
+    Description(#[from] crate::ScenarioError),
+    #[error("{file}: {message}")]
+    File { file: String, message: String },
+    #[error("{file} line {line}, column `{column}`: {message}")]
+    Cell { file: String, line: u64, column: String, message: String },
+}
+
+/// The frame of the log's x, y, z and headings (`frame` key).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrameKey {
+    #[default]
+    Ned,
+    Enu,
+}
+
+impl From<FrameKey> for Frame {
+    fn from(f: FrameKey) -> Self {
+        match f {
+            FrameKey::Ned => Frame::Ned,
+            FrameKey::Enu => Frame::Enu,
+        }
+    }
+}
+
+/// What a CSV source holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SourceKind {
+    Odometry,
+    Speed,
+    Heading,
+    SpeedHeading,
+    Depth,
+    Range,
+    Doppler,
+    BeaconTrack,
+    GroundTruth,
+}
+
+impl SourceKind {
+    /// The column keys this kind needs, and those it may have.
+    fn columns(self) -> (&'static [&'static str], &'static [&'static str]) {
+        match self {
+            SourceKind::Odometry => (&["distance", "heading_change"], &[]),
+            SourceKind::Speed => (&["speed"], &[]),
+            SourceKind::Heading => (&["heading"], &[]),
+            SourceKind::SpeedHeading => (&["speed", "heading"], &[]),
+            SourceKind::Depth => (&["depth"], &[]),
+            SourceKind::Range => (&["beacon", "range"], &[]),
+            SourceKind::Doppler => (&["beacon", "radial_speed"], &[]),
+            SourceKind::BeaconTrack => (&["beacon", "x", "y"], &["z"]),
+            SourceKind::GroundTruth => (&["x", "y"], &["heading"]),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LengthUnit {
+    #[default]
+    M,
+    Cm,
+    Mm,
+    Km,
+}
+
+impl LengthUnit {
+    fn metres(self) -> f64 {
+        match self {
+            LengthUnit::M => 1.0,
+            LengthUnit::Cm => 0.01,
+            LengthUnit::Mm => 0.001,
+            LengthUnit::Km => 1000.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AngleUnit {
+    #[default]
+    Rad,
+    Deg,
+}
+
+impl AngleUnit {
+    fn radians(self) -> f64 {
+        match self {
+            AngleUnit::Rad => 1.0,
+            AngleUnit::Deg => std::f64::consts::PI / 180.0,
+        }
+    }
+}
+
+/// One CSV file: its kind, the time column and the column of each quantity.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Source {
+    pub kind: SourceKind,
+    /// Relative to the log description's directory.
+    pub file: PathBuf,
+    /// The time column, seconds.
+    pub time: String,
+    /// Added to every time of this file, s.
+    #[serde(default)]
+    pub time_offset_s: f64,
+    #[serde(default)]
+    pub length_unit: LengthUnit,
+    #[serde(default)]
+    pub angle_unit: AngleUnit,
+    /// Sort the rows by time instead of refusing rows out of order.
+    #[serde(default)]
+    pub sort: bool,
+    pub distance: Option<String>,
+    pub heading_change: Option<String>,
+    pub speed: Option<String>,
+    pub heading: Option<String>,
+    pub depth: Option<String>,
+    pub beacon: Option<String>,
+    pub range: Option<String>,
+    pub radial_speed: Option<String>,
+    pub x: Option<String>,
+    pub y: Option<String>,
+    pub z: Option<String>,
+}
+
+impl Source {
+    fn column(&self, key: &str) -> Option<&String> {
+        match key {
+            "distance" => self.distance.as_ref(),
+            "heading_change" => self.heading_change.as_ref(),
+            "speed" => self.speed.as_ref(),
+            "heading" => self.heading.as_ref(),
+            "depth" => self.depth.as_ref(),
+            "beacon" => self.beacon.as_ref(),
+            "range" => self.range.as_ref(),
+            "radial_speed" => self.radial_speed.as_ref(),
+            "x" => self.x.as_ref(),
+            "y" => self.y.as_ref(),
+            "z" => self.z.as_ref(),
+            _ => None,
+        }
+    }
+}
+
+const COLUMN_KEYS: [&str; 11] =
+    ["distance", "heading_change", "speed", "heading", "depth", "beacon", "range", "radial_speed", "x", "y", "z"];
+
+/// Fixed beacon positions from a CSV file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeaconTable {
+    pub file: PathBuf,
+    pub id: String,
+    pub x: String,
+    pub y: String,
+    pub z: Option<String>,
+    #[serde(default)]
+    pub length_unit: LengthUnit,
+}
+
+/// One fixed beacon given inline.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeaconEntry {
+    pub id: u32,
+    pub x_m: f64,
+    pub y_m: f64,
+    #[serde(default)]
+    pub z_m: f64,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InitialFrom {
+    /// The first ground-truth pose.
+    #[default]
+    GroundTruth,
+    /// `x_m`, `y_m`, `heading_deg`.
+    Given,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadingFrom {
+    /// The ground truth's heading column.
+    #[default]
+    Column,
+    /// The direction of the ground-truth track over its first `track_m` metres (when
+    /// the heading column is missing or not to be trusted); replay only.
+    Track,
+}
+
+/// Where the estimators start.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Initial {
+    #[serde(default)]
+    pub from: InitialFrom,
+    #[serde(default)]
+    pub heading_from: HeadingFrom,
+    #[serde(default = "default_track_m")]
+    pub track_m: f64,
+    pub x_m: Option<f64>,
+    pub y_m: Option<f64>,
+    pub heading_deg: Option<f64>,
+    #[serde(default = "default_sigma_position_m")]
+    pub sigma_position_m: f64,
+    #[serde(default = "default_sigma_heading_deg")]
+    pub sigma_heading_deg: f64,
+}
+
+fn default_track_m() -> f64 {
+    2.0
+}
+fn default_sigma_position_m() -> f64 {
+    1.0
+}
+fn default_sigma_heading_deg() -> f64 {
+    5.0
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EstimatorKind {
+    /// Odometry (and heading fixes) alone.
+    DeadReckoning,
+    /// The planar EKF with ranges and Doppler speeds.
+    RangeEkf,
+}
+
+/// One estimator to run, with its noise settings (defaults: [`PlanarNoise`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EstimatorSpec {
+    pub name: String,
+    pub kind: EstimatorKind,
+    #[serde(default)]
+    pub estimate_bias: bool,
+    #[serde(default)]
+    pub bias_m: f64,
+    #[serde(default = "default_bias_sigma_m")]
+    pub bias_sigma_m: f64,
+    pub nis_gate: Option<f64>,
+    pub range_sigma_m: Option<f64>,
+    pub heading_sigma_deg: Option<f64>,
+    pub doppler_sigma_m_s: Option<f64>,
+    pub distance_sigma_frac: Option<f64>,
+    pub heading_change_sigma_frac: Option<f64>,
+    pub heading_walk_deg_per_sqrt_m: Option<f64>,
+    pub speed_sigma_m_s: Option<f64>,
+    pub bias_walk_m_per_sqrt_s: Option<f64>,
+}
+
+fn default_bias_sigma_m() -> f64 {
+    5.0
+}
+
+impl EstimatorSpec {
+    pub fn config(&self) -> PlanarConfig {
+        let d = PlanarNoise::default();
+        let noise = PlanarNoise {
+            distance_sigma_frac: self.distance_sigma_frac.unwrap_or(d.distance_sigma_frac),
+            heading_change_sigma_frac: self.heading_change_sigma_frac.unwrap_or(d.heading_change_sigma_frac),
+            heading_walk_rad_per_sqrt_m: self
+                .heading_walk_deg_per_sqrt_m
+                .map_or(d.heading_walk_rad_per_sqrt_m, f64::to_radians),
+            speed_sigma_m_s: self.speed_sigma_m_s.unwrap_or(d.speed_sigma_m_s),
+            range_sigma_m: self.range_sigma_m.unwrap_or(d.range_sigma_m),
+            heading_sigma_rad: self.heading_sigma_deg.map_or(d.heading_sigma_rad, f64::to_radians),
+            doppler_sigma_m_s: self.doppler_sigma_m_s.unwrap_or(d.doppler_sigma_m_s),
+            bias_walk_m_per_sqrt_s: self.bias_walk_m_per_sqrt_s.unwrap_or(d.bias_walk_m_per_sqrt_s),
+        };
+        PlanarConfig {
+            use_beacons: self.kind == EstimatorKind::RangeEkf,
+            estimate_bias: self.estimate_bias,
+            bias_m: self.bias_m,
+            bias_sigma_m: self.bias_sigma_m,
+            nis_gate: self.nis_gate,
+            noise,
+        }
+    }
+}
+
+/// The log description file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LogDescription {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default)]
+    pub frame: FrameKey,
+    #[serde(default, rename = "source")]
+    pub sources: Vec<Source>,
+    pub beacons: Option<BeaconTable>,
+    #[serde(default, rename = "beacon")]
+    pub beacon_list: Vec<BeaconEntry>,
+    pub initial: Initial,
+    #[serde(rename = "estimator")]
+    pub estimators: Vec<EstimatorSpec>,
+}
+
+/// A ground-truth pose (heading when the log has one). Items hold SI values in the
+/// log's frame (x, y in `north_m`, `east_m` for NED logs) until [`Input::to_ned`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TruthPose {
+    pub north_m: f64,
+    pub east_m: f64,
+    pub heading_rad: Option<f64>,
+}
+
+/// One item of the time-ordered stream.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Input {
+    Measurement(Measurement),
+    /// A beacon's position now (a moving beacon's track; fixes later measurements).
+    BeaconPosition {
+        beacon_id: u32,
+        position: Vector3<f64>,
+    },
+    Truth(TruthPose),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Item {
+    pub t_s: f64,
+    pub input: Input,
+}
+
+impl Input {
+    /// This input, given in `frame`, in NED: the one place where logs and streams
+    /// change frame.
+    pub fn to_ned(self, frame: Frame) -> Input {
+        let point = |p: Vector3<f64>| frame.to_ned(p.x, p.y, p.z);
+        match self {
+            Input::Measurement(m) => Input::Measurement(match m {
+                Measurement::Odometry { distance_m, heading_change_rad } => {
+                    Measurement::Odometry { distance_m, heading_change_rad: frame.turn_to_ned(heading_change_rad) }
+                }
+                Measurement::Heading { heading_rad } => {
+                    Measurement::Heading { heading_rad: frame.heading_to_ned(heading_rad) }
+                }
+                Measurement::Range { beacon_id, beacon, range_m } => {
+                    Measurement::Range { beacon_id, beacon: point(beacon), range_m }
+                }
+                Measurement::Doppler { beacon_id, beacon, radial_speed_m_s } => {
+                    Measurement::Doppler { beacon_id, beacon: point(beacon), radial_speed_m_s }
+                }
+                other @ (Measurement::Speed { .. } | Measurement::Depth { .. }) => other,
+            }),
+            Input::BeaconPosition { beacon_id, position } => {
+                Input::BeaconPosition { beacon_id, position: point(position) }
+            }
+            Input::Truth(p) => {
+                let n = frame.to_ned(p.north_m, p.east_m, 0.0);
+                Input::Truth(TruthPose {
+                    north_m: n.x,
+                    east_m: n.y,
+                    heading_rad: p.heading_rad.map(|h| frame.heading_to_ned(h)),
+                })
+            }
+        }
+    }
+}
+
+/// A loaded log: the description, fixed beacons and the merged stream (SI units, the
+/// log's frame).
+#[derive(Debug, Clone)]
+pub struct Log {
+    pub description: LogDescription,
+    pub frame: Frame,
+    pub beacons: BTreeMap<u32, Vector3<f64>>,
+    pub items: Vec<Item>,
+}
+
+impl LogDescription {
+    /// Reads and checks a log description (the CSV files are not read).
+    pub fn load(path: &Path) -> Result<Self, LogError> {
+        let name = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| LogError::File { file: name.clone(), message: e.to_string() })?;
+        let d: LogDescription = deserialize(&text, &name)?;
+        d.check(&name)?;
+        Ok(d)
+    }
+
+    fn check(&self, name: &str) -> Result<(), LogError> {
+        let bad = |key: String, value: String, allowed: &str| {
+            LogError::Description(crate::ScenarioError::Invalid {
+                source_name: name.to_string(),
+                key,
+                value,
+                allowed: allowed.to_string(),
+            })
+        };
+        for (i, s) in self.sources.iter().enumerate() {
+            let (required, optional) = s.kind.columns();
+            for key in required {
+                if s.column(key).is_none() {
+                    let msg = format!("a {:?} source needs the column keys {}", s.kind, required.join(", "));
+                    return Err(bad(format!("source[{i}].{key}"), "missing".into(), &msg));
+                }
+            }
+            for key in COLUMN_KEYS {
+                if s.column(key).is_some() && !required.contains(&key) && !optional.contains(&key) {
+                    let allowed: Vec<&str> = required.iter().chain(optional).copied().collect();
+                    let msg =
+                        format!("does not apply to a {:?} source (its column keys: {})", s.kind, allowed.join(", "));
+                    return Err(bad(
+                        format!("source[{i}].{key}"),
+                        format!("{:?}", s.column(key).unwrap_or(&String::new())),
+                        &msg,
+                    ));
+                }
+            }
+            if !s.time_offset_s.is_finite() {
+                return Err(bad(
+                    format!("source[{i}].time_offset_s"),
+                    s.time_offset_s.to_string(),
+                    "a finite number of seconds",
+                ));
+            }
+        }
+        if self.estimators.is_empty() {
+            return Err(bad("estimator".into(), "[]".into(), "at least one [[estimator]] table"));
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for (i, e) in self.estimators.iter().enumerate() {
+            if e.name.is_empty() || e.name.contains([',', '"', '\n']) || !names.insert(e.name.as_str()) {
+                return Err(bad(
+                    format!("estimator[{i}].name"),
+                    format!("{:?}", e.name),
+                    "a unique, non-empty name without commas or quotes",
+                ));
+            }
+            let positive = [
+                ("range_sigma_m", e.range_sigma_m),
+                ("heading_sigma_deg", e.heading_sigma_deg),
+                ("doppler_sigma_m_s", e.doppler_sigma_m_s),
+                ("nis_gate", e.nis_gate),
+                ("bias_sigma_m", Some(e.bias_sigma_m)),
+            ];
+            for (key, v) in positive {
+                if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
+                    return Err(bad(format!("estimator[{i}].{key}"), v.to_string(), "a number > 0"));
+                }
+            }
+            let non_negative = [
+                ("distance_sigma_frac", e.distance_sigma_frac),
+                ("heading_change_sigma_frac", e.heading_change_sigma_frac),
+                ("heading_walk_deg_per_sqrt_m", e.heading_walk_deg_per_sqrt_m),
+                ("speed_sigma_m_s", e.speed_sigma_m_s),
+                ("bias_walk_m_per_sqrt_s", e.bias_walk_m_per_sqrt_s),
+                ("bias_m", Some(e.bias_m)),
+            ];
+            for (key, v) in non_negative {
+                if let Some(v) = v.filter(|v| !(v.is_finite() && (*v >= 0.0 || key == "bias_m"))) {
+                    return Err(bad(format!("estimator[{i}].{key}"), v.to_string(), "a finite number >= 0"));
+                }
+            }
+        }
+        let init = &self.initial;
+        if init.from == InitialFrom::Given && (init.x_m.is_none() || init.y_m.is_none() || init.heading_deg.is_none()) {
+            return Err(bad(
+                "initial.from".into(),
+                "\"given\"".into(),
+                "needs initial.x_m, initial.y_m and initial.heading_deg",
+            ));
+        }
+        for (key, v) in [
+            ("sigma_position_m", init.sigma_position_m),
+            ("sigma_heading_deg", init.sigma_heading_deg),
+            ("track_m", init.track_m),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(format!("initial.{key}"), v.to_string(), "a number > 0"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Fixed beacons (the log's frame): the `[beacons]` file and the inline `[[beacon]]`
+    /// entries.
+    pub fn fixed_beacons(&self, base: &Path) -> Result<BTreeMap<u32, Vector3<f64>>, LogError> {
+        let mut out = BTreeMap::new();
+        if let Some(t) = &self.beacons {
+            let mut table = Table::open(base, &t.file)?;
+            let (id, x, y) = (table.index(&t.id)?, table.index(&t.x)?, table.index(&t.y)?);
+            let z = t.z.as_ref().map(|z| table.index(z)).transpose()?;
+            let scale = t.length_unit.metres();
+            while let Some(row) = table.next_row()? {
+                let b = row.beacon_id(id)?;
+                let z = z.map_or(Ok(0.0), |z| row.number(z))?;
+                let p = Vector3::new(row.number(x)?, row.number(y)?, z) * scale;
+                if out.insert(b, p).is_some() {
+                    return Err(row.error(id, format!("beacon {b} appears twice")));
+                }
+            }
+        }
+        for b in &self.beacon_list {
+            if out.insert(b.id, Vector3::new(b.x_m, b.y_m, b.z_m)).is_some() {
+                return Err(LogError::File {
+                    file: "[[beacon]]".into(),
+                    message: format!("beacon {} is given twice", b.id),
+                });
+            }
+        }
+        Ok(out)
+    }
+}
+
+impl Log {
+    /// Loads a log description and every file it names (relative to its directory).
+    pub fn load(path: &Path) -> Result<Self, LogError> {
+        let description = LogDescription::load(path)?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let frame = Frame::from(description.frame);
+        let beacons = description.fixed_beacons(base)?;
+        let tracked: std::collections::BTreeSet<u32> = Default::default();
+        let mut keyed: Vec<((f64, u8, usize, usize), Item)> = Vec::new();
+        let mut tracked = tracked;
+        // beacon tracks first, so that ranges may name tracked beacons
+        let order: Vec<usize> = (0..description.sources.len())
+            .filter(|&i| description.sources[i].kind == SourceKind::BeaconTrack)
+            .chain((0..description.sources.len()).filter(|&i| description.sources[i].kind != SourceKind::BeaconTrack))
+            .collect();
+        for i in order {
+            let s = &description.sources[i];
+            let rows = read_source(base, s, &beacons, &mut tracked)?;
+            for (r, item) in rows.into_iter().enumerate() {
+                // at equal times: beacon positions, then measurements, then the truth
+                let rank = match item.input {
+                    Input::BeaconPosition { .. } => 0,
+                    Input::Measurement(_) => 1,
+                    Input::Truth(_) => 2,
+                };
+                keyed.push(((item.t_s, rank, i, r), item));
+            }
+        }
+        keyed.sort_by(|a, b| {
+            let (ka, kb) = (a.0, b.0);
+            ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1)).then(ka.2.cmp(&kb.2)).then(ka.3.cmp(&kb.3))
+        });
+        Ok(Self { description, frame, beacons, items: keyed.into_iter().map(|(_, item)| item).collect() })
+    }
+
+    /// The initial pose (NED) and time, from the description: given, or the first
+    /// ground-truth pose (heading from its column or its track).
+    pub fn initial_pose(&self) -> Result<(f64, (f64, f64, f64)), LogError> {
+        let init = &self.description.initial;
+        let truth: Vec<(f64, TruthPose)> = self
+            .items
+            .iter()
+            .filter_map(|i| match i.input.to_ned(self.frame) {
+                Input::Truth(p) => Some((i.t_s, p)),
+                _ => None,
+            })
+            .collect();
+        let first_t = self.items.first().map_or(0.0, |i| i.t_s);
+        if init.from == InitialFrom::Given {
+            let p = self.frame.to_ned(init.x_m.unwrap_or(0.0), init.y_m.unwrap_or(0.0), 0.0);
+            let psi = self.frame.heading_to_ned(init.heading_deg.unwrap_or(0.0).to_radians());
+            return Ok((first_t, (p.x, p.y, psi)));
+        }
+        let no_truth = || {
+            LogError::File {
+            file: self.description.name.clone(),
+            message: "initial.from = \"ground_truth\" but the log has no ground_truth source (give the pose with from = \"given\")".into(),
+        }
+        };
+        let (t0, p0) = *truth.first().ok_or_else(no_truth)?;
+        let psi = match init.heading_from {
+            HeadingFrom::Column => p0.heading_rad.ok_or_else(|| LogError::File {
+                file: self.description.name.clone(),
+                message: "initial.heading_from = \"column\" but the ground_truth source has no heading column (use \"track\")".into(),
+            })?,
+            HeadingFrom::Track => {
+                let far = truth.iter().find(|(_, p)| (p.north_m - p0.north_m).hypot(p.east_m - p0.east_m) >= init.track_m);
+                let (_, p) = far.ok_or_else(|| LogError::File {
+                    file: self.description.name.clone(),
+                    message: format!("the ground truth never moves {} m from its start (initial.track_m)", init.track_m),
+                })?;
+                (p.east_m - p0.east_m).atan2(p.north_m - p0.north_m)
+            }
+        };
+        Ok((t0, (p0.north_m, p0.east_m, psi)))
+    }
+}
+
+/// A CSV file being read, with its header.
+struct Table {
+    file: String,
+    header: Vec<String>,
+    reader: csv::Reader<std::fs::File>,
+    record: csv::StringRecord,
+}
+
+/// One row of a [`Table`].
+struct Row<'a> {
+    table: &'a Table,
+    line: u64,
+}
+
+impl Table {
+    fn open(base: &Path, file: &Path) -> Result<Self, LogError> {
+        let path = base.join(file);
+        let name = path.display().to_string();
+        let f = std::fs::File::open(&path)
+            .map_err(|e| LogError::File { file: name.clone(), message: format!("cannot open: {e}") })?;
+        let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(f);
+        let header = reader
+            .headers()
+            .map_err(|e| LogError::File { file: name.clone(), message: format!("cannot read the header: {e}") })?
+            .iter()
+            .map(String::from)
+            .collect();
+        Ok(Self { file: name, header, reader, record: csv::StringRecord::new() })
+    }
+
+    fn index(&self, column: &str) -> Result<usize, LogError> {
+        self.header.iter().position(|h| h == column).ok_or_else(|| LogError::File {
+            file: self.file.clone(),
+            message: format!("no column `{column}` (columns: {})", self.header.join(", ")),
+        })
+    }
+
+    fn next_row(&mut self) -> Result<Option<Row<'_>>, LogError> {
+        match self.reader.read_record(&mut self.record) {
+            Ok(false) => Ok(None),
+            Ok(true) => {
+                let line = self.record.position().map_or(0, |p| p.line());
+                Ok(Some(Row { table: self, line }))
+            }
+            Err(e) => Err(LogError::File { file: self.file.clone(), message: format!("malformed CSV: {e}") }),
+        }
+    }
+}
+
+impl Row<'_> {
+    fn error(&self, column: usize, message: String) -> LogError {
+        LogError::Cell {
+            file: self.table.file.clone(),
+            line: self.line,
+            column: self.table.header[column].clone(),
+            message,
+        }
+    }
+
+    fn cell(&self, column: usize) -> &str {
+        self.table.record.get(column).unwrap_or("")
+    }
+
+    fn number(&self, column: usize) -> Result<f64, LogError> {
+        let cell = self.cell(column);
+        match cell.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(self.error(column, format!("`{cell}` is not finite; a finite number is expected"))),
+            Err(_) => Err(self.error(column, format!("`{cell}` is not a number"))),
+        }
+    }
+
+    fn beacon_id(&self, column: usize) -> Result<u32, LogError> {
+        let cell = self.cell(column);
+        cell.parse::<u32>()
+            .map_err(|_| self.error(column, format!("`{cell}` is not a beacon id (a non-negative integer)")))
+    }
+}
+
+/// Reads one source into stream items (NED, SI), in time order.
+fn read_source(
+    base: &Path,
+    s: &Source,
+    beacons: &BTreeMap<u32, Vector3<f64>>,
+    tracked: &mut std::collections::BTreeSet<u32>,
+) -> Result<Vec<Item>, LogError> {
+    let mut table = Table::open(base, &s.file)?;
+    let time = table.index(&s.time)?;
+    let col = |key: &str, table: &Table| s.column(key).map(|c| table.index(c)).transpose();
+    let cols: BTreeMap<&str, usize> = COLUMN_KEYS
+        .iter()
+        .filter_map(|k| col(k, &table).transpose().map(|r| r.map(|c| (*k, c))))
+        .collect::<Result<_, _>>()?;
+    let (len, ang) = (s.length_unit.metres(), s.angle_unit.radians());
+    let mut items = Vec::new();
+    let mut previous: Option<f64> = None;
+    let known = |tracked: &std::collections::BTreeSet<u32>| {
+        beacons.keys().chain(tracked.iter()).map(|b| b.to_string()).collect::<Vec<_>>().join(", ")
+    };
+    while let Some(row) = table.next_row()? {
+        let t = row.number(time)? + s.time_offset_s;
+        if let Some(p) = previous.filter(|p| t < *p && !s.sort) {
+            return Err(row.error(
+                time,
+                format!("time {t} is before {p} on the row above; rows must be in time order (or set sort = true on this source)"),
+            ));
+        }
+        previous = Some(t);
+        let num = |k: &str| row.number(cols[k]);
+        let beacon = |tracked: &std::collections::BTreeSet<u32>| -> Result<(u32, Vector3<f64>), LogError> {
+            let id = row.beacon_id(cols["beacon"])?;
+            match beacons.get(&id) {
+                Some(p) => Ok((id, *p)),
+                None if tracked.contains(&id) => Ok((id, Vector3::new(f64::NAN, f64::NAN, f64::NAN))),
+                None => {
+                    Err(row.error(cols["beacon"], format!("beacon {id} is not among the beacons ({})", known(tracked))))
+                }
+            }
+        };
+        let mut push = |m: Measurement| items.push(Item { t_s: t, input: Input::Measurement(m) });
+        match s.kind {
+            SourceKind::Odometry => push(Measurement::Odometry {
+                distance_m: num("distance")? * len,
+                heading_change_rad: num("heading_change")? * ang,
+            }),
+            SourceKind::Speed => push(Measurement::Speed { speed_m_s: num("speed")? * len }),
+            SourceKind::Heading => push(Measurement::Heading { heading_rad: num("heading")? * ang }),
+            SourceKind::SpeedHeading => {
+                push(Measurement::Speed { speed_m_s: num("speed")? * len });
+                push(Measurement::Heading { heading_rad: num("heading")? * ang });
+            }
+            SourceKind::Depth => push(Measurement::Depth { depth_m: num("depth")? * len }),
+            SourceKind::Range => {
+                let (beacon_id, beacon) = beacon(tracked)?;
+                push(Measurement::Range { beacon_id, beacon, range_m: num("range")? * len })
+            }
+            SourceKind::Doppler => {
+                let (beacon_id, beacon) = beacon(tracked)?;
+                push(Measurement::Doppler { beacon_id, beacon, radial_speed_m_s: num("radial_speed")? * len })
+            }
+            SourceKind::BeaconTrack => {
+                let beacon_id = row.beacon_id(cols["beacon"])?;
+                let z = cols.get("z").map_or(Ok(0.0), |&c| row.number(c))?;
+                let position = Vector3::new(num("x")?, num("y")?, z) * len;
+                tracked.insert(beacon_id);
+                items.push(Item { t_s: t, input: Input::BeaconPosition { beacon_id, position } });
+            }
+            SourceKind::GroundTruth => {
+                let heading_rad = cols.get("heading").map(|&c| row.number(c)).transpose()?.map(|h| h * ang);
+                let pose = TruthPose { north_m: num("x")? * len, east_m: num("y")? * len, heading_rad };
+                items.push(Item { t_s: t, input: Input::Truth(pose) });
+            }
+        }
+    }
+    if items.is_empty() {
+        return Err(LogError::File { file: table.file.clone(), message: "no rows".into() });
+    }
+    Ok(items)
+}

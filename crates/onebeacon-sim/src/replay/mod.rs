@@ -1,0 +1,78 @@
+//! Replaying real logs: a log description maps CSV files and columns to measurement
+//! kinds ([`log`]); the [`session`] runs every configured estimator over the merged,
+//! time-ordered stream, as `onebeacon stream` does live; [`replay`] does a whole log
+//! and keeps what the outputs need.
+
+pub mod log;
+pub mod session;
+
+pub use log::{Input, Item, Log, LogDescription, LogError, TruthPose};
+pub use session::{ErrorStats, Rejection, Session, Start, Step};
+
+use crate::run::{Estimate, StepRecord};
+use nalgebra::{Vector2, Vector3};
+use std::collections::BTreeSet;
+
+/// A replayed log: one record per ground-truth pose (per measurement when the log
+/// has no ground truth), and the session with its statistics and rejections.
+#[derive(Debug, Clone)]
+pub struct Replay {
+    pub trajectory: Vec<StepRecord>,
+    pub session: Session,
+}
+
+/// The session a log describes, restricted to `beacons` when given.
+pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
+    let (t0, pose) = log.initial_pose()?;
+    let d = &log.description;
+    let estimators = d.estimators.iter().map(|e| (e.name.clone(), e.config())).collect();
+    let sigmas = (d.initial.sigma_position_m, d.initial.sigma_heading_deg.to_radians());
+    Ok(Session::new(log.frame, estimators, Start::At { t0_s: Some(t0), pose }, sigmas, beacons))
+}
+
+/// Runs every estimator of `log` over its stream.
+pub fn replay(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Replay, LogError> {
+    let mut session = session_for(log, beacons)?;
+    let has_truth = log.items.iter().any(|i| matches!(i.input, Input::Truth(_)));
+    let mut trajectory = Vec::new();
+    let mut heard = false;
+    for item in &log.items {
+        let Some(step) = session.push(item) else { continue };
+        heard |= step.outcomes.iter().any(|o| matches!(o, Some(onebeacon::nav::Outcome::Accepted(_))));
+        if has_truth && step.truth.is_none() || !has_truth && !matches!(item.input, Input::Measurement(_)) {
+            continue;
+        }
+        trajectory.push(record(&step, session.last_beacon, heard));
+        heard = false;
+    }
+    Ok(Replay { trajectory, session })
+}
+
+/// A trajectory row (NED) from a step.
+fn record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord {
+    let truth = step.truth;
+    let estimates = step
+        .estimates
+        .iter()
+        .map(|e| {
+            let (error_m, nees) = truth.map_or((f64::NAN, f64::NAN), |p| session::error_and_nees(e, &p));
+            Estimate {
+                pos: Vector3::new(e.north_m, e.east_m, 0.0),
+                psi: e.heading_rad,
+                speed: None,
+                sigma_pos: Vector2::new(e.sigma_north_m, e.sigma_east_m),
+                error_m,
+                nees,
+            }
+        })
+        .collect();
+    StepRecord {
+        t_s: step.t_s,
+        truth_pos: truth.map_or(Vector3::repeat(f64::NAN), |p| Vector3::new(p.north_m, p.east_m, 0.0)),
+        truth_heading: truth.and_then(|p| p.heading_rad).unwrap_or(f64::NAN),
+        truth_speed: f64::NAN,
+        beacon: beacon.unwrap_or(Vector3::repeat(f64::NAN)),
+        frame: heard,
+        estimates,
+    }
+}

@@ -1,0 +1,227 @@
+//! The engine shared by `replay` and `stream`: every configured estimator fed the same
+//! time-ordered items one at a time, scored against the ground truth when it comes.
+
+use super::log::{Input, Item, TruthPose};
+use nalgebra::{Matrix2, Vector2, Vector3};
+use onebeacon::geo::Frame;
+use onebeacon::nav::{Measurement, Outcome, PlanarConfig, PlanarEstimate, PlanarNavigator};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// When and where the estimators start.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Start {
+    /// At `t0_s` (the first item's time when `None`) from a NED pose (N, E, psi).
+    At { t0_s: Option<f64>, pose: (f64, f64, f64) },
+    /// At the first ground-truth item that carries a heading.
+    FirstTruth,
+}
+
+/// A measurement an estimator's gate rejected.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rejection {
+    pub estimator: usize,
+    pub t_s: f64,
+    pub kind: &'static str,
+    pub beacon_id: u32,
+    pub value: f64,
+    pub nis: f64,
+}
+
+/// Error statistics of one estimator against the ground truth.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ErrorStats {
+    pub count: usize,
+    pub sum_m: f64,
+    pub sum_sq_m2: f64,
+    pub max_m: f64,
+    pub final_m: f64,
+    pub rejected: usize,
+    pub failed: usize,
+}
+
+impl ErrorStats {
+    pub fn rmse_m(&self) -> f64 {
+        (self.sum_sq_m2 / self.count as f64).sqrt()
+    }
+    pub fn mean_m(&self) -> f64 {
+        self.sum_m / self.count as f64
+    }
+}
+
+/// What one item did: each estimator's outcome (none for beacon positions and truth)
+/// and estimate, and the errors when the item is a ground-truth pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    pub t_s: f64,
+    pub outcomes: Vec<Option<Outcome>>,
+    pub estimates: Vec<PlanarEstimate>,
+    pub truth: Option<TruthPose>,
+    pub errors_m: Option<Vec<f64>>,
+}
+
+/// Horizontal error and its NEES against `truth`.
+pub fn error_and_nees(e: &PlanarEstimate, truth: &TruthPose) -> (f64, f64) {
+    let d = Vector2::new(e.north_m - truth.north_m, e.east_m - truth.east_m);
+    let p = Matrix2::new(e.sigma_north_m.powi(2), e.cov_north_east_m2, e.cov_north_east_m2, e.sigma_east_m.powi(2));
+    let nees = p.try_inverse().map_or(f64::NAN, |pi| d.dot(&(pi * d)));
+    (d.norm(), nees)
+}
+
+/// Every estimator on one stream. Estimates and errors are in NED.
+#[derive(Debug, Clone)]
+pub struct Session {
+    pub names: Vec<String>,
+    /// The frame of the items pushed.
+    frame: Frame,
+    configs: Vec<PlanarConfig>,
+    navs: Vec<PlanarNavigator>,
+    start: Start,
+    sigma_position_m: f64,
+    sigma_heading_rad: f64,
+    /// Only these beacons are used (all when `None`).
+    beacons: Option<BTreeSet<u32>>,
+    tracked: BTreeMap<u32, Vector3<f64>>,
+    pub stats: Vec<ErrorStats>,
+    pub rejected: Vec<Rejection>,
+    /// Items before the start, and beacon measurements left out by the beacon filter
+    /// or naming a beacon whose position is not known yet.
+    pub before_start: usize,
+    pub left_out: usize,
+    /// The position of the last beacon heard.
+    pub last_beacon: Option<Vector3<f64>>,
+}
+
+impl Session {
+    pub fn new(
+        frame: Frame,
+        estimators: Vec<(String, PlanarConfig)>,
+        start: Start,
+        (sigma_position_m, sigma_heading_rad): (f64, f64),
+        beacons: Option<BTreeSet<u32>>,
+    ) -> Self {
+        let n = estimators.len();
+        let (names, configs) = estimators.into_iter().unzip();
+        Self {
+            names,
+            frame,
+            configs,
+            navs: Vec::new(),
+            start,
+            sigma_position_m,
+            sigma_heading_rad,
+            beacons,
+            tracked: BTreeMap::new(),
+            stats: vec![ErrorStats::default(); n],
+            rejected: Vec::new(),
+            before_start: 0,
+            left_out: 0,
+            last_beacon: None,
+        }
+    }
+
+    /// Every estimator's latest estimate (empty before the start).
+    pub fn final_estimates(&self) -> Vec<PlanarEstimate> {
+        self.navs.iter().map(PlanarNavigator::estimate).collect()
+    }
+
+    pub fn started(&self) -> bool {
+        !self.navs.is_empty()
+    }
+
+    fn begin(&mut self, t0: f64, pose: (f64, f64, f64)) {
+        self.navs = self
+            .configs
+            .iter()
+            .map(|c| PlanarNavigator::new(*c, t0, pose, self.sigma_position_m, self.sigma_heading_rad))
+            .collect();
+    }
+
+    /// Processes one item (in the session's frame); `None` before the estimators start.
+    pub fn push(&mut self, item: &Item) -> Option<Step> {
+        let t = item.t_s;
+        let item = &Item { t_s: t, input: item.input.to_ned(self.frame) };
+        if let Input::BeaconPosition { beacon_id, position } = item.input {
+            self.tracked.insert(beacon_id, position);
+        }
+        if !self.started() {
+            match (self.start, &item.input) {
+                (Start::At { t0_s, pose }, _) if t0_s.is_none_or(|t0| t >= t0) => self.begin(t0_s.unwrap_or(t), pose),
+                (Start::FirstTruth, Input::Truth(TruthPose { north_m, east_m, heading_rad: Some(h) })) => {
+                    self.begin(t, (*north_m, *east_m, *h))
+                }
+                _ => {
+                    self.before_start += 1;
+                    return None;
+                }
+            }
+        }
+        let mut outcomes = vec![None; self.navs.len()];
+        let mut truth = None;
+        match item.input {
+            Input::Measurement(m) => {
+                if let Some(m) = self.resolve(m) {
+                    for (i, nav) in self.navs.iter_mut().enumerate() {
+                        let out = nav.process(t, &m);
+                        self.stats[i].failed += usize::from(matches!(out, Outcome::Failed(_)));
+                        if let Outcome::Rejected(nis) = out {
+                            self.stats[i].rejected += 1;
+                            let (kind, beacon_id, value) = match m {
+                                Measurement::Range { beacon_id, range_m, .. } => ("range", beacon_id, range_m),
+                                Measurement::Doppler { beacon_id, radial_speed_m_s, .. } => {
+                                    ("doppler", beacon_id, radial_speed_m_s)
+                                }
+                                _ => ("other", 0, f64::NAN),
+                            };
+                            self.rejected.push(Rejection { estimator: i, t_s: t, kind, beacon_id, value, nis });
+                        }
+                        outcomes[i] = Some(out);
+                    }
+                }
+            }
+            Input::Truth(p) => truth = Some(p),
+            Input::BeaconPosition { .. } => {}
+        }
+        let estimates: Vec<PlanarEstimate> = self.navs.iter().map(PlanarNavigator::estimate).collect();
+        let errors_m = truth.map(|p| {
+            estimates
+                .iter()
+                .zip(self.stats.iter_mut())
+                .map(|(e, s)| {
+                    let (err, _) = error_and_nees(e, &p);
+                    s.count += 1;
+                    s.sum_m += err;
+                    s.sum_sq_m2 += err * err;
+                    s.max_m = s.max_m.max(err);
+                    s.final_m = err;
+                    err
+                })
+                .collect()
+        });
+        Some(Step { t_s: t, outcomes, estimates, truth, errors_m })
+    }
+
+    /// A beacon measurement with its beacon's position (tracked beacons: the latest),
+    /// or `None` when the beacon is filtered out or its position is not known yet.
+    fn resolve(&mut self, m: Measurement) -> Option<Measurement> {
+        let (id, beacon) = match m {
+            Measurement::Range { beacon_id, beacon, .. } | Measurement::Doppler { beacon_id, beacon, .. } => {
+                (beacon_id, beacon)
+            }
+            other => return Some(other),
+        };
+        let position = if beacon.iter().all(|v| v.is_finite()) { Some(beacon) } else { self.tracked.get(&id).copied() };
+        let allowed = self.beacons.as_ref().is_none_or(|b| b.contains(&id));
+        let Some(position) = position.filter(|_| allowed) else {
+            self.left_out += 1;
+            return None;
+        };
+        self.last_beacon = Some(position);
+        Some(match m {
+            Measurement::Range { range_m, .. } => Measurement::Range { beacon_id: id, beacon: position, range_m },
+            Measurement::Doppler { radial_speed_m_s, .. } => {
+                Measurement::Doppler { beacon_id: id, beacon: position, radial_speed_m_s }
+            }
+            other => other,
+        })
+    }
+}

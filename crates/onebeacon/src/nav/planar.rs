@@ -1,0 +1,417 @@
+//! Planar navigation for logs and live streams: dead reckoning from odometry increments
+//! (wheels, DVL) or a forward speed, corrected by ranges and Doppler speeds to beacons
+//! at known positions and by heading fixes. The filter behind `onebeacon replay` and
+//! `onebeacon stream`; it runs as measurements arrive, one at a time.
+//!
+//! State [N, E, psi, b]: horizontal NED position (m), heading from north toward east
+//! (rad) and a range bias (m) common to all ranges. The vehicle's depth is a known
+//! input (pressure sensor) that enters slant ranges. When the bias is not estimated it
+//! stays at its configured value with zero variance, so one filter serves both cases.
+
+use crate::filter::{Ekf, FilterError, Gated};
+use crate::geo::wrap_angle;
+use crate::measure::{RadialSpeed2d, ScalarModel, SlantRange, StateComponent};
+use nalgebra::{Matrix1, Matrix4, Matrix4x2, SMatrix, Vector1, Vector2, Vector3, Vector4};
+
+/// Index of each state component.
+pub mod idx {
+    pub const N: usize = 0;
+    pub const E: usize = 1;
+    pub const PSI: usize = 2;
+    pub const BIAS: usize = 3;
+}
+
+/// Noise of the motion inputs and of the measurements.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarNoise {
+    /// Odometry distance error, as a fraction of each increment.
+    pub distance_sigma_frac: f64,
+    /// Odometry heading-change error, as a fraction of each increment.
+    pub heading_change_sigma_frac: f64,
+    /// Heading random walk per metre travelled, rad / sqrt(m) (slip, gyro drift).
+    pub heading_walk_rad_per_sqrt_m: f64,
+    /// Forward-speed input error, m/s (speed logs).
+    pub speed_sigma_m_s: f64,
+    pub range_sigma_m: f64,
+    pub heading_sigma_rad: f64,
+    pub doppler_sigma_m_s: f64,
+    /// Random walk of the range bias, m / sqrt(s).
+    pub bias_walk_m_per_sqrt_s: f64,
+}
+
+impl Default for PlanarNoise {
+    fn default() -> Self {
+        Self {
+            distance_sigma_frac: 0.02,
+            heading_change_sigma_frac: 0.02,
+            heading_walk_rad_per_sqrt_m: 0.005,
+            speed_sigma_m_s: 0.05,
+            range_sigma_m: 1.5,
+            heading_sigma_rad: 2f64.to_radians(),
+            doppler_sigma_m_s: 0.1,
+            bias_walk_m_per_sqrt_s: 0.005,
+        }
+    }
+}
+
+/// What an estimator uses and how.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarConfig {
+    /// Use ranges and Doppler speeds (false: dead reckoning, heading fixes only).
+    pub use_beacons: bool,
+    /// Estimate the range bias as a state.
+    pub estimate_bias: bool,
+    /// The range bias, m: the initial value when estimated, the known value otherwise.
+    pub bias_m: f64,
+    /// Initial standard deviation of an estimated bias, m.
+    pub bias_sigma_m: f64,
+    /// Reject a range or Doppler speed whose NIS exceeds this (chi-square, 1 dof:
+    /// 3.84 at 95 %, 6.63 at 99 %, 10.83 at 99.9 %); `None` accepts everything.
+    pub nis_gate: Option<f64>,
+    pub noise: PlanarNoise,
+}
+
+impl Default for PlanarConfig {
+    fn default() -> Self {
+        Self {
+            use_beacons: true,
+            estimate_bias: false,
+            bias_m: 0.0,
+            bias_sigma_m: 5.0,
+            nis_gate: None,
+            noise: PlanarNoise::default(),
+        }
+    }
+}
+
+/// One measurement, in NED and SI units. Beacon measurements carry the beacon's
+/// position (at transmit time for a moving beacon).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Measurement {
+    /// Distance travelled and heading change since the previous increment.
+    Odometry {
+        distance_m: f64,
+        heading_change_rad: f64,
+    },
+    /// Forward speed, held until the next one (DVL, propeller model).
+    Speed {
+        speed_m_s: f64,
+    },
+    Heading {
+        heading_rad: f64,
+    },
+    /// The vehicle's depth, held until the next one.
+    Depth {
+        depth_m: f64,
+    },
+    Range {
+        beacon_id: u32,
+        beacon: Vector3<f64>,
+        range_m: f64,
+    },
+    /// Radial speed toward the beacon, positive when closing (garin2024 eq. 13).
+    Doppler {
+        beacon_id: u32,
+        beacon: Vector3<f64>,
+        radial_speed_m_s: f64,
+    },
+}
+
+/// What processing one measurement did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Outcome {
+    /// An input (odometry, speed, depth) was applied.
+    Applied,
+    /// A correction was accepted or rejected by the gate, with its NIS.
+    Accepted(f64),
+    Rejected(f64),
+    /// Not used by this estimator (dead reckoning and beacons).
+    Skipped,
+    /// The update could not be computed; the state is unchanged.
+    Failed(FilterError),
+}
+
+/// The estimate at one time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarEstimate {
+    pub t_s: f64,
+    pub north_m: f64,
+    pub east_m: f64,
+    pub heading_rad: f64,
+    pub bias_m: f64,
+    pub sigma_north_m: f64,
+    pub sigma_east_m: f64,
+    /// Covariance of north and east, m^2.
+    pub cov_north_east_m2: f64,
+    pub sigma_heading_rad: f64,
+    pub sigma_bias_m: f64,
+}
+
+/// The navigator: an EKF over [N, E, psi, b] with the held inputs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanarNavigator {
+    pub config: PlanarConfig,
+    ekf: Ekf<4>,
+    t_s: f64,
+    /// Latest forward-speed input, and whether it drives the motion between events.
+    speed_m_s: f64,
+    coasting: bool,
+    last_odometry_s: Option<f64>,
+    depth_m: f64,
+}
+
+impl PlanarNavigator {
+    /// Starts at time `t_s` from position (`north_m`, `east_m`) and `heading_rad`, with
+    /// standard deviations `sigma_position_m` (each axis) and `sigma_heading_rad`.
+    pub fn new(
+        config: PlanarConfig,
+        t_s: f64,
+        (north_m, east_m, heading_rad): (f64, f64, f64),
+        sigma_position_m: f64,
+        sigma_heading_rad: f64,
+    ) -> Self {
+        let sb = if config.estimate_bias { config.bias_sigma_m } else { 0.0 };
+        let p = Matrix4::from_diagonal(&Vector4::new(
+            sigma_position_m.powi(2),
+            sigma_position_m.powi(2),
+            sigma_heading_rad.powi(2),
+            sb * sb,
+        ));
+        let x = Vector4::new(north_m, east_m, wrap_angle(heading_rad), config.bias_m);
+        Self { config, ekf: Ekf::new(x, p), t_s, speed_m_s: 0.0, coasting: false, last_odometry_s: None, depth_m: 0.0 }
+    }
+
+    pub fn estimate(&self) -> PlanarEstimate {
+        let (x, p) = (&self.ekf.x, &self.ekf.p);
+        PlanarEstimate {
+            t_s: self.t_s,
+            north_m: x[idx::N],
+            east_m: x[idx::E],
+            heading_rad: wrap_angle(x[idx::PSI]),
+            bias_m: x[idx::BIAS],
+            sigma_north_m: p[(idx::N, idx::N)].sqrt(),
+            sigma_east_m: p[(idx::E, idx::E)].sqrt(),
+            cov_north_east_m2: p[(idx::N, idx::E)],
+            sigma_heading_rad: p[(idx::PSI, idx::PSI)].sqrt(),
+            sigma_bias_m: p[(idx::BIAS, idx::BIAS)].sqrt(),
+        }
+    }
+
+    /// Processes one measurement taken at `t_s` (measurements in time order; an
+    /// earlier time is taken as now).
+    pub fn process(&mut self, t_s: f64, m: &Measurement) -> Outcome {
+        self.advance_to(t_s);
+        let noise = self.config.noise;
+        match *m {
+            Measurement::Odometry { distance_m, heading_change_rad } => {
+                if let Some(t0) = self.last_odometry_s.filter(|t0| t_s > *t0) {
+                    self.speed_m_s = distance_m / (t_s - t0);
+                }
+                self.last_odometry_s = Some(t_s);
+                self.coasting = false;
+                let sd = noise.distance_sigma_frac * distance_m.abs();
+                self.motion(distance_m, heading_change_rad, sd);
+                Outcome::Applied
+            }
+            Measurement::Speed { speed_m_s } => {
+                self.speed_m_s = speed_m_s;
+                self.coasting = true;
+                Outcome::Applied
+            }
+            Measurement::Depth { depth_m } => {
+                self.depth_m = depth_m;
+                Outcome::Applied
+            }
+            Measurement::Heading { heading_rad } => {
+                let model = [&StateComponent::angle(idx::PSI) as &dyn ScalarModel<4>];
+                self.correct(&model, heading_rad, noise.heading_sigma_rad, f64::INFINITY)
+            }
+            Measurement::Range { beacon, range_m, .. } if self.config.use_beacons => {
+                let model = SlantRange { beacon, depth_m: self.depth_m, bias: Some(idx::BIAS) };
+                self.correct(&[&model as &dyn ScalarModel<4>], range_m, noise.range_sigma_m, self.gate())
+            }
+            Measurement::Doppler { beacon, radial_speed_m_s, .. } if self.config.use_beacons => {
+                let model =
+                    RadialSpeed2d { beacon: Vector2::new(beacon.x, beacon.y), known_speed_m_s: Some(self.speed_m_s) };
+                self.correct(&[&model as &dyn ScalarModel<4>], radial_speed_m_s, noise.doppler_sigma_m_s, self.gate())
+            }
+            Measurement::Range { .. } | Measurement::Doppler { .. } => Outcome::Skipped,
+        }
+    }
+
+    fn gate(&self) -> f64 {
+        self.config.nis_gate.unwrap_or(f64::INFINITY)
+    }
+
+    fn correct(&mut self, model: &[&dyn ScalarModel<4>; 1], z: f64, sigma: f64, gate: f64) -> Outcome {
+        match self.ekf.update_gated(model, &Vector1::new(z), &Matrix1::new(sigma * sigma), gate) {
+            Ok(Gated::Accepted(nis)) => Outcome::Accepted(nis),
+            Ok(Gated::Rejected(nis)) => Outcome::Rejected(nis),
+            Err(e) => Outcome::Failed(e),
+        }
+    }
+
+    /// Moves the clock to `t_s`: coasts at the held speed and lets the bias wander.
+    fn advance_to(&mut self, t_s: f64) {
+        let dt = (t_s - self.t_s).max(0.0);
+        self.t_s = self.t_s.max(t_s);
+        if dt == 0.0 {
+            return;
+        }
+        if self.coasting {
+            let n = self.config.noise;
+            self.motion(self.speed_m_s * dt, 0.0, n.speed_sigma_m_s * dt);
+        }
+        if self.config.estimate_bias {
+            self.ekf.p[(idx::BIAS, idx::BIAS)] += self.config.noise.bias_walk_m_per_sqrt_s.powi(2) * dt;
+        }
+    }
+
+    /// Odometry step: `d` along the mid-increment heading, then the heading change
+    /// (second-order odometry model), with distance error `sigma_d`.
+    fn motion(&mut self, d: f64, dpsi: f64, sigma_d: f64) {
+        let n = self.config.noise;
+        let x = &mut self.ekf.x;
+        let (s, c) = (x[idx::PSI] + dpsi / 2.0).sin_cos();
+        x[idx::N] += d * c;
+        x[idx::E] += d * s;
+        x[idx::PSI] = wrap_angle(x[idx::PSI] + dpsi);
+        let mut f = Matrix4::identity();
+        f[(idx::N, idx::PSI)] = -d * s;
+        f[(idx::E, idx::PSI)] = d * c;
+        // input Jacobian, columns d and dpsi
+        let g = Matrix4x2::new(c, -d * s / 2.0, s, d * c / 2.0, 0.0, 1.0, 0.0, 0.0);
+        let var_dpsi = (n.heading_change_sigma_frac * dpsi).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * d.abs();
+        let q_u = SMatrix::<f64, 2, 2>::from_diagonal(&Vector2::new(sigma_d * sigma_d, var_dpsi));
+        let p = f * self.ekf.p * f.transpose() + g * q_u * g.transpose();
+        self.ekf.p = (p + p.transpose()) * 0.5;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+    use std::f64::consts::FRAC_PI_2;
+
+    fn start(config: PlanarConfig) -> PlanarNavigator {
+        PlanarNavigator::new(config, 0.0, (0.0, 0.0, 0.0), 0.0, 0.0)
+    }
+
+    #[test]
+    fn odometry_integrates_a_quarter_circle() {
+        // 100 increments along a quarter circle of radius 10 m: chord steps at the
+        // mid-increment heading land exactly on the arc's end (10, 10)
+        let mut nav = start(PlanarConfig::default());
+        let (k, r) = (100, 10.0);
+        let dpsi = FRAC_PI_2 / k as f64;
+        let chord = 2.0 * r * (dpsi / 2.0).sin();
+        for i in 0..k {
+            assert_eq!(
+                nav.process(i as f64, &Measurement::Odometry { distance_m: chord, heading_change_rad: dpsi }),
+                Outcome::Applied
+            );
+        }
+        let e = nav.estimate();
+        assert_abs_diff_eq!(e.north_m, 10.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(e.east_m, 10.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(e.heading_rad, FRAC_PI_2, epsilon = 1e-12);
+        // uncertainty grew with distance, the bias stayed known
+        assert!(e.sigma_north_m > 0.0 && e.sigma_east_m > 0.0);
+        assert_eq!(e.sigma_bias_m, 0.0);
+    }
+
+    /// The covariance step equals the Jacobians (F, G) of the motion taken by finite
+    /// differences.
+    #[test]
+    fn motion_covariance_matches_finite_differences() {
+        let config = PlanarConfig { estimate_bias: true, ..PlanarConfig::default() };
+        let mut nav = PlanarNavigator::new(config, 0.0, (3.0, -2.0, 0.8), 1.0, 0.1);
+        let p0 = nav.ekf.p;
+        let x0 = nav.ekf.x;
+        let (d, dpsi) = (1.7, 0.3);
+        nav.motion(d, dpsi, 0.1);
+        let step = |x: Vector4<f64>, d: f64, dpsi: f64| {
+            let m = x[2] + dpsi / 2.0;
+            Vector4::new(x[0] + d * m.cos(), x[1] + d * m.sin(), x[2] + dpsi, x[3])
+        };
+        let eps = 1e-6;
+        let f = Matrix4::from_fn(|i, j| {
+            let mut e = Vector4::zeros();
+            e[j] = eps;
+            (step(x0 + e, d, dpsi)[i] - step(x0 - e, d, dpsi)[i]) / (2.0 * eps)
+        });
+        let g = Matrix4x2::from_fn(|i, j| {
+            let (dd, dp) = if j == 0 { (eps, 0.0) } else { (0.0, eps) };
+            (step(x0, d + dd, dpsi + dp)[i] - step(x0, d - dd, dpsi - dp)[i]) / (2.0 * eps)
+        });
+        let n = config.noise;
+        let q = SMatrix::<f64, 2, 2>::from_diagonal(&Vector2::new(
+            0.01,
+            (n.heading_change_sigma_frac * dpsi).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * d,
+        ));
+        let expected = f * p0 * f.transpose() + g * q * g.transpose();
+        assert_abs_diff_eq!(nav.ekf.p, expected, epsilon = 1e-8);
+        assert_abs_diff_eq!(nav.ekf.x, step(x0, d, dpsi), epsilon = 1e-12);
+    }
+
+    #[test]
+    fn speed_input_coasts_between_events() {
+        let mut nav = start(PlanarConfig::default());
+        nav.process(0.0, &Measurement::Heading { heading_rad: 0.0 });
+        nav.process(0.0, &Measurement::Speed { speed_m_s: 1.5 });
+        nav.process(10.0, &Measurement::Depth { depth_m: 20.0 });
+        assert_abs_diff_eq!(nav.estimate().north_m, 15.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(nav.estimate().t_s, 10.0);
+        // coasting goes on until an odometry increment arrives, which ends it
+        nav.process(11.0, &Measurement::Odometry { distance_m: 1.0, heading_change_rad: 0.0 });
+        nav.process(20.0, &Measurement::Depth { depth_m: 20.0 });
+        assert_abs_diff_eq!(nav.estimate().north_m, 15.0 + 1.5 + 1.0, epsilon = 1e-12);
+    }
+
+    /// A static vehicle with unknown position and a biased range sensor, ranged from
+    /// three beacons: the filter recovers position and bias; gating rejects an
+    /// outlier; dead reckoning skips ranges.
+    #[test]
+    fn ranges_fix_position_and_bias_and_gate_outliers() {
+        let truth = Vector3::new(12.0, -7.0, 30.0);
+        let bias = 2.8;
+        let beacons = [Vector3::new(0.0, 0.0, 0.0), Vector3::new(60.0, 10.0, 0.0), Vector3::new(-20.0, 50.0, 0.0)];
+        let config = PlanarConfig { estimate_bias: true, nis_gate: Some(10.83), ..PlanarConfig::default() };
+        let mut nav = PlanarNavigator::new(config, 0.0, (0.0, 0.0, 0.3), 20.0, 0.1);
+        nav.process(0.0, &Measurement::Depth { depth_m: truth.z });
+        let mut t = 0.0;
+        for k in 0..600 {
+            let b = beacons[k % 3];
+            t += 1.0;
+            let range_m = (truth - b).norm() + bias;
+            let out = nav.process(t, &Measurement::Range { beacon_id: (k % 3) as u32, beacon: b, range_m });
+            assert!(matches!(out, Outcome::Accepted(_)), "{out:?}");
+        }
+        let e = nav.estimate();
+        assert_abs_diff_eq!(e.north_m, truth.x, epsilon = 0.1);
+        assert_abs_diff_eq!(e.east_m, truth.y, epsilon = 0.1);
+        assert_abs_diff_eq!(e.bias_m, bias, epsilon = 0.1);
+        let outlier = Measurement::Range { beacon_id: 0, beacon: beacons[0], range_m: truth.norm() + bias + 20.0 };
+        let before = nav.estimate();
+        assert!(matches!(nav.process(t, &outlier), Outcome::Rejected(nis) if nis > 10.83));
+        assert_eq!(nav.estimate(), before);
+        let mut dr = start(PlanarConfig { use_beacons: false, ..PlanarConfig::default() });
+        assert_eq!(dr.process(1.0, &outlier), Outcome::Skipped);
+    }
+
+    #[test]
+    fn doppler_and_heading_corrections() {
+        // heading fix pulls the heading; a Doppler speed with the known odometry speed
+        // is accepted and consistent with the geometry
+        let mut nav = PlanarNavigator::new(PlanarConfig::default(), 0.0, (10.0, 0.0, 0.2), 1.0, 0.3);
+        assert!(matches!(nav.process(0.0, &Measurement::Heading { heading_rad: 0.0 }), Outcome::Accepted(_)));
+        assert!(nav.estimate().heading_rad.abs() < 0.2);
+        nav.process(1.0, &Measurement::Odometry { distance_m: 0.0, heading_change_rad: 0.0 });
+        nav.process(2.0, &Measurement::Odometry { distance_m: 1.5, heading_change_rad: 0.0 });
+        let beacon = Vector3::zeros();
+        // heading north, away from a beacon to the south: opening at the odometry speed
+        let out = nav.process(2.0, &Measurement::Doppler { beacon_id: 0, beacon, radial_speed_m_s: -1.5 });
+        assert!(matches!(out, Outcome::Accepted(nis) if nis < 1.0), "{out:?}");
+    }
+}
