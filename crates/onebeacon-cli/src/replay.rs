@@ -6,7 +6,11 @@ use crate::output::Staging;
 use crate::{plot, report};
 use anyhow::{Context, Result};
 use onebeacon::nav::{Measurement, Outcome};
-use onebeacon_sim::replay::{Input, Item, Log, LogDescription, Session, Start, Step, TruthPose, replay as run_replay};
+use onebeacon_sim::replay::log::HeadingFrom;
+use onebeacon_sim::replay::{
+    Input, Item, Log, LogDescription, Session, Start, Step, TruthPose, new_session, replay as run_replay,
+    resolve_beacon,
+};
 use serde_json::{Map, Value, json};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, Write};
@@ -62,18 +66,11 @@ fn parse_item(
     };
     let kind = v.get("kind").and_then(Value::as_str).ok_or_else(|| format!("missing key `kind` (one of {KINDS})"))?;
     let t_s = num("t_s")?;
-    let beacon = |tracked: &BTreeSet<u32>| -> Result<(u32, nalgebra::Vector3<f64>), String> {
+    let beacon_id = || -> Result<u32, String> {
         let id = v.get("beacon").and_then(Value::as_u64).and_then(|b| u32::try_from(b).ok());
-        let id = id.ok_or_else(|| "`beacon` must be a beacon id (a non-negative integer)".to_string())?;
-        match beacons.get(&id) {
-            Some(p) => Ok((id, *p)),
-            None if tracked.contains(&id) => Ok((id, nalgebra::Vector3::repeat(f64::NAN))),
-            None => {
-                let known: Vec<String> = beacons.keys().chain(tracked.iter()).map(u32::to_string).collect();
-                Err(format!("beacon {id} is not among the beacons ({})", known.join(", ")))
-            }
-        }
+        id.ok_or_else(|| "`beacon` must be a beacon id (a non-negative integer)".to_string())
     };
+    let beacon = |tracked: &BTreeSet<u32>| resolve_beacon(beacon_id()?, beacons, tracked);
     let m = |m: Measurement| Input::Measurement(m);
     let input = match kind {
         "odometry" => {
@@ -91,8 +88,7 @@ fn parse_item(
             m(Measurement::Doppler { beacon_id, beacon, radial_speed_m_s: num("radial_speed_m_s")? })
         }
         "beacon_position" => {
-            let id = v.get("beacon").and_then(Value::as_u64).and_then(|b| u32::try_from(b).ok());
-            let beacon_id = id.ok_or_else(|| "`beacon` must be a beacon id (a non-negative integer)".to_string())?;
+            let beacon_id = beacon_id()?;
             tracked.insert(beacon_id);
             let z = if v.contains_key("z_m") { num("z_m")? } else { 0.0 };
             Input::BeaconPosition { beacon_id, position: nalgebra::Vector3::new(num("x_m")?, num("y_m")?, z) }
@@ -136,11 +132,7 @@ pub fn replay(
         }
         return Ok(());
     }
-    let mut known: BTreeSet<u32> = log.beacons.keys().copied().collect();
-    known.extend(log.items.iter().filter_map(|i| match i.input {
-        Input::BeaconPosition { beacon_id, .. } => Some(beacon_id),
-        _ => None,
-    }));
+    let known = log.beacon_ids();
     let filter = beacon_filter(beacons, &known)?;
     let used: Vec<u32> = filter.clone().map_or_else(|| known.iter().copied().collect(), |f| f.into_iter().collect());
     let suffix =
@@ -254,13 +246,14 @@ fn step_json(line: usize, step: &Step, s: &Session, frame: onebeacon::geo::Frame
         .enumerate()
         .map(|(i, e)| {
             let (x, y, _) = frame.from_ned(&nalgebra::Vector3::new(e.north_m, e.east_m, 0.0));
+            let (sx, sy, _) = frame.from_ned(&nalgebra::Vector3::new(e.sigma_north_m, e.sigma_east_m, 0.0));
             let mut v = json!({
                 "name": s.names[i],
                 "x_m": x,
                 "y_m": y,
                 "heading_rad": frame.heading_from_ned(e.heading_rad),
-                "sigma_x_m": if frame == onebeacon::geo::Frame::Enu { e.sigma_east_m } else { e.sigma_north_m },
-                "sigma_y_m": if frame == onebeacon::geo::Frame::Enu { e.sigma_north_m } else { e.sigma_east_m },
+                "sigma_x_m": sx.abs(),
+                "sigma_y_m": sy.abs(),
                 "range_bias_m": e.bias_m,
             });
             if let Some(o) = step.outcomes[i] {
@@ -276,7 +269,7 @@ fn step_json(line: usize, step: &Step, s: &Session, frame: onebeacon::geo::Frame
                     v["nis"] = json!(n);
                 }
             }
-            if let Some(err) = step.errors_m.as_ref().map(|e| e[i]) {
+            if let Some((err, _)) = step.errors.as_ref().map(|e| e[i]) {
                 v["error_m"] = json!(err);
             }
             v
@@ -293,28 +286,18 @@ pub fn stream(config: &Path) -> Result<()> {
     let beacons = d.fixed_beacons(base)?;
     let frame = onebeacon::geo::Frame::from(d.frame);
     let init = &d.initial;
-    let start = match init.from {
-        onebeacon_sim::replay::log::InitialFrom::Given => {
-            let p = frame.to_ned(init.x_m.unwrap_or(0.0), init.y_m.unwrap_or(0.0), 0.0);
-            Start::At {
-                t0_s: None,
-                pose: (p.x, p.y, frame.heading_to_ned(init.heading_deg.unwrap_or(0.0).to_radians())),
-            }
+    let start = match init.given_pose(frame) {
+        Some(pose) => Start::At { t0_s: None, pose },
+        None if init.heading_from == HeadingFrom::Track => {
+            return Err(BadInput(format!(
+                "{}: key `initial.heading_from` = \"track\": needs the whole log; a stream starts from the first ground_truth line's heading (\"column\") or a given pose",
+                config.display()
+            ))
+            .into());
         }
-        onebeacon_sim::replay::log::InitialFrom::GroundTruth => {
-            if init.heading_from == onebeacon_sim::replay::log::HeadingFrom::Track {
-                return Err(BadInput(format!(
-                    "{}: key `initial.heading_from` = \"track\": needs the whole log; a stream starts from the first ground_truth line's heading (\"column\") or a given pose",
-                    config.display()
-                ))
-                .into());
-            }
-            Start::FirstTruth
-        }
+        None => Start::FirstTruth,
     };
-    let estimators = d.estimators.iter().map(|e| (e.name.clone(), e.config())).collect();
-    let mut session =
-        Session::new(frame, estimators, start, (init.sigma_position_m, init.sigma_heading_deg.to_radians()), None);
+    let mut session = new_session(&d, start, None);
     let mut tracked = BTreeSet::new();
     let stdin = std::io::stdin().lock();
     let mut stdout = std::io::stdout().lock();

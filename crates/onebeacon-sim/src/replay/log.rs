@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 use onebeacon::geo::Frame;
 use onebeacon::nav::{Measurement, PlanarConfig, PlanarNoise};
 use serde::Deserialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Why a log could not be loaded: one line each.
@@ -225,6 +225,17 @@ pub struct Initial {
     pub sigma_position_m: f64,
     #[serde(default = "default_sigma_heading_deg")]
     pub sigma_heading_deg: f64,
+}
+
+impl Initial {
+    /// The given pose in NED (N, E, psi) when `from = "given"`.
+    pub fn given_pose(&self, frame: Frame) -> Option<(f64, f64, f64)> {
+        if self.from != InitialFrom::Given {
+            return None;
+        }
+        let p = frame.to_ned(self.x_m?, self.y_m?, 0.0);
+        Some((p.x, p.y, frame.heading_to_ned(self.heading_deg?.to_radians())))
+    }
 }
 
 fn default_track_m() -> f64 {
@@ -469,12 +480,14 @@ impl LogDescription {
                 ("heading_walk_deg_per_sqrt_m", e.heading_walk_deg_per_sqrt_m),
                 ("speed_sigma_m_s", e.speed_sigma_m_s),
                 ("bias_walk_m_per_sqrt_s", e.bias_walk_m_per_sqrt_s),
-                ("bias_m", Some(e.bias_m)),
             ];
             for (key, v) in non_negative {
-                if let Some(v) = v.filter(|v| !(v.is_finite() && (*v >= 0.0 || key == "bias_m"))) {
+                if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
                     return Err(bad(format!("estimator[{i}].{key}"), v.to_string(), "a finite number >= 0"));
                 }
+            }
+            if !e.bias_m.is_finite() {
+                return Err(bad(format!("estimator[{i}].bias_m"), e.bias_m.to_string(), "a finite number"));
             }
         }
         let init = &self.initial;
@@ -534,9 +547,8 @@ impl Log {
         let base = path.parent().unwrap_or(Path::new("."));
         let frame = Frame::from(description.frame);
         let beacons = description.fixed_beacons(base)?;
-        let tracked: std::collections::BTreeSet<u32> = Default::default();
+        let mut tracked = BTreeSet::new();
         let mut keyed: Vec<((f64, u8, usize, usize), Item)> = Vec::new();
-        let mut tracked = tracked;
         // beacon tracks first, so that ranges may name tracked beacons
         let order: Vec<usize> = (0..description.sources.len())
             .filter(|&i| description.sources[i].kind == SourceKind::BeaconTrack)
@@ -562,6 +574,15 @@ impl Log {
         Ok(Self { description, frame, beacons, items: keyed.into_iter().map(|(_, item)| item).collect() })
     }
 
+    /// Every beacon of the log: fixed ones and those with a track.
+    pub fn beacon_ids(&self) -> BTreeSet<u32> {
+        let tracked = self.items.iter().filter_map(|i| match i.input {
+            Input::BeaconPosition { beacon_id, .. } => Some(beacon_id),
+            _ => None,
+        });
+        self.beacons.keys().copied().chain(tracked).collect()
+    }
+
     /// The initial pose (NED) and time, from the description: given, or the first
     /// ground-truth pose (heading from its column or its track).
     pub fn initial_pose(&self) -> Result<(f64, (f64, f64, f64)), LogError> {
@@ -575,10 +596,8 @@ impl Log {
             })
             .collect();
         let first_t = self.items.first().map_or(0.0, |i| i.t_s);
-        if init.from == InitialFrom::Given {
-            let p = self.frame.to_ned(init.x_m.unwrap_or(0.0), init.y_m.unwrap_or(0.0), 0.0);
-            let psi = self.frame.heading_to_ned(init.heading_deg.unwrap_or(0.0).to_radians());
-            return Ok((first_t, (p.x, p.y, psi)));
+        if let Some(pose) = init.given_pose(self.frame) {
+            return Ok((first_t, pose));
         }
         let no_truth = || {
             LogError::File {
@@ -602,6 +621,24 @@ impl Log {
             }
         };
         Ok((t0, (p0.north_m, p0.east_m, psi)))
+    }
+}
+
+/// The position of beacon `id` for a measurement (log or stream): a fixed beacon's, or
+/// NaN for a tracked one (the session supplies its latest position); otherwise the
+/// message naming the known beacons.
+pub fn resolve_beacon(
+    id: u32,
+    fixed: &BTreeMap<u32, Vector3<f64>>,
+    tracked: &BTreeSet<u32>,
+) -> Result<(u32, Vector3<f64>), String> {
+    match fixed.get(&id) {
+        Some(p) => Ok((id, *p)),
+        None if tracked.contains(&id) => Ok((id, Vector3::repeat(f64::NAN))),
+        None => {
+            let known: Vec<String> = fixed.keys().chain(tracked).map(u32::to_string).collect();
+            Err(format!("beacon {id} is not among the beacons ({})", known.join(", ")))
+        }
     }
 }
 
@@ -689,7 +726,7 @@ fn read_source(
     base: &Path,
     s: &Source,
     beacons: &BTreeMap<u32, Vector3<f64>>,
-    tracked: &mut std::collections::BTreeSet<u32>,
+    tracked: &mut BTreeSet<u32>,
 ) -> Result<Vec<Item>, LogError> {
     let mut table = Table::open(base, &s.file)?;
     let time = table.index(&s.time)?;
@@ -701,9 +738,6 @@ fn read_source(
     let (len, ang) = (s.length_unit.metres(), s.angle_unit.radians());
     let mut items = Vec::new();
     let mut previous: Option<f64> = None;
-    let known = |tracked: &std::collections::BTreeSet<u32>| {
-        beacons.keys().chain(tracked.iter()).map(|b| b.to_string()).collect::<Vec<_>>().join(", ")
-    };
     while let Some(row) = table.next_row()? {
         let t = row.number(time)? + s.time_offset_s;
         if let Some(p) = previous.filter(|p| t < *p && !s.sort) {
@@ -714,15 +748,9 @@ fn read_source(
         }
         previous = Some(t);
         let num = |k: &str| row.number(cols[k]);
-        let beacon = |tracked: &std::collections::BTreeSet<u32>| -> Result<(u32, Vector3<f64>), LogError> {
+        let beacon = |tracked: &BTreeSet<u32>| {
             let id = row.beacon_id(cols["beacon"])?;
-            match beacons.get(&id) {
-                Some(p) => Ok((id, *p)),
-                None if tracked.contains(&id) => Ok((id, Vector3::new(f64::NAN, f64::NAN, f64::NAN))),
-                None => {
-                    Err(row.error(cols["beacon"], format!("beacon {id} is not among the beacons ({})", known(tracked))))
-                }
-            }
+            resolve_beacon(id, beacons, tracked).map_err(|m| row.error(cols["beacon"], m))
         };
         let mut push = |m: Measurement| items.push(Item { t_s: t, input: Input::Measurement(m) });
         match s.kind {

@@ -6,7 +6,7 @@
 pub mod log;
 pub mod session;
 
-pub use log::{Input, Item, Log, LogDescription, LogError, TruthPose};
+pub use log::{Input, Item, Log, LogDescription, LogError, TruthPose, resolve_beacon};
 pub use session::{ErrorStats, Rejection, Session, Start, Step};
 
 use crate::run::{Estimate, StepRecord};
@@ -21,13 +21,18 @@ pub struct Replay {
     pub session: Session,
 }
 
-/// The session a log describes, restricted to `beacons` when given.
-pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
-    let (t0, pose) = log.initial_pose()?;
-    let d = &log.description;
+/// A session of the description's estimators, starting at `start`, restricted to
+/// `beacons` when given (replay and stream).
+pub fn new_session(d: &LogDescription, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
     let estimators = d.estimators.iter().map(|e| (e.name.clone(), e.config())).collect();
     let sigmas = (d.initial.sigma_position_m, d.initial.sigma_heading_deg.to_radians());
-    Ok(Session::new(log.frame, estimators, Start::At { t0_s: Some(t0), pose }, sigmas, beacons))
+    Session::new(d.frame.into(), estimators, start, sigmas, beacons)
+}
+
+/// The session a log describes, started at its initial pose.
+pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
+    let (t0, pose) = log.initial_pose()?;
+    Ok(new_session(&log.description, Start::At { t0_s: Some(t0), pose }, beacons))
 }
 
 /// Runs every estimator of `log` over its stream.
@@ -54,8 +59,9 @@ fn record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord 
     let estimates = step
         .estimates
         .iter()
-        .map(|e| {
-            let (error_m, nees) = truth.map_or((f64::NAN, f64::NAN), |p| session::error_and_nees(e, &p));
+        .enumerate()
+        .map(|(i, e)| {
+            let (error_m, nees) = step.errors.as_ref().map_or((f64::NAN, f64::NAN), |errors| errors[i]);
             Estimate {
                 pos: Vector3::new(e.north_m, e.east_m, 0.0),
                 psi: e.heading_rad,

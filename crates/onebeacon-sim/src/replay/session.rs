@@ -49,18 +49,19 @@ impl ErrorStats {
 }
 
 /// What one item did: each estimator's outcome (none for beacon positions and truth)
-/// and estimate, and the errors when the item is a ground-truth pose.
+/// and estimate, and when the item is a ground-truth pose each estimator's horizontal
+/// error (m) and its NEES.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Step {
     pub t_s: f64,
     pub outcomes: Vec<Option<Outcome>>,
     pub estimates: Vec<PlanarEstimate>,
     pub truth: Option<TruthPose>,
-    pub errors_m: Option<Vec<f64>>,
+    pub errors: Option<Vec<(f64, f64)>>,
 }
 
 /// Horizontal error and its NEES against `truth`.
-pub fn error_and_nees(e: &PlanarEstimate, truth: &TruthPose) -> (f64, f64) {
+fn error_and_nees(e: &PlanarEstimate, truth: &TruthPose) -> (f64, f64) {
     let d = Vector2::new(e.north_m - truth.north_m, e.east_m - truth.east_m);
     let p = Matrix2::new(e.sigma_north_m.powi(2), e.cov_north_east_m2, e.cov_north_east_m2, e.sigma_east_m.powi(2));
     let nees = p.try_inverse().map_or(f64::NAN, |pi| d.dot(&(pi * d)));
@@ -182,22 +183,22 @@ impl Session {
             Input::BeaconPosition { .. } => {}
         }
         let estimates: Vec<PlanarEstimate> = self.navs.iter().map(PlanarNavigator::estimate).collect();
-        let errors_m = truth.map(|p| {
+        let errors = truth.map(|p| {
             estimates
                 .iter()
                 .zip(self.stats.iter_mut())
                 .map(|(e, s)| {
-                    let (err, _) = error_and_nees(e, &p);
+                    let (err, nees) = error_and_nees(e, &p);
                     s.count += 1;
                     s.sum_m += err;
                     s.sum_sq_m2 += err * err;
                     s.max_m = s.max_m.max(err);
                     s.final_m = err;
-                    err
+                    (err, nees)
                 })
                 .collect()
         });
-        Some(Step { t_s: t, outcomes, estimates, truth, errors_m })
+        Some(Step { t_s: t, outcomes, estimates, truth, errors })
     }
 
     /// A beacon measurement with its beacon's position (tracked beacons: the latest),
