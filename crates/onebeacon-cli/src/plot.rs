@@ -15,13 +15,18 @@ use std::path::Path;
 use std::sync::Once;
 
 const FONT: &str = "sans-serif";
-const PALETTE: [RGBColor; 6] = [
+/// The ten "tab10" colours, red first: distinct for up to ten estimators.
+const PALETTE: [RGBColor; 10] = [
     RGBColor(214, 39, 40),
     RGBColor(31, 119, 180),
     RGBColor(44, 160, 44),
     RGBColor(255, 127, 14),
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
 ];
 
 type Chart<'a> = ChartContext<'a, BitMapBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;

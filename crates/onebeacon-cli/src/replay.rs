@@ -165,20 +165,23 @@ pub fn replay(
     }
     println!("{title}: {} measurements, replayed in {:.1} ms", log.items.len(), wall_s * 1e3);
     println!(
-        "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9}",
-        "estimator", "rmse_m", "mean_m", "final_m", "max_m", "rejected", "bias_m"
+        "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
+        "estimator", "rmse_m", "mean_m", "final_m", "max_m", "rejected", "bias_m", "k_range", "k_dist", "k_turn"
     );
     for (e, st) in summary["estimators"].as_array().into_iter().flatten().zip(&s.stats) {
         let f = |k: &str| e[k].as_f64().map_or("-".into(), |v| format!("{v:.3}"));
         println!(
-            "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9}",
+            "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
             e["name"].as_str().unwrap_or(""),
             f("rmse_m"),
             f("mean_error_m"),
             f("final_error_m"),
             f("max_error_m"),
             st.rejected,
-            f("range_bias_m")
+            f("range_bias_m"),
+            f("range_scale"),
+            f("distance_scale"),
+            f("turn_scale")
         );
     }
     println!("wrote:");
@@ -207,6 +210,9 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
                 "rejected": st.rejected,
                 "failed_updates": st.failed,
                 "range_bias_m": num(e.bias_m),
+                "range_scale": num(e.range_scale),
+                "distance_scale": num(e.distance_scale),
+                "turn_scale": num(e.turn_scale),
                 "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad)},
             })
         })
@@ -255,6 +261,9 @@ fn step_json(line: usize, step: &Step, s: &Session, frame: onebeacon::geo::Frame
                 "sigma_x_m": sx.abs(),
                 "sigma_y_m": sy.abs(),
                 "range_bias_m": e.bias_m,
+                "range_scale": e.range_scale,
+                "distance_scale": e.distance_scale,
+                "turn_scale": e.turn_scale,
             });
             if let Some(o) = step.outcomes[i] {
                 let (outcome, nis) = match o {

@@ -47,26 +47,36 @@ fn rmse(estimators: &[Value], name: &str) -> f64 {
 }
 
 /// The targets that the data allow (see the closing note for the table): all
-/// four beacons with bias estimation within 1.5 m RMSE on both logs; on plaza2, where
-/// dead reckoning drifts (32 m RMSE), single beacons 1 and 5 bring it under a quarter.
+/// four beacons within 1.5 m RMSE on both logs, with the bias estimated and with the
+/// calibration states; on plaza2, where dead reckoning drifts (32 m RMSE), each single
+/// beacon brings the calibrated filter under a fifth of it.
 #[test]
 fn plaza_all_beacons_and_single_beacons() {
     let dir = scratch("plaza");
+    let find = |all: &[Value], name: &str, key: &str| all.iter().find(|e| e["name"] == name).unwrap()[key].clone();
     for n in [1, 2] {
         let all = replay_json(&plaza(n), None, &dir.join(format!("all{n}")));
-        assert!(rmse(&all, "ekf-bias") <= 1.5, "plaza{n}: {all:?}");
-        assert!(rmse(&all, "ekf-bias-gated") <= 1.5);
-        // the estimated bias is near the data's +2.8 m
-        let bias = all.iter().find(|e| e["name"] == "ekf-bias").unwrap()["range_bias_m"].as_f64().unwrap();
+        for name in ["ekf-bias", "ekf-bias-gated", "ekf-cal", "ekf-cal-gated"] {
+            assert!(rmse(&all, name) <= 1.5, "plaza{n} {name}: {all:?}");
+        }
+        // an offset alone lands near the data's +2.8 m; the calibrated filter finds
+        // that the ranges read about 7 % long instead
+        let bias = find(&all, "ekf-bias", "range_bias_m").as_f64().unwrap();
         assert!((1.5..4.0).contains(&bias), "plaza{n} bias {bias}");
+        let scale = find(&all, "ekf-cal", "range_scale").as_f64().unwrap();
+        assert!((0.06..0.08).contains(&scale), "plaza{n} range scale {scale}");
         // without the bias the gate rejects many true ranges; with it, next to none
-        let rejected = |name: &str| all.iter().find(|e| e["name"] == name).unwrap()["rejected"].as_u64().unwrap();
+        let rejected = |name: &str| find(&all, name, "rejected").as_u64().unwrap();
         assert!(rejected("ekf-gated") > 10 * rejected("ekf-bias-gated").max(1));
     }
     let dr = rmse(&replay_json(&plaza(2), None, &dir.join("dr")), "dead-reckoning");
-    for b in ["1", "5"] {
+    for b in ["0", "1", "5", "6"] {
         let single = replay_json(&plaza(2), Some(b), &dir.join(format!("b{b}")));
-        assert!(rmse(&single, "ekf-bias") < dr / 4.0, "beacon {b}: {single:?} vs {dr}");
+        assert!(rmse(&single, "ekf-cal") <= dr / 5.0, "beacon {b}: {single:?} vs {dr}");
+        // the turn scale found from one beacon is the plaza2 odometry's (-4.6 % by a
+        // least-squares fit of the whole track)
+        let turn = find(&single, "ekf-cal", "turn_scale").as_f64().unwrap();
+        assert!((-0.06..-0.03).contains(&turn), "beacon {b}: turn scale {turn}");
     }
     // the outputs are all there
     for f in ["trajectory.csv", "summary.json", "rejected.csv", "top_view.png", "error.png"] {

@@ -39,7 +39,16 @@ fn measure_plaza_table() {
                 .stats
                 .iter()
                 .zip(r.session.final_estimates())
-                .map(|(s, e)| format!("{:.2} [{} rej, bias {:.2}]", s.rmse_m(), s.rejected, e.bias_m))
+                .map(|(s, e)| {
+                    format!(
+                        "{:.2} [{} rej, b {:.2}, kr {:.3}, kt {:.3}]",
+                        s.rmse_m(),
+                        s.rejected,
+                        e.bias_m,
+                        e.range_scale,
+                        e.turn_scale
+                    )
+                })
                 .collect();
             eprintln!("| {} | {} |", b.map_or("all".into(), |b| b.to_string()), cells.join(" | "));
         }

@@ -269,6 +269,18 @@ pub struct EstimatorSpec {
     pub bias_m: f64,
     #[serde(default = "default_bias_sigma_m")]
     pub bias_sigma_m: f64,
+    #[serde(default)]
+    pub estimate_range_scale: bool,
+    #[serde(default = "default_range_scale_sigma")]
+    pub range_scale_sigma: f64,
+    #[serde(default)]
+    pub estimate_distance_scale: bool,
+    #[serde(default = "default_distance_scale_sigma")]
+    pub distance_scale_sigma: f64,
+    #[serde(default)]
+    pub estimate_turn_scale: bool,
+    #[serde(default = "default_turn_scale_sigma")]
+    pub turn_scale_sigma: f64,
     pub nis_gate: Option<f64>,
     pub range_sigma_m: Option<f64>,
     pub heading_sigma_deg: Option<f64>,
@@ -281,7 +293,16 @@ pub struct EstimatorSpec {
 }
 
 fn default_bias_sigma_m() -> f64 {
-    5.0
+    PlanarConfig::default().bias_sigma_m
+}
+fn default_range_scale_sigma() -> f64 {
+    PlanarConfig::default().range_scale_sigma
+}
+fn default_distance_scale_sigma() -> f64 {
+    PlanarConfig::default().distance_scale_sigma
+}
+fn default_turn_scale_sigma() -> f64 {
+    PlanarConfig::default().turn_scale_sigma
 }
 
 impl EstimatorSpec {
@@ -304,6 +325,12 @@ impl EstimatorSpec {
             estimate_bias: self.estimate_bias,
             bias_m: self.bias_m,
             bias_sigma_m: self.bias_sigma_m,
+            estimate_range_scale: self.estimate_range_scale,
+            range_scale_sigma: self.range_scale_sigma,
+            estimate_distance_scale: self.estimate_distance_scale,
+            distance_scale_sigma: self.distance_scale_sigma,
+            estimate_turn_scale: self.estimate_turn_scale,
+            turn_scale_sigma: self.turn_scale_sigma,
             nis_gate: self.nis_gate,
             noise,
         }
@@ -468,6 +495,9 @@ impl LogDescription {
                 ("doppler_sigma_m_s", e.doppler_sigma_m_s),
                 ("nis_gate", e.nis_gate),
                 ("bias_sigma_m", Some(e.bias_sigma_m)),
+                ("range_scale_sigma", Some(e.range_scale_sigma)),
+                ("distance_scale_sigma", Some(e.distance_scale_sigma)),
+                ("turn_scale_sigma", Some(e.turn_scale_sigma)),
             ];
             for (key, v) in positive {
                 if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {

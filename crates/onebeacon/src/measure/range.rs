@@ -54,20 +54,29 @@ impl<const N: usize> ScalarModel<N> for Range3d {
 }
 
 /// Slant range from a vehicle at a known depth (pressure sensor) whose horizontal
-/// position is the state's components 0, 1 (N, E) to `beacon` (NED, m), plus a range
-/// bias read from state component `bias` when it is estimated (radio or acoustic
-/// ranges read long by a constant: plaza's +2.8 m, a wrong sound speed).
+/// position is the state's components 0, 1 (N, E) to `beacon` (NED, m), as a sensor
+/// with a scale error and an offset reads it: (1 + k) r + b. The scale error k is read
+/// from state component `scale` (a wrong propagation speed: travel times converted
+/// with a sound speed 2 % low read 2 % short) and the offset b from component `bias`
+/// (a fixed latency, a cable delay); either is zero when its index is `None`.
 #[derive(Debug, Clone, Copy)]
 pub struct SlantRange {
     pub beacon: Vector3<f64>,
     pub depth_m: f64,
     pub bias: Option<usize>,
+    pub scale: Option<usize>,
+}
+
+impl SlantRange {
+    fn gain<const N: usize>(&self, x: &SVector<f64, N>) -> f64 {
+        1.0 + self.scale.map_or(0.0, |i| x[i])
+    }
 }
 
 impl<const N: usize> ScalarModel<N> for SlantRange {
     fn predict(&self, x: &SVector<f64, N>) -> f64 {
         let d = Vector3::new(x[0], x[1], self.depth_m) - self.beacon;
-        d.norm() + self.bias.map_or(0.0, |i| x[i])
+        self.gain(x) * d.norm() + self.bias.map_or(0.0, |i| x[i])
     }
 
     fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
@@ -75,11 +84,15 @@ impl<const N: usize> ScalarModel<N> for SlantRange {
         let r = d.norm();
         let mut h = SMatrix::<f64, 1, N>::zeros();
         if r > 1e-9 {
-            h[0] = d.x / r;
-            h[1] = d.y / r;
+            let g = self.gain(x);
+            h[0] = g * d.x / r;
+            h[1] = g * d.y / r;
         }
         if let Some(i) = self.bias {
             h[i] = 1.0;
+        }
+        if let Some(i) = self.scale {
+            h[i] = r;
         }
         h
     }
@@ -111,13 +124,14 @@ mod tests {
     }
 
     #[test]
-    fn slant_range_with_bias() {
-        let m = SlantRange { beacon: Vector3::new(50.0, 100.0, 0.5), depth_m: 12.5, bias: Some(3) };
-        let x = SVector::<f64, 4>::from([53.0, 104.0, 0.3, 2.8]);
-        assert_abs_diff_eq!(ScalarModel::<4>::predict(&m, &x), 15.8, epsilon = 1e-12); // 3-4-12 + bias
-        assert_abs_diff_eq!(ScalarModel::<4>::jacobian(&m, &x), finite_difference::<4>(&m, &x), epsilon = 1e-7);
-        let fixed = SlantRange { bias: None, ..m };
-        assert_abs_diff_eq!(ScalarModel::<4>::predict(&fixed, &x), 13.0, epsilon = 1e-12);
-        assert_eq!(ScalarModel::<4>::jacobian(&fixed, &x)[3], 0.0);
+    fn slant_range_with_bias_and_scale() {
+        let m = SlantRange { beacon: Vector3::new(50.0, 100.0, 0.5), depth_m: 12.5, bias: Some(3), scale: Some(4) };
+        let x = SVector::<f64, 5>::from([53.0, 104.0, 0.3, 2.8, 0.07]);
+        assert_abs_diff_eq!(ScalarModel::<5>::predict(&m, &x), 1.07 * 13.0 + 2.8, epsilon = 1e-12); // 3-4-12
+        assert_abs_diff_eq!(ScalarModel::<5>::jacobian(&m, &x), finite_difference::<5>(&m, &x), epsilon = 1e-7);
+        let fixed = SlantRange { bias: None, scale: None, ..m };
+        assert_abs_diff_eq!(ScalarModel::<5>::predict(&fixed, &x), 13.0, epsilon = 1e-12);
+        let h = ScalarModel::<5>::jacobian(&fixed, &x);
+        assert_eq!((h[3], h[4]), (0.0, 0.0));
     }
 }
