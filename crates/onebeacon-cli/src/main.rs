@@ -174,6 +174,13 @@ fn non_negative_f64(s: &str) -> Result<f64, String> {
 pub struct BadInput(pub String);
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`| head`, a reader that
+    // quit) would panic; the default action ends the process quietly instead.
+    #[cfg(unix)]
+    // SAFETY: called first thing, before any other thread exists
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

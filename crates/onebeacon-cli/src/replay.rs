@@ -165,13 +165,24 @@ pub fn replay(
     }
     println!("{title}: {} measurements, replayed in {:.1} ms", log.items.len(), wall_s * 1e3);
     println!(
-        "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
-        "estimator", "rmse_m", "mean_m", "final_m", "max_m", "rejected", "bias_m", "k_range", "k_dist", "k_turn"
+        "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}",
+        "estimator",
+        "rmse_m",
+        "mean_m",
+        "final_m",
+        "max_m",
+        "rejected",
+        "bias_m",
+        "k_range",
+        "k_dist",
+        "k_turn",
+        "nees",
+        "in95_%"
     );
     for (e, st) in summary["estimators"].as_array().into_iter().flatten().zip(&s.stats) {
         let f = |k: &str| e[k].as_f64().map_or("-".into(), |v| format!("{v:.3}"));
         println!(
-            "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
+            "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}",
             e["name"].as_str().unwrap_or(""),
             f("rmse_m"),
             f("mean_error_m"),
@@ -181,7 +192,9 @@ pub fn replay(
             f("range_bias_m"),
             f("range_scale"),
             f("distance_scale"),
-            f("turn_scale")
+            f("turn_scale"),
+            e["nees_mean"].as_f64().map_or("-".into(), |v| format!("{v:.1}")),
+            e["nees_within_95_pct"].as_f64().map_or("-".into(), |v| format!("{v:.0}"))
         );
     }
     println!("wrote:");
@@ -209,6 +222,8 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
                 "max_error_m": if st.count > 0 { num(st.max_m) } else { Value::Null },
                 "rejected": st.rejected,
                 "failed_updates": st.failed,
+                "nees_mean": num(st.nees_mean()),
+                "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
                 "range_bias_m": num(e.bias_m),
                 "range_scale": num(e.range_scale),
                 "distance_scale": num(e.distance_scale),

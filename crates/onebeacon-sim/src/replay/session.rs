@@ -3,6 +3,7 @@
 
 use super::log::{Input, Item, TruthPose};
 use nalgebra::{Matrix2, Vector2, Vector3};
+use onebeacon::filter::consistency::nees;
 use onebeacon::geo::Frame;
 use onebeacon::nav::{Measurement, Outcome, PlanarConfig, PlanarEstimate, PlanarNavigator};
 use std::collections::{BTreeMap, BTreeSet};
@@ -37,7 +38,15 @@ pub struct ErrorStats {
     pub final_m: f64,
     pub rejected: usize,
     pub failed: usize,
+    /// Position NEES (2 dof): sum and count of the finite ones, and how many were within
+    /// the 95 % chi-square quantile.
+    pub nees_sum: f64,
+    pub nees_count: usize,
+    pub nees_within_95: usize,
 }
+
+/// The 95 % quantile of chi-square with 2 degrees of freedom, -2 ln 0.05.
+pub const NEES_95_2DOF: f64 = 5.991464547107982;
 
 impl ErrorStats {
     pub fn rmse_m(&self) -> f64 {
@@ -45,6 +54,27 @@ impl ErrorStats {
     }
     pub fn mean_m(&self) -> f64 {
         self.sum_m / self.count as f64
+    }
+    /// Mean position NEES: 2 for a consistent filter, more for an overconfident one.
+    pub fn nees_mean(&self) -> f64 {
+        self.nees_sum / self.nees_count as f64
+    }
+    /// Fraction of the NEES values within the 95 % quantile (0.95 when consistent).
+    pub fn nees_within_95_fraction(&self) -> f64 {
+        self.nees_within_95 as f64 / self.nees_count as f64
+    }
+
+    fn push(&mut self, err: f64, nees: f64) {
+        self.count += 1;
+        self.sum_m += err;
+        self.sum_sq_m2 += err * err;
+        self.max_m = self.max_m.max(err);
+        self.final_m = err;
+        if nees.is_finite() {
+            self.nees_sum += nees;
+            self.nees_count += 1;
+            self.nees_within_95 += usize::from(nees <= NEES_95_2DOF);
+        }
     }
 }
 
@@ -60,12 +90,11 @@ pub struct Step {
     pub errors: Option<Vec<(f64, f64)>>,
 }
 
-/// Horizontal error and its NEES against `truth`.
+/// Horizontal error and its NEES against `truth` (NaN when the covariance is singular).
 fn error_and_nees(e: &PlanarEstimate, truth: &TruthPose) -> (f64, f64) {
     let d = Vector2::new(e.north_m - truth.north_m, e.east_m - truth.east_m);
     let p = Matrix2::new(e.sigma_north_m.powi(2), e.cov_north_east_m2, e.cov_north_east_m2, e.sigma_east_m.powi(2));
-    let nees = p.try_inverse().map_or(f64::NAN, |pi| d.dot(&(pi * d)));
-    (d.norm(), nees)
+    (d.norm(), nees(&d, &p).unwrap_or(f64::NAN))
 }
 
 /// Every estimator on one stream. Estimates and errors are in NED.
@@ -189,11 +218,7 @@ impl Session {
                 .zip(self.stats.iter_mut())
                 .map(|(e, s)| {
                     let (err, nees) = error_and_nees(e, &p);
-                    s.count += 1;
-                    s.sum_m += err;
-                    s.sum_sq_m2 += err * err;
-                    s.max_m = s.max_m.max(err);
-                    s.final_m = err;
+                    s.push(err, nees);
                     (err, nees)
                 })
                 .collect()
@@ -224,5 +249,26 @@ impl Session {
             }
             other => other,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+    #[test]
+    fn nees_quantile_and_statistics() {
+        let q = ChiSquared::new(2.0).unwrap().inverse_cdf(0.95);
+        approx::assert_relative_eq!(NEES_95_2DOF, q, max_relative = 1e-9);
+        let mut s = ErrorStats::default();
+        for (err, nees) in [(1.0, 1.0), (3.0, 9.0), (2.0, f64::NAN), (2.0, 2.0)] {
+            s.push(err, nees);
+        }
+        assert_eq!((s.count, s.nees_count, s.nees_within_95), (4, 3, 2));
+        approx::assert_relative_eq!(s.nees_mean(), 4.0);
+        approx::assert_relative_eq!(s.nees_within_95_fraction(), 2.0 / 3.0);
+        approx::assert_relative_eq!(s.rmse_m(), (18.0f64 / 4.0).sqrt());
+        assert_eq!((s.max_m, s.final_m), (3.0, 2.0));
     }
 }
