@@ -5,7 +5,7 @@ use crate::BadInput;
 use crate::output::Staging;
 use crate::{plot, report};
 use anyhow::{Context, Result};
-use onebeacon::nav::{Measurement, Outcome};
+use onebeacon::nav::{Measurement, Outcome, PlanarEstimate};
 use onebeacon_sim::replay::log::HeadingFrom;
 use onebeacon_sim::replay::{
     Input, Item, Log, LogDescription, Session, Start, Step, TruthPose, new_session, replay as run_replay,
@@ -164,44 +164,44 @@ pub fn replay(
         return Ok(());
     }
     println!("{title}: {} measurements, replayed in {:.1} ms", log.items.len(), wall_s * 1e3);
-    println!(
-        "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}",
-        "estimator",
-        "rmse_m",
-        "mean_m",
-        "final_m",
-        "max_m",
-        "rejected",
-        "bias_m",
-        "k_range",
-        "k_dist",
-        "k_turn",
-        "nees",
-        "in95_%"
-    );
-    for (e, st) in summary["estimators"].as_array().into_iter().flatten().zip(&s.stats) {
-        let f = |k: &str| e[k].as_f64().map_or("-".into(), |v| format!("{v:.3}"));
-        println!(
-            "{:<20} {:>8} {:>8} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}",
-            e["name"].as_str().unwrap_or(""),
-            f("rmse_m"),
-            f("mean_error_m"),
-            f("final_error_m"),
-            f("max_error_m"),
-            st.rejected,
-            f("range_bias_m"),
-            f("range_scale"),
-            f("distance_scale"),
-            f("turn_scale"),
-            e["nees_mean"].as_f64().map_or("-".into(), |v| format!("{v:.1}")),
-            e["nees_within_95_pct"].as_f64().map_or("-".into(), |v| format!("{v:.0}"))
-        );
+    // (header, summary key, decimals)
+    const COLUMNS: [(&str, &str, usize); 11] = [
+        ("rmse_m", "rmse_m", 3),
+        ("mean_m", "mean_error_m", 3),
+        ("final_m", "final_error_m", 3),
+        ("max_m", "max_error_m", 3),
+        ("rejected", "rejected", 0),
+        ("bias_m", "range_bias_m", 3),
+        ("k_range", "range_scale", 3),
+        ("k_dist", "distance_scale", 3),
+        ("k_turn", "turn_scale", 3),
+        ("nees", "nees_mean", 1),
+        ("in95_%", "nees_within_95_pct", 0),
+    ];
+    let header: String = COLUMNS.iter().map(|(h, _, _)| format!(" {h:>9}")).collect();
+    println!("{:<20}{header}", "estimator");
+    for e in summary["estimators"].as_array().into_iter().flatten() {
+        let cells: String = COLUMNS
+            .iter()
+            .map(|(_, k, d)| e[*k].as_f64().map_or(format!(" {:>9}", "-"), |v| format!(" {v:>9.d$}", d = *d)))
+            .collect();
+        println!("{:<20}{cells}", e["name"].as_str().unwrap_or(""));
     }
     println!("wrote:");
     for f in files {
         println!("  {}", f.display());
     }
     Ok(())
+}
+
+/// The range and odometry calibration states of an estimate, as output keys.
+fn calibration(e: &PlanarEstimate) -> [(&'static str, f64); 4] {
+    [
+        ("range_bias_m", e.bias_m),
+        ("range_scale", e.range_scale),
+        ("distance_scale", e.distance_scale),
+        ("turn_scale", e.turn_scale),
+    ]
 }
 
 fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
@@ -214,7 +214,7 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
         .zip(&finals)
         .map(|((name, st), e)| {
             let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m, e.east_m, 0.0));
-            json!({
+            let mut v = json!({
                 "name": name,
                 "rmse_m": num(st.rmse_m()),
                 "mean_error_m": num(st.mean_m()),
@@ -224,12 +224,12 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
                 "failed_updates": st.failed,
                 "nees_mean": num(st.nees_mean()),
                 "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
-                "range_bias_m": num(e.bias_m),
-                "range_scale": num(e.range_scale),
-                "distance_scale": num(e.distance_scale),
-                "turn_scale": num(e.turn_scale),
                 "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad)},
-            })
+            });
+            for (k, x) in calibration(e) {
+                v[k] = num(x);
+            }
+            v
         })
         .collect();
     json!({
@@ -275,11 +275,10 @@ fn step_json(line: usize, step: &Step, s: &Session, frame: onebeacon::geo::Frame
                 "heading_rad": frame.heading_from_ned(e.heading_rad),
                 "sigma_x_m": sx.abs(),
                 "sigma_y_m": sy.abs(),
-                "range_bias_m": e.bias_m,
-                "range_scale": e.range_scale,
-                "distance_scale": e.distance_scale,
-                "turn_scale": e.turn_scale,
             });
+            for (k, x) in calibration(e) {
+                v[k] = json!(x);
+            }
             if let Some(o) = step.outcomes[i] {
                 let (outcome, nis) = match o {
                     Outcome::Applied => ("applied", None),

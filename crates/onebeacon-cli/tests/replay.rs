@@ -25,6 +25,23 @@ fn run(args: &[&str]) -> Output {
     bin().args(args).output().expect("binary runs")
 }
 
+/// `onebeacon stream CONFIG` fed `input` on stdin (from a thread, so a large input
+/// cannot block on a full stdout pipe).
+fn stream(config: &str, input: Vec<u8>) -> Output {
+    let mut child = bin()
+        .args(["stream", config])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || stdin.write_all(&input).unwrap());
+    let o = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    o
+}
+
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
@@ -99,18 +116,7 @@ fn streaming_equals_replay() {
     let summary = replay_json(&log, None, &dir.join("out"));
     let items = run(&["replay", &log, "--print-stream"]);
     assert!(items.status.success());
-    let mut child = bin()
-        .args(["stream", &log])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stdin = child.stdin.take().unwrap();
-    let input = items.stdout.clone();
-    let writer = std::thread::spawn(move || stdin.write_all(&input).unwrap());
-    let o = child.wait_with_output().unwrap();
-    writer.join().unwrap();
+    let o = stream(&log, items.stdout.clone());
     assert!(o.status.success(), "{}", text(&o.stderr));
     let lines: Vec<Value> = text(&o.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert!(lines.len() > 20_000);
@@ -235,15 +241,7 @@ fn stream_reports_bad_lines_and_goes_on() {
         r#"{"t_s": 2.0, "kind": "range", "beacon": 0, "range_m": 9.6}"#,
     ]
     .join("\n");
-    let mut child = bin()
-        .args(["stream", &path])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child.stdin.take().unwrap().write_all(input.as_bytes()).unwrap();
-    let o = child.wait_with_output().unwrap();
+    let o = stream(&path, input.into_bytes());
     assert!(o.status.success());
     let err = text(&o.stderr);
     for (line, what) in

@@ -267,20 +267,16 @@ pub struct EstimatorSpec {
     pub estimate_bias: bool,
     #[serde(default)]
     pub bias_m: f64,
-    #[serde(default = "default_bias_sigma_m")]
-    pub bias_sigma_m: f64,
+    pub bias_sigma_m: Option<f64>,
     #[serde(default)]
     pub estimate_range_scale: bool,
-    #[serde(default = "default_range_scale_sigma")]
-    pub range_scale_sigma: f64,
+    pub range_scale_sigma: Option<f64>,
     #[serde(default)]
     pub estimate_distance_scale: bool,
-    #[serde(default = "default_distance_scale_sigma")]
-    pub distance_scale_sigma: f64,
+    pub distance_scale_sigma: Option<f64>,
     #[serde(default)]
     pub estimate_turn_scale: bool,
-    #[serde(default = "default_turn_scale_sigma")]
-    pub turn_scale_sigma: f64,
+    pub turn_scale_sigma: Option<f64>,
     pub nis_gate: Option<f64>,
     pub range_sigma_m: Option<f64>,
     pub heading_sigma_deg: Option<f64>,
@@ -292,22 +288,10 @@ pub struct EstimatorSpec {
     pub bias_walk_m_per_sqrt_s: Option<f64>,
 }
 
-fn default_bias_sigma_m() -> f64 {
-    PlanarConfig::default().bias_sigma_m
-}
-fn default_range_scale_sigma() -> f64 {
-    PlanarConfig::default().range_scale_sigma
-}
-fn default_distance_scale_sigma() -> f64 {
-    PlanarConfig::default().distance_scale_sigma
-}
-fn default_turn_scale_sigma() -> f64 {
-    PlanarConfig::default().turn_scale_sigma
-}
-
 impl EstimatorSpec {
     pub fn config(&self) -> PlanarConfig {
-        let d = PlanarNoise::default();
+        let c = PlanarConfig::default();
+        let d = c.noise;
         let noise = PlanarNoise {
             distance_sigma_frac: self.distance_sigma_frac.unwrap_or(d.distance_sigma_frac),
             heading_change_sigma_frac: self.heading_change_sigma_frac.unwrap_or(d.heading_change_sigma_frac),
@@ -324,13 +308,13 @@ impl EstimatorSpec {
             use_beacons: self.kind == EstimatorKind::RangeEkf,
             estimate_bias: self.estimate_bias,
             bias_m: self.bias_m,
-            bias_sigma_m: self.bias_sigma_m,
+            bias_sigma_m: self.bias_sigma_m.unwrap_or(c.bias_sigma_m),
             estimate_range_scale: self.estimate_range_scale,
-            range_scale_sigma: self.range_scale_sigma,
+            range_scale_sigma: self.range_scale_sigma.unwrap_or(c.range_scale_sigma),
             estimate_distance_scale: self.estimate_distance_scale,
-            distance_scale_sigma: self.distance_scale_sigma,
+            distance_scale_sigma: self.distance_scale_sigma.unwrap_or(c.distance_scale_sigma),
             estimate_turn_scale: self.estimate_turn_scale,
-            turn_scale_sigma: self.turn_scale_sigma,
+            turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
             nis_gate: self.nis_gate,
             noise,
         }
@@ -494,10 +478,10 @@ impl LogDescription {
                 ("heading_sigma_deg", e.heading_sigma_deg),
                 ("doppler_sigma_m_s", e.doppler_sigma_m_s),
                 ("nis_gate", e.nis_gate),
-                ("bias_sigma_m", Some(e.bias_sigma_m)),
-                ("range_scale_sigma", Some(e.range_scale_sigma)),
-                ("distance_scale_sigma", Some(e.distance_scale_sigma)),
-                ("turn_scale_sigma", Some(e.turn_scale_sigma)),
+                ("bias_sigma_m", e.bias_sigma_m),
+                ("range_scale_sigma", e.range_scale_sigma),
+                ("distance_scale_sigma", e.distance_scale_sigma),
+                ("turn_scale_sigma", e.turn_scale_sigma),
             ];
             for (key, v) in positive {
                 if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
