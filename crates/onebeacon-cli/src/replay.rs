@@ -5,7 +5,7 @@ use crate::BadInput;
 use crate::output::Staging;
 use crate::{plot, report};
 use anyhow::{Context, Result};
-use onebeacon::nav::{Measurement, Outcome, PlanarEstimate};
+use onebeacon::nav::{BeaconFix, Estimate, Kind, Outcome};
 use onebeacon_sim::replay::log::HeadingFrom;
 use onebeacon_sim::replay::{
     Input, Item, Log, LogDescription, Session, Start, Step, TruthPose, new_session, replay as run_replay,
@@ -20,20 +20,40 @@ use std::path::{Path, PathBuf};
 pub fn item_json(item: &Item) -> Value {
     let t = item.t_s;
     match item.input {
-        Input::Measurement(m) => match m {
-            Measurement::Odometry { distance_m, heading_change_rad } => {
-                json!({"t_s": t, "kind": "odometry", "distance_m": distance_m, "heading_change_rad": heading_change_rad})
+        Input::Measurement(m) => {
+            let mut v = match m {
+                Kind::Odometry { distance_m, heading_change_rad } => {
+                    json!({"distance_m": distance_m, "heading_change_rad": heading_change_rad})
+                }
+                Kind::Speed { speed_m_s } => json!({"speed_m_s": speed_m_s}),
+                Kind::Heading { heading_rad } => json!({"heading_rad": heading_rad}),
+                Kind::Depth { depth_m } => json!({"depth_m": depth_m}),
+                Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
+                    json!({"roll_rad": roll_rad, "pitch_rad": pitch_rad, "heading_rad": heading_rad})
+                }
+                Kind::BodyVelocity { nu } => json!({"nu": nu}),
+                Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
+                    json!({"heading_rad": heading_rad, "yaw_rate_rad_s": yaw_rate_rad_s, "accel_m_s2": accel_m_s2})
+                }
+                Kind::Range { range_m, .. } => json!({"range_m": range_m}),
+                Kind::Doppler { radial_speed_m_s, .. } => json!({"radial_speed_m_s": radial_speed_m_s}),
+                Kind::RangeDoppler { range_m, radial_speed_m_s, .. } => {
+                    json!({"range_m": range_m, "radial_speed_m_s": radial_speed_m_s})
+                }
+            };
+            v["t_s"] = json!(t);
+            v["kind"] = json!(m.name());
+            if let Some(b) = m.beacon() {
+                v["beacon"] = json!(b.id);
+                if b.sigma_m > 0.0 {
+                    v["beacon_sigma_m"] = json!(b.sigma_m);
+                }
+                if let Some(t_tx) = b.t_tx_s {
+                    v["t_tx_s"] = json!(t_tx);
+                }
             }
-            Measurement::Speed { speed_m_s } => json!({"t_s": t, "kind": "speed", "speed_m_s": speed_m_s}),
-            Measurement::Heading { heading_rad } => json!({"t_s": t, "kind": "heading", "heading_rad": heading_rad}),
-            Measurement::Depth { depth_m } => json!({"t_s": t, "kind": "depth", "depth_m": depth_m}),
-            Measurement::Range { beacon_id, range_m, .. } => {
-                json!({"t_s": t, "kind": "range", "beacon": beacon_id, "range_m": range_m})
-            }
-            Measurement::Doppler { beacon_id, radial_speed_m_s, .. } => {
-                json!({"t_s": t, "kind": "doppler", "beacon": beacon_id, "radial_speed_m_s": radial_speed_m_s})
-            }
-        },
+            v
+        }
         Input::BeaconPosition { beacon_id, position } => json!({"t_s": t, "kind": "beacon_position",
             "beacon": beacon_id, "x_m": position.x, "y_m": position.y, "z_m": position.z}),
         Input::Truth(p) => {
@@ -46,7 +66,8 @@ pub fn item_json(item: &Item) -> Value {
     }
 }
 
-const KINDS: &str = "odometry, speed, heading, depth, range, doppler, beacon_position, ground_truth";
+const KINDS: &str = "odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
+    range_doppler, beacon_position, ground_truth";
 
 /// Parses one JSON line into an item; fixed beacons resolve `beacon` ids, tracked ones
 /// (`beacon_position` lines seen so far) are resolved by the session.
@@ -56,45 +77,70 @@ fn parse_item(
     tracked: &mut BTreeSet<u32>,
 ) -> Result<Item, String> {
     let v: Map<String, Value> = serde_json::from_str(line).map_err(|e| format!("not a JSON object: {e}"))?;
-    let num = |key: &str| -> Result<f64, String> {
-        match v.get(key) {
-            None => Err(format!("missing key `{key}`")),
-            Some(x) => {
-                x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| format!("`{key}` = {x} is not a finite number"))
-            }
-        }
+    let finite = |key: &str, x: &Value| -> Result<f64, String> {
+        x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| format!("`{key}` = {x} is not a finite number"))
     };
+    let num = |key: &str| -> Result<f64, String> {
+        v.get(key).map_or_else(|| Err(format!("missing key `{key}`")), |x| finite(key, x))
+    };
+    let optional = |key: &str| v.get(key).map(|x| finite(key, x)).transpose();
     let kind = v.get("kind").and_then(Value::as_str).ok_or_else(|| format!("missing key `kind` (one of {KINDS})"))?;
     let t_s = num("t_s")?;
     let beacon_id = || -> Result<u32, String> {
         let id = v.get("beacon").and_then(Value::as_u64).and_then(|b| u32::try_from(b).ok());
         id.ok_or_else(|| "`beacon` must be a beacon id (a non-negative integer)".to_string())
     };
-    let beacon = |tracked: &BTreeSet<u32>| resolve_beacon(beacon_id()?, beacons, tracked);
-    let m = |m: Measurement| Input::Measurement(m);
+    let beacon = |tracked: &BTreeSet<u32>| -> Result<BeaconFix, String> {
+        let mut b = resolve_beacon(beacon_id()?, beacons, tracked)?;
+        b.sigma_m = optional("beacon_sigma_m")?.unwrap_or(0.0);
+        if b.sigma_m < 0.0 {
+            return Err(format!("`beacon_sigma_m` = {} must be >= 0", b.sigma_m));
+        }
+        b.t_tx_s = optional("t_tx_s")?;
+        Ok(b)
+    };
+    let m = Input::Measurement;
     let input = match kind {
         "odometry" => {
-            m(Measurement::Odometry { distance_m: num("distance_m")?, heading_change_rad: num("heading_change_rad")? })
+            m(Kind::Odometry { distance_m: num("distance_m")?, heading_change_rad: num("heading_change_rad")? })
         }
-        "speed" => m(Measurement::Speed { speed_m_s: num("speed_m_s")? }),
-        "heading" => m(Measurement::Heading { heading_rad: num("heading_rad")? }),
-        "depth" => m(Measurement::Depth { depth_m: num("depth_m")? }),
-        "range" => {
-            let (beacon_id, beacon) = beacon(tracked)?;
-            m(Measurement::Range { beacon_id, beacon, range_m: num("range_m")? })
+        "speed" => m(Kind::Speed { speed_m_s: num("speed_m_s")? }),
+        "heading" => m(Kind::Heading { heading_rad: num("heading_rad")? }),
+        "depth" => m(Kind::Depth { depth_m: num("depth_m")? }),
+        "attitude" => m(Kind::Attitude {
+            roll_rad: num("roll_rad")?,
+            pitch_rad: num("pitch_rad")?,
+            heading_rad: num("heading_rad")?,
+        }),
+        "body_velocity" => {
+            let nu = v.get("nu").and_then(Value::as_array).filter(|a| a.len() == 6);
+            let nu = nu.ok_or("`nu` must be [u, v, w, p, q, r] (m/s, rad/s)")?;
+            let mut out = [0.0; 6];
+            for (o, x) in out.iter_mut().zip(nu) {
+                *o = finite("nu", x)?;
+            }
+            m(Kind::BodyVelocity { nu: out })
         }
-        "doppler" => {
-            let (beacon_id, beacon) = beacon(tracked)?;
-            m(Measurement::Doppler { beacon_id, beacon, radial_speed_m_s: num("radial_speed_m_s")? })
-        }
+        "inertial" => m(Kind::Inertial {
+            heading_rad: num("heading_rad")?,
+            yaw_rate_rad_s: num("yaw_rate_rad_s")?,
+            accel_m_s2: num("accel_m_s2")?,
+        }),
+        "range" => m(Kind::Range { beacon: beacon(tracked)?, range_m: num("range_m")? }),
+        "doppler" => m(Kind::Doppler { beacon: beacon(tracked)?, radial_speed_m_s: num("radial_speed_m_s")? }),
+        "range_doppler" => m(Kind::RangeDoppler {
+            beacon: beacon(tracked)?,
+            range_m: num("range_m")?,
+            radial_speed_m_s: num("radial_speed_m_s")?,
+        }),
         "beacon_position" => {
             let beacon_id = beacon_id()?;
             tracked.insert(beacon_id);
-            let z = if v.contains_key("z_m") { num("z_m")? } else { 0.0 };
+            let z = optional("z_m")?.unwrap_or(0.0);
             Input::BeaconPosition { beacon_id, position: nalgebra::Vector3::new(num("x_m")?, num("y_m")?, z) }
         }
         "ground_truth" => {
-            let heading_rad = if v.contains_key("heading_rad") { Some(num("heading_rad")?) } else { None };
+            let heading_rad = optional("heading_rad")?;
             Input::Truth(TruthPose { north_m: num("x_m")?, east_m: num("y_m")?, heading_rad })
         }
         other => return Err(format!("unknown kind `{other}` (one of {KINDS})")),
@@ -195,9 +241,9 @@ pub fn replay(
 }
 
 /// The range and odometry calibration states of an estimate, as output keys.
-fn calibration(e: &PlanarEstimate) -> [(&'static str, f64); 4] {
+fn calibration(e: &Estimate) -> [(&'static str, f64); 4] {
     [
-        ("range_bias_m", e.bias_m),
+        ("range_bias_m", e.range_bias_m),
         ("range_scale", e.range_scale),
         ("distance_scale", e.distance_scale),
         ("turn_scale", e.turn_scale),
@@ -213,7 +259,7 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
         .zip(&s.stats)
         .zip(&finals)
         .map(|((name, st), e)| {
-            let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m, e.east_m, 0.0));
+            let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m(), e.east_m(), 0.0));
             let mut v = json!({
                 "name": name,
                 "rmse_m": num(st.rmse_m()),
@@ -266,8 +312,8 @@ fn step_json(line: usize, step: &Step, s: &Session, frame: onebeacon::geo::Frame
         .iter()
         .enumerate()
         .map(|(i, e)| {
-            let (x, y, _) = frame.from_ned(&nalgebra::Vector3::new(e.north_m, e.east_m, 0.0));
-            let (sx, sy, _) = frame.from_ned(&nalgebra::Vector3::new(e.sigma_north_m, e.sigma_east_m, 0.0));
+            let (x, y, _) = frame.from_ned(&nalgebra::Vector3::new(e.north_m(), e.east_m(), 0.0));
+            let (sx, sy, _) = frame.from_ned(&nalgebra::Vector3::new(e.sigma_north_m(), e.sigma_east_m(), 0.0));
             let mut v = json!({
                 "name": s.names[i],
                 "x_m": x,

@@ -77,6 +77,15 @@ impl ErrorAccumulator {
         self.failed_updates += 1;
     }
 
+    /// Counts the failed updates among a navigator's outcomes.
+    pub fn count_failures(&mut self, outcomes: impl IntoIterator<Item = onebeacon::nav::Outcome>) {
+        for o in outcomes {
+            if matches!(o, onebeacon::nav::Outcome::Failed(_)) {
+                self.failed_updates += 1;
+            }
+        }
+    }
+
     /// The run's statistics; `distance_m` is the distance travelled in the run.
     pub fn finish(&self, distance_m: f64) -> RunMetrics {
         let n = self.n.max(1) as f64;

@@ -1,16 +1,26 @@
 //! Posterior Cramer-Rao bound of the moving-beacon, range-only case (Tichavsky et al.
-//! 1998; ../shared/acoustics.md): J_{k+1} = (Q_k + F_k J_k^-1 F_k')^-1 + E[H' R^-1 H].
+//! 1998): J_{k+1} = (Q_k + F_k J_k^-1 F_k')^-1 + E[H' R^-1 H].
 //! The vehicle's truth does not depend on the draws, so F_k and Q_k are evaluated on
 //! it; the range information depends on where the guided ASV was, so it is averaged
 //! over the Monte Carlo runs first, then one recursion is run (never an average of
-//! per-run inverses).
+//! per-run inverses). Q and R are read from the navigator's own models
+//! ([`onebeacon::nav::SensorNoise`]), so the bound and the filter share every noise.
 
 use crate::run::truth_trajectory;
 use crate::scenario::{MovingBeacon, MovingBeaconCell};
 use crate::vehicles::rov::body_velocity;
 use nalgebra::{Matrix6, SVector};
 use onebeacon::filter::ProcessModel;
-use onebeacon::models::kinematic6dof::{Cov, Kinematic6Dof, idx};
+use onebeacon::measure::ScalarModel;
+use onebeacon::models::kinematic6dof::Cov;
+
+/// One step of the recursion from the bound `c` = J^-1: the bound after a transition
+/// with Jacobian `f` and process noise `q`, and measurements of information `info`.
+fn step(c: &Cov, f: &Cov, q: &Cov, info: &Cov) -> Cov {
+    let predicted = f * c * f.transpose() + q;
+    let j = predicted.try_inverse().unwrap_or_else(Cov::zeros) + info;
+    j.try_inverse().unwrap_or(predicted)
+}
 
 /// Root of the bound on the mean squared horizontal position error over the mission,
 /// given the sum over `runs` runs of the range information received at each step.
@@ -22,15 +32,12 @@ pub fn horizontal_rmse_bound(
 ) -> f64 {
     let truth = truth_trajectory(s, cell);
     let dt = s.mission.dt_s;
-    let n = &s.sensors;
-    let (v2, w2) = (n.velocity_noise_m_s.powi(2), n.rate_noise_rad_s.powi(2));
-    let q_nu = Cov::from_diagonal(&SVector::from([v2, v2, v2, w2, w2, w2]));
-    let att = n.attitude_noise_deg.to_radians().powi(2);
-    let mut sensor_info = Cov::zeros(); // depth and attitude every step
-    sensor_info[(idx::D, idx::D)] = 1.0 / n.depth_noise_m.powi(2);
-    for a in [idx::ROLL, idx::PITCH, idx::YAW] {
-        sensor_info[(a, a)] = 1.0 / att;
-    }
+    let noise = s.sensor_noise();
+    // depth and attitude every step: H' R^-1 H of the navigator's models
+    let sensor_info = noise.depth_attitude_models().iter().fold(Cov::zeros(), |acc, m| {
+        let h = ScalarModel::<6>::jacobian(m, &truth[0]);
+        acc + h.transpose() * h / m.variance(&truth[0])
+    });
     let i = &s.initial;
     let a0 = i.attitude_sigma_deg.to_radians().powi(2);
     let p0 = Cov::from_diagonal(&SVector::from([
@@ -44,16 +51,70 @@ pub fn horizontal_rmse_bound(
     let mut c = p0; // the bound itself, J^-1
     let mut sum = c[(0, 0)] + c[(1, 1)];
     for k in 1..truth.len() {
-        let model = Kinematic6Dof::new(body_velocity(&s.vehicle, cell.path, (k - 1) as f64 * dt + dt / 2.0));
+        let model = noise.process_model(body_velocity(&s.vehicle, cell.path, (k - 1) as f64 * dt + dt / 2.0));
         let f = model.jacobian(&truth[k - 1], dt);
-        let g = model.input_jacobian(&truth[k - 1], dt);
-        let predicted = f * c * f.transpose() + g * q_nu * g.transpose();
-        let mut j = predicted.try_inverse().unwrap_or_else(Cov::zeros) + sensor_info;
-        if let Some(info) = information_sum.get(k) {
-            j += info / runs as f64;
-        }
-        c = j.try_inverse().unwrap_or(predicted);
+        let q = model.noise_covariance(&truth[k - 1], dt);
+        let info = information_sum.get(k).map_or(sensor_info, |i| sensor_info + i / runs as f64);
+        c = step(&c, &f, &q, &info);
         sum += c[(0, 0)] + c[(1, 1)];
     }
     (sum / truth.len() as f64).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::moving_beacon::PathKind;
+    use crate::scenario::{Scenario, builtin, parse};
+    use approx::assert_relative_eq;
+
+    /// A stationary vehicle without process noise: the bound is the inverse of the
+    /// summed information, J_k = J0 + k S + sum of the range information up to k, with S
+    /// the depth and attitude information 1/sigma^2 on their diagonal (closed form,
+    /// written out here from the scenario's sigmas).
+    #[test]
+    fn static_vehicle_without_process_noise_sums_the_information() {
+        let Scenario::MovingBeacon(mut s) = parse(builtin("sousa").unwrap().toml, "sousa").unwrap() else {
+            unreachable!()
+        };
+        s.mission.duration_s = 3.0;
+        s.mission.dt_s = 0.5;
+        s.sensors.velocity_noise_m_s = 0.0;
+        s.sensors.rate_noise_rad_s = 0.0;
+        let cell = MovingBeaconCell { path: PathKind::Stationary, ..s.base_cell() };
+        let steps = s.steps();
+        assert_eq!(steps, 6);
+        // range information at steps 2 and 5 from two beacons, summed over 4 runs
+        let h = |b: [f64; 3]| {
+            let v = SVector::<f64, 6>::from([-b[0], -b[1], 5.0 - b[2], 0.0, 0.0, 0.0]).normalize();
+            v * v.transpose()
+        };
+        let mut info = vec![Matrix6::zeros(); steps + 1];
+        info[2] = h([30.0, 0.0, 0.0]) * 4.0 * 2.0;
+        info[5] = h([0.0, 40.0, 0.0]) * 4.0 * 3.0;
+        let bound = horizontal_rmse_bound(&s, &cell, &info, 4);
+
+        let i = &s.initial;
+        let att = i.attitude_sigma_deg.to_radians().powi(-2);
+        let mut j = Cov::from_diagonal(&SVector::from([
+            i.position_sigma_m.powi(-2),
+            i.position_sigma_m.powi(-2),
+            i.depth_sigma_m.powi(-2),
+            att,
+            att,
+            att,
+        ]));
+        let n = &s.sensors;
+        let satt = n.attitude_noise_deg.to_radians().powi(-2);
+        let sensor = Cov::from_diagonal(&SVector::from([0.0, 0.0, n.depth_noise_m.powi(-2), satt, satt, satt]));
+        let mut sum = 0.0;
+        for (k, info_k) in info.iter().enumerate() {
+            if k > 0 {
+                j += sensor + info_k / 4.0;
+            }
+            let c = j.try_inverse().unwrap();
+            sum += c[(0, 0)] + c[(1, 1)];
+        }
+        assert_relative_eq!(bound, (sum / (steps + 1) as f64).sqrt(), max_relative = 1e-9);
+    }
 }

@@ -6,7 +6,7 @@ use crate::seed::{Stream, gauss, rng};
 use crate::vehicles::TruthState;
 use nalgebra::Vector2;
 use onebeacon::geo::wrap_angle;
-use onebeacon::nav::{CommFrame, Proprioceptive};
+use onebeacon::nav::{BeaconFix, Kind};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 
@@ -40,10 +40,10 @@ impl SensorSuite {
     /// AHRS heading with white noise and a linearly drifting bias (3.5.3), and IMU yaw
     /// rate and forward acceleration with white noise (4.1.1), at time `t`, given the
     /// commanded (true) yaw rate and acceleration.
-    pub fn proprioceptive(&mut self, t: f64, truth: &TruthState, omega: f64, accel: f64) -> Proprioceptive {
+    pub fn proprioceptive(&mut self, t: f64, truth: &TruthState, omega: f64, accel: f64) -> Kind {
         let bias = self.bias0_rad + self.bias_rate_rad_s * t;
         let heading_noise = gauss(&mut self.heading, self.noise.heading_noise_deg.to_radians());
-        Proprioceptive {
+        Kind::Inertial {
             heading_rad: wrap_angle(truth.psi + bias + heading_noise),
             yaw_rate_rad_s: omega + gauss(&mut self.imu, self.noise.gyro_noise_rad_s),
             accel_m_s2: accel + gauss(&mut self.imu, self.noise.accel_noise_m_s2),
@@ -52,7 +52,7 @@ impl SensorSuite {
 
     /// A communication frame from `beacon` (None if lost): OWTT range (eq. 19) and
     /// Doppler radial speed (eq. 13-14), each with white noise.
-    pub fn comm_frame(&mut self, truth: &TruthState, beacon: Vector2<f64>) -> Option<CommFrame> {
+    pub fn comm_frame(&mut self, truth: &TruthState, beacon: Vector2<f64>) -> Option<Kind> {
         // always draw all three numbers so that a loss does not shift later draws
         let lost = self.acoustic.random::<f64>() < self.frame_loss_prob;
         let range_noise = gauss(&mut self.acoustic, self.noise.range_noise_m);
@@ -62,8 +62,8 @@ impl SensorSuite {
         }
         let d = truth.pos - beacon;
         let bearing_to_beacon = d.y.atan2(d.x) + std::f64::consts::PI; // eq. 14
-        Some(CommFrame {
-            beacon_ned_m: beacon,
+        Some(Kind::RangeDoppler {
+            beacon: BeaconFix::fixed(0, nalgebra::Vector3::new(beacon.x, beacon.y, 0.0)),
             range_m: d.norm() + range_noise,
             radial_speed_m_s: truth.v * (bearing_to_beacon - truth.psi).cos() + doppler_noise, // eq. 13
         })
@@ -79,12 +79,17 @@ mod tests {
     fn noise_free_measurements_equal_the_truth() {
         let mut s = SensorSuite::new(&Sensors::noise_free(), 0.0, 3, 0);
         let truth = TruthState { pos: Vector2::new(10.0, 0.0), psi: std::f64::consts::PI, v: 1.5 };
-        let f = s.comm_frame(&truth, Vector2::zeros()).unwrap();
-        assert_abs_diff_eq!(f.range_m, 10.0, epsilon = 1e-12);
-        assert_abs_diff_eq!(f.radial_speed_m_s, 1.5, epsilon = 1e-12); // heading at the beacon
-        let p = s.proprioceptive(100.0, &truth, 0.02, -0.01);
-        assert_abs_diff_eq!(p.heading_rad.abs(), std::f64::consts::PI, epsilon = 1e-12);
-        assert_eq!((p.yaw_rate_rad_s, p.accel_m_s2), (0.02, -0.01));
+        let Some(Kind::RangeDoppler { range_m, radial_speed_m_s, .. }) = s.comm_frame(&truth, Vector2::zeros()) else {
+            panic!("a frame")
+        };
+        assert_abs_diff_eq!(range_m, 10.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(radial_speed_m_s, 1.5, epsilon = 1e-12); // heading at the beacon
+        let Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } = s.proprioceptive(100.0, &truth, 0.02, -0.01)
+        else {
+            panic!("an inertial sample")
+        };
+        assert_abs_diff_eq!(heading_rad.abs(), std::f64::consts::PI, epsilon = 1e-12);
+        assert_eq!((yaw_rate_rad_s, accel_m_s2), (0.02, -0.01));
     }
 
     #[test]
@@ -95,11 +100,11 @@ mod tests {
         let (mut n, mut sum2, mut lost) = (0, 0.0, 0);
         for _ in 0..20_000 {
             match s.comm_frame(&truth, Vector2::zeros()) {
-                Some(f) => {
+                Some(Kind::RangeDoppler { range_m, .. }) => {
                     n += 1;
-                    sum2 += (f.range_m - 50.0).powi(2);
+                    sum2 += (range_m - 50.0).powi(2);
                 }
-                None => lost += 1,
+                _ => lost += 1,
             }
         }
         let sigma = (sum2 / n as f64).sqrt();

@@ -44,7 +44,7 @@ fn measure_plaza_table() {
                         "{:.2} [{} rej, b {:.2}, kr {:.3}, kt {:.3}]",
                         s.rmse_m(),
                         s.rejected,
-                        e.bias_m,
+                        e.range_bias_m,
                         e.range_scale,
                         e.turn_scale
                     )

@@ -1,34 +1,41 @@
-//! One EKF step of garin2024's filter: predict and update (target: under 1 us).
+//! One filter step of garin2024's navigator, predict and update, with the EKF (target:
+//! under 1 us) and the UKF.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nalgebra::{SVector, Vector2};
+use nalgebra::{SVector, Vector3};
+use onebeacon::filter::{FilterKind, UkfParams};
 use onebeacon::models::unicycle::{Cov, State};
-use onebeacon::nav::{Aiding, CommFrame, EkfTuning, Proprioceptive, SingleBeaconEkf};
+use onebeacon::nav::{Aiding, BeaconFix, EkfTuning, Kind, Measurement, Navigator, SingleBeaconNavigator};
 use std::hint::black_box;
 
-fn filter(aiding: Aiding) -> SingleBeaconEkf {
+fn navigator(filter: FilterKind) -> SingleBeaconNavigator {
     let z0 = State::from([10.0, 20.0, 1.0, 1.0, 0.01, 0.0]);
     let p0 = Cov::from_diagonal(&SVector::from([1.0, 1.0, 0.01, 0.01, 1e-4, 1e-4]));
-    SingleBeaconEkf::new(aiding, EkfTuning::default(), z0, p0)
+    SingleBeaconNavigator::new(Aiding::RangeDoppler, EkfTuning::default(), filter, 0.0, z0, p0)
 }
 
 fn bench(c: &mut Criterion) {
-    let sample = Proprioceptive { heading_rad: 1.0, yaw_rate_rad_s: 0.01, accel_m_s2: 0.0 };
-    let frame = CommFrame { beacon_ned_m: Vector2::new(50.0, 100.0), range_m: 89.0, radial_speed_m_s: 0.8 };
-
-    let mut f = filter(Aiding::RangeDoppler);
-    c.bench_function("ekf predict + proprioceptive update (M=3)", |b| {
-        b.iter(|| black_box(f.step(0.25, black_box(&sample), None)))
-    });
-    let mut f = filter(Aiding::RangeDoppler);
-    c.bench_function("ekf predict + comm frame update (M=5)", |b| {
-        b.iter(|| {
-            let r = f.step(0.25, black_box(&sample), Some(black_box(&frame)));
-            // keep the filter near its operating point
-            f = filter(Aiding::RangeDoppler);
-            black_box(r)
-        })
-    });
+    let inertial = Kind::Inertial { heading_rad: 1.0, yaw_rate_rad_s: 0.01, accel_m_s2: 0.0 };
+    let beacon = BeaconFix::fixed(0, Vector3::new(50.0, 100.0, 0.0));
+    let frame = Kind::RangeDoppler { beacon, range_m: 89.0, radial_speed_m_s: 0.8 };
+    for (name, kind) in [("ekf", FilterKind::Ekf), ("ukf", FilterKind::Ukf(UkfParams::default()))] {
+        let mut f = navigator(kind);
+        let mut t = 0.0;
+        c.bench_function(&format!("{name} predict + proprioceptive update (M=3)"), |b| {
+            b.iter(|| {
+                t += 0.25;
+                black_box(f.process(black_box(&Measurement::new(t, inertial))))
+            })
+        });
+        c.bench_function(&format!("{name} predict + comm frame update (M=5)"), |b| {
+            b.iter(|| {
+                // from the same operating point every time
+                let mut f = navigator(kind);
+                f.process(&Measurement::new(0.25, frame));
+                black_box(f.process(black_box(&Measurement::new(0.25, inertial))))
+            })
+        });
+    }
 }
 
 criterion_group!(benches, bench);

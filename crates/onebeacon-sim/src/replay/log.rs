@@ -4,8 +4,9 @@
 
 use crate::scenario::load::deserialize;
 use nalgebra::Vector3;
+use onebeacon::filter::FilterKind;
 use onebeacon::geo::Frame;
-use onebeacon::nav::{Measurement, PlanarConfig, PlanarNoise};
+use onebeacon::nav::{BeaconFix, Kind, PlanarConfig, PlanarNoise};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -286,9 +287,19 @@ pub struct EstimatorSpec {
     pub heading_walk_deg_per_sqrt_m: Option<f64>,
     pub speed_sigma_m_s: Option<f64>,
     pub bias_walk_m_per_sqrt_s: Option<f64>,
+    /// `"ekf"` (default) or `"ukf"`, with the UKF's sigma-point parameters.
+    #[serde(default)]
+    pub filter: crate::scenario::FilterName,
+    pub ukf_alpha: Option<f64>,
+    pub ukf_beta: Option<f64>,
+    pub ukf_kappa: Option<f64>,
 }
 
 impl EstimatorSpec {
+    pub fn filter_kind(&self) -> FilterKind {
+        self.filter.kind(self.ukf_alpha, self.ukf_beta, self.ukf_kappa)
+    }
+
     pub fn config(&self) -> PlanarConfig {
         let c = PlanarConfig::default();
         let d = c.noise;
@@ -352,7 +363,7 @@ pub struct TruthPose {
 /// One item of the time-ordered stream.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Input {
-    Measurement(Measurement),
+    Measurement(Kind),
     /// A beacon's position now (a moving beacon's track; fixes later measurements).
     BeaconPosition {
         beacon_id: u32,
@@ -373,21 +384,21 @@ impl Input {
     pub fn to_ned(self, frame: Frame) -> Input {
         let point = |p: Vector3<f64>| frame.to_ned(p.x, p.y, p.z);
         match self {
-            Input::Measurement(m) => Input::Measurement(match m {
-                Measurement::Odometry { distance_m, heading_change_rad } => {
-                    Measurement::Odometry { distance_m, heading_change_rad: frame.turn_to_ned(heading_change_rad) }
+            Input::Measurement(mut m) => {
+                if let Some(b) = m.beacon_mut() {
+                    b.position_ned_m = point(b.position_ned_m);
                 }
-                Measurement::Heading { heading_rad } => {
-                    Measurement::Heading { heading_rad: frame.heading_to_ned(heading_rad) }
-                }
-                Measurement::Range { beacon_id, beacon, range_m } => {
-                    Measurement::Range { beacon_id, beacon: point(beacon), range_m }
-                }
-                Measurement::Doppler { beacon_id, beacon, radial_speed_m_s } => {
-                    Measurement::Doppler { beacon_id, beacon: point(beacon), radial_speed_m_s }
-                }
-                other @ (Measurement::Speed { .. } | Measurement::Depth { .. }) => other,
-            }),
+                Input::Measurement(match m {
+                    Kind::Odometry { distance_m, heading_change_rad } => {
+                        Kind::Odometry { distance_m, heading_change_rad: frame.turn_to_ned(heading_change_rad) }
+                    }
+                    Kind::Heading { heading_rad } => Kind::Heading { heading_rad: frame.heading_to_ned(heading_rad) },
+                    Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
+                        Kind::Attitude { roll_rad, pitch_rad, heading_rad: frame.heading_to_ned(heading_rad) }
+                    }
+                    other => other,
+                })
+            }
             Input::BeaconPosition { beacon_id, position } => {
                 Input::BeaconPosition { beacon_id, position: point(position) }
             }
@@ -500,6 +511,8 @@ impl LogDescription {
                     return Err(bad(format!("estimator[{i}].{key}"), v.to_string(), "a finite number >= 0"));
                 }
             }
+            crate::scenario::validate::check_ukf(&format!("estimator[{i}]"), 7, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))
+                .map_err(|v| crate::scenario::load::invalid(name, v))?;
             if !e.bias_m.is_finite() {
                 return Err(bad(format!("estimator[{i}].bias_m"), e.bias_m.to_string(), "a finite number"));
             }
@@ -645,10 +658,10 @@ pub fn resolve_beacon(
     id: u32,
     fixed: &BTreeMap<u32, Vector3<f64>>,
     tracked: &BTreeSet<u32>,
-) -> Result<(u32, Vector3<f64>), String> {
+) -> Result<BeaconFix, String> {
     match fixed.get(&id) {
-        Some(p) => Ok((id, *p)),
-        None if tracked.contains(&id) => Ok((id, Vector3::repeat(f64::NAN))),
+        Some(p) => Ok(BeaconFix::fixed(id, *p)),
+        None if tracked.contains(&id) => Ok(BeaconFix::fixed(id, Vector3::repeat(f64::NAN))),
         None => {
             let known: Vec<String> = fixed.keys().chain(tracked).map(u32::to_string).collect();
             Err(format!("beacon {id} is not among the beacons ({})", known.join(", ")))
@@ -766,26 +779,26 @@ fn read_source(
             let id = row.beacon_id(cols["beacon"])?;
             resolve_beacon(id, beacons, tracked).map_err(|m| row.error(cols["beacon"], m))
         };
-        let mut push = |m: Measurement| items.push(Item { t_s: t, input: Input::Measurement(m) });
+        let mut push = |m: Kind| items.push(Item { t_s: t, input: Input::Measurement(m) });
         match s.kind {
-            SourceKind::Odometry => push(Measurement::Odometry {
+            SourceKind::Odometry => push(Kind::Odometry {
                 distance_m: num("distance")? * len,
                 heading_change_rad: num("heading_change")? * ang,
             }),
-            SourceKind::Speed => push(Measurement::Speed { speed_m_s: num("speed")? * len }),
-            SourceKind::Heading => push(Measurement::Heading { heading_rad: num("heading")? * ang }),
+            SourceKind::Speed => push(Kind::Speed { speed_m_s: num("speed")? * len }),
+            SourceKind::Heading => push(Kind::Heading { heading_rad: num("heading")? * ang }),
             SourceKind::SpeedHeading => {
-                push(Measurement::Speed { speed_m_s: num("speed")? * len });
-                push(Measurement::Heading { heading_rad: num("heading")? * ang });
+                push(Kind::Speed { speed_m_s: num("speed")? * len });
+                push(Kind::Heading { heading_rad: num("heading")? * ang });
             }
-            SourceKind::Depth => push(Measurement::Depth { depth_m: num("depth")? * len }),
+            SourceKind::Depth => push(Kind::Depth { depth_m: num("depth")? * len }),
             SourceKind::Range => {
-                let (beacon_id, beacon) = beacon(tracked)?;
-                push(Measurement::Range { beacon_id, beacon, range_m: num("range")? * len })
+                let beacon = beacon(tracked)?;
+                push(Kind::Range { beacon, range_m: num("range")? * len })
             }
             SourceKind::Doppler => {
-                let (beacon_id, beacon) = beacon(tracked)?;
-                push(Measurement::Doppler { beacon_id, beacon, radial_speed_m_s: num("radial_speed")? * len })
+                let beacon = beacon(tracked)?;
+                push(Kind::Doppler { beacon, radial_speed_m_s: num("radial_speed")? * len })
             }
             SourceKind::BeaconTrack => {
                 let beacon_id = row.beacon_id(cols["beacon"])?;

@@ -24,7 +24,7 @@ pub struct Replay {
 /// A session of the description's estimators, starting at `start`, restricted to
 /// `beacons` when given (replay and stream).
 pub fn new_session(d: &LogDescription, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
-    let estimators = d.estimators.iter().map(|e| (e.name.clone(), e.config())).collect();
+    let estimators = d.estimators.iter().map(|e| (e.name.clone(), e.config(), e.filter_kind())).collect();
     let sigmas = (d.initial.sigma_position_m, d.initial.sigma_heading_deg.to_radians());
     Session::new(d.frame.into(), estimators, start, sigmas, beacons)
 }
@@ -63,10 +63,10 @@ fn record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord 
         .map(|(i, e)| {
             let (error_m, nees) = step.errors.as_ref().map_or((f64::NAN, f64::NAN), |errors| errors[i]);
             Estimate {
-                pos: Vector3::new(e.north_m, e.east_m, 0.0),
+                pos: Vector3::new(e.north_m(), e.east_m(), 0.0),
                 psi: e.heading_rad,
                 speed: None,
-                sigma_pos: Vector2::new(e.sigma_north_m, e.sigma_east_m),
+                sigma_pos: Vector2::new(e.sigma_north_m(), e.sigma_east_m()),
                 error_m,
                 nees,
             }

@@ -2,10 +2,11 @@
 //! time-ordered items one at a time, scored against the ground truth when it comes.
 
 use super::log::{Input, Item, TruthPose};
-use nalgebra::{Matrix2, Vector2, Vector3};
+use nalgebra::{Vector2, Vector3};
+use onebeacon::filter::FilterKind;
 use onebeacon::filter::consistency::nees;
 use onebeacon::geo::Frame;
-use onebeacon::nav::{Measurement, Outcome, PlanarConfig, PlanarEstimate, PlanarNavigator};
+use onebeacon::nav::{Estimate, Kind, Measurement, Navigator, Outcome, PlanarConfig, PlanarNavigator};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// When and where the estimators start.
@@ -85,16 +86,15 @@ impl ErrorStats {
 pub struct Step {
     pub t_s: f64,
     pub outcomes: Vec<Option<Outcome>>,
-    pub estimates: Vec<PlanarEstimate>,
+    pub estimates: Vec<Estimate>,
     pub truth: Option<TruthPose>,
     pub errors: Option<Vec<(f64, f64)>>,
 }
 
 /// Horizontal error and its NEES against `truth` (NaN when the covariance is singular).
-fn error_and_nees(e: &PlanarEstimate, truth: &TruthPose) -> (f64, f64) {
-    let d = Vector2::new(e.north_m - truth.north_m, e.east_m - truth.east_m);
-    let p = Matrix2::new(e.sigma_north_m.powi(2), e.cov_north_east_m2, e.cov_north_east_m2, e.sigma_east_m.powi(2));
-    (d.norm(), nees(&d, &p).unwrap_or(f64::NAN))
+fn error_and_nees(e: &Estimate, truth: &TruthPose) -> (f64, f64) {
+    let d = Vector2::new(e.north_m() - truth.north_m, e.east_m() - truth.east_m);
+    (d.norm(), nees(&d, &e.horizontal_cov_m2).unwrap_or(f64::NAN))
 }
 
 /// Every estimator on one stream. Estimates and errors are in NED.
@@ -103,7 +103,7 @@ pub struct Session {
     pub names: Vec<String>,
     /// The frame of the items pushed.
     frame: Frame,
-    configs: Vec<PlanarConfig>,
+    configs: Vec<(PlanarConfig, FilterKind)>,
     navs: Vec<PlanarNavigator>,
     start: Start,
     sigma_position_m: f64,
@@ -124,13 +124,13 @@ pub struct Session {
 impl Session {
     pub fn new(
         frame: Frame,
-        estimators: Vec<(String, PlanarConfig)>,
+        estimators: Vec<(String, PlanarConfig, FilterKind)>,
         start: Start,
         (sigma_position_m, sigma_heading_rad): (f64, f64),
         beacons: Option<BTreeSet<u32>>,
     ) -> Self {
         let n = estimators.len();
-        let (names, configs) = estimators.into_iter().unzip();
+        let (names, configs) = estimators.into_iter().map(|(n, c, f)| (n, (c, f))).unzip();
         Self {
             names,
             frame,
@@ -150,7 +150,7 @@ impl Session {
     }
 
     /// Every estimator's latest estimate (empty before the start).
-    pub fn final_estimates(&self) -> Vec<PlanarEstimate> {
+    pub fn final_estimates(&self) -> Vec<Estimate> {
         self.navs.iter().map(PlanarNavigator::estimate).collect()
     }
 
@@ -162,7 +162,7 @@ impl Session {
         self.navs = self
             .configs
             .iter()
-            .map(|c| PlanarNavigator::new(*c, t0, pose, self.sigma_position_m, self.sigma_heading_rad))
+            .map(|(c, f)| PlanarNavigator::new(*c, *f, t0, pose, self.sigma_position_m, self.sigma_heading_rad))
             .collect();
     }
 
@@ -189,19 +189,20 @@ impl Session {
         let mut truth = None;
         match item.input {
             Input::Measurement(m) => {
-                if let Some(m) = self.resolve(m) {
+                if let Some(kind) = self.resolve(m) {
+                    let m = Measurement::new(t, kind);
                     for (i, nav) in self.navs.iter_mut().enumerate() {
-                        let out = nav.process(t, &m);
+                        let out = nav.process(&m);
                         self.stats[i].failed += usize::from(matches!(out, Outcome::Failed(_)));
                         if let Outcome::Rejected(nis) = out {
                             self.stats[i].rejected += 1;
-                            let (kind, beacon_id, value) = match m {
-                                Measurement::Range { beacon_id, range_m, .. } => ("range", beacon_id, range_m),
-                                Measurement::Doppler { beacon_id, radial_speed_m_s, .. } => {
-                                    ("doppler", beacon_id, radial_speed_m_s)
-                                }
-                                _ => ("other", 0, f64::NAN),
+                            let (beacon_id, value) = match kind {
+                                Kind::Range { beacon, range_m } => (beacon.id, range_m),
+                                Kind::Doppler { beacon, radial_speed_m_s }
+                                | Kind::RangeDoppler { beacon, radial_speed_m_s, .. } => (beacon.id, radial_speed_m_s),
+                                _ => (0, f64::NAN),
                             };
+                            let kind = kind.name();
                             self.rejected.push(Rejection { estimator: i, t_s: t, kind, beacon_id, value, nis });
                         }
                         outcomes[i] = Some(out);
@@ -211,7 +212,7 @@ impl Session {
             Input::Truth(p) => truth = Some(p),
             Input::BeaconPosition { .. } => {}
         }
-        let estimates: Vec<PlanarEstimate> = self.navs.iter().map(PlanarNavigator::estimate).collect();
+        let estimates: Vec<Estimate> = self.navs.iter().map(PlanarNavigator::estimate).collect();
         let errors = truth.map(|p| {
             estimates
                 .iter()
@@ -228,27 +229,22 @@ impl Session {
 
     /// A beacon measurement with its beacon's position (tracked beacons: the latest),
     /// or `None` when the beacon is filtered out or its position is not known yet.
-    fn resolve(&mut self, m: Measurement) -> Option<Measurement> {
-        let (id, beacon) = match m {
-            Measurement::Range { beacon_id, beacon, .. } | Measurement::Doppler { beacon_id, beacon, .. } => {
-                (beacon_id, beacon)
-            }
-            other => return Some(other),
+    fn resolve(&mut self, mut m: Kind) -> Option<Kind> {
+        let Some(beacon) = m.beacon_mut() else { return Some(m) };
+        let id = beacon.id;
+        let position = if beacon.position_ned_m.iter().all(|v| v.is_finite()) {
+            Some(beacon.position_ned_m)
+        } else {
+            self.tracked.get(&id).copied()
         };
-        let position = if beacon.iter().all(|v| v.is_finite()) { Some(beacon) } else { self.tracked.get(&id).copied() };
         let allowed = self.beacons.as_ref().is_none_or(|b| b.contains(&id));
         let Some(position) = position.filter(|_| allowed) else {
             self.left_out += 1;
             return None;
         };
+        beacon.position_ned_m = position;
         self.last_beacon = Some(position);
-        Some(match m {
-            Measurement::Range { range_m, .. } => Measurement::Range { beacon_id: id, beacon: position, range_m },
-            Measurement::Doppler { radial_speed_m_s, .. } => {
-                Measurement::Doppler { beacon_id: id, beacon: position, radial_speed_m_s }
-            }
-            other => other,
-        })
+        Some(m)
     }
 }
 

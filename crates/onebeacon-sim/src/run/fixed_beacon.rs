@@ -9,8 +9,8 @@ use crate::sensors::SensorSuite;
 use crate::vehicles::{TruthState, feedback_linearising_control};
 use nalgebra::{SVector, Vector2, Vector3};
 use onebeacon::filter::consistency::nees;
-use onebeacon::models::unicycle::{Cov, State, idx};
-use onebeacon::nav::SingleBeaconEkf;
+use onebeacon::models::unicycle::{Cov, State};
+use onebeacon::nav::{Measurement, Navigator, SingleBeaconNavigator};
 
 /// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
 pub(super) fn simulate(s: &FixedBeacon, cell: &FixedBeaconCell, seed: u64, run: u64, record: bool) -> RunOutput {
@@ -39,34 +39,31 @@ pub(super) fn simulate(s: &FixedBeacon, cell: &FixedBeaconCell, seed: u64, run: 
     let z_true = State::from([truth.pos.x, truth.pos.y, truth.psi, truth.v, omega, accel]);
     let z0 = z_true + sigma0.map(|sd| gauss(&mut init_rng, sd));
     let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
-    let mut filters: Vec<SingleBeaconEkf> =
-        s.estimators.iter().map(|e| SingleBeaconEkf::new(e.kind.aiding(), e.tuning(), z0, p0)).collect();
+    let mut filters: Vec<SingleBeaconNavigator> = s
+        .estimators
+        .iter()
+        .map(|e| SingleBeaconNavigator::new(e.kind.aiding(), e.tuning(), e.filter_kind(), 0.0, z0, p0))
+        .collect();
 
     let mut acc = vec![ErrorAccumulator::new(steps + 1); filters.len()];
     let mut trajectory = Vec::with_capacity(if record { steps + 1 } else { 0 });
     let mut distance = 0.0;
     let mut frames_decoded = 0;
     // scores every filter against the truth; builds the estimates only when recording
-    let observe = |filters: &[SingleBeaconEkf], acc: &mut [ErrorAccumulator], truth: &TruthState, record: bool| {
-        let mut estimates = Vec::with_capacity(if record { filters.len() } else { 0 });
-        for (f, a) in filters.iter().zip(acc.iter_mut()) {
-            let e = f.position() - truth.pos;
-            let p = f.position_covariance();
-            let n = nees(&e, &p);
-            a.push(e.norm(), n);
-            if record {
-                estimates.push(Estimate {
-                    pos: Vector3::new(f.position().x, f.position().y, 0.0),
-                    psi: onebeacon::geo::wrap_angle(f.state()[idx::PSI]),
-                    speed: Some(f.state()[idx::V]),
-                    sigma_pos: Vector2::new(p[(0, 0)].max(0.0).sqrt(), p[(1, 1)].max(0.0).sqrt()),
-                    error_m: e.norm(),
-                    nees: n.unwrap_or(f64::NAN),
-                });
+    let observe =
+        |filters: &[SingleBeaconNavigator], acc: &mut [ErrorAccumulator], truth: &TruthState, record: bool| {
+            let mut estimates = Vec::with_capacity(if record { filters.len() } else { 0 });
+            for (f, a) in filters.iter().zip(acc.iter_mut()) {
+                let est = f.estimate();
+                let e = est.position_ned_m.xy() - truth.pos;
+                let n = nees(&e, &est.horizontal_cov_m2);
+                a.push(e.norm(), n);
+                if record {
+                    estimates.push(Estimate::new(&est, e.norm(), n));
+                }
             }
-        }
-        estimates
-    };
+            estimates
+        };
     let estimates = observe(&filters, &mut acc, &truth, record);
     if record {
         trajectory.push(step_record(0.0, &truth, beacon, false, estimates));
@@ -92,9 +89,9 @@ pub(super) fn simulate(s: &FixedBeacon, cell: &FixedBeaconCell, seed: u64, run: 
         };
         frames_decoded += u64::from(frame.is_some());
         for (f, a) in filters.iter_mut().zip(acc.iter_mut()) {
-            if f.step(dt, &sample, frame.as_ref()).is_err() {
-                a.failed_update();
-            }
+            // a frame decoded during the step is fused with the step's inertial sample
+            let outcomes = frame.iter().chain([&sample]).map(|kind| f.process(&Measurement::new(t, *kind)));
+            a.count_failures(outcomes);
         }
         let estimates = observe(&filters, &mut acc, &truth, record);
         if record {
@@ -175,6 +172,10 @@ mod tests {
             e.r_yaw_rate_rad2_s2 = 1e-10;
             e.r_accel_m2_s4 = 1e-10;
         }
+        // the UKF too
+        let mut ukf = s.estimators[0].clone();
+        ukf.filter = crate::scenario::FilterName::Ukf;
+        s.estimators.push(ukf);
         let out = simulate(&s, &s.base_cell(), 1, 0, false);
         assert!((out.distance_m - 1567.0).abs() < 2.0, "distance {}", out.distance_m);
         for (e, m) in s.estimators.iter().zip(&out.metrics) {

@@ -27,6 +27,20 @@ pub struct Estimate {
     pub nees: f64,
 }
 
+impl Estimate {
+    /// The record of navigator estimate `e` with its horizontal error and NEES.
+    pub fn new(e: &onebeacon::nav::Estimate, error_m: f64, nees: Option<f64>) -> Self {
+        Self {
+            pos: e.position_ned_m,
+            psi: e.heading_rad,
+            speed: e.speed_m_s,
+            sigma_pos: Vector2::new(e.sigma_north_m(), e.sigma_east_m()),
+            error_m,
+            nees: nees.unwrap_or(f64::NAN),
+        }
+    }
+}
+
 /// Truth and all estimates at one step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepRecord {

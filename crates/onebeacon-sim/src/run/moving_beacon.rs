@@ -12,12 +12,12 @@ use crate::scenario::{MovingBeacon, MovingBeaconCell};
 use crate::seed::{Stream, gauss, rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::rov::{body_velocity, rk4_step};
-use nalgebra::{SVector, Vector2, Vector3, Vector4};
+use nalgebra::{SVector, Vector2, Vector3};
 use onebeacon::filter::consistency::nees;
 use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, ReachingSet, best_standoff};
-use onebeacon::measure::{Range3d, ScalarModel};
+use onebeacon::measure::ScalarModel;
 use onebeacon::models::kinematic6dof::{BodyVelocity, Cov, State, idx, rotation};
-use onebeacon::nav::{OwttRange, Range6DofEkf, SensorNoise};
+use onebeacon::nav::{BeaconFix, Kind, Measurement, Navigator, Range6DofNavigator};
 
 /// The vehicle's true state at every step (it does not depend on the draws).
 pub fn truth_trajectory(s: &MovingBeacon, cell: &MovingBeaconCell) -> Vec<State> {
@@ -59,12 +59,7 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
     let lim =
         AsvLimits { max_speed_m_s: s.asv.max_speed_m_s, max_turn_rate_rad_s: s.asv.max_turn_rate_deg_s.to_radians() };
     let sens = &s.sensors;
-    let noise = SensorNoise {
-        velocity_m_s: sens.velocity_noise_m_s,
-        rate_rad_s: sens.rate_noise_rad_s,
-        depth_m: sens.depth_noise_m,
-        attitude_rad: sens.attitude_noise_deg.to_radians(),
-    };
+    let noise = s.sensor_noise();
     let mut vel_rng = rng(seed, run, Stream::Imu);
     let mut att_rng = rng(seed, run, Stream::Heading);
     let mut ac_rng = rng(seed, run, Stream::Acoustic);
@@ -76,8 +71,11 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
     let mut init_rng = rng(seed, run, Stream::Initial);
     let eta0 = truth[0] + sigma0.map(|sd| gauss(&mut init_rng, sd));
     let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
-    let mut filters: Vec<Range6DofEkf> = s.estimators.iter().map(|_| Range6DofEkf::new(noise, eta0, p0)).collect();
-    let uses_ranges: Vec<bool> = s.estimators.iter().map(|e| e.kind == EstimatorKind::RangeEkf).collect();
+    let mut filters: Vec<Range6DofNavigator> = s
+        .estimators
+        .iter()
+        .map(|e| Range6DofNavigator::new(noise, e.kind == EstimatorKind::RangeEkf, e.filter_kind(), 0.0, eta0, p0))
+        .collect();
 
     let planner = |metric| FimPlanner {
         metric,
@@ -100,22 +98,15 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
     let mut guidance = Vec::new();
     let (mut distance, mut heard) = (0.0, 0u64);
 
-    let observe = |filters: &[Range6DofEkf], acc: &mut [ErrorAccumulator], eta: &State| {
+    let observe = |filters: &[Range6DofNavigator], acc: &mut [ErrorAccumulator], eta: &State| {
         let mut out = Vec::with_capacity(if record { filters.len() } else { 0 });
         for (f, a) in filters.iter().zip(acc.iter_mut()) {
-            let e = (f.position() - eta.fixed_rows::<3>(0)).xy();
-            let p = f.horizontal_covariance();
-            let n = nees(&e, &p);
+            let est = f.estimate();
+            let e = (est.position_ned_m - eta.fixed_rows::<3>(0)).xy();
+            let n = nees(&e, &est.horizontal_cov_m2);
             a.push(e.norm(), n);
             if record {
-                out.push(Estimate {
-                    pos: f.position(),
-                    psi: onebeacon::geo::wrap_angle(f.state()[idx::YAW]),
-                    speed: None,
-                    sigma_pos: Vector2::new(p[(0, 0)].max(0.0).sqrt(), p[(1, 1)].max(0.0).sqrt()),
-                    error_m: e.norm(),
-                    nees: n.unwrap_or(f64::NAN),
-                });
+                out.push(Estimate::new(&est, e.norm(), n));
             }
         }
         out
@@ -138,7 +129,7 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
             ); // eq. 4.3
             in_flight.push(InFlight { ping: Ping { t_tx: t0, origin: beacon_at(&asv) }, gps });
             let est = &filters[0];
-            let target = est.position();
+            let target = est.estimate().position_ned_m;
             let lin = nu_meas.fixed_rows::<3>(0).into_owned();
             let st = est.state();
             let target_next = target + rotation(st[idx::ROLL], st[idx::PITCH], st[idx::YAW]) * lin * period;
@@ -191,53 +182,44 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
         distance += (p1v - p0v).norm();
 
         // pings heard during the step, in order of arrival
-        let mut arrivals: Vec<(f64, OwttRange)> = Vec::new();
+        let mut arrivals: Vec<Measurement> = Vec::new();
         in_flight.retain(|f| match f.ping.arrival(c, t0, &p0v, t1, &p1v) {
             Some(t_rx) => {
-                let range = c * (t_rx - f.ping.t_tx) + gauss(&mut ac_rng, s.acoustics.range_noise_m);
-                let m = OwttRange {
-                    t_tx_s: f.ping.t_tx,
-                    t_rx_s: t_rx,
-                    beacon_ned_m: f.gps,
-                    beacon_sigma_m: s.asv.gps_noise_m,
-                    range_m: range,
-                    sigma_m: s.acoustics.range_noise_m,
-                };
-                arrivals.push((t_rx, m));
+                let range_m = c * (t_rx - f.ping.t_tx) + gauss(&mut ac_rng, s.acoustics.range_noise_m);
+                let beacon =
+                    BeaconFix { id: 0, position_ned_m: f.gps, sigma_m: s.asv.gps_noise_m, t_tx_s: Some(f.ping.t_tx) };
+                arrivals.push(Measurement::new(t_rx, Kind::Range { beacon, range_m }));
                 false
             }
             None => true,
         });
-        arrivals.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (_, m) in &arrivals {
-            // information of this range about the true state, for the bound
-            let model = Range3d { beacon: m.beacon_ned_m };
-            let h = ScalarModel::<6>::jacobian(&model, &truth[k]);
-            let var = m.sigma_m.powi(2) + m.beacon_sigma_m.powi(2) * (h[0] * h[0] + h[1] * h[1]);
-            range_information.push((k, h.transpose() * h / var));
+        arrivals.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        for m in &arrivals {
+            // information of this range about the true state, for the bound: the
+            // navigator's own range model, at the truth
+            if let Kind::Range { beacon, .. } = m.kind {
+                let model = noise.range_model(&beacon);
+                let h = ScalarModel::<6>::jacobian(&model, &truth[k]);
+                range_information.push((k, h.transpose() * h / model.variance(&truth[k])));
+            }
         }
         heard += arrivals.len() as u64;
 
-        let z = Vector4::new(
-            truth[k][idx::D] + gauss(&mut att_rng, sens.depth_noise_m),
-            truth[k][idx::ROLL] + gauss(&mut att_rng, noise.attitude_rad),
-            truth[k][idx::PITCH] + gauss(&mut att_rng, noise.attitude_rad),
-            onebeacon::geo::wrap_angle(truth[k][idx::YAW] + gauss(&mut att_rng, noise.attitude_rad)),
-        );
-        for ((f, a), ranges) in filters.iter_mut().zip(acc.iter_mut()).zip(&uses_ranges) {
-            // predict to each arrival, update with it, then to the end of the step
-            let mut t = t0;
-            for (t_rx, m) in arrivals.iter().filter(|_| *ranges) {
-                f.predict(t_rx - t, &nu_meas);
-                if f.update_range(m).is_err() {
-                    a.failed_update();
-                }
-                t = *t_rx;
-            }
-            f.predict(t1 - t, &nu_meas);
-            if f.update_attitude_depth(&z).is_err() {
-                a.failed_update();
-            }
+        let depth = Kind::Depth { depth_m: truth[k][idx::D] + gauss(&mut att_rng, sens.depth_noise_m) };
+        let attitude = Kind::Attitude {
+            roll_rad: truth[k][idx::ROLL] + gauss(&mut att_rng, noise.attitude_rad),
+            pitch_rad: truth[k][idx::PITCH] + gauss(&mut att_rng, noise.attitude_rad),
+            heading_rad: onebeacon::geo::wrap_angle(truth[k][idx::YAW] + gauss(&mut att_rng, noise.attitude_rad)),
+        };
+        // the step's body velocities from its start, the ranges as they arrive, then
+        // depth and attitude at its end
+        let events: Vec<Measurement> = [Measurement::new(t0, Kind::BodyVelocity { nu: nu_meas.into() })]
+            .into_iter()
+            .chain(arrivals.iter().copied())
+            .chain([Measurement::new(t1, depth), Measurement::new(t1, attitude)])
+            .collect();
+        for (f, a) in filters.iter_mut().zip(acc.iter_mut()) {
+            a.count_failures(events.iter().map(|m| f.process(m)));
         }
         let estimates = observe(&filters, &mut acc, &truth[k]);
         if record {

@@ -1,7 +1,8 @@
 //! Scenarios of kind `fixed_beacon` (garin2024): an AUV on a boustrophedon, a fixed
 //! beacon, range and Doppler from communication frames. Unknown keys are errors.
 
-use super::{World, default_runs, default_seed};
+use super::{FilterName, World, default_runs, default_seed};
+use onebeacon::filter::FilterKind;
 use onebeacon::nav::{Aiding, EkfTuning};
 use serde::{Deserialize, Serialize};
 
@@ -255,6 +256,13 @@ pub struct EstimatorSpec {
     pub r_yaw_rate_rad2_s2: f64,
     #[serde(default = "default_r_accel")]
     pub r_accel_m2_s4: f64,
+    /// `"ekf"` (default) or `"ukf"`.
+    #[serde(default)]
+    pub filter: FilterName,
+    /// The UKF's sigma-point parameters (default 1, 2, 0).
+    pub ukf_alpha: Option<f64>,
+    pub ukf_beta: Option<f64>,
+    pub ukf_kappa: Option<f64>,
 }
 
 fn default_q() -> [f64; 6] {
@@ -289,11 +297,20 @@ impl EstimatorSpec {
             r_heading_rad2: t.r_heading_rad2,
             r_yaw_rate_rad2_s2: t.r_yaw_rate_rad2_s2,
             r_accel_m2_s4: t.r_accel_m2_s4,
+            filter: FilterName::Ekf,
+            ukf_alpha: None,
+            ukf_beta: None,
+            ukf_kappa: None,
         }
     }
 
-    pub fn name(&self) -> &str {
-        self.name.as_deref().unwrap_or(self.kind.label())
+    /// Name in outputs: `name`, or the kind with "-ukf" for the UKF.
+    pub fn name(&self) -> String {
+        self.name.clone().unwrap_or_else(|| format!("{}{}", self.kind.label(), self.filter.suffix()))
+    }
+
+    pub fn filter_kind(&self) -> FilterKind {
+        self.filter.kind(self.ukf_alpha, self.ukf_beta, self.ukf_kappa)
     }
 
     pub fn tuning(&self) -> EkfTuning {

@@ -18,6 +18,7 @@ pub use fixed_beacon::{FixedBeacon, FixedBeaconCell};
 pub use load::{ScenarioError, load, parse};
 pub use moving_beacon::{MovingBeacon, MovingBeaconCell};
 
+use onebeacon::filter::{FilterKind, UkfParams};
 use serde::{Deserialize, Serialize};
 
 /// Which world a scenario describes.
@@ -29,6 +30,41 @@ pub enum World {
     FixedBeacon,
     /// An underwater vehicle and a beacon on a guided surface vehicle (sousa).
     MovingBeacon,
+}
+
+/// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table
+/// (scenarios) and `[[estimator]]` table (log descriptions).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FilterName {
+    /// Extended Kalman filter.
+    #[default]
+    Ekf,
+    /// Unscented Kalman filter (Merwe sigma points: `ukf_alpha`, `ukf_beta`, `ukf_kappa`).
+    Ukf,
+}
+
+impl FilterName {
+    /// The filter with its parameters; absent UKF keys take [`UkfParams::default`].
+    pub fn kind(self, alpha: Option<f64>, beta: Option<f64>, kappa: Option<f64>) -> FilterKind {
+        let d = UkfParams::default();
+        match self {
+            FilterName::Ekf => FilterKind::Ekf,
+            FilterName::Ukf => FilterKind::Ukf(UkfParams {
+                alpha: alpha.unwrap_or(d.alpha),
+                beta: beta.unwrap_or(d.beta),
+                kappa: kappa.unwrap_or(d.kappa),
+            }),
+        }
+    }
+
+    /// Suffix of a default estimator name: "" for the EKF, "-ukf".
+    pub fn suffix(self) -> &'static str {
+        match self {
+            FilterName::Ekf => "",
+            FilterName::Ukf => "-ukf",
+        }
+    }
 }
 
 pub(crate) fn default_seed() -> u64 {

@@ -3,7 +3,8 @@
 //! steered by a guidance law, one-way travel-time ranges propagating at the speed of
 //! sound between moving ends. Unknown keys are errors.
 
-use super::{World, default_runs, default_seed};
+use super::{FilterName, World, default_runs, default_seed};
+use onebeacon::filter::FilterKind;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -39,10 +40,7 @@ pub struct MovingBeacon {
 }
 
 fn default_estimators() -> Vec<EstimatorSpec> {
-    vec![
-        EstimatorSpec { kind: EstimatorKind::RangeEkf, name: None },
-        EstimatorSpec { kind: EstimatorKind::DeadReckoning, name: None },
-    ]
+    vec![EstimatorSpec::new(EstimatorKind::RangeEkf), EstimatorSpec::new(EstimatorKind::DeadReckoning)]
 }
 
 /// Time step and duration.
@@ -269,11 +267,28 @@ pub struct EstimatorSpec {
     pub kind: EstimatorKind,
     #[serde(default)]
     pub name: Option<String>,
+    /// `"ekf"` (default) or `"ukf"`.
+    #[serde(default)]
+    pub filter: FilterName,
+    /// The UKF's sigma-point parameters (default 1, 2, 0).
+    pub ukf_alpha: Option<f64>,
+    pub ukf_beta: Option<f64>,
+    pub ukf_kappa: Option<f64>,
 }
 
 impl EstimatorSpec {
-    pub fn name(&self) -> &str {
-        self.name.as_deref().unwrap_or(self.kind.label())
+    /// An EKF estimator of `kind`.
+    pub fn new(kind: EstimatorKind) -> Self {
+        Self { kind, name: None, filter: FilterName::Ekf, ukf_alpha: None, ukf_beta: None, ukf_kappa: None }
+    }
+
+    /// Name in outputs: `name`, or the kind with "-ukf" for the UKF.
+    pub fn name(&self) -> String {
+        self.name.clone().unwrap_or_else(|| format!("{}{}", self.kind.label(), self.filter.suffix()))
+    }
+
+    pub fn filter_kind(&self) -> FilterKind {
+        self.filter.kind(self.ukf_alpha, self.ukf_beta, self.ukf_kappa)
     }
 }
 
@@ -318,5 +333,18 @@ impl MovingBeacon {
 
     pub fn steps(&self) -> usize {
         (self.mission.duration_s / self.mission.dt_s).round() as usize
+    }
+
+    /// The vehicle's sensor noise, which the world draws from and the filters and the
+    /// bound read (a matched filter).
+    pub fn sensor_noise(&self) -> onebeacon::nav::SensorNoise {
+        let n = &self.sensors;
+        onebeacon::nav::SensorNoise {
+            velocity_m_s: n.velocity_noise_m_s,
+            rate_rad_s: n.rate_noise_rad_s,
+            depth_m: n.depth_noise_m,
+            attitude_rad: n.attitude_noise_deg.to_radians(),
+            range_m: self.acoustics.range_noise_m,
+        }
     }
 }

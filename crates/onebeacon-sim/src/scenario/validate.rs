@@ -72,7 +72,7 @@ fn check_steps(duration_s: f64, dt_s: f64) -> Result<(), Violation> {
 }
 
 /// At least one estimator; names of ASCII letters, digits and + - _ . , all different.
-fn check_estimator_names(names: &[&str]) -> Result<(), Violation> {
+fn check_estimator_names(names: &[String]) -> Result<(), Violation> {
     if names.is_empty() {
         return Err(Violation {
             key: "estimators".into(),
@@ -92,6 +92,30 @@ fn check_estimator_names(names: &[&str]) -> Result<(), Violation> {
         if names[..k].contains(name) {
             return Err(violation("must differ from the other estimators' names (set `name`)"));
         }
+    }
+    Ok(())
+}
+
+/// The UKF's sigma-point keys of estimator `k` (`prefix` names its table), for a state
+/// of `states` components: 0 < alpha <= 1, beta >= 0, states + kappa > 0.
+pub(crate) fn check_ukf(
+    prefix: &str,
+    states: usize,
+    (alpha, beta, kappa): (Option<f64>, Option<f64>, Option<f64>),
+) -> Result<(), Violation> {
+    let bad = |key: &str, v: f64, allowed: String| Violation {
+        key: format!("{prefix}.{key}"),
+        value: format!("{v:?}"),
+        allowed,
+    };
+    if let Some(a) = alpha.filter(|a| !(a.is_finite() && *a > 0.0 && *a <= 1.0)) {
+        return Err(bad("ukf_alpha", a, "must be a number in (0, 1]".into()));
+    }
+    if let Some(b) = beta {
+        check(&format!("{prefix}.ukf_beta"), b, Rule::NonNegative)?;
+    }
+    if let Some(k) = kappa.filter(|k| !(k.is_finite() && *k + states as f64 > 0.0)) {
+        return Err(bad("ukf_kappa", k, format!("must be a finite number > -{states} (the state size)")));
     }
     Ok(())
 }
@@ -159,6 +183,9 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
         attitude_sigma_deg: Positive,
     });
     check_estimator_names(&s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
+    for (k, e) in s.estimators.iter().enumerate() {
+        check_ukf(&format!("estimators[{k}]"), 6, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
+    }
     check_list_nonempty("sweep.path", &s.sweep.path)?;
     check_list_nonempty("sweep.guidance", &s.sweep.guidance)?;
     check_list_nonempty("sweep.depth_m", &s.sweep.depth_m)?;
@@ -232,6 +259,7 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
         check(&key("r_heading_rad2"), e.r_heading_rad2, Positive)?;
         check(&key("r_yaw_rate_rad2_s2"), e.r_yaw_rate_rad2_s2, Positive)?;
         check(&key("r_accel_m2_s4"), e.r_accel_m2_s4, Positive)?;
+        check_ukf(&format!("estimators[{k}]"), 6, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
     }
 
     if let Some(v) = &s.sweep.t_com_s {

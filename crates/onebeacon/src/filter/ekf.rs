@@ -17,7 +17,7 @@ pub enum FilterError {
     NonFinite,
 }
 
-/// A discrete-time process model x_{k+1} = f(x_k, dt).
+/// A discrete-time process model x_{k+1} = f(x_k, dt) + w, w ~ N(0, Q), that owns its Q.
 pub trait ProcessModel<const N: usize> {
     /// The predicted state after `dt` seconds.
     fn propagate(&self, x: &SVector<f64, N>, dt: f64) -> SVector<f64, N>;
@@ -26,6 +26,16 @@ pub trait ProcessModel<const N: usize> {
     /// Both at once; override when they share work (the same sines, say).
     fn transition(&self, x: &SVector<f64, N>, dt: f64) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
         (self.propagate(x, dt), self.jacobian(x, dt))
+    }
+    /// The process noise covariance Q the model adds over `dt` from `x` (zero for a
+    /// deterministic model).
+    fn noise_covariance(&self, _x: &SVector<f64, N>, _dt: f64) -> SMatrix<f64, N, N> {
+        SMatrix::zeros()
+    }
+    /// Whether state component `i` is an angle (averaged and differenced wrapped to
+    /// (-pi, pi] by the unscented filter).
+    fn is_angle(&self, _i: usize) -> bool {
+        false
     }
     /// The predicted covariance F P F' + Q; override to exploit the sparsity of F.
     fn propagate_covariance(
@@ -47,6 +57,16 @@ pub trait MeasurementModel<const N: usize, const M: usize> {
     /// Whether component `i` is an angle, whose innovation is wrapped to (-pi, pi].
     fn is_angle(&self, _i: usize) -> bool {
         false
+    }
+    /// The noise covariance R of a measurement taken at `x` (it may depend on the state:
+    /// a beacon's position error projected on the line of sight).
+    fn covariance(&self, x: &SVector<f64, N>) -> SMatrix<f64, M, M>;
+    /// A noisy measurement at `x`: h(x) plus a draw from N(0, R(x)). What the simulator
+    /// measures, so the filter's R and the world's noise are one number.
+    fn sample(&self, x: &SVector<f64, N>, rng: &mut dyn rand::Rng) -> SVector<f64, M> {
+        let l = self.covariance(x).cholesky().map_or_else(SMatrix::zeros, |c| c.l());
+        let n = SVector::<f64, M>::from_fn(|_, _| rand::RngExt::sample(rng, rand_distr::StandardNormal));
+        self.predict(x) + l * n
     }
 }
 
@@ -123,6 +143,33 @@ impl<const N: usize> Ekf<N> {
     }
 }
 
+impl<const N: usize> super::GaussianFilter<N> for Ekf<N> {
+    fn mean(&self) -> &SVector<f64, N> {
+        &self.x
+    }
+    fn covariance(&self) -> &SMatrix<f64, N, N> {
+        &self.p
+    }
+    fn mean_mut(&mut self) -> &mut SVector<f64, N> {
+        &mut self.x
+    }
+    fn covariance_mut(&mut self) -> &mut SMatrix<f64, N, N> {
+        &mut self.p
+    }
+    fn predict<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) {
+        Ekf::predict(self, model, dt, q)
+    }
+    fn update_gated<const M: usize, H: MeasurementModel<N, M>>(
+        &mut self,
+        model: &H,
+        z: &SVector<f64, M>,
+        r: &SMatrix<f64, M, M>,
+        max_nis: f64,
+    ) -> Result<Gated, FilterError> {
+        Ekf::update_gated(self, model, z, r, max_nis)
+    }
+}
+
 /// What a gated update did, with the measurement's NIS.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Gated {
@@ -164,6 +211,9 @@ mod tests {
         }
         fn jacobian(&self, _x: &Vector2<f64>) -> Matrix1x2<f64> {
             Matrix1x2::new(1.0, 0.0)
+        }
+        fn covariance(&self, _x: &Vector2<f64>) -> nalgebra::Matrix1<f64> {
+            nalgebra::Matrix1::new(0.3)
         }
     }
 
@@ -224,6 +274,9 @@ mod tests {
         }
         fn jacobian(&self, _x: &Vector2<f64>) -> Matrix1x2<f64> {
             Matrix1x2::new(1.0, 0.0)
+        }
+        fn covariance(&self, _x: &Vector2<f64>) -> nalgebra::Matrix1<f64> {
+            nalgebra::Matrix1::new(0.1)
         }
         fn is_angle(&self, _i: usize) -> bool {
             true

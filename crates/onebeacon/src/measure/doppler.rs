@@ -11,11 +11,13 @@ use nalgebra::{SMatrix, SVector, Vector2};
 
 /// Radial speed of the vehicle toward `beacon` (NED, m), read from the unicycle state
 /// layout (position, heading, forward speed), or with the forward speed a known input
-/// (`known_speed_m_s`: odometry, DVL), when only position and heading are states.
+/// (`known_speed_m_s`: odometry, DVL), when only position and heading are states. Noise
+/// variance `var` ((m/s)^2).
 #[derive(Debug, Clone, Copy)]
 pub struct RadialSpeed2d {
     pub beacon: Vector2<f64>,
     pub known_speed_m_s: Option<f64>,
+    pub var: f64,
 }
 
 impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
@@ -42,6 +44,10 @@ impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
         }
         h
     }
+
+    fn variance(&self, _x: &SVector<f64, N>) -> f64 {
+        self.var
+    }
 }
 
 impl RadialSpeed2d {
@@ -63,7 +69,7 @@ mod tests {
 
     #[test]
     fn sign_is_positive_when_closing() {
-        let m = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None };
+        let m = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, var: 0.1 };
         // vehicle 10 m north of the beacon heading south at 1.5 m/s: closing at 1.5
         assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &state(10.0, 0.0, PI, 1.5)), 1.5, epsilon = 1e-12);
         // heading north: opening
@@ -77,7 +83,7 @@ mod tests {
 
     #[test]
     fn jacobian_matches_finite_differences() {
-        let m = RadialSpeed2d { beacon: Vector2::new(50.0, 100.0), known_speed_m_s: None };
+        let m = RadialSpeed2d { beacon: Vector2::new(50.0, 100.0), known_speed_m_s: None, var: 0.1 };
         let known = RadialSpeed2d { known_speed_m_s: Some(1.3), ..m };
         for x in [state(10.0, 20.0, 0.4, 1.1), state(80.0, 230.0, -2.5, 0.9), state(49.0, 101.0, 3.0, -1.2)] {
             for m in [m, known] {

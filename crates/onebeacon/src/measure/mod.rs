@@ -1,5 +1,7 @@
-//! Measurement models: h(x), its Jacobian, and whether it is an angle.
+//! Measurement models: h(x), its Jacobian, whether it is an angle, and its noise.
 //!
+//! A model owns its noise: the filter reads R from it and the simulator draws the
+//! measurement from it ([`ScalarModel::sample`]), so no noise formula is written twice.
 //! Each physical measurement is a [`ScalarModel`]; a filter update stacks any number of
 //! them into one vector measurement (an array `[&dyn ScalarModel<N>; M]` is a
 //! [`MeasurementModel`]), as garin2024 eq. 18 and 20 stack range, Doppler speed, heading,
@@ -29,6 +31,16 @@ pub trait ScalarModel<const N: usize> {
     fn is_angle(&self) -> bool {
         false
     }
+    /// The noise variance of a measurement taken at `x`.
+    fn variance(&self, x: &SVector<f64, N>) -> f64;
+    /// A draw of the measurement noise at `x`: sqrt(variance) times a standard normal.
+    fn noise(&self, x: &SVector<f64, N>, rng: &mut dyn rand::Rng) -> f64 {
+        self.variance(x).sqrt() * rand::RngExt::sample::<f64, _>(rng, rand_distr::StandardNormal)
+    }
+    /// A noisy measurement at `x`: h(x) plus [`ScalarModel::noise`].
+    fn sample(&self, x: &SVector<f64, N>, rng: &mut dyn rand::Rng) -> f64 {
+        self.predict(x) + self.noise(x, rng)
+    }
 }
 
 impl<const N: usize, const M: usize> MeasurementModel<N, M> for [&dyn ScalarModel<N>; M] {
@@ -44,6 +56,13 @@ impl<const N: usize, const M: usize> MeasurementModel<N, M> for [&dyn ScalarMode
     }
     fn is_angle(&self, i: usize) -> bool {
         self[i].is_angle()
+    }
+    /// Independent components: R = diag of their variances.
+    fn covariance(&self, x: &SVector<f64, N>) -> SMatrix<f64, M, M> {
+        SMatrix::from_diagonal(&SVector::from_fn(|i, _| self[i].variance(x)))
+    }
+    fn sample(&self, x: &SVector<f64, N>, rng: &mut dyn rand::Rng) -> SVector<f64, M> {
+        SVector::from_fn(|i, _| self[i].sample(x, rng))
     }
 }
 

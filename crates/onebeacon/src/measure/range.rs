@@ -4,10 +4,12 @@
 use super::ScalarModel;
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
-/// Range from the state's position (components 0, 1) to `beacon` (NED, m).
+/// Range from the state's position (components 0, 1) to `beacon` (NED, m), with noise
+/// variance `var` (m^2).
 #[derive(Debug, Clone, Copy)]
 pub struct Range2d {
     pub beacon: Vector2<f64>,
+    pub var: f64,
 }
 
 impl<const N: usize> ScalarModel<N> for Range2d {
@@ -26,13 +28,21 @@ impl<const N: usize> ScalarModel<N> for Range2d {
         }
         h
     }
+
+    fn variance(&self, _x: &SVector<f64, N>) -> f64 {
+        self.var
+    }
 }
 
 /// Slant range from the state's position (components 0, 1, 2: N, E, D) to `beacon`
-/// (NED, m), e.g. an ASV's transducer at its position when it transmitted.
+/// (NED, m), e.g. an ASV's transducer at its position when it transmitted, with range
+/// noise `sigma_m` and the beacon's own position error `beacon_sigma_m` per horizontal
+/// axis (its GPS): the variance adds that error's projection on the line of sight.
 #[derive(Debug, Clone, Copy)]
 pub struct Range3d {
     pub beacon: Vector3<f64>,
+    pub sigma_m: f64,
+    pub beacon_sigma_m: f64,
 }
 
 impl<const N: usize> ScalarModel<N> for Range3d {
@@ -51,6 +61,12 @@ impl<const N: usize> ScalarModel<N> for Range3d {
         }
         h
     }
+
+    fn variance(&self, x: &SVector<f64, N>) -> f64 {
+        let h = ScalarModel::<N>::jacobian(self, x);
+        let horizontal = h[0] * h[0] + h[1] * h[1];
+        self.sigma_m.powi(2) + self.beacon_sigma_m.powi(2) * horizontal // eq. 3.10 with the GPS error
+    }
 }
 
 /// Slant range from a vehicle at a known depth (pressure sensor) whose horizontal
@@ -58,13 +74,15 @@ impl<const N: usize> ScalarModel<N> for Range3d {
 /// with a scale error and an offset reads it: (1 + k) r + b. The scale error k is read
 /// from state component `scale` (a wrong propagation speed: travel times converted
 /// with a sound speed 2 % low read 2 % short) and the offset b from component `bias`
-/// (a fixed latency, a cable delay); either is zero when its index is `None`.
+/// (a fixed latency, a cable delay); either is zero when its index is `None`. Noise
+/// variance `var` (m^2).
 #[derive(Debug, Clone, Copy)]
 pub struct SlantRange {
     pub beacon: Vector3<f64>,
     pub depth_m: f64,
     pub bias: Option<usize>,
     pub scale: Option<usize>,
+    pub var: f64,
 }
 
 impl SlantRange {
@@ -96,6 +114,10 @@ impl<const N: usize> ScalarModel<N> for SlantRange {
         }
         h
     }
+
+    fn variance(&self, _x: &SVector<f64, N>) -> f64 {
+        self.var
+    }
 }
 
 #[cfg(test)]
@@ -106,8 +128,8 @@ mod tests {
 
     #[test]
     fn range_and_jacobian() {
-        let m = Range2d { beacon: Vector2::new(50.0, 100.0) };
-        let m3 = Range3d { beacon: Vector3::new(50.0, 100.0, 0.5) };
+        let m = Range2d { beacon: Vector2::new(50.0, 100.0), var: 1.0 };
+        let m3 = Range3d { beacon: Vector3::new(50.0, 100.0, 0.5), sigma_m: 1.0, beacon_sigma_m: 0.0 };
         let x3 = SVector::<f64, 6>::from([53.0, 104.0, 12.5, 0.1, -0.1, 2.0]);
         assert_abs_diff_eq!(ScalarModel::<6>::predict(&m3, &x3), 13.0, epsilon = 1e-12); // 3-4-12
         let (h, fd) = (ScalarModel::<6>::jacobian(&m3, &x3), finite_difference::<6>(&m3, &x3));
@@ -125,7 +147,13 @@ mod tests {
 
     #[test]
     fn slant_range_with_bias_and_scale() {
-        let m = SlantRange { beacon: Vector3::new(50.0, 100.0, 0.5), depth_m: 12.5, bias: Some(3), scale: Some(4) };
+        let m = SlantRange {
+            beacon: Vector3::new(50.0, 100.0, 0.5),
+            depth_m: 12.5,
+            bias: Some(3),
+            scale: Some(4),
+            var: 1.0,
+        };
         let x = SVector::<f64, 5>::from([53.0, 104.0, 0.3, 2.8, 0.07]);
         assert_abs_diff_eq!(ScalarModel::<5>::predict(&m, &x), 1.07 * 13.0 + 2.8, epsilon = 1e-12); // 3-4-12
         assert_abs_diff_eq!(ScalarModel::<5>::jacobian(&m, &x), finite_difference::<5>(&m, &x), epsilon = 1e-7);

@@ -4,21 +4,23 @@
 use super::ScalarModel;
 use nalgebra::{SMatrix, SVector};
 
-/// Measures state component `index`; `angle` wraps its innovation.
+/// Measures state component `index` with noise variance `var`; `angle` wraps its
+/// innovation.
 #[derive(Debug, Clone, Copy)]
 pub struct StateComponent {
     pub index: usize,
     pub angle: bool,
+    pub var: f64,
 }
 
 impl StateComponent {
     /// A non-angular component.
-    pub const fn value(index: usize) -> Self {
-        Self { index, angle: false }
+    pub const fn value(index: usize, var: f64) -> Self {
+        Self { index, angle: false, var }
     }
     /// An angular component (heading).
-    pub const fn angle(index: usize) -> Self {
-        Self { index, angle: true }
+    pub const fn angle(index: usize, var: f64) -> Self {
+        Self { index, angle: true, var }
     }
 }
 
@@ -34,6 +36,9 @@ impl<const N: usize> ScalarModel<N> for StateComponent {
     fn is_angle(&self) -> bool {
         self.angle
     }
+    fn variance(&self, _x: &SVector<f64, N>) -> f64 {
+        self.var
+    }
 }
 
 #[cfg(test)]
@@ -46,7 +51,7 @@ mod tests {
     fn jacobian_matches_finite_differences() {
         let x = SVector::<f64, 6>::from([1.0, 2.0, 0.3, 1.1, 0.02, -0.1]);
         for i in 0..6 {
-            let m = StateComponent::value(i);
+            let m = StateComponent::value(i, 1.0);
             let h = ScalarModel::<6>::jacobian(&m, &x);
             let fd = finite_difference::<6>(&m, &x);
             for j in 0..6 {

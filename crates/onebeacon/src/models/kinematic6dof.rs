@@ -30,10 +30,14 @@ pub type Cov = SMatrix<f64, DIM, DIM>;
 /// Body velocities [u, v, w, p, q, r].
 pub type BodyVelocity = SVector<f64, DIM>;
 
-/// The Euler-discretised 6-DOF kinematics for one step's body velocities `nu`.
+/// The Euler-discretised 6-DOF kinematics for one step's measured body velocities `nu`,
+/// with their noise: standard deviations of u, v, w (`velocity_sigma_m_s`) and of p, q,
+/// r (`rate_sigma_rad_s`), mapped into the state by dt J(eta) (eq. 3.2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Kinematic6Dof {
     pub nu: BodyVelocity,
+    pub velocity_sigma_m_s: f64,
+    pub rate_sigma_rad_s: f64,
 }
 
 /// Body-to-NED rotation R = Rz(psi) Ry(theta) Rx(phi) (eq. 4.5, upper-left block).
@@ -75,8 +79,23 @@ fn drz(a: f64) -> Matrix3<f64> {
 }
 
 impl Kinematic6Dof {
+    /// Noise-free kinematics (truth, Jacobian tests).
     pub fn new(nu: BodyVelocity) -> Self {
-        Self { nu }
+        Self { nu, velocity_sigma_m_s: 0.0, rate_sigma_rad_s: 0.0 }
+    }
+
+    /// The covariance of the body-velocity input, diag(u, v, w, p, q, r variances).
+    pub fn input_covariance(&self) -> Cov {
+        let (v2, w2) = (self.velocity_sigma_m_s.powi(2), self.rate_sigma_rad_s.powi(2));
+        Cov::from_diagonal(&SVector::from([v2, v2, v2, w2, w2, w2]))
+    }
+
+    /// The input as the vehicle's sensors measure it: `nu` plus a draw of their noise
+    /// (u, v, w, then p, q, r).
+    pub fn sample_input(&self, rng: &mut dyn rand::Rng) -> BodyVelocity {
+        let mut draw = |sigma: f64| sigma * rand::RngExt::sample::<f64, _>(rng, rand_distr::StandardNormal);
+        let (v, w) = (self.velocity_sigma_m_s, self.rate_sigma_rad_s);
+        self.nu + SVector::from([draw(v), draw(v), draw(v), draw(w), draw(w), draw(w)])
     }
 
     fn split(&self) -> (Vector3<f64>, Vector3<f64>) {
@@ -94,6 +113,15 @@ impl Kinematic6Dof {
 }
 
 impl ProcessModel<DIM> for Kinematic6Dof {
+    /// G Q_nu G' with G = dt J(eta) (eq. 3.2, second term).
+    fn noise_covariance(&self, eta: &State, dt: f64) -> Cov {
+        let g = self.input_jacobian(eta, dt);
+        g * self.input_covariance() * g.transpose()
+    }
+
+    fn is_angle(&self, i: usize) -> bool {
+        i >= idx::ROLL
+    }
     fn propagate(&self, eta: &State, dt: f64) -> State {
         let (lin, ang) = self.split();
         let (phi, theta, psi) = (eta[3], eta[4], eta[5]);

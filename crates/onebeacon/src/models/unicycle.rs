@@ -23,11 +23,22 @@ pub const DIM: usize = 6;
 pub type State = SVector<f64, DIM>;
 pub type Cov = SMatrix<f64, DIM, DIM>;
 
-/// Euler-discretised unicycle with turn rate and acceleration states.
+/// Euler-discretised unicycle with turn rate and acceleration states, and its process
+/// noise: the diagonal of Q per step (garin2024 eq. 25 gives Q per step, not per second).
 #[derive(Debug, Clone, Copy, Default)]
-pub struct UnicycleAccel;
+pub struct UnicycleAccel {
+    pub q_diag: [f64; DIM],
+}
 
 impl ProcessModel<DIM> for UnicycleAccel {
+    fn noise_covariance(&self, _z: &State, _dt: f64) -> Cov {
+        Cov::from_diagonal(&State::from(self.q_diag))
+    }
+
+    fn is_angle(&self, i: usize) -> bool {
+        i == idx::PSI
+    }
+
     fn propagate(&self, z: &State, dt: f64) -> State {
         self.transition(z, dt).0
     }
@@ -80,7 +91,7 @@ mod tests {
 
     #[test]
     fn jacobian_matches_finite_differences() {
-        let m = UnicycleAccel;
+        let m = UnicycleAccel::default();
         let dt = 0.25;
         for z in [
             State::from([3.0, -2.0, 0.7, 1.2, 0.05, -0.02]),
@@ -104,7 +115,7 @@ mod tests {
 
     #[test]
     fn sparse_covariance_prediction_equals_dense_product() {
-        let m = UnicycleAccel;
+        let m = UnicycleAccel::default();
         let z = State::from([3.0, -2.0, 0.7, 1.2, 0.05, -0.02]);
         let f = m.jacobian(&z, 0.25);
         let l = Cov::from_fn(|i, j| if j <= i { 0.1 + (i * 6 + j) as f64 * 0.07 } else { 0.0 });
@@ -122,7 +133,7 @@ mod tests {
         // heading east (psi = pi/2) at 2 m/s for 10 steps of 0.5 s: 10 m east
         let mut z = State::from([0.0, 0.0, std::f64::consts::FRAC_PI_2, 2.0, 0.0, 0.0]);
         for _ in 0..10 {
-            z = UnicycleAccel.propagate(&z, 0.5);
+            z = UnicycleAccel::default().propagate(&z, 0.5);
         }
         assert_abs_diff_eq!(z[idx::X], 0.0, epsilon = 1e-12);
         assert_abs_diff_eq!(z[idx::Y], 10.0, epsilon = 1e-12);

@@ -1,10 +1,79 @@
 //! Navigators: a process model, measurement models and a filter put together, fed with
-//! sensor samples as they arrive on the vehicle.
+//! [`Measurement`] events as they arrive on the vehicle.
+//!
+//! Every navigator implements [`Navigator`]: `process` one event, read the
+//! [`Estimate`]. Each is written once against [`crate::filter::GaussianFilter`], so it
+//! runs with the EKF or the UKF ([`crate::filter::FilterKind`]). The simulator, the log
+//! replay and the live stream drive them through this interface alone.
 
+pub mod event;
 pub mod planar;
 pub mod range_6dof;
 pub mod single_beacon;
 
-pub use planar::{Measurement, Outcome, PlanarConfig, PlanarEstimate, PlanarNavigator, PlanarNoise};
-pub use range_6dof::{OwttRange, Range6DofEkf, SensorNoise};
-pub use single_beacon::{Aiding, CommFrame, EkfTuning, Proprioceptive, SingleBeaconEkf};
+pub use event::{BeaconFix, Kind, Measurement};
+pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
+pub use range_6dof::{Range6DofNavigator, SensorNoise};
+pub use single_beacon::{Aiding, EkfTuning, SingleBeaconNavigator};
+
+use crate::filter::FilterError;
+use nalgebra::{Matrix2, Vector3};
+
+/// What processing one measurement did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Outcome {
+    /// An input was applied (odometry, speed, body velocity), or a measurement held for
+    /// the filter's next tick (a frame fused with the next inertial sample).
+    Applied,
+    /// A correction was accepted or rejected by the gate, with its NIS.
+    Accepted(f64),
+    Rejected(f64),
+    /// Not used by this navigator (dead reckoning and beacons, say).
+    Skipped,
+    /// The update could not be computed; the state is unchanged.
+    Failed(FilterError),
+}
+
+/// A navigator's estimate at one time: the part every navigator has (position, heading,
+/// their uncertainty) and the sensor calibration states some estimate (zero otherwise).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    pub t_s: f64,
+    /// NED position, m (down: the depth state, or the latest known depth).
+    pub position_ned_m: Vector3<f64>,
+    /// Covariance of north and east, m^2.
+    pub horizontal_cov_m2: Matrix2<f64>,
+    /// Heading, rad in (-pi, pi].
+    pub heading_rad: f64,
+    pub sigma_heading_rad: f64,
+    /// Forward speed, m/s, when it is a state.
+    pub speed_m_s: Option<f64>,
+    /// Range offset b (m) and scale error k_r, odometry distance and turn scale errors.
+    pub range_bias_m: f64,
+    pub range_scale: f64,
+    pub distance_scale: f64,
+    pub turn_scale: f64,
+}
+
+impl Estimate {
+    pub fn north_m(&self) -> f64 {
+        self.position_ned_m.x
+    }
+    pub fn east_m(&self) -> f64 {
+        self.position_ned_m.y
+    }
+    pub fn sigma_north_m(&self) -> f64 {
+        self.horizontal_cov_m2[(0, 0)].max(0.0).sqrt()
+    }
+    pub fn sigma_east_m(&self) -> f64 {
+        self.horizontal_cov_m2[(1, 1)].max(0.0).sqrt()
+    }
+}
+
+/// One estimator on a vehicle: fed measurements in time order, asked for its estimate.
+pub trait Navigator: Send {
+    /// Processes one measurement (an earlier time than the last is taken as now).
+    fn process(&mut self, m: &Measurement) -> Outcome;
+    /// The current estimate.
+    fn estimate(&self) -> Estimate;
+}

@@ -13,10 +13,11 @@
 //! every combination. Doppler speeds are not scaled by k_r (acoustic Doppler speeds share
 //! the sound-speed error; modelling that is left for when a log needs it).
 
-use crate::filter::{Ekf, FilterError, Gated};
+use super::{Estimate, Kind, Measurement, Navigator, Outcome};
+use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::geo::wrap_angle;
 use crate::measure::{RadialSpeed2d, ScalarModel, SlantRange, StateComponent};
-use nalgebra::{Matrix1, SMatrix, SVector, Vector1, Vector2, Vector3};
+use nalgebra::{SMatrix, SVector, Vector1, Vector2, Vector3};
 
 /// Number of state components.
 pub const STATES: usize = 7;
@@ -115,79 +116,89 @@ impl Default for PlanarConfig {
     }
 }
 
-/// One measurement, in NED and SI units. Beacon measurements carry the beacon's
-/// position (at transmit time for a moving beacon).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Measurement {
-    /// Distance travelled and heading change since the previous increment.
-    Odometry {
-        distance_m: f64,
-        heading_change_rad: f64,
-    },
-    /// Forward speed, held until the next one (DVL, propeller model).
-    Speed {
-        speed_m_s: f64,
-    },
-    Heading {
-        heading_rad: f64,
-    },
-    /// The vehicle's depth, held until the next one.
-    Depth {
-        depth_m: f64,
-    },
-    Range {
-        beacon_id: u32,
-        beacon: Vector3<f64>,
-        range_m: f64,
-    },
-    /// Radial speed toward the beacon, positive when closing (garin2024 eq. 13).
-    Doppler {
-        beacon_id: u32,
-        beacon: Vector3<f64>,
-        radial_speed_m_s: f64,
-    },
+/// An odometry step with measured distance `d` and heading change `dpsi`, corrected by
+/// the scale states: (1 + k_d) d along the mid-increment heading, then the heading
+/// change (1 + k_t) dpsi (second-order odometry model), with distance error `sigma_d`
+/// and the configured heading noise.
+#[derive(Debug, Clone, Copy)]
+struct OdometryStep {
+    d: f64,
+    dpsi: f64,
+    sigma_d: f64,
+    noise: PlanarNoise,
 }
 
-/// What processing one measurement did.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Outcome {
-    /// An input (odometry, speed, depth) was applied.
-    Applied,
-    /// A correction was accepted or rejected by the gate, with its NIS.
-    Accepted(f64),
-    Rejected(f64),
-    /// Not used by this estimator (dead reckoning and beacons).
-    Skipped,
-    /// The update could not be computed; the state is unchanged.
-    Failed(FilterError),
+impl OdometryStep {
+    /// Input Jacobian G (columns d and dpsi) at `x`.
+    fn input_jacobian(&self, x: &State) -> SMatrix<f64, STATES, 2> {
+        let (gain_d, gain_t) = (1.0 + x[idx::DISTANCE_SCALE], 1.0 + x[idx::TURN_SCALE]);
+        let (dc, dpsic) = (gain_d * self.d, gain_t * self.dpsi);
+        let (s, c) = (x[idx::PSI] + dpsic / 2.0).sin_cos();
+        let mut g = SMatrix::<f64, STATES, 2>::zeros();
+        g[(idx::N, 0)] = gain_d * c;
+        g[(idx::E, 0)] = gain_d * s;
+        g[(idx::N, 1)] = -dc * s * gain_t / 2.0;
+        g[(idx::E, 1)] = dc * c * gain_t / 2.0;
+        g[(idx::PSI, 1)] = gain_t;
+        g
+    }
 }
 
-/// The estimate at one time.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PlanarEstimate {
-    pub t_s: f64,
-    pub north_m: f64,
-    pub east_m: f64,
-    pub heading_rad: f64,
-    pub bias_m: f64,
-    pub sigma_north_m: f64,
-    pub sigma_east_m: f64,
-    /// Covariance of north and east, m^2.
-    pub cov_north_east_m2: f64,
-    pub sigma_heading_rad: f64,
-    pub sigma_bias_m: f64,
-    /// Scale errors of the ranges (k_r) and of the odometry (k_d, k_t); zero when not
-    /// estimated.
-    pub range_scale: f64,
-    pub distance_scale: f64,
-    pub turn_scale: f64,
+impl ProcessModel<STATES> for OdometryStep {
+    fn propagate(&self, x: &State, _dt: f64) -> State {
+        let (gain_d, gain_t) = (1.0 + x[idx::DISTANCE_SCALE], 1.0 + x[idx::TURN_SCALE]);
+        let (dc, dpsic) = (gain_d * self.d, gain_t * self.dpsi);
+        let (s, c) = (x[idx::PSI] + dpsic / 2.0).sin_cos();
+        let mut n = *x;
+        n[idx::N] += dc * c;
+        n[idx::E] += dc * s;
+        n[idx::PSI] = wrap_angle(x[idx::PSI] + dpsic);
+        n
+    }
+
+    fn jacobian(&self, x: &State, _dt: f64) -> Cov {
+        let (d, dpsi) = (self.d, self.dpsi);
+        let (gain_d, gain_t) = (1.0 + x[idx::DISTANCE_SCALE], 1.0 + x[idx::TURN_SCALE]);
+        let (dc, dpsic) = (gain_d * d, gain_t * dpsi);
+        let (s, c) = (x[idx::PSI] + dpsic / 2.0).sin_cos();
+        let mut f = Cov::identity();
+        f[(idx::N, idx::PSI)] = -dc * s;
+        f[(idx::E, idx::PSI)] = dc * c;
+        f[(idx::N, idx::DISTANCE_SCALE)] = d * c;
+        f[(idx::E, idx::DISTANCE_SCALE)] = d * s;
+        f[(idx::N, idx::TURN_SCALE)] = -dc * s * dpsi / 2.0;
+        f[(idx::E, idx::TURN_SCALE)] = dc * c * dpsi / 2.0;
+        f[(idx::PSI, idx::TURN_SCALE)] = dpsi;
+        f
+    }
+
+    /// G Q_u G' with the distance error and the heading-change error (its fraction plus
+    /// the random walk per metre).
+    fn noise_covariance(&self, x: &State, _dt: f64) -> Cov {
+        let n = self.noise;
+        let g = self.input_jacobian(x);
+        let var_dpsi =
+            (n.heading_change_sigma_frac * self.dpsi).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * self.d.abs();
+        let q_u = SMatrix::<f64, 2, 2>::from_diagonal(&Vector2::new(self.sigma_d * self.sigma_d, var_dpsi));
+        g * q_u * g.transpose()
+    }
+
+    fn is_angle(&self, i: usize) -> bool {
+        i == idx::PSI
+    }
+
+    fn propagate_covariance(&self, f: &Cov, p: &Cov, q: &Cov) -> Cov {
+        let p = f * p * f.transpose() + q;
+        (p + p.transpose()) * 0.5
+    }
 }
 
-/// The navigator: an EKF over [N, E, psi, b, k_r, k_d, k_t] with the held inputs.
+/// The navigator: an EKF or UKF over [N, E, psi, b, k_r, k_d, k_t] with the held
+/// inputs (speed, depth).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlanarNavigator {
     pub config: PlanarConfig,
-    ekf: Ekf<STATES>,
+    filter: AnyFilter<STATES>,
     t_s: f64,
     /// Latest forward-speed input, and whether it drives the motion between events.
     speed_m_s: f64,
@@ -201,6 +212,7 @@ impl PlanarNavigator {
     /// standard deviations `sigma_position_m` (each axis) and `sigma_heading_rad`.
     pub fn new(
         config: PlanarConfig,
+        filter: FilterKind,
         t_s: f64,
         (north_m, east_m, heading_rad): (f64, f64, f64),
         sigma_position_m: f64,
@@ -218,73 +230,14 @@ impl PlanarNavigator {
         ]);
         let p = Cov::from_diagonal(&sigmas.component_mul(&sigmas));
         let x = State::from([north_m, east_m, wrap_angle(heading_rad), config.bias_m, 0.0, 0.0, 0.0]);
-        Self { config, ekf: Ekf::new(x, p), t_s, speed_m_s: 0.0, coasting: false, last_odometry_s: None, depth_m: 0.0 }
-    }
-
-    pub fn estimate(&self) -> PlanarEstimate {
-        let (x, p) = (&self.ekf.x, &self.ekf.p);
-        PlanarEstimate {
-            t_s: self.t_s,
-            north_m: x[idx::N],
-            east_m: x[idx::E],
-            heading_rad: wrap_angle(x[idx::PSI]),
-            bias_m: x[idx::BIAS],
-            sigma_north_m: p[(idx::N, idx::N)].sqrt(),
-            sigma_east_m: p[(idx::E, idx::E)].sqrt(),
-            cov_north_east_m2: p[(idx::N, idx::E)],
-            sigma_heading_rad: p[(idx::PSI, idx::PSI)].sqrt(),
-            sigma_bias_m: p[(idx::BIAS, idx::BIAS)].sqrt(),
-            range_scale: x[idx::RANGE_SCALE],
-            distance_scale: x[idx::DISTANCE_SCALE],
-            turn_scale: x[idx::TURN_SCALE],
-        }
-    }
-
-    /// Processes one measurement taken at `t_s` (measurements in time order; an
-    /// earlier time is taken as now).
-    pub fn process(&mut self, t_s: f64, m: &Measurement) -> Outcome {
-        self.advance_to(t_s);
-        let noise = self.config.noise;
-        match *m {
-            Measurement::Odometry { distance_m, heading_change_rad } => {
-                if let Some(t0) = self.last_odometry_s.filter(|t0| t_s > *t0) {
-                    self.speed_m_s = distance_m / (t_s - t0);
-                }
-                self.last_odometry_s = Some(t_s);
-                self.coasting = false;
-                let sd = noise.distance_sigma_frac * distance_m.abs();
-                self.motion(distance_m, heading_change_rad, sd);
-                Outcome::Applied
-            }
-            Measurement::Speed { speed_m_s } => {
-                self.speed_m_s = speed_m_s;
-                self.coasting = true;
-                Outcome::Applied
-            }
-            Measurement::Depth { depth_m } => {
-                self.depth_m = depth_m;
-                Outcome::Applied
-            }
-            Measurement::Heading { heading_rad } => {
-                let model = [&StateComponent::angle(idx::PSI) as &dyn ScalarModel<STATES>];
-                self.correct(&model, heading_rad, noise.heading_sigma_rad, f64::INFINITY)
-            }
-            Measurement::Range { beacon, range_m, .. } if self.config.use_beacons => {
-                let model =
-                    SlantRange { beacon, depth_m: self.depth_m, bias: Some(idx::BIAS), scale: Some(idx::RANGE_SCALE) };
-                self.correct(&[&model as &dyn ScalarModel<STATES>], range_m, noise.range_sigma_m, self.gate())
-            }
-            Measurement::Doppler { beacon, radial_speed_m_s, .. } if self.config.use_beacons => {
-                let model =
-                    RadialSpeed2d { beacon: Vector2::new(beacon.x, beacon.y), known_speed_m_s: Some(self.speed_m_s) };
-                self.correct(
-                    &[&model as &dyn ScalarModel<STATES>],
-                    radial_speed_m_s,
-                    noise.doppler_sigma_m_s,
-                    self.gate(),
-                )
-            }
-            Measurement::Range { .. } | Measurement::Doppler { .. } => Outcome::Skipped,
+        Self {
+            config,
+            filter: AnyFilter::new(filter, x, p),
+            t_s,
+            speed_m_s: 0.0,
+            coasting: false,
+            last_odometry_s: None,
+            depth_m: 0.0,
         }
     }
 
@@ -292,8 +245,10 @@ impl PlanarNavigator {
         self.config.nis_gate.unwrap_or(f64::INFINITY)
     }
 
-    fn correct(&mut self, model: &[&dyn ScalarModel<STATES>; 1], z: f64, sigma: f64, gate: f64) -> Outcome {
-        match self.ekf.update_gated(model, &Vector1::new(z), &Matrix1::new(sigma * sigma), gate) {
+    fn correct(&mut self, model: &dyn ScalarModel<STATES>, z: f64, gate: f64) -> Outcome {
+        let model = [model];
+        let r = model.covariance(self.filter.mean());
+        match self.filter.update_gated(&model, &Vector1::new(z), &r, gate) {
             Ok(Gated::Accepted(nis)) => Outcome::Accepted(nis),
             Ok(Gated::Rejected(nis)) => Outcome::Rejected(nis),
             Err(e) => Outcome::Failed(e),
@@ -312,52 +267,109 @@ impl PlanarNavigator {
             self.motion(self.speed_m_s * dt, 0.0, n.speed_sigma_m_s * dt);
         }
         if self.config.estimate_bias {
-            self.ekf.p[(idx::BIAS, idx::BIAS)] += self.config.noise.bias_walk_m_per_sqrt_s.powi(2) * dt;
+            self.filter.covariance_mut()[(idx::BIAS, idx::BIAS)] +=
+                self.config.noise.bias_walk_m_per_sqrt_s.powi(2) * dt;
         }
     }
 
-    /// Odometry step with measured distance `d` and heading change `dpsi`, corrected by
-    /// the scale states: (1 + k_d) d along the mid-increment heading, then the heading
-    /// change (1 + k_t) dpsi (second-order odometry model), with distance error `sigma_d`.
     fn motion(&mut self, d: f64, dpsi: f64, sigma_d: f64) {
-        let n = self.config.noise;
-        let x = &mut self.ekf.x;
-        let (gain_d, gain_t) = (1.0 + x[idx::DISTANCE_SCALE], 1.0 + x[idx::TURN_SCALE]);
-        let (dc, dpsic) = (gain_d * d, gain_t * dpsi);
-        let (s, c) = (x[idx::PSI] + dpsic / 2.0).sin_cos();
-        x[idx::N] += dc * c;
-        x[idx::E] += dc * s;
-        x[idx::PSI] = wrap_angle(x[idx::PSI] + dpsic);
-        let mut f = Cov::identity();
-        f[(idx::N, idx::PSI)] = -dc * s;
-        f[(idx::E, idx::PSI)] = dc * c;
-        f[(idx::N, idx::DISTANCE_SCALE)] = d * c;
-        f[(idx::E, idx::DISTANCE_SCALE)] = d * s;
-        f[(idx::N, idx::TURN_SCALE)] = -dc * s * dpsi / 2.0;
-        f[(idx::E, idx::TURN_SCALE)] = dc * c * dpsi / 2.0;
-        f[(idx::PSI, idx::TURN_SCALE)] = dpsi;
-        // input Jacobian, columns d and dpsi
-        let mut g = SMatrix::<f64, STATES, 2>::zeros();
-        g[(idx::N, 0)] = gain_d * c;
-        g[(idx::E, 0)] = gain_d * s;
-        g[(idx::N, 1)] = -dc * s * gain_t / 2.0;
-        g[(idx::E, 1)] = dc * c * gain_t / 2.0;
-        g[(idx::PSI, 1)] = gain_t;
-        let var_dpsi = (n.heading_change_sigma_frac * dpsi).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * d.abs();
-        let q_u = SMatrix::<f64, 2, 2>::from_diagonal(&Vector2::new(sigma_d * sigma_d, var_dpsi));
-        let p = f * self.ekf.p * f.transpose() + g * q_u * g.transpose();
-        self.ekf.p = (p + p.transpose()) * 0.5;
+        let step = OdometryStep { d, dpsi, sigma_d, noise: self.config.noise };
+        let q = step.noise_covariance(self.filter.mean(), 0.0);
+        self.filter.predict(&step, 0.0, &q);
+    }
+
+    /// The slant-range model to `beacon` with this navigator's bias and scale states.
+    fn range_model(&self, beacon: Vector3<f64>) -> SlantRange {
+        let var = self.config.noise.range_sigma_m * self.config.noise.range_sigma_m;
+        SlantRange { beacon, depth_m: self.depth_m, bias: Some(idx::BIAS), scale: Some(idx::RANGE_SCALE), var }
+    }
+
+    fn doppler_model(&self, beacon: Vector3<f64>) -> RadialSpeed2d {
+        let var = self.config.noise.doppler_sigma_m_s * self.config.noise.doppler_sigma_m_s;
+        RadialSpeed2d { beacon: beacon.xy(), known_speed_m_s: Some(self.speed_m_s), var }
+    }
+}
+
+impl Navigator for PlanarNavigator {
+    /// Processes one measurement (measurements in time order; an earlier time is taken
+    /// as now).
+    fn process(&mut self, m: &Measurement) -> Outcome {
+        let t_s = m.t_s;
+        self.advance_to(t_s);
+        let noise = self.config.noise;
+        let beacons = self.config.use_beacons;
+        match m.kind {
+            Kind::Odometry { distance_m, heading_change_rad } => {
+                if let Some(t0) = self.last_odometry_s.filter(|t0| t_s > *t0) {
+                    self.speed_m_s = distance_m / (t_s - t0);
+                }
+                self.last_odometry_s = Some(t_s);
+                self.coasting = false;
+                let sd = noise.distance_sigma_frac * distance_m.abs();
+                self.motion(distance_m, heading_change_rad, sd);
+                Outcome::Applied
+            }
+            Kind::Speed { speed_m_s } => {
+                self.speed_m_s = speed_m_s;
+                self.coasting = true;
+                Outcome::Applied
+            }
+            Kind::Depth { depth_m } => {
+                self.depth_m = depth_m;
+                Outcome::Applied
+            }
+            Kind::Heading { heading_rad } | Kind::Attitude { heading_rad, .. } => {
+                let var = noise.heading_sigma_rad * noise.heading_sigma_rad;
+                self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, f64::INFINITY)
+            }
+            Kind::Range { beacon, range_m } if beacons => {
+                let model = self.range_model(beacon.position_ned_m);
+                self.correct(&model, range_m, self.gate())
+            }
+            Kind::Doppler { beacon, radial_speed_m_s } if beacons => {
+                let model = self.doppler_model(beacon.position_ned_m);
+                self.correct(&model, radial_speed_m_s, self.gate())
+            }
+            Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } if beacons => {
+                let range = self.correct(&self.range_model(beacon.position_ned_m), range_m, self.gate());
+                let doppler = self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, self.gate());
+                // the worse of the two outcomes
+                match (range, doppler) {
+                    (Outcome::Failed(e), _) | (_, Outcome::Failed(e)) => Outcome::Failed(e),
+                    (Outcome::Rejected(n), _) | (_, Outcome::Rejected(n)) => Outcome::Rejected(n),
+                    (a, _) => a,
+                }
+            }
+            _ => Outcome::Skipped,
+        }
+    }
+
+    fn estimate(&self) -> Estimate {
+        let (x, p) = (self.filter.mean(), self.filter.covariance());
+        Estimate {
+            t_s: self.t_s,
+            position_ned_m: Vector3::new(x[idx::N], x[idx::E], self.depth_m),
+            horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
+            heading_rad: wrap_angle(x[idx::PSI]),
+            sigma_heading_rad: p[(idx::PSI, idx::PSI)].sqrt(),
+            speed_m_s: None,
+            range_bias_m: x[idx::BIAS],
+            range_scale: x[idx::RANGE_SCALE],
+            distance_scale: x[idx::DISTANCE_SCALE],
+            turn_scale: x[idx::TURN_SCALE],
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nav::BeaconFix;
     use approx::assert_abs_diff_eq;
     use std::f64::consts::FRAC_PI_2;
 
     fn start(config: PlanarConfig) -> PlanarNavigator {
-        PlanarNavigator::new(config, 0.0, (0.0, 0.0, 0.0), 0.0, 0.0)
+        PlanarNavigator::new(config, FilterKind::Ekf, 0.0, (0.0, 0.0, 0.0), 0.0, 0.0)
     }
 
     #[test]
@@ -370,17 +382,20 @@ mod tests {
         let chord = 2.0 * r * (dpsi / 2.0).sin();
         for i in 0..k {
             assert_eq!(
-                nav.process(i as f64, &Measurement::Odometry { distance_m: chord, heading_change_rad: dpsi }),
+                nav.process(&Measurement::new(
+                    i as f64,
+                    Kind::Odometry { distance_m: chord, heading_change_rad: dpsi }
+                )),
                 Outcome::Applied
             );
         }
         let e = nav.estimate();
-        assert_abs_diff_eq!(e.north_m, 10.0, epsilon = 1e-9);
-        assert_abs_diff_eq!(e.east_m, 10.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(e.north_m(), 10.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(e.east_m(), 10.0, epsilon = 1e-9);
         assert_abs_diff_eq!(e.heading_rad, FRAC_PI_2, epsilon = 1e-12);
         // uncertainty grew with distance, the bias stayed known
-        assert!(e.sigma_north_m > 0.0 && e.sigma_east_m > 0.0);
-        assert_eq!(e.sigma_bias_m, 0.0);
+        assert!(e.sigma_north_m() > 0.0 && e.sigma_east_m() > 0.0);
+        assert_eq!(nav.filter.covariance()[(idx::BIAS, idx::BIAS)], 0.0);
     }
 
     /// The covariance step equals the Jacobians (F, G) of the motion taken by finite
@@ -394,12 +409,12 @@ mod tests {
             estimate_turn_scale: true,
             ..PlanarConfig::default()
         };
-        let mut nav = PlanarNavigator::new(config, 0.0, (3.0, -2.0, 0.8), 1.0, 0.1);
-        nav.ekf.x[idx::RANGE_SCALE] = 0.07;
-        nav.ekf.x[idx::DISTANCE_SCALE] = 0.03;
-        nav.ekf.x[idx::TURN_SCALE] = -0.05;
-        let p0 = nav.ekf.p;
-        let x0 = nav.ekf.x;
+        let mut nav = PlanarNavigator::new(config, FilterKind::Ekf, 0.0, (3.0, -2.0, 0.8), 1.0, 0.1);
+        nav.filter.mean_mut()[idx::RANGE_SCALE] = 0.07;
+        nav.filter.mean_mut()[idx::DISTANCE_SCALE] = 0.03;
+        nav.filter.mean_mut()[idx::TURN_SCALE] = -0.05;
+        let p0 = *nav.filter.covariance();
+        let x0 = *nav.filter.mean();
         let (d, dpsi) = (1.7, 0.3);
         nav.motion(d, dpsi, 0.1);
         let step = |x: State, d: f64, dpsi: f64| {
@@ -423,22 +438,22 @@ mod tests {
             (n.heading_change_sigma_frac * dpsi).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * d,
         ));
         let expected = f * p0 * f.transpose() + g * q * g.transpose();
-        assert_abs_diff_eq!(nav.ekf.p, expected, epsilon = 1e-8);
-        assert_abs_diff_eq!(nav.ekf.x, step(x0, d, dpsi), epsilon = 1e-12);
+        assert_abs_diff_eq!(*nav.filter.covariance(), expected, epsilon = 1e-8);
+        assert_abs_diff_eq!(*nav.filter.mean(), step(x0, d, dpsi), epsilon = 1e-12);
     }
 
     #[test]
     fn speed_input_coasts_between_events() {
         let mut nav = start(PlanarConfig::default());
-        nav.process(0.0, &Measurement::Heading { heading_rad: 0.0 });
-        nav.process(0.0, &Measurement::Speed { speed_m_s: 1.5 });
-        nav.process(10.0, &Measurement::Depth { depth_m: 20.0 });
-        assert_abs_diff_eq!(nav.estimate().north_m, 15.0, epsilon = 1e-12);
+        nav.process(&Measurement::new(0.0, Kind::Heading { heading_rad: 0.0 }));
+        nav.process(&Measurement::new(0.0, Kind::Speed { speed_m_s: 1.5 }));
+        nav.process(&Measurement::new(10.0, Kind::Depth { depth_m: 20.0 }));
+        assert_abs_diff_eq!(nav.estimate().north_m(), 15.0, epsilon = 1e-12);
         assert_abs_diff_eq!(nav.estimate().t_s, 10.0);
         // coasting goes on until an odometry increment arrives, which ends it
-        nav.process(11.0, &Measurement::Odometry { distance_m: 1.0, heading_change_rad: 0.0 });
-        nav.process(20.0, &Measurement::Depth { depth_m: 20.0 });
-        assert_abs_diff_eq!(nav.estimate().north_m, 15.0 + 1.5 + 1.0, epsilon = 1e-12);
+        nav.process(&Measurement::new(11.0, Kind::Odometry { distance_m: 1.0, heading_change_rad: 0.0 }));
+        nav.process(&Measurement::new(20.0, Kind::Depth { depth_m: 20.0 }));
+        assert_abs_diff_eq!(nav.estimate().north_m(), 15.0 + 1.5 + 1.0, epsilon = 1e-12);
     }
 
     /// A static vehicle with unknown position and a biased range sensor, ranged from
@@ -450,26 +465,27 @@ mod tests {
         let bias = 2.8;
         let beacons = [Vector3::new(0.0, 0.0, 0.0), Vector3::new(60.0, 10.0, 0.0), Vector3::new(-20.0, 50.0, 0.0)];
         let config = PlanarConfig { estimate_bias: true, nis_gate: Some(10.83), ..PlanarConfig::default() };
-        let mut nav = PlanarNavigator::new(config, 0.0, (0.0, 0.0, 0.3), 20.0, 0.1);
-        nav.process(0.0, &Measurement::Depth { depth_m: truth.z });
+        let mut nav = PlanarNavigator::new(config, FilterKind::Ekf, 0.0, (0.0, 0.0, 0.3), 20.0, 0.1);
+        nav.process(&Measurement::new(0.0, Kind::Depth { depth_m: truth.z }));
         let mut t = 0.0;
         for k in 0..600 {
             let b = beacons[k % 3];
             t += 1.0;
             let range_m = (truth - b).norm() + bias;
-            let out = nav.process(t, &Measurement::Range { beacon_id: (k % 3) as u32, beacon: b, range_m });
+            let out =
+                nav.process(&Measurement::new(t, Kind::Range { beacon: BeaconFix::fixed((k % 3) as u32, b), range_m }));
             assert!(matches!(out, Outcome::Accepted(_)), "{out:?}");
         }
         let e = nav.estimate();
-        assert_abs_diff_eq!(e.north_m, truth.x, epsilon = 0.1);
-        assert_abs_diff_eq!(e.east_m, truth.y, epsilon = 0.1);
-        assert_abs_diff_eq!(e.bias_m, bias, epsilon = 0.1);
-        let outlier = Measurement::Range { beacon_id: 0, beacon: beacons[0], range_m: truth.norm() + bias + 20.0 };
+        assert_abs_diff_eq!(e.north_m(), truth.x, epsilon = 0.1);
+        assert_abs_diff_eq!(e.east_m(), truth.y, epsilon = 0.1);
+        assert_abs_diff_eq!(e.range_bias_m, bias, epsilon = 0.1);
+        let outlier = Kind::Range { beacon: BeaconFix::fixed(0, beacons[0]), range_m: truth.norm() + bias + 20.0 };
         let before = nav.estimate();
-        assert!(matches!(nav.process(t, &outlier), Outcome::Rejected(nis) if nis > 10.83));
+        assert!(matches!(nav.process(&Measurement::new(t, outlier)), Outcome::Rejected(nis) if nis > 10.83));
         assert_eq!(nav.estimate(), before);
         let mut dr = start(PlanarConfig { use_beacons: false, ..PlanarConfig::default() });
-        assert_eq!(dr.process(1.0, &outlier), Outcome::Skipped);
+        assert_eq!(dr.process(&Measurement::new(1.0, outlier)), Outcome::Skipped);
     }
 
     /// A vehicle whose odometry over-reports turns (true turn = 0.96 x measured,
@@ -482,7 +498,7 @@ mod tests {
         let (k_t, k_r, offset) = (-0.04, 0.07, 0.5);
         let beacon = Vector3::new(0.0, 0.0, 0.0);
         let run = |config: PlanarConfig| {
-            let mut nav = PlanarNavigator::new(config, 0.0, (-40.0, 0.0, 0.0), 0.5, 0.02);
+            let mut nav = PlanarNavigator::new(config, FilterKind::Ekf, 0.0, (-40.0, 0.0, 0.0), 0.5, 0.02);
             let (mut n, mut e, mut psi) = (-40.0_f64, 0.0_f64, 0.0_f64);
             let mut worst = 0.0_f64;
             for k in 1..=3000 {
@@ -493,14 +509,17 @@ mod tests {
                 n += 0.5 * (psi + true_dpsi / 2.0).cos();
                 e += 0.5 * (psi + true_dpsi / 2.0).sin();
                 psi += true_dpsi;
-                nav.process(t, &Measurement::Odometry { distance_m: 0.5, heading_change_rad: measured_dpsi });
+                nav.process(&Measurement::new(
+                    t,
+                    Kind::Odometry { distance_m: 0.5, heading_change_rad: measured_dpsi },
+                ));
                 if k % 4 == 0 {
                     let range_m = (1.0 + k_r) * (Vector3::new(n, e, 0.0) - beacon).norm() + offset;
-                    nav.process(t, &Measurement::Range { beacon_id: 0, beacon, range_m });
+                    nav.process(&Measurement::new(t, Kind::Range { beacon: BeaconFix::fixed(0, beacon), range_m }));
                 }
                 let est = nav.estimate();
                 if k > 1500 {
-                    worst = worst.max((est.north_m - n).hypot(est.east_m - e));
+                    worst = worst.max((est.north_m() - n).hypot(est.east_m() - e));
                 }
             }
             (nav.estimate(), worst)
@@ -519,7 +538,7 @@ mod tests {
         let (est, worst) = run(calibrated);
         assert_abs_diff_eq!(est.turn_scale, k_t, epsilon = 0.001);
         assert_abs_diff_eq!(est.range_scale, k_r, epsilon = 0.002);
-        assert_abs_diff_eq!(est.bias_m, offset, epsilon = 0.1);
+        assert_abs_diff_eq!(est.range_bias_m, offset, epsilon = 0.1);
         assert!(worst < 0.1, "calibrated: worst error over the second half {worst} m");
         let (_, worst_plain) = run(PlanarConfig { estimate_bias: true, ..PlanarConfig::default() });
         assert!(worst_plain > 5.0, "uncalibrated: {worst_plain} m");
@@ -529,14 +548,20 @@ mod tests {
     fn doppler_and_heading_corrections() {
         // heading fix pulls the heading; a Doppler speed with the known odometry speed
         // is accepted and consistent with the geometry
-        let mut nav = PlanarNavigator::new(PlanarConfig::default(), 0.0, (10.0, 0.0, 0.2), 1.0, 0.3);
-        assert!(matches!(nav.process(0.0, &Measurement::Heading { heading_rad: 0.0 }), Outcome::Accepted(_)));
+        let mut nav = PlanarNavigator::new(PlanarConfig::default(), FilterKind::Ekf, 0.0, (10.0, 0.0, 0.2), 1.0, 0.3);
+        assert!(matches!(
+            nav.process(&Measurement::new(0.0, Kind::Heading { heading_rad: 0.0 })),
+            Outcome::Accepted(_)
+        ));
         assert!(nav.estimate().heading_rad.abs() < 0.2);
-        nav.process(1.0, &Measurement::Odometry { distance_m: 0.0, heading_change_rad: 0.0 });
-        nav.process(2.0, &Measurement::Odometry { distance_m: 1.5, heading_change_rad: 0.0 });
+        nav.process(&Measurement::new(1.0, Kind::Odometry { distance_m: 0.0, heading_change_rad: 0.0 }));
+        nav.process(&Measurement::new(2.0, Kind::Odometry { distance_m: 1.5, heading_change_rad: 0.0 }));
         let beacon = Vector3::zeros();
         // heading north, away from a beacon to the south: opening at the odometry speed
-        let out = nav.process(2.0, &Measurement::Doppler { beacon_id: 0, beacon, radial_speed_m_s: -1.5 });
+        let out = nav.process(&Measurement::new(
+            2.0,
+            Kind::Doppler { beacon: BeaconFix::fixed(0, beacon), radial_speed_m_s: -1.5 },
+        ));
         assert!(matches!(out, Outcome::Accepted(nis) if nis < 1.0), "{out:?}");
     }
 }

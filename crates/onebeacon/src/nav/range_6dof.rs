@@ -3,10 +3,12 @@
 //! (eq. 3.3-3.6), and OWTT range updates to a beacon whose position travels with the
 //! measurement (eq. 3.7-3.10).
 
-use crate::filter::{Ekf, FilterError};
+use super::{BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
+use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
+use crate::geo::wrap_angle;
 use crate::measure::{Range3d, ScalarModel, StateComponent};
 use crate::models::kinematic6dof::{BodyVelocity, Cov, DIM, Kinematic6Dof, State, idx};
-use nalgebra::{Matrix2, SMatrix, SVector, Vector1, Vector3, Vector4};
+use nalgebra::{SVector, Vector1};
 
 /// Noise of the vehicle's sensors as the filter models them (standard deviations).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,98 +20,147 @@ pub struct SensorNoise {
     pub depth_m: f64,
     /// Roll, pitch, heading, rad.
     pub attitude_rad: f64,
-}
-
-/// A one-way travel-time range: the beacon's position when it transmitted (as the
-/// beacon vehicle knew it, with the standard deviation of that knowledge per horizontal
-/// axis), and the range c (t_rx - t_tx).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct OwttRange {
-    pub t_tx_s: f64,
-    pub t_rx_s: f64,
-    pub beacon_ned_m: Vector3<f64>,
-    pub beacon_sigma_m: f64,
+    /// Acoustic range, m.
     pub range_m: f64,
-    /// Range noise standard deviation, m.
-    pub sigma_m: f64,
 }
 
-/// The EKF of sousa section 3.2 over eta = [N, E, D, phi, theta, psi].
+impl SensorNoise {
+    /// The process model of body velocities `nu` with this noise.
+    pub fn process_model(&self, nu: BodyVelocity) -> Kinematic6Dof {
+        Kinematic6Dof { nu, velocity_sigma_m_s: self.velocity_m_s, rate_sigma_rad_s: self.rate_rad_s }
+    }
+
+    /// The depth sensor and AHRS models (eq. 3.3-3.6): depth, roll, pitch, heading.
+    pub fn depth_attitude_models(&self) -> [StateComponent; 4] {
+        let (d2, a2) = (self.depth_m.powi(2), self.attitude_rad.powi(2));
+        [
+            StateComponent::value(idx::D, d2),
+            StateComponent::angle(idx::ROLL, a2),
+            StateComponent::angle(idx::PITCH, a2),
+            StateComponent::angle(idx::YAW, a2),
+        ]
+    }
+
+    /// The range model to `beacon` (eq. 3.7-3.10), with the beacon's own position error.
+    pub fn range_model(&self, beacon: &BeaconFix) -> Range3d {
+        Range3d { beacon: beacon.position_ned_m, sigma_m: self.range_m, beacon_sigma_m: beacon.sigma_m }
+    }
+}
+
+/// The navigator of sousa section 3.2 over eta = [N, E, D, phi, theta, psi], with an
+/// EKF or a UKF: dead reckoning on the held body velocities ([`Kind::BodyVelocity`]),
+/// range updates at their receive time ([`Kind::Range`], the beacon's position and GPS
+/// error travelling with it), and depth with attitude: a depth is held and fused with
+/// the next attitude fix ([`Kind::Attitude`]) in one update (eq. 3.3-3.6).
 #[derive(Debug, Clone)]
-pub struct Range6DofEkf {
+pub struct Range6DofNavigator {
     noise: SensorNoise,
-    q_nu: Cov,
-    ekf: Ekf<DIM>,
+    use_ranges: bool,
+    filter: AnyFilter<DIM>,
+    t_s: f64,
+    nu: BodyVelocity,
+    depth: Option<f64>,
 }
 
-const DEPTH: StateComponent = StateComponent::value(idx::D);
-const ROLL: StateComponent = StateComponent::angle(idx::ROLL);
-const PITCH: StateComponent = StateComponent::angle(idx::PITCH);
-const YAW: StateComponent = StateComponent::angle(idx::YAW);
-
-impl Range6DofEkf {
-    pub fn new(noise: SensorNoise, eta0: State, p0: Cov) -> Self {
-        let (v2, w2) = (noise.velocity_m_s.powi(2), noise.rate_rad_s.powi(2));
-        let q_nu = Cov::from_diagonal(&SVector::from([v2, v2, v2, w2, w2, w2]));
-        Self { noise, q_nu, ekf: Ekf::new(eta0, p0) }
-    }
-
-    /// Dead reckoning over `dt` with the measured body velocities `nu`: P = F P F' +
-    /// G Q G' with G = dt J (eq. 3.2).
-    pub fn predict(&mut self, dt: f64, nu: &BodyVelocity) {
-        let model = Kinematic6Dof::new(*nu);
-        let g = model.input_jacobian(&self.ekf.x, dt);
-        let q = g * self.q_nu * g.transpose();
-        self.ekf.predict(&model, dt, &q);
-    }
-
-    /// Depth and attitude update (eq. 3.3-3.6); `z` = [D, phi, theta, psi].
-    pub fn update_attitude_depth(&mut self, z: &Vector4<f64>) -> Result<f64, FilterError> {
-        let models: [&dyn ScalarModel<DIM>; 4] = [&DEPTH, &ROLL, &PITCH, &YAW];
-        let (d2, a2) = (self.noise.depth_m.powi(2), self.noise.attitude_rad.powi(2));
-        let r = SMatrix::<f64, 4, 4>::from_diagonal(&Vector4::new(d2, a2, a2, a2));
-        self.ekf.update(&models, z, &r)
-    }
-
-    /// Range update (eq. 3.7-3.10). The beacon's position error adds its projection on
-    /// the horizontal line of sight to the range variance.
-    pub fn update_range(&mut self, m: &OwttRange) -> Result<f64, FilterError> {
-        let model = Range3d { beacon: m.beacon_ned_m };
-        let h = ScalarModel::<DIM>::jacobian(&model, &self.ekf.x);
-        let horizontal = h[0] * h[0] + h[1] * h[1];
-        let r = m.sigma_m.powi(2) + m.beacon_sigma_m.powi(2) * horizontal;
-        let models: [&dyn ScalarModel<DIM>; 1] = [&model];
-        self.ekf.update(&models, &Vector1::new(m.range_m), &nalgebra::Matrix1::new(r))
+impl Range6DofNavigator {
+    /// A navigator at `t0_s` from `eta0` with covariance `p0`; `use_ranges` false is dead
+    /// reckoning (attitude and depth only).
+    pub fn new(noise: SensorNoise, use_ranges: bool, filter: FilterKind, t0_s: f64, eta0: State, p0: Cov) -> Self {
+        let filter = AnyFilter::new(filter, eta0, p0);
+        Self { noise, use_ranges, filter, t_s: t0_s, nu: BodyVelocity::zeros(), depth: None }
     }
 
     pub fn state(&self) -> &State {
-        &self.ekf.x
+        self.filter.mean()
     }
     pub fn covariance(&self) -> &Cov {
-        &self.ekf.p
+        self.filter.covariance()
     }
-    /// NED position, m.
-    pub fn position(&self) -> Vector3<f64> {
-        self.ekf.x.fixed_rows::<3>(0).into_owned()
+
+    /// Dead reckoning to `t_s` on the held body velocities: P = F P F' + G Q G' with
+    /// G = dt J (eq. 3.2).
+    fn advance_to(&mut self, t_s: f64) {
+        let dt = t_s - self.t_s;
+        if dt > 0.0 {
+            let model = self.noise.process_model(self.nu);
+            let q = model.noise_covariance(self.filter.mean(), dt);
+            self.filter.predict(&model, dt, &q);
+            self.t_s = t_s;
+        }
     }
-    /// Covariance of the horizontal position.
-    pub fn horizontal_covariance(&self) -> Matrix2<f64> {
-        self.ekf.p.fixed_view::<2, 2>(0, 0).into_owned()
+
+    fn update<const M: usize>(&mut self, models: [&dyn ScalarModel<DIM>; M], z: SVector<f64, M>) -> Outcome {
+        let r = models.covariance(self.filter.mean());
+        match self.filter.update_gated(&models, &z, &r, f64::INFINITY) {
+            Ok(g) => Outcome::Accepted(Gated::nis(g)),
+            Err(e) => Outcome::Failed(e),
+        }
+    }
+}
+
+impl Navigator for Range6DofNavigator {
+    fn process(&mut self, m: &Measurement) -> Outcome {
+        match m.kind {
+            Kind::BodyVelocity { nu } => {
+                self.advance_to(m.t_s);
+                self.nu = SVector::from(nu);
+                Outcome::Applied
+            }
+            Kind::Depth { depth_m } => {
+                self.depth = Some(depth_m);
+                Outcome::Applied
+            }
+            Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
+                self.advance_to(m.t_s);
+                let [d, roll, pitch, yaw] = self.noise.depth_attitude_models();
+                match self.depth.take() {
+                    Some(depth) => {
+                        self.update([&d, &roll, &pitch, &yaw], SVector::from([depth, roll_rad, pitch_rad, heading_rad]))
+                    }
+                    None => self.update([&roll, &pitch, &yaw], SVector::from([roll_rad, pitch_rad, heading_rad])),
+                }
+            }
+            Kind::Range { beacon, range_m } if self.use_ranges => {
+                // range update (eq. 3.7-3.10) at the receive time
+                self.advance_to(m.t_s);
+                let model = self.noise.range_model(&beacon);
+                self.update([&model], Vector1::new(range_m))
+            }
+            _ => Outcome::Skipped,
+        }
+    }
+
+    fn estimate(&self) -> Estimate {
+        let (x, p) = (self.filter.mean(), self.filter.covariance());
+        Estimate {
+            t_s: self.t_s,
+            position_ned_m: x.fixed_rows::<3>(0).into_owned(),
+            horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
+            heading_rad: wrap_angle(x[idx::YAW]),
+            sigma_heading_rad: p[(idx::YAW, idx::YAW)].max(0.0).sqrt(),
+            speed_m_s: None,
+            range_bias_m: 0.0,
+            range_scale: 0.0,
+            distance_scale: 0.0,
+            turn_scale: 0.0,
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::filter::ProcessModel;
+    use crate::filter::UkfParams;
+    use crate::nav::BeaconFix;
+    use nalgebra::Vector3;
 
     fn noise() -> SensorNoise {
-        SensorNoise { velocity_m_s: 0.05, rate_rad_s: 0.002, depth_m: 0.05, attitude_rad: 0.02 }
+        SensorNoise { velocity_m_s: 0.05, rate_rad_s: 0.002, depth_m: 0.05, attitude_rad: 0.02, range_m: 0.1 }
     }
 
     /// A stationary vehicle 20 m deep, ranges from a beacon circling it at 30 m with no
     /// noise: the horizontal position converges from a 5 m error to centimetres, while
-    /// dead reckoning alone keeps the error.
+    /// dead reckoning alone keeps the error; with the EKF and with the UKF.
     #[test]
     fn ranges_from_a_circling_beacon_fix_the_position() {
         let truth = State::from([0.0, 0.0, 20.0, 0.0, 0.0, 0.3]);
@@ -117,48 +168,51 @@ mod tests {
         start[idx::N] += 3.0;
         start[idx::E] -= 4.0;
         let p0 = Cov::from_diagonal(&SVector::from([25.0, 25.0, 0.01, 1e-3, 1e-3, 1e-3]));
-        let mut f = Range6DofEkf::new(noise(), start, p0);
-        let mut dr = f.clone();
-        let still = BodyVelocity::zeros();
-        for k in 0..600 {
-            f.predict(0.1, &still);
-            dr.predict(0.1, &still);
-            let z = Vector4::new(20.0, 0.0, 0.0, 0.3);
-            f.update_attitude_depth(&z).unwrap();
-            dr.update_attitude_depth(&z).unwrap();
-            if k % 50 == 0 {
-                let a = k as f64 * 0.02;
-                let beacon = Vector3::new(30.0 * a.cos(), 30.0 * a.sin(), 0.0);
-                let range = (truth.fixed_rows::<3>(0) - beacon).norm();
-                let m = OwttRange {
-                    t_tx_s: 0.0,
-                    t_rx_s: 0.0,
-                    beacon_ned_m: beacon,
-                    beacon_sigma_m: 0.0,
-                    range_m: range,
-                    sigma_m: 0.1,
-                };
-                f.update_range(&m).unwrap();
+        for kind in [FilterKind::Ekf, FilterKind::Ukf(UkfParams::default())] {
+            let mut f = Range6DofNavigator::new(noise(), true, kind, 0.0, start, p0);
+            let mut dr = Range6DofNavigator::new(noise(), false, kind, 0.0, start, p0);
+            for k in 0..600 {
+                let t = (k + 1) as f64 * 0.1;
+                let mut events = vec![
+                    Kind::BodyVelocity { nu: [0.0; 6] },
+                    Kind::Depth { depth_m: 20.0 },
+                    Kind::Attitude { roll_rad: 0.0, pitch_rad: 0.0, heading_rad: 0.3 },
+                ];
+                if k % 50 == 0 {
+                    let a = k as f64 * 0.02;
+                    let beacon = Vector3::new(30.0 * a.cos(), 30.0 * a.sin(), 0.0);
+                    let range_m = (truth.fixed_rows::<3>(0) - beacon).norm();
+                    events.push(Kind::Range { beacon: BeaconFix::fixed(0, beacon), range_m });
+                }
+                for e in events {
+                    let m = Measurement::new(t, e);
+                    assert!(!matches!(f.process(&m), Outcome::Failed(_)));
+                    dr.process(&m);
+                }
             }
+            let err = |e: &Range6DofNavigator| (e.state().fixed_rows::<3>(0) - truth.fixed_rows::<3>(0)).xy().norm();
+            assert!(err(&f) < 0.05, "{kind:?}: range-aided error {}", err(&f));
+            assert!(err(&dr) > 4.9, "{kind:?}: dead-reckoning error {}", err(&dr));
+            // the covariance shrank accordingly
+            assert!(f.estimate().horizontal_cov_m2.trace() < 0.05);
         }
-        let err = |e: &Range6DofEkf| (e.position() - truth.fixed_rows::<3>(0)).xy().norm();
-        assert!(err(&f) < 0.05, "range-aided error {}", err(&f));
-        assert!(err(&dr) > 4.9, "dead-reckoning error {}", err(&dr));
-        // the covariance shrank accordingly
-        assert!(f.horizontal_covariance().trace() < 0.05);
     }
 
     /// Prediction agrees with the model and inflates P by the mapped input noise.
     #[test]
     fn prediction_maps_input_noise() {
         let eta = State::from([1.0, 2.0, 3.0, 0.1, -0.1, 1.0]);
-        let mut f = Range6DofEkf::new(noise(), eta, Cov::zeros());
-        let nu = BodyVelocity::from([1.0, 0.0, 0.1, 0.0, 0.0, 0.05]);
-        f.predict(0.5, &nu);
-        let m = Kinematic6Dof::new(nu);
+        let mut f = Range6DofNavigator::new(noise(), true, FilterKind::Ekf, 0.0, eta, Cov::zeros());
+        let nu = [1.0, 0.0, 0.1, 0.0, 0.0, 0.05];
+        f.process(&Measurement::new(0.0, Kind::BodyVelocity { nu }));
+        f.process(&Measurement::new(0.5, Kind::Depth { depth_m: 3.0 })); // held, no motion
+        assert_eq!(f.state(), &eta);
+        f.process(&Measurement::new(0.5, Kind::BodyVelocity { nu }));
+        let m = Kinematic6Dof::new(SVector::from(nu));
         assert!((f.state() - m.propagate(&eta, 0.5)).norm() < 1e-12);
         let g = m.input_jacobian(&eta, 0.5);
-        let expected = g * f.q_nu * g.transpose();
-        assert!((f.covariance() - expected).norm() < 1e-15);
+        let (v2, w2) = (0.05f64.powi(2), 0.002f64.powi(2));
+        let q_nu = Cov::from_diagonal(&SVector::from([v2, v2, v2, w2, w2, w2]));
+        assert!((f.covariance() - g * q_nu * g.transpose()).norm() < 1e-15);
     }
 }

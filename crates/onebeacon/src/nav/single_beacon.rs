@@ -7,10 +7,12 @@
 //! stacked into one update (eq. 18 left, 22). [`Aiding::RangeOnly`] is the ROSB baseline:
 //! the same filter without the Doppler speed.
 
-use crate::filter::{Ekf, FilterError};
+use super::{Estimate, Kind, Measurement, Navigator, Outcome};
+use crate::filter::{AnyFilter, FilterError, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
+use crate::geo::wrap_angle;
 use crate::measure::{RadialSpeed2d, Range2d, ScalarModel, StateComponent};
 use crate::models::unicycle::{Cov, DIM, State, UnicycleAccel, idx};
-use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+use nalgebra::{SVector, Vector2, Vector3};
 
 /// Which beacon measurements the filter uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -61,119 +63,144 @@ impl Default for EkfTuning {
     }
 }
 
-/// Proprioceptive sample of one time step: AHRS heading and IMU rate and acceleration.
+/// A frame waiting for the next inertial sample: its beacon (NED, m), range, Doppler.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Proprioceptive {
-    pub heading_rad: f64,
-    pub yaw_rate_rad_s: f64,
-    pub accel_m_s2: f64,
+struct Frame {
+    beacon: Vector2<f64>,
+    range_m: f64,
+    radial_speed_m_s: f64,
 }
 
-/// What a decoded communication frame gives: the beacon's position (it travels with the
-/// frame), the one-way travel-time range and the Doppler radial speed (positive closing).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CommFrame {
-    pub beacon_ned_m: Vector2<f64>,
-    pub range_m: f64,
-    pub radial_speed_m_s: f64,
-}
-
-/// The single-beacon EKF of garin2024 (or its range-only ROSB variant).
+/// The single-beacon navigator of garin2024 (or its range-only ROSB variant) over the
+/// unicycle state [x, y, psi, v, Omega, a], with an EKF or a UKF.
+///
+/// It runs at the rate of its inertial samples ([`Kind::Inertial`]): each predicts from
+/// the previous one and updates with heading, yaw rate and acceleration, stacked with
+/// the range (and Doppler speed) of a frame decoded since ([`Kind::RangeDoppler`] or
+/// [`Kind::Range`]), as in garin2024 eq. 18.
 #[derive(Debug, Clone)]
-pub struct SingleBeaconEkf {
+pub struct SingleBeaconNavigator {
     aiding: Aiding,
     tuning: EkfTuning,
-    q: Cov,
-    ekf: Ekf<DIM>,
+    model: UnicycleAccel,
+    filter: AnyFilter<DIM>,
+    t_s: f64,
+    pending: Option<Frame>,
 }
 
-const HEADING: StateComponent = StateComponent::angle(idx::PSI);
-const YAW_RATE: StateComponent = StateComponent::value(idx::OMEGA);
-const ACCEL: StateComponent = StateComponent::value(idx::ACCEL);
-
-impl SingleBeaconEkf {
-    /// A filter starting at state `z0` = [x, y, psi, v, Omega, a] with covariance `p0`.
-    pub fn new(aiding: Aiding, tuning: EkfTuning, z0: State, p0: Cov) -> Self {
-        Self { aiding, q: Cov::from_diagonal(&SVector::from(tuning.q_diag)), tuning, ekf: Ekf::new(z0, p0) }
+impl SingleBeaconNavigator {
+    /// A navigator at time `t0_s` with state `z0` = [x, y, psi, v, Omega, a] and
+    /// covariance `p0`.
+    pub fn new(aiding: Aiding, tuning: EkfTuning, filter: FilterKind, t0_s: f64, z0: State, p0: Cov) -> Self {
+        let model = UnicycleAccel { q_diag: tuning.q_diag };
+        Self { aiding, tuning, model, filter: AnyFilter::new(filter, z0, p0), t_s: t0_s, pending: None }
     }
 
     pub fn aiding(&self) -> Aiding {
         self.aiding
     }
 
-    /// One time step of `dt` seconds: predict, then update with the proprioceptive
-    /// sample and, if one was decoded during the step, the communication frame.
-    /// Returns the NIS of the update.
-    pub fn step(&mut self, dt: f64, sample: &Proprioceptive, frame: Option<&CommFrame>) -> Result<f64, FilterError> {
-        self.ekf.predict(&UnicycleAccel, dt, &self.q);
+    /// The state estimate [x, y, psi, v, Omega, a].
+    pub fn state(&self) -> &State {
+        self.filter.mean()
+    }
+
+    /// The state covariance.
+    pub fn covariance(&self) -> &Cov {
+        self.filter.covariance()
+    }
+
+    /// Predicts to `t_s`, then one stacked update of the inertial sample and the
+    /// pending frame. Returns the NIS.
+    fn tick(&mut self, t_s: f64, heading: f64, yaw_rate: f64, accel: f64) -> Result<f64, FilterError> {
+        let dt = t_s - self.t_s;
+        if dt > 0.0 {
+            let q = self.model.noise_covariance(self.filter.mean(), dt);
+            self.filter.predict(&self.model, dt, &q);
+            self.t_s = t_s;
+        }
         let t = &self.tuning;
-        let proprio = [sample.heading_rad, sample.yaw_rate_rad_s, sample.accel_m_s2];
-        let proprio_r = [t.r_heading_rad2, t.r_yaw_rate_rad2_s2, t.r_accel_m2_s4];
-        match (frame, self.aiding) {
-            (None, _) => self.update([&HEADING, &YAW_RATE, &ACCEL], proprio, proprio_r),
+        let heading_m = StateComponent::angle(idx::PSI, t.r_heading_rad2);
+        let yaw_rate_m = StateComponent::value(idx::OMEGA, t.r_yaw_rate_rad2_s2);
+        let accel_m = StateComponent::value(idx::ACCEL, t.r_accel_m2_s4);
+        let proprio = [heading, yaw_rate, accel];
+        match (self.pending.take(), self.aiding) {
+            (None, _) => self.update([&heading_m, &yaw_rate_m, &accel_m], proprio),
             (Some(f), Aiding::RangeOnly) => {
-                let range = Range2d { beacon: f.beacon_ned_m };
-                self.update(
-                    [&range, &HEADING, &YAW_RATE, &ACCEL],
-                    [f.range_m, proprio[0], proprio[1], proprio[2]],
-                    [t.r_range_m2, proprio_r[0], proprio_r[1], proprio_r[2]],
-                )
+                let range = Range2d { beacon: f.beacon, var: t.r_range_m2 };
+                self.update([&range, &heading_m, &yaw_rate_m, &accel_m], [f.range_m, heading, yaw_rate, accel])
             }
             (Some(f), Aiding::RangeDoppler) => {
-                let range = Range2d { beacon: f.beacon_ned_m };
-                let doppler = RadialSpeed2d { beacon: f.beacon_ned_m, known_speed_m_s: None };
+                let range = Range2d { beacon: f.beacon, var: t.r_range_m2 };
+                let doppler = RadialSpeed2d { beacon: f.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
                 self.update(
-                    [&range, &doppler, &HEADING, &YAW_RATE, &ACCEL], // eq. 18, 20
-                    [f.range_m, f.radial_speed_m_s, proprio[0], proprio[1], proprio[2]],
-                    [t.r_range_m2, t.r_doppler_m2_s2, proprio_r[0], proprio_r[1], proprio_r[2]],
+                    [&range, &doppler, &heading_m, &yaw_rate_m, &accel_m], // eq. 18, 20
+                    [f.range_m, f.radial_speed_m_s, heading, yaw_rate, accel],
                 )
             }
         }
     }
 
-    fn update<const M: usize>(
-        &mut self,
-        models: [&dyn ScalarModel<DIM>; M],
-        z: [f64; M],
-        r_diag: [f64; M],
-    ) -> Result<f64, FilterError> {
-        let r = SMatrix::<f64, M, M>::from_diagonal(&SVector::from(r_diag));
-        self.ekf.update(&models, &SVector::from(z), &r)
+    fn update<const M: usize>(&mut self, models: [&dyn ScalarModel<DIM>; M], z: [f64; M]) -> Result<f64, FilterError> {
+        let r = models.covariance(self.filter.mean());
+        self.filter.update_gated(&models, &SVector::from(z), &r, f64::INFINITY).map(Gated::nis)
+    }
+}
+
+impl Navigator for SingleBeaconNavigator {
+    fn process(&mut self, m: &Measurement) -> Outcome {
+        match m.kind {
+            Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
+                match self.tick(m.t_s, heading_rad, yaw_rate_rad_s, accel_m_s2) {
+                    Ok(nis) => Outcome::Accepted(nis),
+                    Err(e) => Outcome::Failed(e),
+                }
+            }
+            Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } => {
+                self.pending = Some(Frame { beacon: beacon.position_ned_m.xy(), range_m, radial_speed_m_s });
+                Outcome::Applied
+            }
+            Kind::Range { beacon, range_m } if self.aiding == Aiding::RangeOnly => {
+                let radial_speed_m_s = f64::NAN; // not used by the range-only filter
+                self.pending = Some(Frame { beacon: beacon.position_ned_m.xy(), range_m, radial_speed_m_s });
+                Outcome::Applied
+            }
+            _ => Outcome::Skipped,
+        }
     }
 
-    /// The state estimate [x, y, psi, v, Omega, a].
-    pub fn state(&self) -> &State {
-        &self.ekf.x
-    }
-
-    /// The state covariance.
-    pub fn covariance(&self) -> &Cov {
-        &self.ekf.p
-    }
-
-    /// Estimated horizontal position (north, east), m.
-    pub fn position(&self) -> Vector2<f64> {
-        Vector2::new(self.ekf.x[idx::X], self.ekf.x[idx::Y])
-    }
-
-    /// Covariance of the horizontal position.
-    pub fn position_covariance(&self) -> Matrix2<f64> {
-        self.ekf.p.fixed_view::<2, 2>(0, 0).into_owned()
+    fn estimate(&self) -> Estimate {
+        let (x, p) = (self.filter.mean(), self.filter.covariance());
+        Estimate {
+            t_s: self.t_s,
+            position_ned_m: Vector3::new(x[idx::X], x[idx::Y], 0.0),
+            horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
+            heading_rad: wrap_angle(x[idx::PSI]),
+            sigma_heading_rad: p[(idx::PSI, idx::PSI)].max(0.0).sqrt(),
+            speed_m_s: Some(x[idx::V]),
+            range_bias_m: 0.0,
+            range_scale: 0.0,
+            distance_scale: 0.0,
+            turn_scale: 0.0,
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::filter::ProcessModel;
+    use crate::filter::UkfParams;
+    use crate::nav::BeaconFix;
     use approx::assert_abs_diff_eq;
     use std::f64::consts::FRAC_PI_2;
 
     /// A vehicle heading east at 1 m/s from a wrong start position is pulled onto the
-    /// truth by ranges and Doppler speeds from a beacon, faster than by ranges alone.
+    /// truth by ranges and Doppler speeds from a beacon, faster than by ranges alone;
+    /// with the EKF and with the UKF.
     #[test]
     fn range_doppler_corrects_a_speed_error_that_range_only_keeps_longer() {
         let beacon = Vector2::new(40.0, 0.0);
+        let fix = BeaconFix::fixed(0, Vector3::new(beacon.x, beacon.y, 0.0));
         let dt = 0.25;
         let tuning = EkfTuning {
             q_diag: [1e-4, 1e-4, 1e-6, 1e-4, 1e-6, 1e-6],
@@ -187,27 +214,40 @@ mod tests {
         let mut start = truth0;
         start[idx::V] = 0.7; // 30 % speed error
         let p0 = Cov::from_diagonal(&SVector::from([1.0, 1.0, 1e-3, 0.1, 1e-4, 1e-4]));
-        let mut filters = [
-            SingleBeaconEkf::new(Aiding::RangeDoppler, tuning, start, p0),
-            SingleBeaconEkf::new(Aiding::RangeOnly, tuning, start, p0),
-        ];
-        let mut truth = truth0;
-        let mut speed_err = [0.0; 2];
-        for k in 1..=120 {
-            truth = UnicycleAccel.propagate(&truth, dt);
-            let sample = Proprioceptive { heading_rad: FRAC_PI_2, yaw_rate_rad_s: 0.0, accel_m_s2: 0.0 };
-            let frame = (k % 12 == 0).then(|| CommFrame {
-                beacon_ned_m: beacon,
-                range_m: Range2d { beacon }.predict(&truth),
-                radial_speed_m_s: RadialSpeed2d { beacon, known_speed_m_s: None }.predict(&truth),
-            });
-            for (f, e) in filters.iter_mut().zip(speed_err.iter_mut()) {
-                f.step(dt, &sample, frame.as_ref()).unwrap();
-                *e = (f.state()[idx::V] - 1.0).abs();
+        for kind in [FilterKind::Ekf, FilterKind::Ukf(UkfParams::default())] {
+            let mut filters = [
+                SingleBeaconNavigator::new(Aiding::RangeDoppler, tuning, kind, 0.0, start, p0),
+                SingleBeaconNavigator::new(Aiding::RangeOnly, tuning, kind, 0.0, start, p0),
+            ];
+            let mut truth = truth0;
+            let (mut speed_err, mut speed_err_sum) = ([0.0; 2], [0.0; 2]);
+            let truth_model = UnicycleAccel::default();
+            for k in 1..=120 {
+                let t = k as f64 * dt;
+                truth = truth_model.propagate(&truth, dt);
+                let frame = (k % 12 == 0).then(|| Kind::RangeDoppler {
+                    beacon: fix,
+                    range_m: ScalarModel::<DIM>::predict(&Range2d { beacon, var: 0.0 }, &truth),
+                    radial_speed_m_s: RadialSpeed2d { beacon, known_speed_m_s: None, var: 0.0 }.predict(&truth),
+                });
+                let inertial = Kind::Inertial { heading_rad: FRAC_PI_2, yaw_rate_rad_s: 0.0, accel_m_s2: 0.0 };
+                for (f, e) in filters.iter_mut().zip(speed_err.iter_mut()) {
+                    if let Some(frame) = frame {
+                        assert_eq!(f.process(&Measurement::new(t, frame)), Outcome::Applied);
+                    }
+                    assert!(matches!(f.process(&Measurement::new(t, inertial)), Outcome::Accepted(_)));
+                    *e = (f.state()[idx::V] - 1.0).abs();
+                }
+                for (sum, e) in speed_err_sum.iter_mut().zip(speed_err) {
+                    *sum += e;
+                }
             }
+            assert!(speed_err[0] < 0.01, "{kind:?}: range+doppler speed error {}", speed_err[0]);
+            // range-only keeps the speed error longer: a larger mean over the run
+            assert!(speed_err_sum[0] < speed_err_sum[1], "{kind:?}: {speed_err_sum:?}");
+            let e = filters[0].estimate();
+            assert_abs_diff_eq!(e.north_m(), truth[0], epsilon = 0.5);
+            assert_abs_diff_eq!(e.east_m(), truth[1], epsilon = 0.5);
         }
-        assert!(speed_err[0] < 0.01, "range+doppler speed error {}", speed_err[0]);
-        assert!(speed_err[0] < speed_err[1]);
-        assert_abs_diff_eq!(filters[0].position(), Vector2::new(truth[0], truth[1]), epsilon = 0.5);
     }
 }

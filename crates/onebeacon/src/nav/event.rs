@@ -1,0 +1,103 @@
+//! The one measurement event: what a simulated world, a replayed log and a live stream
+//! all hand to a navigator. SI units, NED frame, radians.
+
+use nalgebra::Vector3;
+
+/// A beacon as an acoustic measurement carries it: its id, its position when it
+/// transmitted (NED, m; NaN until a tracked beacon's position is resolved), how well it
+/// knew that position (standard deviation per horizontal axis, m: an ASV's GPS), and
+/// the transmit time when known (OWTT).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeaconFix {
+    pub id: u32,
+    pub position_ned_m: Vector3<f64>,
+    pub sigma_m: f64,
+    pub t_tx_s: Option<f64>,
+}
+
+impl BeaconFix {
+    /// A beacon at a known, exact position.
+    pub fn fixed(id: u32, position_ned_m: Vector3<f64>) -> Self {
+        Self { id, position_ned_m, sigma_m: 0.0, t_tx_s: None }
+    }
+}
+
+/// What was measured. Inputs (odometry, speed, body velocity, a held depth) drive the
+/// motion; the rest are corrections. Each navigator uses the kinds its model has and
+/// skips the others.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Kind {
+    /// Distance travelled and heading change since the previous increment (wheels, DVL).
+    Odometry { distance_m: f64, heading_change_rad: f64 },
+    /// Forward speed, held until the next one (DVL, propeller model).
+    Speed { speed_m_s: f64 },
+    /// Heading from a compass or AHRS.
+    Heading { heading_rad: f64 },
+    /// Depth from a pressure sensor.
+    Depth { depth_m: f64 },
+    /// Roll, pitch and heading from an AHRS.
+    Attitude { roll_rad: f64, pitch_rad: f64, heading_rad: f64 },
+    /// Body velocities [u, v, w, p, q, r] (DVL and gyros), held until the next sample.
+    BodyVelocity { nu: [f64; 6] },
+    /// AHRS heading with gyro yaw rate and accelerometer forward acceleration, sampled
+    /// together (garin2024 eq. 18, right).
+    Inertial { heading_rad: f64, yaw_rate_rad_s: f64, accel_m_s2: f64 },
+    /// One-way travel-time (or two-way) range to a beacon, m.
+    Range { beacon: BeaconFix, range_m: f64 },
+    /// Radial speed toward a beacon from a Doppler shift, positive when closing
+    /// (garin2024 eq. 13).
+    Doppler { beacon: BeaconFix, radial_speed_m_s: f64 },
+    /// A decoded communication frame: range and Doppler radial speed at once
+    /// (garin2024 eq. 18, left).
+    RangeDoppler { beacon: BeaconFix, range_m: f64, radial_speed_m_s: f64 },
+}
+
+impl Kind {
+    /// The beacon an acoustic measurement names.
+    pub fn beacon(&self) -> Option<&BeaconFix> {
+        match self {
+            Kind::Range { beacon, .. } | Kind::Doppler { beacon, .. } | Kind::RangeDoppler { beacon, .. } => {
+                Some(beacon)
+            }
+            _ => None,
+        }
+    }
+
+    pub fn beacon_mut(&mut self) -> Option<&mut BeaconFix> {
+        match self {
+            Kind::Range { beacon, .. } | Kind::Doppler { beacon, .. } | Kind::RangeDoppler { beacon, .. } => {
+                Some(beacon)
+            }
+            _ => None,
+        }
+    }
+
+    /// Short name (stream lines, rejection lists).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Kind::Odometry { .. } => "odometry",
+            Kind::Speed { .. } => "speed",
+            Kind::Heading { .. } => "heading",
+            Kind::Depth { .. } => "depth",
+            Kind::Attitude { .. } => "attitude",
+            Kind::BodyVelocity { .. } => "body_velocity",
+            Kind::Inertial { .. } => "inertial",
+            Kind::Range { .. } => "range",
+            Kind::Doppler { .. } => "doppler",
+            Kind::RangeDoppler { .. } => "range_doppler",
+        }
+    }
+}
+
+/// One measurement: when it was taken (received, for an acoustic one), s, and what.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measurement {
+    pub t_s: f64,
+    pub kind: Kind,
+}
+
+impl Measurement {
+    pub fn new(t_s: f64, kind: Kind) -> Self {
+        Self { t_s, kind }
+    }
+}
