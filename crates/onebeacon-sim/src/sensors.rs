@@ -1,14 +1,24 @@
 //! What the vehicle's sensors and modem report: the truth plus errors, drawn from the
-//! run's seeded random streams (garin2024 sections 3.5, 4.1.1).
+//! run's seeded random streams (garin2024 sections 3.5, 4.1.1). Each white-noise error
+//! is drawn from the measurement model the filters use ([`ScalarModel::noise`]), built
+//! with the world's noise.
 
 use crate::scenario::fixed_beacon::Sensors;
 use crate::seed::{Stream, gauss, rng};
 use crate::vehicles::TruthState;
 use nalgebra::Vector2;
 use onebeacon::geo::wrap_angle;
+use onebeacon::measure::{RadialSpeed2d, Range2d, ScalarModel, StateComponent};
+use onebeacon::models::unicycle::{State, idx};
 use onebeacon::nav::{BeaconFix, Kind};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
+
+/// The truth in the unicycle state layout [x, y, psi, v, Omega, a] the models read (the
+/// commanded rates do not enter any measurement model's noise).
+fn state(truth: &TruthState) -> State {
+    State::from([truth.pos.x, truth.pos.y, truth.psi, truth.v, 0.0, 0.0])
+}
 
 /// The sensor suite of one run.
 pub struct SensorSuite {
@@ -41,12 +51,17 @@ impl SensorSuite {
     /// rate and forward acceleration with white noise (4.1.1), at time `t`, given the
     /// commanded (true) yaw rate and acceleration.
     pub fn proprioceptive(&mut self, t: f64, truth: &TruthState, omega: f64, accel: f64) -> Kind {
+        let n = &self.noise;
+        let x = state(truth);
         let bias = self.bias0_rad + self.bias_rate_rad_s * t;
-        let heading_noise = gauss(&mut self.heading, self.noise.heading_noise_deg.to_radians());
+        let heading = StateComponent::angle(idx::PSI, n.heading_noise_deg.to_radians().powi(2));
+        let gyro = StateComponent::value(idx::OMEGA, n.gyro_noise_rad_s.powi(2));
+        let accelerometer = StateComponent::value(idx::ACCEL, n.accel_noise_m_s2.powi(2));
+        let heading_noise = heading.noise(&x, &mut self.heading);
         Kind::Inertial {
             heading_rad: wrap_angle(truth.psi + bias + heading_noise),
-            yaw_rate_rad_s: omega + gauss(&mut self.imu, self.noise.gyro_noise_rad_s),
-            accel_m_s2: accel + gauss(&mut self.imu, self.noise.accel_noise_m_s2),
+            yaw_rate_rad_s: omega + gyro.noise(&x, &mut self.imu),
+            accel_m_s2: accel + accelerometer.noise(&x, &mut self.imu),
         }
     }
 
@@ -55,8 +70,10 @@ impl SensorSuite {
     pub fn comm_frame(&mut self, truth: &TruthState, beacon: Vector2<f64>) -> Option<Kind> {
         // always draw all three numbers so that a loss does not shift later draws
         let lost = self.acoustic.random::<f64>() < self.frame_loss_prob;
-        let range_noise = gauss(&mut self.acoustic, self.noise.range_noise_m);
-        let doppler_noise = gauss(&mut self.acoustic, self.noise.doppler_noise_m_s);
+        let (n, x) = (&self.noise, state(truth));
+        let range_noise = Range2d { beacon, var: n.range_noise_m.powi(2) }.noise(&x, &mut self.acoustic);
+        let doppler = RadialSpeed2d { beacon, known_speed_m_s: None, var: n.doppler_noise_m_s.powi(2) };
+        let doppler_noise = doppler.noise(&x, &mut self.acoustic);
         if lost {
             return None;
         }

@@ -58,7 +58,6 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
     let z_tx = s.asv.transducer_depth_m;
     let lim =
         AsvLimits { max_speed_m_s: s.asv.max_speed_m_s, max_turn_rate_rad_s: s.asv.max_turn_rate_deg_s.to_radians() };
-    let sens = &s.sensors;
     let noise = s.sensor_noise();
     let mut vel_rng = rng(seed, run, Stream::Imu);
     let mut att_rng = rng(seed, run, Stream::Heading);
@@ -168,16 +167,8 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
         asv = asv.step(u, r, dt);
 
         // the vehicle's body velocities over the step, as measured
-        let nu_true = body_velocity(&s.vehicle, cell.path, t0 + dt / 2.0);
-        nu_meas = nu_true
-            + SVector::<f64, 6>::from([
-                gauss(&mut vel_rng, sens.velocity_noise_m_s),
-                gauss(&mut vel_rng, sens.velocity_noise_m_s),
-                gauss(&mut vel_rng, sens.velocity_noise_m_s),
-                gauss(&mut vel_rng, sens.rate_noise_rad_s),
-                gauss(&mut vel_rng, sens.rate_noise_rad_s),
-                gauss(&mut vel_rng, sens.rate_noise_rad_s),
-            ]);
+        // drawn from the process model the navigators use
+        nu_meas = noise.process_model(body_velocity(&s.vehicle, cell.path, t0 + dt / 2.0)).sample_input(&mut vel_rng);
         let (p0v, p1v) = (truth[k - 1].fixed_rows::<3>(0).into_owned(), truth[k].fixed_rows::<3>(0).into_owned());
         distance += (p1v - p0v).norm();
 
@@ -185,7 +176,11 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
         let mut arrivals: Vec<Measurement> = Vec::new();
         in_flight.retain(|f| match f.ping.arrival(c, t0, &p0v, t1, &p1v) {
             Some(t_rx) => {
-                let range_m = c * (t_rx - f.ping.t_tx) + gauss(&mut ac_rng, s.acoustics.range_noise_m);
+                // the range noise of the navigators' range model (the GPS error is drawn
+                // apart, on the position the ASV reports)
+                let at_origin = BeaconFix::fixed(0, f.ping.origin);
+                let range_noise = noise.range_model(&at_origin).noise(&truth[k], &mut ac_rng);
+                let range_m = c * (t_rx - f.ping.t_tx) + range_noise;
                 let beacon =
                     BeaconFix { id: 0, position_ned_m: f.gps, sigma_m: s.asv.gps_noise_m, t_tx_s: Some(f.ping.t_tx) };
                 arrivals.push(Measurement::new(t_rx, Kind::Range { beacon, range_m }));
@@ -205,11 +200,13 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
         }
         heard += arrivals.len() as u64;
 
-        let depth = Kind::Depth { depth_m: truth[k][idx::D] + gauss(&mut att_rng, sens.depth_noise_m) };
+        let [d_m, roll_m, pitch_m, yaw_m] = noise.depth_attitude_models();
+        let x = &truth[k];
+        let depth = Kind::Depth { depth_m: x[idx::D] + d_m.noise(x, &mut att_rng) };
         let attitude = Kind::Attitude {
-            roll_rad: truth[k][idx::ROLL] + gauss(&mut att_rng, noise.attitude_rad),
-            pitch_rad: truth[k][idx::PITCH] + gauss(&mut att_rng, noise.attitude_rad),
-            heading_rad: onebeacon::geo::wrap_angle(truth[k][idx::YAW] + gauss(&mut att_rng, noise.attitude_rad)),
+            roll_rad: x[idx::ROLL] + roll_m.noise(x, &mut att_rng),
+            pitch_rad: x[idx::PITCH] + pitch_m.noise(x, &mut att_rng),
+            heading_rad: onebeacon::geo::wrap_angle(x[idx::YAW] + yaw_m.noise(x, &mut att_rng)),
         };
         // the step's body velocities from its start, the ranges as they arrive, then
         // depth and attitude at its end
