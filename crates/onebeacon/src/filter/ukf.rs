@@ -87,7 +87,12 @@ impl<const N: usize> Ukf<N> {
     /// The 2N + 1 sigma points of (x, P), as columns offsets from x: point 0 is x, point
     /// 1 + i is x + d_i and point 1 + N + i is x - d_i.
     fn spread(&self, c: f64) -> Result<SMatrix<f64, N, N>, FilterError> {
-        let l = psd_cholesky(&self.p).ok_or(FilterError::InnovationNotPositiveDefinite)?;
+        // nalgebra's factorisation when P is positive definite (the common case, and
+        // the faster one), the semi-definite one when a state has zero variance
+        let l = match self.p.cholesky() {
+            Some(ch) => ch.unpack(),
+            None => psd_cholesky(&self.p).ok_or(FilterError::InnovationNotPositiveDefinite)?,
+        };
         Ok(l * c.sqrt())
     }
 }
@@ -276,6 +281,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// On a mildly nonlinear problem (a range from a beacon 1 km away, a 0.1 m position
+    /// uncertainty) the UKF and the EKF agree to first order: the linearisation error is
+    /// of order sigma^2 / r = 1e-5 m, far below the update itself (0.5 m).
+    #[test]
+    fn agrees_with_the_ekf_to_first_order_on_a_mildly_nonlinear_problem() {
+        use crate::measure::{Range2d, ScalarModel};
+        let beacon = Vector2::new(800.0, 600.0);
+        let range = Range2d { beacon, var: 0.01 };
+        let models: [&dyn ScalarModel<2>; 1] = [&range];
+        let x0 = Vector2::new(0.3, -0.2);
+        let p0 = Matrix2::new(0.01, 0.002, 0.002, 0.02);
+        let z = Vector1::new(999.5); // true range from x0 is about 999.70
+        let mut ekf = Ekf::new(x0, p0);
+        let mut ukf = Ukf::new(x0, p0, UkfParams::default());
+        let r = models.covariance(&x0);
+        let a = ekf.update_gated(&models, &z, &r, f64::INFINITY).unwrap().nis();
+        let b = ukf.update_gated(&models, &z, &r, f64::INFINITY).unwrap().nis();
+        assert!((ekf.x - x0).norm() > 0.05, "the update moves the state");
+        assert!((ekf.x - ukf.x).norm() < 1e-4, "EKF {} UKF {}", ekf.x, ukf.x);
+        assert!((ekf.p - ukf.p).norm() < 1e-6 * p0.norm() * 1e2, "EKF {} UKF {}", ekf.p, ukf.p);
+        assert_relative_eq!(a, b, max_relative = 1e-3);
+        // and a strongly nonlinear one (beacon 0.5 m away) separates them
+        let near = Range2d { beacon: Vector2::new(0.6, 0.2), var: 0.01 };
+        let models: [&dyn ScalarModel<2>; 1] = [&near];
+        let (mut ekf, mut ukf) = (Ekf::new(x0, p0 * 10.0), Ukf::new(x0, p0 * 10.0, UkfParams::default()));
+        let z = Vector1::new(0.3);
+        ekf.update_gated(&models, &z, &r, f64::INFINITY).unwrap();
+        ukf.update_gated(&models, &z, &r, f64::INFINITY).unwrap();
+        assert!((ekf.x - ukf.x).norm() > 1e-3);
     }
 
     /// A zero-variance state stays exactly zero-variance and at its value.
