@@ -66,6 +66,19 @@ impl<const N: usize, const M: usize> MeasurementModel<N, M> for [&dyn ScalarMode
     }
 }
 
+/// Central finite-difference Jacobian of a scalar model, for tests.
+#[cfg(test)]
+pub(crate) fn finite_difference<const N: usize>(m: &dyn ScalarModel<N>, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
+    SMatrix::from_fn(|_, j| {
+        let eps = 1e-6 * x[j].abs().max(1.0);
+        let mut xp = *x;
+        let mut xm = *x;
+        xp[j] += eps;
+        xm[j] -= eps;
+        (m.predict(&xp) - m.predict(&xm)) / (2.0 * eps)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -101,17 +114,4 @@ mod tests {
         let corr = cov[(0, 1)] / (cov[(0, 0)] * cov[(1, 1)]).sqrt();
         assert!(corr.abs() < 4.0 / (n as f64).sqrt(), "correlation {corr}");
     }
-}
-
-/// Central finite-difference Jacobian of a scalar model, for tests.
-#[cfg(test)]
-pub(crate) fn finite_difference<const N: usize>(m: &dyn ScalarModel<N>, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
-    SMatrix::from_fn(|_, j| {
-        let eps = 1e-6 * x[j].abs().max(1.0);
-        let mut xp = *x;
-        let mut xm = *x;
-        xp[j] += eps;
-        xm[j] -= eps;
-        (m.predict(&xp) - m.predict(&xm)) / (2.0 * eps)
-    })
 }
