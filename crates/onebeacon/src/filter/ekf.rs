@@ -186,7 +186,7 @@ impl Gated {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use nalgebra::{Matrix1x2, Matrix2, Vector1, Vector2};
@@ -194,7 +194,7 @@ mod tests {
     use rand_distr::StandardNormal;
 
     /// Constant-velocity model in one dimension: x = [position, velocity].
-    struct ConstantVelocity;
+    pub(crate) struct ConstantVelocity;
     impl ProcessModel<2> for ConstantVelocity {
         fn propagate(&self, x: &Vector2<f64>, dt: f64) -> Vector2<f64> {
             self.jacobian(x, dt) * x
@@ -204,7 +204,7 @@ mod tests {
         }
     }
     /// Position measurement.
-    struct PositionFix;
+    pub(crate) struct PositionFix;
     impl MeasurementModel<2, 1> for PositionFix {
         fn predict(&self, x: &Vector2<f64>) -> Vector1<f64> {
             Vector1::new(x[0])

@@ -229,27 +229,7 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use rand_distr::StandardNormal;
 
-    struct ConstantVelocity;
-    impl ProcessModel<2> for ConstantVelocity {
-        fn propagate(&self, x: &Vector2<f64>, dt: f64) -> Vector2<f64> {
-            self.jacobian(x, dt) * x
-        }
-        fn jacobian(&self, _x: &Vector2<f64>, dt: f64) -> Matrix2<f64> {
-            Matrix2::new(1.0, dt, 0.0, 1.0)
-        }
-    }
-    struct PositionFix;
-    impl MeasurementModel<2, 1> for PositionFix {
-        fn predict(&self, x: &Vector2<f64>) -> Vector1<f64> {
-            Vector1::new(x[0])
-        }
-        fn jacobian(&self, _x: &Vector2<f64>) -> nalgebra::Matrix1x2<f64> {
-            nalgebra::Matrix1x2::new(1.0, 0.0)
-        }
-        fn covariance(&self, _x: &Vector2<f64>) -> Matrix1<f64> {
-            Matrix1::new(0.3)
-        }
-    }
+    use crate::filter::ekf::tests::{ConstantVelocity, PositionFix};
 
     /// On a linear-Gaussian problem the unscented transform is exact: the UKF equals the
     /// Kalman filter (here the EKF, itself checked against the closed form in ekf.rs)
