@@ -270,7 +270,7 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
                 "failed_updates": st.failed,
                 "nees_mean": num(st.nees_mean()),
                 "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
-                "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad)},
+                "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())},
             });
             for (k, x) in calibration(e) {
                 v[k] = num(x);
@@ -318,7 +318,7 @@ fn step_json(line: usize, step: &Step, s: &Session, frame: onebeacon::geo::Frame
                 "name": s.names[i],
                 "x_m": x,
                 "y_m": y,
-                "heading_rad": frame.heading_from_ned(e.heading_rad),
+                "heading_rad": frame.heading_from_ned(e.heading_rad()),
                 "sigma_x_m": sx.abs(),
                 "sigma_y_m": sy.abs(),
             });

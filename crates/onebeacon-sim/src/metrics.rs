@@ -73,10 +73,6 @@ impl ErrorAccumulator {
         }
     }
 
-    pub fn failed_update(&mut self) {
-        self.failed_updates += 1;
-    }
-
     /// Counts the failed updates among a navigator's outcomes.
     pub fn count_failures(&mut self, outcomes: impl IntoIterator<Item = onebeacon::nav::Outcome>) {
         for o in outcomes {

@@ -1,7 +1,7 @@
 //! Seeds: every random stream of a run is derived from (base seed, run index, stream),
 //! so a run is a pure function of its inputs and does not depend on scheduling.
 
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 
 /// The random streams of one run. Separate streams keep, for example, the IMU noise of
@@ -23,10 +23,8 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// A zero-mean Gaussian draw of standard deviation `sigma`.
-pub fn gauss<R: rand::Rng + ?Sized>(rng: &mut R, sigma: f64) -> f64 {
-    sigma * rng.sample::<f64, _>(rand_distr::StandardNormal)
-}
+/// A zero-mean Gaussian draw of standard deviation `sigma` (the models' own draw).
+pub use onebeacon::measure::gauss;
 
 /// The generator of stream `stream` of run `run` under base seed `seed`.
 pub fn rng(seed: u64, run: u64, stream: Stream) -> Pcg64Mcg {
@@ -36,6 +34,7 @@ pub fn rng(seed: u64, run: u64, stream: Stream) -> Pcg64Mcg {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::RngExt;
 
     #[test]
     fn streams_differ_and_repeat() {

@@ -29,6 +29,8 @@ pub struct SensorSuite {
     acoustic: Pcg64Mcg,
     bias0_rad: f64,
     bias_rate_rad_s: f64,
+    /// The AHRS heading, gyro and accelerometer models with the world's noise.
+    inertial: [StateComponent; 3],
 }
 
 impl SensorSuite {
@@ -44,6 +46,11 @@ impl SensorSuite {
             acoustic: rng(seed, run, Stream::Acoustic),
             bias0_rad,
             bias_rate_rad_s,
+            inertial: [
+                StateComponent::angle(idx::PSI, noise.heading_noise_deg.to_radians().powi(2)),
+                StateComponent::value(idx::OMEGA, noise.gyro_noise_rad_s.powi(2)),
+                StateComponent::value(idx::ACCEL, noise.accel_noise_m_s2.powi(2)),
+            ],
         }
     }
 
@@ -51,12 +58,9 @@ impl SensorSuite {
     /// rate and forward acceleration with white noise (4.1.1), at time `t`, given the
     /// commanded (true) yaw rate and acceleration.
     pub fn proprioceptive(&mut self, t: f64, truth: &TruthState, omega: f64, accel: f64) -> Kind {
-        let n = &self.noise;
         let x = state(truth);
         let bias = self.bias0_rad + self.bias_rate_rad_s * t;
-        let heading = StateComponent::angle(idx::PSI, n.heading_noise_deg.to_radians().powi(2));
-        let gyro = StateComponent::value(idx::OMEGA, n.gyro_noise_rad_s.powi(2));
-        let accelerometer = StateComponent::value(idx::ACCEL, n.accel_noise_m_s2.powi(2));
+        let [heading, gyro, accelerometer] = &self.inertial;
         let heading_noise = heading.noise(&x, &mut self.heading);
         Kind::Inertial {
             heading_rad: wrap_angle(truth.psi + bias + heading_noise),

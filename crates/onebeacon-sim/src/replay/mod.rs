@@ -64,7 +64,7 @@ fn record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord 
             let (error_m, nees) = step.errors.as_ref().map_or((f64::NAN, f64::NAN), |errors| errors[i]);
             Estimate {
                 pos: Vector3::new(e.north_m(), e.east_m(), 0.0),
-                psi: e.heading_rad,
+                psi: e.heading_rad(),
                 speed: None,
                 sigma_pos: Vector2::new(e.sigma_north_m(), e.sigma_east_m()),
                 error_m,

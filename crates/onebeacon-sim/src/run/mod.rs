@@ -32,7 +32,7 @@ impl Estimate {
     pub fn new(e: &onebeacon::nav::Estimate, error_m: f64, nees: Option<f64>) -> Self {
         Self {
             pos: e.position_ned_m,
-            psi: e.heading_rad,
+            psi: e.heading_rad(),
             speed: e.speed_m_s,
             sigma_pos: Vector2::new(e.sigma_north_m(), e.sigma_east_m()),
             error_m,

@@ -210,13 +210,11 @@ pub(super) fn simulate(s: &MovingBeacon, cell: &MovingBeaconCell, seed: u64, run
         };
         // the step's body velocities from its start, the ranges as they arrive, then
         // depth and attitude at its end
-        let events: Vec<Measurement> = [Measurement::new(t0, Kind::BodyVelocity { nu: nu_meas.into() })]
-            .into_iter()
-            .chain(arrivals.iter().copied())
-            .chain([Measurement::new(t1, depth), Measurement::new(t1, attitude)])
-            .collect();
+        let start = Measurement::new(t0, Kind::BodyVelocity { nu: nu_meas.into() });
+        let end = [Measurement::new(t1, depth), Measurement::new(t1, attitude)];
         for (f, a) in filters.iter_mut().zip(acc.iter_mut()) {
-            a.count_failures(events.iter().map(|m| f.process(m)));
+            let events = std::iter::once(&start).chain(&arrivals).chain(&end);
+            a.count_failures(events.map(|m| f.process(m)));
         }
         let estimates = observe(&filters, &mut acc, &truth[k]);
         if record {

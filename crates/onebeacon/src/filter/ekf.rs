@@ -63,9 +63,9 @@ pub trait MeasurementModel<const N: usize, const M: usize> {
     fn covariance(&self, x: &SVector<f64, N>) -> SMatrix<f64, M, M>;
     /// A noisy measurement at `x`: h(x) plus a draw from N(0, R(x)). What the simulator
     /// measures, so the filter's R and the world's noise are one number.
-    fn sample(&self, x: &SVector<f64, N>, rng: &mut dyn rand::Rng) -> SVector<f64, M> {
+    fn sample<R: rand::Rng + ?Sized>(&self, x: &SVector<f64, N>, rng: &mut R) -> SVector<f64, M> {
         let l = self.covariance(x).cholesky().map_or_else(SMatrix::zeros, |c| c.l());
-        let n = SVector::<f64, M>::from_fn(|_, _| rand::RngExt::sample(rng, rand_distr::StandardNormal));
+        let n = SVector::<f64, M>::from_fn(|_, _| crate::measure::gauss(rng, 1.0));
         self.predict(x) + l * n
     }
 }

@@ -146,6 +146,7 @@ impl<const N: usize> GaussianFilter<N> for Ukf<N> {
     /// Unscented prediction: every sigma point through the model, the (angle-aware)
     /// weighted mean, and P = sum Wc dY dY' + Q. A covariance that is not positive
     /// semi-definite leaves the filter as it was.
+    #[inline(never)] // keeps the EKF path of AnyFilter small where the UKF is not used
     fn predict<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) {
         let (c, wm0, wc0, wi) = self.params.weights(N);
         let Ok(d) = self.spread(c) else { return };
@@ -167,6 +168,7 @@ impl<const N: usize> GaussianFilter<N> for Ukf<N> {
         self.p = (p + p.transpose()) * 0.5;
     }
 
+    #[inline(never)]
     fn update_gated<const M: usize, H: MeasurementModel<N, M>>(
         &mut self,
         model: &H,

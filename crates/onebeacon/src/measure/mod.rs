@@ -20,6 +20,7 @@ pub use state::StateComponent;
 
 use crate::filter::MeasurementModel;
 use nalgebra::{SMatrix, SVector};
+use rand::{Rng, RngExt};
 
 /// One scalar measurement z = h(x) + v.
 pub trait ScalarModel<const N: usize> {
@@ -34,16 +35,49 @@ pub trait ScalarModel<const N: usize> {
     /// The noise variance of a measurement taken at `x`.
     fn variance(&self, x: &SVector<f64, N>) -> f64;
     /// A draw of the measurement noise at `x`: sqrt(variance) times a standard normal.
-    fn noise(&self, x: &SVector<f64, N>, rng: &mut dyn rand::Rng) -> f64 {
-        self.variance(x).sqrt() * rand::RngExt::sample::<f64, _>(rng, rand_distr::StandardNormal)
+    fn noise<R: Rng + ?Sized>(&self, x: &SVector<f64, N>, rng: &mut R) -> f64
+    where
+        Self: Sized,
+    {
+        gauss(rng, self.variance(x).sqrt())
     }
     /// A noisy measurement at `x`: h(x) plus [`ScalarModel::noise`].
-    fn sample(&self, x: &SVector<f64, N>, rng: &mut dyn rand::Rng) -> f64 {
+    fn sample<R: Rng + ?Sized>(&self, x: &SVector<f64, N>, rng: &mut R) -> f64
+    where
+        Self: Sized,
+    {
         self.predict(x) + self.noise(x, rng)
     }
 }
 
-impl<const N: usize, const M: usize> MeasurementModel<N, M> for [&dyn ScalarModel<N>; M] {
+/// A zero-mean Gaussian draw of standard deviation `sigma` (every noise draw of the
+/// models and of the simulated world).
+pub fn gauss<R: Rng + ?Sized>(rng: &mut R, sigma: f64) -> f64 {
+    sigma * rng.sample::<f64, _>(rand_distr::StandardNormal)
+}
+
+/// A reference to a scalar model is that model (so `[&dyn ScalarModel<N>; M]` stacks
+/// models of different kinds).
+impl<const N: usize, T: ScalarModel<N> + ?Sized> ScalarModel<N> for &T {
+    fn predict(&self, x: &SVector<f64, N>) -> f64 {
+        (**self).predict(x)
+    }
+    fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
+        (**self).jacobian(x)
+    }
+    fn is_angle(&self) -> bool {
+        (**self).is_angle()
+    }
+    fn variance(&self, x: &SVector<f64, N>) -> f64 {
+        (**self).variance(x)
+    }
+}
+
+/// Scalar models stacked into one vector measurement with independent components: h(x)
+/// and the Jacobian row by row, R = diag of their variances. Models of one kind by value
+/// (`[StateComponent; 3]`) are dispatched statically; `[&dyn ScalarModel<N>; M]` mixes
+/// kinds (a range with heading and rates).
+impl<const N: usize, const M: usize, T: ScalarModel<N>> MeasurementModel<N, M> for [T; M] {
     fn predict(&self, x: &SVector<f64, N>) -> SVector<f64, M> {
         SVector::from_fn(|i, _| self[i].predict(x))
     }
@@ -57,12 +91,11 @@ impl<const N: usize, const M: usize> MeasurementModel<N, M> for [&dyn ScalarMode
     fn is_angle(&self, i: usize) -> bool {
         self[i].is_angle()
     }
-    /// Independent components: R = diag of their variances.
     fn covariance(&self, x: &SVector<f64, N>) -> SMatrix<f64, M, M> {
         SMatrix::from_diagonal(&SVector::from_fn(|i, _| self[i].variance(x)))
     }
-    fn sample(&self, x: &SVector<f64, N>, rng: &mut dyn rand::Rng) -> SVector<f64, M> {
-        SVector::from_fn(|i, _| self[i].sample(x, rng))
+    fn sample<R: Rng + ?Sized>(&self, x: &SVector<f64, N>, rng: &mut R) -> SVector<f64, M> {
+        SVector::from_fn(|i, _| self[i].predict(x) + gauss(rng, self[i].variance(x).sqrt()))
     }
 }
 

@@ -29,9 +29,9 @@ impl<const N: usize> ScalarModel<N> for StateComponent {
         x[self.index]
     }
     fn jacobian(&self, _x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
-        let mut h = SMatrix::<f64, 1, N>::zeros();
-        h[self.index] = 1.0; // eq. 24
-        h
+        // eq. 24; element by element rather than a store at a run-time index into a
+        // zeroed row, which the whole-row loads that follow stall on
+        SMatrix::from_fn(|_, j| if j == self.index { 1.0 } else { 0.0 })
     }
     fn is_angle(&self) -> bool {
         self.angle

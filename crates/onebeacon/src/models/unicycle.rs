@@ -67,6 +67,7 @@ impl ProcessModel<DIM> for UnicycleAccel {
 
     /// F P F' + Q with F = I + E, E having the six entries of eq. 21 off the diagonal:
     /// a third of the work of the dense products.
+    #[inline]
     fn propagate_covariance(&self, f: &Cov, p: &Cov, q: &Cov) -> Cov {
         use idx::*;
         let e = |i, j| f[(i, j)];

@@ -43,9 +43,10 @@ pub struct Estimate {
     pub position_ned_m: Vector3<f64>,
     /// Covariance of north and east, m^2.
     pub horizontal_cov_m2: Matrix2<f64>,
-    /// Heading, rad in (-pi, pi].
-    pub heading_rad: f64,
-    pub sigma_heading_rad: f64,
+    /// Heading as the state holds it, rad (not wrapped: [`Estimate::heading_rad`] wraps
+    /// it, so that scoring every step pays for no wrap), and its variance, rad^2.
+    pub(crate) heading_state_rad: f64,
+    pub(crate) heading_var_rad2: f64,
     /// Forward speed, m/s, when it is a state.
     pub speed_m_s: Option<f64>,
     /// Range offset b (m) and scale error k_r, odometry distance and turn scale errors.
@@ -67,6 +68,13 @@ impl Estimate {
     }
     pub fn sigma_east_m(&self) -> f64 {
         self.horizontal_cov_m2[(1, 1)].max(0.0).sqrt()
+    }
+    /// Heading, rad in (-pi, pi].
+    pub fn heading_rad(&self) -> f64 {
+        crate::geo::wrap_angle(self.heading_state_rad)
+    }
+    pub fn sigma_heading_rad(&self) -> f64 {
+        self.heading_var_rad2.max(0.0).sqrt()
     }
 }
 

@@ -350,8 +350,8 @@ impl Navigator for PlanarNavigator {
             t_s: self.t_s,
             position_ned_m: Vector3::new(x[idx::N], x[idx::E], self.depth_m),
             horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
-            heading_rad: wrap_angle(x[idx::PSI]),
-            sigma_heading_rad: p[(idx::PSI, idx::PSI)].sqrt(),
+            heading_state_rad: x[idx::PSI],
+            heading_var_rad2: p[(idx::PSI, idx::PSI)],
             speed_m_s: None,
             range_bias_m: x[idx::BIAS],
             range_scale: x[idx::RANGE_SCALE],
@@ -392,7 +392,7 @@ mod tests {
         let e = nav.estimate();
         assert_abs_diff_eq!(e.north_m(), 10.0, epsilon = 1e-9);
         assert_abs_diff_eq!(e.east_m(), 10.0, epsilon = 1e-9);
-        assert_abs_diff_eq!(e.heading_rad, FRAC_PI_2, epsilon = 1e-12);
+        assert_abs_diff_eq!(e.heading_rad(), FRAC_PI_2, epsilon = 1e-12);
         // uncertainty grew with distance, the bias stayed known
         assert!(e.sigma_north_m() > 0.0 && e.sigma_east_m() > 0.0);
         assert_eq!(nav.filter.covariance()[(idx::BIAS, idx::BIAS)], 0.0);
@@ -553,7 +553,7 @@ mod tests {
             nav.process(&Measurement::new(0.0, Kind::Heading { heading_rad: 0.0 })),
             Outcome::Accepted(_)
         ));
-        assert!(nav.estimate().heading_rad.abs() < 0.2);
+        assert!(nav.estimate().heading_rad().abs() < 0.2);
         nav.process(&Measurement::new(1.0, Kind::Odometry { distance_m: 0.0, heading_change_rad: 0.0 }));
         nav.process(&Measurement::new(2.0, Kind::Odometry { distance_m: 1.5, heading_change_rad: 0.0 }));
         let beacon = Vector3::zeros();

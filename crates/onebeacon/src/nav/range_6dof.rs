@@ -5,8 +5,7 @@
 
 use super::{BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
-use crate::geo::wrap_angle;
-use crate::measure::{Range3d, ScalarModel, StateComponent};
+use crate::measure::{Range3d, StateComponent};
 use crate::models::kinematic6dof::{BodyVelocity, Cov, DIM, Kinematic6Dof, State, idx};
 use nalgebra::{SVector, Vector1};
 
@@ -55,6 +54,8 @@ impl SensorNoise {
 #[derive(Debug, Clone)]
 pub struct Range6DofNavigator {
     noise: SensorNoise,
+    /// The depth sensor and AHRS models, built once.
+    depth_attitude: [StateComponent; 4],
     use_ranges: bool,
     filter: AnyFilter<DIM>,
     t_s: f64,
@@ -67,7 +68,8 @@ impl Range6DofNavigator {
     /// reckoning (attitude and depth only).
     pub fn new(noise: SensorNoise, use_ranges: bool, filter: FilterKind, t0_s: f64, eta0: State, p0: Cov) -> Self {
         let filter = AnyFilter::new(filter, eta0, p0);
-        Self { noise, use_ranges, filter, t_s: t0_s, nu: BodyVelocity::zeros(), depth: None }
+        let depth_attitude = noise.depth_attitude_models();
+        Self { noise, depth_attitude, use_ranges, filter, t_s: t0_s, nu: BodyVelocity::zeros(), depth: None }
     }
 
     pub fn state(&self) -> &State {
@@ -88,13 +90,18 @@ impl Range6DofNavigator {
             self.t_s = t_s;
         }
     }
+}
 
-    fn update<const M: usize>(&mut self, models: [&dyn ScalarModel<DIM>; M], z: SVector<f64, M>) -> Outcome {
-        let r = models.covariance(self.filter.mean());
-        match self.filter.update_gated(&models, &z, &r, f64::INFINITY) {
-            Ok(g) => Outcome::Accepted(Gated::nis(g)),
-            Err(e) => Outcome::Failed(e),
-        }
+/// One update of `filter` with the stacked `models` and their values `z`.
+fn update<const M: usize, H: MeasurementModel<DIM, M>>(
+    filter: &mut AnyFilter<DIM>,
+    models: &H,
+    z: SVector<f64, M>,
+) -> Outcome {
+    let r = models.covariance(filter.mean());
+    match filter.update_gated(models, &z, &r, f64::INFINITY) {
+        Ok(g) => Outcome::Accepted(Gated::nis(g)),
+        Err(e) => Outcome::Failed(e),
     }
 }
 
@@ -112,19 +119,20 @@ impl Navigator for Range6DofNavigator {
             }
             Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
                 self.advance_to(m.t_s);
-                let [d, roll, pitch, yaw] = self.noise.depth_attitude_models();
+                let (f, models) = (&mut self.filter, &self.depth_attitude);
                 match self.depth.take() {
-                    Some(depth) => {
-                        self.update([&d, &roll, &pitch, &yaw], SVector::from([depth, roll_rad, pitch_rad, heading_rad]))
+                    Some(depth) => update(f, models, SVector::from([depth, roll_rad, pitch_rad, heading_rad])),
+                    None => {
+                        let [_, roll, pitch, yaw] = models;
+                        update(f, &[roll, pitch, yaw], SVector::from([roll_rad, pitch_rad, heading_rad]))
                     }
-                    None => self.update([&roll, &pitch, &yaw], SVector::from([roll_rad, pitch_rad, heading_rad])),
                 }
             }
             Kind::Range { beacon, range_m } if self.use_ranges => {
                 // range update (eq. 3.7-3.10) at the receive time
                 self.advance_to(m.t_s);
                 let model = self.noise.range_model(&beacon);
-                self.update([&model], Vector1::new(range_m))
+                update(&mut self.filter, &[model], Vector1::new(range_m))
             }
             _ => Outcome::Skipped,
         }
@@ -136,8 +144,8 @@ impl Navigator for Range6DofNavigator {
             t_s: self.t_s,
             position_ned_m: x.fixed_rows::<3>(0).into_owned(),
             horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
-            heading_rad: wrap_angle(x[idx::YAW]),
-            sigma_heading_rad: p[(idx::YAW, idx::YAW)].max(0.0).sqrt(),
+            heading_state_rad: x[idx::YAW],
+            heading_var_rad2: p[(idx::YAW, idx::YAW)],
             speed_m_s: None,
             range_bias_m: 0.0,
             range_scale: 0.0,

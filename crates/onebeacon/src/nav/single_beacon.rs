@@ -9,7 +9,6 @@
 
 use super::{Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::filter::{AnyFilter, FilterError, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
-use crate::geo::wrap_angle;
 use crate::measure::{RadialSpeed2d, Range2d, ScalarModel, StateComponent};
 use crate::models::unicycle::{Cov, DIM, State, UnicycleAccel, idx};
 use nalgebra::{SVector, Vector2, Vector3};
@@ -83,6 +82,10 @@ pub struct SingleBeaconNavigator {
     aiding: Aiding,
     tuning: EkfTuning,
     model: UnicycleAccel,
+    /// The model's Q per step (it depends on neither the state nor dt).
+    q: Cov,
+    /// The AHRS heading, gyro and accelerometer models, built once.
+    inertial: [StateComponent; 3],
     filter: AnyFilter<DIM>,
     t_s: f64,
     pending: Option<Frame>,
@@ -93,7 +96,13 @@ impl SingleBeaconNavigator {
     /// covariance `p0`.
     pub fn new(aiding: Aiding, tuning: EkfTuning, filter: FilterKind, t0_s: f64, z0: State, p0: Cov) -> Self {
         let model = UnicycleAccel { q_diag: tuning.q_diag };
-        Self { aiding, tuning, model, filter: AnyFilter::new(filter, z0, p0), t_s: t0_s, pending: None }
+        let q = model.noise_covariance(&z0, 0.0);
+        let inertial = [
+            StateComponent::angle(idx::PSI, tuning.r_heading_rad2),
+            StateComponent::value(idx::OMEGA, tuning.r_yaw_rate_rad2_s2),
+            StateComponent::value(idx::ACCEL, tuning.r_accel_m2_s4),
+        ];
+        Self { aiding, tuning, model, q, inertial, filter: AnyFilter::new(filter, z0, p0), t_s: t0_s, pending: None }
     }
 
     pub fn aiding(&self) -> Aiding {
@@ -105,46 +114,41 @@ impl SingleBeaconNavigator {
         self.filter.mean()
     }
 
-    /// The state covariance.
-    pub fn covariance(&self) -> &Cov {
-        self.filter.covariance()
-    }
-
     /// Predicts to `t_s`, then one stacked update of the inertial sample and the
     /// pending frame. Returns the NIS.
     fn tick(&mut self, t_s: f64, heading: f64, yaw_rate: f64, accel: f64) -> Result<f64, FilterError> {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
-            let q = self.model.noise_covariance(self.filter.mean(), dt);
-            self.filter.predict(&self.model, dt, &q);
+            self.filter.predict(&self.model, dt, &self.q);
             self.t_s = t_s;
         }
-        let t = &self.tuning;
-        let heading_m = StateComponent::angle(idx::PSI, t.r_heading_rad2);
-        let yaw_rate_m = StateComponent::value(idx::OMEGA, t.r_yaw_rate_rad2_s2);
-        let accel_m = StateComponent::value(idx::ACCEL, t.r_accel_m2_s4);
-        let proprio = [heading, yaw_rate, accel];
+        let (t, f) = (&self.tuning, &mut self.filter);
+        let [heading_m, yaw_rate_m, accel_m] = &self.inertial;
         match (self.pending.take(), self.aiding) {
-            (None, _) => self.update([&heading_m, &yaw_rate_m, &accel_m], proprio),
-            (Some(f), Aiding::RangeOnly) => {
-                let range = Range2d { beacon: f.beacon, var: t.r_range_m2 };
-                self.update([&range, &heading_m, &yaw_rate_m, &accel_m], [f.range_m, heading, yaw_rate, accel])
+            (None, _) => update(f, &self.inertial, [heading, yaw_rate, accel]),
+            (Some(fr), Aiding::RangeOnly) => {
+                let range = Range2d { beacon: fr.beacon, var: t.r_range_m2 };
+                let models: [&dyn ScalarModel<DIM>; 4] = [&range, heading_m, yaw_rate_m, accel_m];
+                update(f, &models, [fr.range_m, heading, yaw_rate, accel])
             }
-            (Some(f), Aiding::RangeDoppler) => {
-                let range = Range2d { beacon: f.beacon, var: t.r_range_m2 };
-                let doppler = RadialSpeed2d { beacon: f.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
-                self.update(
-                    [&range, &doppler, &heading_m, &yaw_rate_m, &accel_m], // eq. 18, 20
-                    [f.range_m, f.radial_speed_m_s, heading, yaw_rate, accel],
-                )
+            (Some(fr), Aiding::RangeDoppler) => {
+                let range = Range2d { beacon: fr.beacon, var: t.r_range_m2 };
+                let doppler = RadialSpeed2d { beacon: fr.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
+                let models: [&dyn ScalarModel<DIM>; 5] = [&range, &doppler, heading_m, yaw_rate_m, accel_m]; // eq. 18, 20
+                update(f, &models, [fr.range_m, fr.radial_speed_m_s, heading, yaw_rate, accel])
             }
         }
     }
+}
 
-    fn update<const M: usize>(&mut self, models: [&dyn ScalarModel<DIM>; M], z: [f64; M]) -> Result<f64, FilterError> {
-        let r = models.covariance(self.filter.mean());
-        self.filter.update_gated(&models, &SVector::from(z), &r, f64::INFINITY).map(Gated::nis)
-    }
+/// One update of `filter` with the stacked `models` and their values `z`; the NIS.
+fn update<const M: usize, H: MeasurementModel<DIM, M>>(
+    filter: &mut AnyFilter<DIM>,
+    models: &H,
+    z: [f64; M],
+) -> Result<f64, FilterError> {
+    let r = models.covariance(filter.mean());
+    filter.update_gated(models, &SVector::from(z), &r, f64::INFINITY).map(Gated::nis)
 }
 
 impl Navigator for SingleBeaconNavigator {
@@ -175,8 +179,8 @@ impl Navigator for SingleBeaconNavigator {
             t_s: self.t_s,
             position_ned_m: Vector3::new(x[idx::X], x[idx::Y], 0.0),
             horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
-            heading_rad: wrap_angle(x[idx::PSI]),
-            sigma_heading_rad: p[(idx::PSI, idx::PSI)].max(0.0).sqrt(),
+            heading_state_rad: x[idx::PSI],
+            heading_var_rad2: p[(idx::PSI, idx::PSI)],
             speed_m_s: Some(x[idx::V]),
             range_bias_m: 0.0,
             range_scale: 0.0,
