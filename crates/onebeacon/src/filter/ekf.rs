@@ -5,6 +5,7 @@
 //! which components are angles. The covariance update is in Joseph form, which stays
 //! symmetric positive semi-definite for any gain.
 
+use super::GaussianFilter;
 use crate::geo::wrap_angle;
 use nalgebra::{SMatrix, SVector};
 
@@ -82,13 +83,6 @@ impl<const N: usize> Ekf<N> {
         Self { x, p }
     }
 
-    /// Prediction (Algorithm 1, lines 1, 3, 4): x = f(x), P = F P F' + Q.
-    pub fn predict<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) {
-        let (x, f) = model.transition(&self.x, dt);
-        self.x = x;
-        self.p = model.propagate_covariance(&f, &self.p, q);
-    }
-
     /// Update with measurement `z` of noise covariance `r` (Algorithm 1, lines 2, 5-8,
     /// with the Joseph-form covariance). Returns the normalised innovation squared
     /// (NIS), distributed chi-square with M degrees of freedom when the filter is
@@ -99,13 +93,34 @@ impl<const N: usize> Ekf<N> {
         z: &SVector<f64, M>,
         r: &SMatrix<f64, M, M>,
     ) -> Result<f64, FilterError> {
-        self.update_gated(model, z, r, f64::INFINITY).map(|g| g.nis())
+        GaussianFilter::update_gated(self, model, z, r, f64::INFINITY).map(|g| g.nis())
+    }
+}
+
+impl<const N: usize> GaussianFilter<N> for Ekf<N> {
+    fn mean(&self) -> &SVector<f64, N> {
+        &self.x
+    }
+    fn covariance(&self) -> &SMatrix<f64, N, N> {
+        &self.p
+    }
+    fn mean_mut(&mut self) -> &mut SVector<f64, N> {
+        &mut self.x
+    }
+    fn covariance_mut(&mut self) -> &mut SMatrix<f64, N, N> {
+        &mut self.p
+    }
+    /// Prediction (Algorithm 1, lines 1, 3, 4): x = f(x), P = F P F' + Q.
+    fn predict<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) {
+        let (x, f) = model.transition(&self.x, dt);
+        self.x = x;
+        self.p = model.propagate_covariance(&f, &self.p, q);
     }
 
     /// [`Ekf::update`] with innovation gating: a measurement whose NIS exceeds `max_nis`
     /// (a chi-square quantile with M degrees of freedom) is rejected and leaves the
     /// state untouched.
-    pub fn update_gated<const M: usize, H: MeasurementModel<N, M>>(
+    fn update_gated<const M: usize, H: MeasurementModel<N, M>>(
         &mut self,
         model: &H,
         z: &SVector<f64, M>,
@@ -140,33 +155,6 @@ impl<const N: usize> Ekf<N> {
         let p = a - (a * h.transpose()) * k.transpose() + k * r * k.transpose();
         self.p = (p + p.transpose()) * 0.5;
         Ok(Gated::Accepted(nis))
-    }
-}
-
-impl<const N: usize> super::GaussianFilter<N> for Ekf<N> {
-    fn mean(&self) -> &SVector<f64, N> {
-        &self.x
-    }
-    fn covariance(&self) -> &SMatrix<f64, N, N> {
-        &self.p
-    }
-    fn mean_mut(&mut self) -> &mut SVector<f64, N> {
-        &mut self.x
-    }
-    fn covariance_mut(&mut self) -> &mut SMatrix<f64, N, N> {
-        &mut self.p
-    }
-    fn predict<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) {
-        Ekf::predict(self, model, dt, q)
-    }
-    fn update_gated<const M: usize, H: MeasurementModel<N, M>>(
-        &mut self,
-        model: &H,
-        z: &SVector<f64, M>,
-        r: &SMatrix<f64, M, M>,
-        max_nis: f64,
-    ) -> Result<Gated, FilterError> {
-        Ekf::update_gated(self, model, z, r, max_nis)
     }
 }
 

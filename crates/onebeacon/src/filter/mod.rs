@@ -89,7 +89,7 @@ impl<const N: usize> GaussianFilter<N> for AnyFilter<N> {
     fn predict<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) {
         match self {
             AnyFilter::Ekf(f) => f.predict(model, dt, q),
-            AnyFilter::Ukf(f) => GaussianFilter::predict(f, model, dt, q),
+            AnyFilter::Ukf(f) => f.predict(model, dt, q),
         }
     }
     fn update_gated<const M: usize, H: MeasurementModel<N, M>>(

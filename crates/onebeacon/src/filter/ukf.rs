@@ -251,7 +251,7 @@ mod tests {
                 truth = ConstantVelocity.propagate(&truth, dt);
                 let z = Vector1::new(truth[0] + 0.3f64.sqrt() * rng.sample::<f64, _>(StandardNormal));
                 kf.predict(&ConstantVelocity, dt, &q);
-                GaussianFilter::predict(&mut ukf, &ConstantVelocity, dt, &q);
+                ukf.predict(&ConstantVelocity, dt, &q);
                 let a = kf.update_gated(&PositionFix, &z, &r, f64::INFINITY).unwrap();
                 let b = ukf.update_gated(&PositionFix, &z, &r, f64::INFINITY).unwrap();
                 assert_relative_eq!(a.nis(), b.nis(), max_relative = 1e-7);
@@ -333,7 +333,7 @@ mod tests {
         }
         let pi = std::f64::consts::PI;
         let mut ukf = Ukf::new(SVector::<f64, 1>::new(pi - 0.01), Matrix1::new(0.04), UkfParams::default());
-        GaussianFilter::predict(&mut ukf, &Heading, 1.0, &Matrix1::new(0.0));
+        ukf.predict(&Heading, 1.0, &Matrix1::new(0.0));
         assert_relative_eq!(ukf.x[0], pi - 0.01, epsilon = 1e-12);
         assert_relative_eq!(ukf.p[(0, 0)], 0.04, max_relative = 1e-12);
     }
