@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 use onebeacon::dsp::beamform::azimuth_inclination;
 use onebeacon::dsp::matched_filter::MatchedFilter;
 use onebeacon::dsp::modes::ModeBank;
-use onebeacon::dsp::receiver::{Receiver, ReceiverConfig};
+use onebeacon::dsp::receiver::{Receiver, ReceiverConfig, receive_frame};
 use onebeacon::dsp::waveform::rypkema_modes;
 use onebeacon_sim::acoustics::channel::simulate_ping;
 use onebeacon_sim::scenario::ping::{PingConfig, WaveformKind};
@@ -183,39 +183,18 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     Ok(())
 }
 
-/// A garin frame: range from frame synchronisation on the pilots (eq. 12), Doppler speed
-/// from the tone (baseband, decimation to about 400 Hz, periodogram maximum; eq. 9's
-/// single lag is only a baseline), direction by SPD-BF on the pilot section.
+/// A garin frame through [`receive_frame`]: range, Doppler speed, direction.
 fn process_frame(c: &PingConfig, captures: &[Vec<f64>], staging: Option<Staging>, as_json: bool) -> Result<()> {
-    use onebeacon::dsp::beamform::{DirectionGrid, Snapshot, SpdBf};
-    use onebeacon::dsp::doppler::{baseband, periodogram_frequency, radial_speed};
-    use onebeacon::dsp::matched_filter::estimate_range;
-    let fs = c.capture.fs_hz;
-    let n = captures[0].len();
-    let sound = c.sound_speed_m_s();
-    let frame = c.frame();
-    // Doppler speed from the tone over the whole capture (no synchronisation needed)
-    let d = (fs / 400.0).round() as usize;
-    let z = baseband(&captures[0], frame.f_pt_hz, fs, d);
-    let f_d = periodogram_frequency(&z, fs / d as f64, 80.0);
-    let v = radial_speed(f_d, frame.f_pt_hz, sound);
-    // then synchronise on the Doppler-compensated pilots (eq. 10-12)
-    let alpha = 1.0 + v / sound;
-    let (template, t_start) = frame.pilot_template_scaled(fs, alpha);
-    let mf = MatchedFilter::classical(&template, frame.band(), fs, n);
-    let envelopes: Vec<Vec<f64>> = captures.iter().map(|x| mf.envelope(x)).collect();
-    let sync = estimate_range(&envelopes, 15, fs, sound);
-    let range_m = sound * (alpha * sync.lag / fs - t_start); // eq. 12
     let elements = c.elements();
-    let (az, inc) = if elements.len() > 1 {
-        let snap = Snapshot::from_segment(captures, sync.lag.round() as usize, template.len(), frame.band(), fs);
-        let mut spd = SpdBf::new(&elements, sound, 0.25f64.to_radians());
-        spd.compute(&snap);
-        let (u, _) = DirectionGrid::new(2f64.to_radians()).search(|u| spd.power(u));
-        azimuth_inclination(&u)
-    } else {
-        (f64::NAN, f64::NAN)
+    let config = ReceiverConfig {
+        fs_hz: c.capture.fs_hz,
+        capture_len: captures[0].len(),
+        sound_speed_m_s: c.sound_speed_m_s(),
+        ..ReceiverConfig::default()
     };
+    let est = receive_frame(&c.frame(), &elements, &config, captures);
+    let (range_m, v) = (est.range_m, est.radial_speed_m_s);
+    let (az, inc) = est.direction.unwrap_or((f64::NAN, f64::NAN));
     let num = |x: f64| if x.is_finite() { json!(x) } else { serde_json::Value::Null };
     let result = json!({
         "range_m": range_m,
@@ -223,11 +202,11 @@ fn process_frame(c: &PingConfig, captures: &[Vec<f64>], staging: Option<Staging>
         "inclination_deg": num(inc.to_degrees()),
         "mode": serde_json::Value::Null,
         "radial_speed_m_s": v,
-        "consistent": sync.consistent,
+        "consistent": est.sync.consistent,
     });
     if let Some(staging) = staging {
         // lags in metres, scaled by the Doppler compensation, less the pilots' offset
-        write_range_outputs(&staging, &sync.distribution, alpha * sound / fs, sound * t_start, range_m, &result)?;
+        write_range_outputs(&staging, &est.sync.distribution, est.metres_per_lag, est.offset_m, range_m, &result)?;
         for f in staging.commit()? {
             eprintln!("wrote {}", f.display());
         }
