@@ -42,11 +42,11 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, out: Option<Pat
     let cell = s.base_cell();
     let result = simulate(&s, &cell, seed, run, true);
 
-    let names = s.estimator_names();
-    staging.write("trajectory.csv", &report::trajectory_csv(&names, &result.trajectory)?)?;
+    let (vehicles, names) = (s.vehicle_names(), s.track_labels());
+    staging.write("trajectory.csv", &report::trajectory_csv(&vehicles, &names, &result.trajectory)?)?;
     staging.write("summary.json", report::run_summary_json(&s, seed, run, &cell, &result).as_bytes())?;
     let title = format!("{} seed {seed} run {run}, {}", s.name(), cell.label());
-    plot::top_view(&staging.file("top_view.png"), &names, &title, &result.trajectory, None)
+    plot::top_view(&staging.file("top_view.png"), &vehicles, &names, &title, &result.trajectory, None)
         .context("cannot draw top_view.png")?;
     plot::error_vs_time(&staging.file("error.png"), &names, &title, &result.trajectory)
         .context("cannot draw error.png")?;

@@ -98,11 +98,12 @@ fn line(
     Ok(())
 }
 
-/// Top view: truth, every estimate (`names`, in the records' order), the beacons:
-/// `fixed_beacons` when given (replayed logs), else the records' beacon (its track when
-/// it moves). East to the right, north up, equal scales.
+/// Top view: every vehicle's truth (`vehicles`), every estimate (`names`, in the
+/// records' order), the beacons: `fixed_beacons` when given (replayed logs), else the
+/// records' beacon (its track when it moves). East to the right, north up, equal scales.
 pub fn top_view(
     path: &Path,
+    vehicles: &[String],
     names: &[String],
     title: &str,
     traj: &[StepRecord],
@@ -114,7 +115,7 @@ pub fn top_view(
         traj.iter()
             .flat_map(|r| {
                 let beacon = if fixed_beacons.is_none() { Some(r.beacon) } else { None };
-                [Some(r.truth_pos), beacon].into_iter().flatten().chain(r.estimates.iter().map(|e| e.pos))
+                r.truth.iter().map(|t| t.pos).chain(beacon).chain(r.estimates.iter().map(|e| e.pos))
             })
             .chain(fixed.iter().copied())
     };
@@ -137,8 +138,12 @@ pub fn top_view(
             Some("beacon (ASV)"),
         )?;
     }
-    let truth = traj.iter().filter(|r| r.truth_pos.x.is_finite());
-    line(&mut chart, truth.map(|r| (r.truth_pos.y, r.truth_pos.x)), BLACK.stroke_width(2), Some("truth"))?;
+    for (v, name) in vehicles.iter().enumerate() {
+        let truth = traj.iter().map(|r| r.truth[v].pos).filter(|p| p.x.is_finite());
+        let label = if vehicles.len() > 1 { format!("truth {name}") } else { "truth".into() };
+        let style = BLACK.mix(1.0 - 0.35 * v.min(2) as f64).stroke_width(2);
+        line(&mut chart, truth.map(|p| (p.y, p.x)), style, Some(&label))?;
+    }
     for (i, name) in names.iter().enumerate() {
         let points = traj.iter().map(|r| (r.estimates[i].pos.y, r.estimates[i].pos.x));
         line(&mut chart, points, colour(i).stroke_width(1), Some(name))?;
@@ -153,9 +158,11 @@ pub fn top_view(
             .label(if moving { "beacon start" } else { "beacon" })
             .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLUE.filled()));
     }
-    if let Some(first) = traj.iter().find(|r| r.truth_pos.x.is_finite()) {
+    let starts: Vec<Vector3<f64>> =
+        (0..vehicles.len()).filter_map(|v| traj.iter().map(|r| r.truth[v].pos).find(|p| p.x.is_finite())).collect();
+    if !starts.is_empty() {
         chart
-            .draw_series(std::iter::once(Circle::new((first.truth_pos.y, first.truth_pos.x), 5, BLACK.filled())))?
+            .draw_series(starts.iter().map(|p| Circle::new((p.y, p.x), 5, BLACK.filled())))?
             .label("start")
             .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
     }
@@ -214,13 +221,14 @@ pub fn mc_errors(path: &Path, s: &Scenario, r: &McResult) -> Result<()> {
     }
     let (x0, x1) = span(r.cells.iter().map(x_of), 0.05);
     let stats = r.cells.iter().flat_map(|c| c.estimators.iter().flat_map(|(_, m)| [m.mean_error_m, m.rmse_m]));
-    let (_, ymax) = span(stats.chain(r.cells.iter().filter_map(|c| c.pcrb_rmse_m)), 0.1);
+    let (_, ymax) = span(stats.chain(r.cells.iter().flat_map(|c| c.pcrb_rmse_m.iter().copied())), 0.1);
     let cols = if panels.len() > 1 { 2 } else { 1 };
     let rows = panels.len().div_ceil(cols);
     let root = BitMapBackend::new(path, (1000 * cols as u32, 600 * rows as u32)).into_drawing_area();
     root.fill(&WHITE)?;
     let areas = root.split_evenly((rows, cols));
-    let names = s.estimator_names();
+    let tracks = s.tracks();
+    let names: Vec<String> = tracks.iter().map(|t| t.label.clone()).collect();
     for (panel, area) in panels.iter().zip(areas.iter()) {
         let cells: Vec<&CellResult> =
             r.cells.iter().filter(|c| text_of(c, &text_keys[..text_keys.len().min(1)]) == *panel).collect();
@@ -254,7 +262,7 @@ pub fn mc_errors(path: &Path, s: &Scenario, r: &McResult) -> Result<()> {
             chart.draw_series(mean.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
             line(&mut chart, rmse, c.mix(0.6).stroke_width(1), None)?;
             let pcrb: Vec<(f64, f64)> =
-                mine.iter().filter_map(|cell| cell.pcrb_rmse_m.map(|p| (x_of(cell), p))).collect();
+                mine.iter().filter_map(|cell| cell.pcrb(tracks[*est].vehicle_index).map(|p| (x_of(cell), p))).collect();
             if pcrb.len() > 1 {
                 chart.draw_series(DashedLineSeries::new(pcrb, 6, 4, c.mix(0.8).stroke_width(1)))?;
             }

@@ -193,13 +193,13 @@ pub fn replay(
     let s = &r.session;
     let summary = summary_json(&log, &used, s, wall_s);
 
-    staging.write("trajectory.csv", &report::trajectory_csv(&s.names, &r.trajectory)?)?;
+    staging.write("trajectory.csv", &report::trajectory_csv(&["auv".into()], &s.names, &r.trajectory)?)?;
     staging.write("summary.json", serde_json::to_string_pretty(&summary)?.as_bytes())?;
     staging.write("rejected.csv", &rejected_csv(s)?)?;
     let fixed: Vec<_> =
         used.iter().filter_map(|b| log.beacons.get(b)).map(|p| log.frame.to_ned(p.x, p.y, p.z)).collect();
     let title = format!("{name}, beacons {}", used.iter().map(u32::to_string).collect::<Vec<_>>().join(", "));
-    plot::top_view(&staging.file("top_view.png"), &s.names, &title, &r.trajectory, Some(&fixed))
+    plot::top_view(&staging.file("top_view.png"), &["auv".into()], &s.names, &title, &r.trajectory, Some(&fixed))
         .context("cannot draw top_view.png")?;
     plot::error_vs_time(&staging.file("error.png"), &s.names, &title, &r.trajectory)
         .context("cannot draw error.png")?;

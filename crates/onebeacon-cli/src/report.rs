@@ -21,24 +21,19 @@ fn sweep_json(cell: &Cell) -> Value {
     Value::Object(cell.values().into_iter().map(|(k, v)| (k.to_string(), value(v))).collect())
 }
 
-/// trajectory.csv: one row per step with the truth and every estimator's estimate
+/// trajectory.csv: one row per step with the truth of every vehicle (`vehicles`; its
+/// columns prefixed with its name when there are several) and every track's estimate
 /// (`names`, in the records' order), standard deviations, error and NEES.
-pub fn trajectory_csv(names: &[String], trajectory: &[StepRecord]) -> Result<Vec<u8>> {
+pub fn trajectory_csv(vehicles: &[String], names: &[String], trajectory: &[StepRecord]) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> = [
-        "t_s",
-        "truth_north_m",
-        "truth_east_m",
-        "truth_down_m",
-        "truth_heading_deg",
-        "truth_speed_m_s",
-        "beacon_north_m",
-        "beacon_east_m",
-        "beacon_down_m",
-        "frame",
-    ]
-    .map(String::from)
-    .to_vec();
+    let mut header = vec!["t_s".to_string()];
+    for v in vehicles {
+        let prefix = if vehicles.len() > 1 { format!("{v}_") } else { String::new() };
+        for col in ["truth_north_m", "truth_east_m", "truth_down_m", "truth_heading_deg", "truth_speed_m_s"] {
+            header.push(format!("{prefix}{col}"));
+        }
+    }
+    header.extend(["beacon_north_m", "beacon_east_m", "beacon_down_m", "frame"].map(String::from));
     for name in names {
         for col in [
             "north_m",
@@ -58,9 +53,11 @@ pub fn trajectory_csv(names: &[String], trajectory: &[StepRecord]) -> Result<Vec
     let f = |v: f64| format!("{v:.4}");
     for r in trajectory {
         let mut row = vec![format!("{:.2}", r.t_s)];
-        row.extend([r.truth_pos.x, r.truth_pos.y, r.truth_pos.z].map(f));
-        row.push(format!("{:.3}", onebeacon::geo::wrap_angle(r.truth_heading).to_degrees()));
-        row.push(f(r.truth_speed));
+        for t in &r.truth {
+            row.extend([t.pos.x, t.pos.y, t.pos.z].map(f));
+            row.push(format!("{:.3}", onebeacon::geo::wrap_angle(t.heading).to_degrees()));
+            row.push(f(t.speed));
+        }
         row.extend([r.beacon.x, r.beacon.y, r.beacon.z].map(f));
         row.push(u8::from(r.frame).to_string());
         for e in &r.estimates {
@@ -77,12 +74,13 @@ pub fn trajectory_csv(names: &[String], trajectory: &[StepRecord]) -> Result<Vec
 /// summary.json of one run.
 pub fn run_summary_json(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutput) -> String {
     let estimators: Vec<Value> = s
-        .estimator_names()
+        .tracks()
         .iter()
         .zip(&out.metrics)
-        .map(|(name, m)| {
+        .map(|(track, m)| {
             json!({
-                "estimator": name,
+                "vehicle": track.vehicle,
+                "estimator": track.estimator,
                 "mean_error_m": num(m.mean_error_m),
                 "error_variance_m2": num(m.error_variance_m2),
                 "rmse_m": num(m.mse_m2.sqrt()),
@@ -101,7 +99,8 @@ pub fn run_summary_json(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &Ru
         "run": run,
         "sweep": sweep_json(cell),
         "duration_s": num(s.duration_s()),
-        "distance_m": num(out.distance_m),
+        "distance_m": num(out.distance_m[0]),
+        "vehicles": s.vehicle_names().iter().zip(&out.distance_m).map(|(name, d)| json!({"name": name, "distance_m": num(*d)})).collect::<Vec<_>>(),
         "frames_decoded": out.frames_decoded,
         "estimators": estimators,
     });
@@ -113,22 +112,22 @@ pub fn run_table(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutput
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "{}: seed {seed}, run {run}, {}: {:.0} m in {:.0} s, {} acoustic measurements",
+        "{}: seed {seed}, run {run}, {}: {} m in {:.0} s, {} acoustic measurements",
         s.name(),
         cell.label(),
-        out.distance_m,
+        out.distance_m.iter().map(|d| format!("{d:.0}")).collect::<Vec<_>>().join(" + "),
         s.duration_s(),
         out.frames_decoded
     );
     let _ = writeln!(
         t,
-        "{:<16} {:>10} {:>9} {:>9} {:>10} {:>9}",
+        "{:<24} {:>10} {:>9} {:>9} {:>10} {:>9}",
         "estimator", "mean_err_m", "rmse_m", "max_m", "final_m", "nees"
     );
-    for (name, m) in s.estimator_names().iter().zip(&out.metrics) {
+    for (name, m) in s.track_labels().iter().zip(&out.metrics) {
         let _ = writeln!(
             t,
-            "{:<16} {:>10.3} {:>9.3} {:>9.3} {:>10.3} {:>9.2}",
+            "{:<24} {:>10.3} {:>9.3} {:>9.3} {:>10.3} {:>9.2}",
             name,
             m.mean_error_m,
             m.mse_m2.sqrt(),
@@ -146,10 +145,11 @@ pub fn mc_json(s: &Scenario, r: &McResult, wall_s: f64) -> String {
         .cells
         .iter()
         .flat_map(|c| {
-            c.estimators.iter().map(move |(name, m)| {
+            c.estimators.iter().map(move |(track, m)| {
                 json!({
                     "sweep": sweep_json(&c.cell),
-                    "estimator": name,
+                    "vehicle": track.vehicle,
+                    "estimator": track.estimator,
                     "runs": m.runs,
                     "mean_error_m": num(m.mean_error_m),
                     "error_variance_m2": num(m.error_variance_m2),
@@ -160,7 +160,7 @@ pub fn mc_json(s: &Scenario, r: &McResult, wall_s: f64) -> String {
                     "nees_mean": num(m.nees_mean),
                     "nees_band": [num(m.nees_band[0]), num(m.nees_band[1])],
                     "nees_mean_all_runs": num(m.nees_mean_all_runs),
-                    "pcrb_rmse_m": c.pcrb_rmse_m.map(num).unwrap_or(Value::Null),
+                    "pcrb_rmse_m": c.pcrb(track.vehicle_index).map(num).unwrap_or(Value::Null),
                     "mean_error_first_half_m": num(m.mean_error_first_half_m),
                     "mean_error_second_half_m": num(m.mean_error_second_half_m),
                     "failed_updates": m.failed_updates,
@@ -172,8 +172,9 @@ pub fn mc_json(s: &Scenario, r: &McResult, wall_s: f64) -> String {
     serde_json::to_string(&v).expect("serialisable")
 }
 
-/// For moving-beacon sweeps, sousa's layout (Tables 4.1, 4.2): per guidance, rows of
-/// depth, columns of path, "mean (variance) [RMSE/PCRB]" of the first estimator.
+/// For moving-beacon sweeps, sousa's layout (Tables 4.1, 4.2): per guidance and
+/// vehicle, rows of depth, columns of path, "mean (variance) [RMSE/PCRB]" of the
+/// vehicle's first estimator.
 fn depth_by_path_tables(s: &Scenario, r: &McResult) -> String {
     let mut t = String::new();
     let cells: Vec<(&MovingBeaconCell, &onebeacon_sim::montecarlo::CellResult)> = r
@@ -198,30 +199,38 @@ fn depth_by_path_tables(s: &Scenario, r: &McResult) -> String {
             guidances.push(m.guidance);
         }
     }
-    let names = s.estimator_names();
+    let tracks = s.tracks();
+    let firsts: Vec<usize> =
+        (0..s.vehicle_names().len()).filter_map(|v| tracks.iter().position(|t| t.vehicle_index == v)).collect();
     for g in guidances {
-        let _ = writeln!(t);
-        let _ = writeln!(t, "guidance {}: {} mean error m (variance m^2) [RMSE/PCRB]", g.label(), names[0]);
-        let _ = write!(t, "{:>8}", "depth_m");
-        for p in &paths {
-            let _ = write!(t, " {:>26}", p.label());
-        }
-        let _ = writeln!(t);
-        for &d in &depths {
-            let _ = write!(t, "{d:>8}");
+        for &first in &firsts {
+            let track = &tracks[first];
+            let _ = writeln!(t);
+            let _ = writeln!(t, "guidance {}: {} mean error m (variance m^2) [RMSE/PCRB]", g.label(), track.label);
+            let _ = write!(t, "{:>8}", "depth_m");
             for p in &paths {
-                let found = cells.iter().find(|(m, _)| m.path == *p && m.depth_m == d && m.guidance == g);
-                let text = match found {
-                    Some((_, c)) => {
-                        let e = &c.estimators[0].1;
-                        let ratio = c.pcrb_rmse_m.map(|b| format!("{:.2}", e.rmse_m / b)).unwrap_or_else(|| "-".into());
-                        format!("{:.3} ({:.3}) [{ratio}]", e.mean_error_m, e.error_variance_m2)
-                    }
-                    None => "-".into(),
-                };
-                let _ = write!(t, " {text:>26}");
+                let _ = write!(t, " {:>26}", p.label());
             }
             let _ = writeln!(t);
+            for &d in &depths {
+                let _ = write!(t, "{d:>8}");
+                for p in &paths {
+                    let found = cells.iter().find(|(m, _)| m.path == *p && m.depth_m == d && m.guidance == g);
+                    let text = match found {
+                        Some((_, c)) => {
+                            let e = &c.estimators[first].1;
+                            let ratio = c
+                                .pcrb(track.vehicle_index)
+                                .map(|b| format!("{:.2}", e.rmse_m / b))
+                                .unwrap_or_else(|| "-".into());
+                            format!("{:.3} ({:.3}) [{ratio}]", e.mean_error_m, e.error_variance_m2)
+                        }
+                        None => "-".into(),
+                    };
+                    let _ = write!(t, " {text:>26}");
+                }
+                let _ = writeln!(t);
+            }
         }
     }
     t
@@ -241,7 +250,7 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
     let _ = writeln!(t, "Mean positioning error in m (outliers)");
     let width = r.cells.iter().map(|c| c.cell.label().len()).max().unwrap_or(5).max(5);
     let _ = write!(t, "{:<width$}", "sweep");
-    for name in s.estimator_names() {
+    for name in s.track_labels() {
         let _ = write!(t, " {:>18}", name);
     }
     let _ = writeln!(t);
@@ -255,7 +264,7 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
     let _ = writeln!(t);
     let _ = writeln!(
         t,
-        "{:<14} {:<16} {:>10} {:>5} {:>10} {:>8} {:>9} {:>10} {:>8} {:>15} {:>10}",
+        "{:<14} {:<24} {:>10} {:>5} {:>10} {:>8} {:>9} {:>10} {:>8} {:>15} {:>10}",
         "sweep",
         "estimator",
         "mean_m",
@@ -269,12 +278,12 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
         "nees_all"
     );
     for c in &r.cells {
-        for (name, m) in &c.estimators {
+        for (track, m) in &c.estimators {
             let _ = writeln!(
                 t,
-                "{:<width$} {:<16} {:>10.4} {:>5} {:>10.4} {:>8.3} {:>9.4} {:>10.4} {:>8.2} {:>15} {:>10.1} {:>9}",
+                "{:<width$} {:<24} {:>10.4} {:>5} {:>10.4} {:>8.3} {:>9.4} {:>10.4} {:>8.2} {:>15} {:>10.1} {:>9}",
                 c.cell.label(),
-                name,
+                track.label,
                 m.mean_error_m,
                 m.outliers,
                 m.error_variance_m2,
@@ -284,7 +293,7 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
                 m.nees_mean,
                 format!("[{:.2}, {:.2}]", m.nees_band[0], m.nees_band[1]),
                 m.nees_mean_all_runs,
-                c.pcrb_rmse_m.map(|p| format!("{p:.3}")).unwrap_or_else(|| "-".into()),
+                c.pcrb(track.vehicle_index).map(|p| format!("{p:.3}")).unwrap_or_else(|| "-".into()),
             );
         }
     }

@@ -5,12 +5,14 @@
 //! - [`acoustics`]: pings propagating between moving ends;
 //! - [`pcrb`]: the posterior Cramer-Rao bound of the range-only moving-beacon case;
 //! - [`scenario`]: the TOML scenario schema, its validation and the built-in scenarios;
+//! - [`engine`](crate::engine): the one simulation loop, its worlds and its observers;
 //! - [`run`]: one simulated run, a pure function of (scenario, sweep cell, seed, run);
 //! - [`metrics`]: per-run error statistics and their Monte Carlo aggregation;
 //! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count;
 //! - [`replay`]: real logs (CSV files described by a TOML file) through the estimators.
 
 pub mod acoustics;
+mod engine;
 pub mod metrics;
 pub mod montecarlo;
 pub mod pcrb;
@@ -20,5 +22,6 @@ pub mod scenario;
 pub mod seed;
 pub mod sensors;
 pub mod vehicles;
+mod world;
 
 pub use scenario::{Scenario, ScenarioError};

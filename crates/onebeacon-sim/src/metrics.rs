@@ -73,13 +73,9 @@ impl ErrorAccumulator {
         }
     }
 
-    /// Counts the failed updates among a navigator's outcomes.
-    pub fn count_failures(&mut self, outcomes: impl IntoIterator<Item = onebeacon::nav::Outcome>) {
-        for o in outcomes {
-            if matches!(o, onebeacon::nav::Outcome::Failed(_)) {
-                self.failed_updates += 1;
-            }
-        }
+    /// Counts `outcome` if it is a failed update.
+    pub fn count_failure(&mut self, outcome: &onebeacon::nav::Outcome) {
+        self.failed_updates += u64::from(matches!(outcome, onebeacon::nav::Outcome::Failed(_)));
     }
 
     /// The run's statistics; `distance_m` is the distance travelled in the run.

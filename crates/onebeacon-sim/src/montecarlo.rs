@@ -7,7 +7,7 @@
 use crate::metrics::{CellSummary, RunMetrics, summarise};
 use crate::pcrb::horizontal_rmse_bound;
 use crate::run::simulate;
-use crate::scenario::{Cell, Scenario};
+use crate::scenario::{Cell, Scenario, Track};
 use nalgebra::Matrix6;
 use rayon::prelude::*;
 
@@ -15,9 +15,18 @@ use rayon::prelude::*;
 #[derive(Debug, Clone, PartialEq)]
 pub struct CellResult {
     pub cell: Cell,
-    pub estimators: Vec<(String, CellSummary)>,
-    /// Posterior Cramer-Rao bound on the horizontal RMSE (moving-beacon cells).
-    pub pcrb_rmse_m: Option<f64>,
+    /// One summary per (vehicle, estimator) track, in the order of [`Scenario::tracks`].
+    pub estimators: Vec<(Track, CellSummary)>,
+    /// Posterior Cramer-Rao bound on each vehicle's horizontal RMSE (moving-beacon
+    /// cells; empty otherwise).
+    pub pcrb_rmse_m: Vec<f64>,
+}
+
+impl CellResult {
+    /// The bound of vehicle `v`, where there is one.
+    pub fn pcrb(&self, v: usize) -> Option<f64> {
+        self.pcrb_rmse_m.get(v).copied()
+    }
 }
 
 /// The results of a Monte Carlo sweep.
@@ -59,7 +68,7 @@ pub fn monte_carlo(
 }
 
 /// What the aggregation keeps of one run: its metrics and its range information.
-type RunSummary = (Vec<RunMetrics>, Vec<(usize, Matrix6<f64>)>);
+type RunSummary = (Vec<RunMetrics>, Vec<(usize, usize, Matrix6<f64>)>);
 
 fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: &(dyn Fn() + Sync)) -> CellResult {
     let per_run: Vec<RunSummary> = (0..runs as u64)
@@ -71,25 +80,26 @@ fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: 
         })
         .collect();
     let estimators = scenario
-        .estimator_names()
+        .tracks()
         .into_iter()
         .enumerate()
-        .map(|(e, name)| {
+        .map(|(e, track)| {
             let metrics: Vec<_> = per_run.iter().map(|(m, _)| m[e]).collect();
-            (name, summarise(&metrics))
+            (track, summarise(&metrics))
         })
         .collect();
     let pcrb_rmse_m = match (scenario, cell) {
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
-            let mut sum = vec![Matrix6::zeros(); s.steps() + 1];
+            let vehicles = s.vehicles(c);
+            let mut sum = vec![vec![Matrix6::zeros(); s.steps() + 1]; vehicles.len()];
             for (_, info) in &per_run {
-                for (k, m) in info {
-                    sum[*k] += m;
+                for (v, k, m) in info {
+                    sum[*v][*k] += m;
                 }
             }
-            Some(horizontal_rmse_bound(s, c, &sum, runs))
+            vehicles.iter().zip(&sum).map(|(v, sum)| horizontal_rmse_bound(s, v, sum, runs)).collect()
         }
-        _ => None,
+        _ => Vec::new(),
     };
     CellResult { cell: *cell, estimators, pcrb_rmse_m }
 }

@@ -7,7 +7,8 @@
 //! ([`onebeacon::nav::SensorNoise`]), so the bound and the filter share every noise.
 
 use crate::run::truth_trajectory;
-use crate::scenario::{MovingBeacon, MovingBeaconCell};
+use crate::scenario::MovingBeacon;
+use crate::scenario::moving_beacon::Vehicle;
 use crate::vehicles::rov::body_velocity;
 use nalgebra::{Matrix6, SVector};
 use onebeacon::filter::ProcessModel;
@@ -22,15 +23,11 @@ fn step(c: &Cov, f: &Cov, q: &Cov, info: &Cov) -> Cov {
     j.try_inverse().unwrap_or(predicted)
 }
 
-/// Root of the bound on the mean squared horizontal position error over the mission,
-/// given the sum over `runs` runs of the range information received at each step.
-pub fn horizontal_rmse_bound(
-    s: &MovingBeacon,
-    cell: &MovingBeaconCell,
-    information_sum: &[Matrix6<f64>],
-    runs: usize,
-) -> f64 {
-    let truth = truth_trajectory(s, cell);
+/// Root of the bound on the mean squared horizontal position error of vehicle `v`
+/// (path and depth set: [`MovingBeacon::vehicles`]) over the mission, given the sum
+/// over `runs` runs of the range information it received at each step.
+pub fn horizontal_rmse_bound(s: &MovingBeacon, v: &Vehicle, information_sum: &[Matrix6<f64>], runs: usize) -> f64 {
+    let truth = truth_trajectory(s, v);
     let dt = s.mission.dt_s;
     let noise = s.sensor_noise();
     // depth and attitude every step: H' R^-1 H of the navigator's models
@@ -51,7 +48,7 @@ pub fn horizontal_rmse_bound(
     let mut c = p0; // the bound itself, J^-1
     let mut sum = c[(0, 0)] + c[(1, 1)];
     for k in 1..truth.len() {
-        let model = noise.process_model(body_velocity(&s.vehicle, cell.path, (k - 1) as f64 * dt + dt / 2.0));
+        let model = noise.process_model(body_velocity(v, v.path, (k - 1) as f64 * dt + dt / 2.0));
         let f = model.jacobian(&truth[k - 1], dt);
         let q = model.noise_covariance(&truth[k - 1], dt);
         let info = information_sum.get(k).map_or(sensor_info, |i| sensor_info + i / runs as f64);
@@ -65,7 +62,7 @@ pub fn horizontal_rmse_bound(
 mod tests {
     use super::*;
     use crate::scenario::moving_beacon::PathKind;
-    use crate::scenario::{Scenario, builtin, parse};
+    use crate::scenario::{MovingBeaconCell, Scenario, builtin, parse};
     use approx::assert_relative_eq;
 
     /// A stationary vehicle without process noise: the bound is the inverse of the
@@ -92,7 +89,7 @@ mod tests {
         let mut info = vec![Matrix6::zeros(); steps + 1];
         info[2] = h([30.0, 0.0, 0.0]) * 4.0 * 2.0;
         info[5] = h([0.0, 40.0, 0.0]) * 4.0 * 3.0;
-        let bound = horizontal_rmse_bound(&s, &cell, &info, 4);
+        let bound = horizontal_rmse_bound(&s, &s.vehicles(&cell)[0], &info, 4);
 
         let i = &s.initial;
         let att = i.attitude_sigma_deg.to_radians().powi(-2);

@@ -28,7 +28,13 @@ pub use onebeacon::measure::gauss;
 
 /// The generator of stream `stream` of run `run` under base seed `seed`.
 pub fn rng(seed: u64, run: u64, stream: Stream) -> Pcg64Mcg {
-    Pcg64Mcg::seed_from_u64(mix(seed ^ mix(run ^ mix(stream as u64))))
+    vehicle_rng(seed, run, 0, stream)
+}
+
+/// The generator of stream `stream` of underwater vehicle `vehicle` (vehicle 0's are
+/// the run's own streams, so adding a vehicle to a world changes no draw of the first).
+pub fn vehicle_rng(seed: u64, run: u64, vehicle: usize, stream: Stream) -> Pcg64Mcg {
+    Pcg64Mcg::seed_from_u64(mix(seed ^ mix(run ^ mix(stream as u64 + 16 * vehicle as u64))))
 }
 
 #[cfg(test)]
@@ -44,6 +50,9 @@ mod tests {
         let d: u64 = rng(1, 0, Stream::Heading).random();
         let e: u64 = rng(2, 0, Stream::Imu).random();
         assert_eq!(a, b);
+        let f: u64 = vehicle_rng(1, 0, 1, Stream::Imu).random();
+        let g: u64 = vehicle_rng(1, 0, 0, Stream::Imu).random();
         assert!(a != c && a != d && a != e && c != d);
+        assert!(f != a && g == a);
     }
 }

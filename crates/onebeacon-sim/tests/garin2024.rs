@@ -14,7 +14,7 @@ fn garin(t_com: &[f64]) -> Scenario {
 }
 
 fn cell<'a>(r: &'a onebeacon_sim::montecarlo::McResult, cell: usize, name: &str) -> &'a CellSummary {
-    &r.cells[cell].estimators.iter().find(|(n, _)| n == name).unwrap().1
+    &r.cells[cell].estimators.iter().find(|(n, _)| n.label == name).unwrap().1
 }
 
 /// range+doppler beats range-only at short and long T_com; error grows with T_com; at

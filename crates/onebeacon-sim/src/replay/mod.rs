@@ -9,7 +9,7 @@ pub mod session;
 pub use log::{Input, Item, Log, LogDescription, LogError, TruthPose, resolve_beacon};
 pub use session::{ErrorStats, Rejection, Session, Start, Step};
 
-use crate::run::{Estimate, StepRecord};
+use crate::run::{Estimate, StepRecord, TruthRecord};
 use nalgebra::{Vector2, Vector3};
 use std::collections::BTreeSet;
 
@@ -63,6 +63,7 @@ fn record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord 
         .map(|(i, e)| {
             let (error_m, nees) = step.errors.as_ref().map_or((f64::NAN, f64::NAN), |errors| errors[i]);
             Estimate {
+                vehicle: 0,
                 pos: Vector3::new(e.north_m(), e.east_m(), 0.0),
                 psi: e.heading_rad(),
                 speed: None,
@@ -74,9 +75,11 @@ fn record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord 
         .collect();
     StepRecord {
         t_s: step.t_s,
-        truth_pos: truth.map_or(Vector3::repeat(f64::NAN), |p| Vector3::new(p.north_m, p.east_m, 0.0)),
-        truth_heading: truth.and_then(|p| p.heading_rad).unwrap_or(f64::NAN),
-        truth_speed: f64::NAN,
+        truth: vec![TruthRecord {
+            pos: truth.map_or(Vector3::repeat(f64::NAN), |p| Vector3::new(p.north_m, p.east_m, 0.0)),
+            heading: truth.and_then(|p| p.heading_rad).unwrap_or(f64::NAN),
+            speed: f64::NAN,
+        }],
         beacon: beacon.unwrap_or(Vector3::repeat(f64::NAN)),
         frame: heard,
         estimates,

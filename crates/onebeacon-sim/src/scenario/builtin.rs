@@ -11,6 +11,7 @@ pub struct Builtin {
 pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "garin2024", toml: include_str!("../../../../scenarios/garin2024.toml") },
     Builtin { name: "sousa", toml: include_str!("../../../../scenarios/sousa.toml") },
+    Builtin { name: "sousa-pair", toml: include_str!("../../../../scenarios/sousa-pair.toml") },
 ];
 
 /// The built-in scenario called `name`.

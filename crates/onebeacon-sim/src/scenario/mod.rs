@@ -74,6 +74,16 @@ pub(crate) fn default_runs<const N: usize>() -> usize {
     N
 }
 
+/// One estimator on one vehicle: what a row of metrics is about.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Track {
+    pub vehicle: String,
+    pub vehicle_index: usize,
+    pub estimator: String,
+    /// The estimator's name, or `vehicle/estimator` when the world has several vehicles.
+    pub label: String,
+}
+
 /// A parsed, validated scenario.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Scenario {
@@ -148,11 +158,40 @@ impl Scenario {
             Scenario::MovingBeacon(s) => s.runs,
         }
     }
-    /// The estimators' names, in the order of every run's metrics.
-    pub fn estimator_names(&self) -> Vec<String> {
+    /// The (vehicle, estimator) tracks, in the order of every run's metrics and
+    /// records: each vehicle's estimators in scenario order, vehicle after vehicle.
+    pub fn tracks(&self) -> Vec<Track> {
+        let vehicles = self.vehicle_names();
+        let estimators: Vec<String> = match self {
+            Scenario::FixedBeacon(s) => s.estimators.iter().map(|e| e.name()).collect(),
+            Scenario::MovingBeacon(s) => s.estimators.iter().map(|e| e.name()).collect(),
+        };
+        let several = vehicles.len() > 1;
+        let mut tracks = Vec::new();
+        for (index, vehicle) in vehicles.iter().enumerate() {
+            for estimator in &estimators {
+                let label = if several { format!("{vehicle}/{estimator}") } else { estimator.clone() };
+                tracks.push(Track {
+                    vehicle: vehicle.clone(),
+                    vehicle_index: index,
+                    estimator: estimator.clone(),
+                    label,
+                });
+            }
+        }
+        tracks
+    }
+
+    /// The track labels, in order.
+    pub fn track_labels(&self) -> Vec<String> {
+        self.tracks().into_iter().map(|t| t.label).collect()
+    }
+
+    /// The underwater vehicles' names, in order.
+    pub fn vehicle_names(&self) -> Vec<String> {
         match self {
-            Scenario::FixedBeacon(s) => s.estimators.iter().map(|e| e.name().to_string()).collect(),
-            Scenario::MovingBeacon(s) => s.estimators.iter().map(|e| e.name().to_string()).collect(),
+            Scenario::FixedBeacon(_) => vec!["auv".into()],
+            Scenario::MovingBeacon(s) => s.vehicles(&s.base_cell()).into_iter().filter_map(|v| v.name).collect(),
         }
     }
     /// The cell `run` simulates: the scenario's own values, no sweep.

@@ -23,6 +23,11 @@ pub struct MovingBeacon {
     pub mission: Mission,
     #[serde(default)]
     pub vehicle: Vehicle,
+    /// More underwater vehicles in the same water: the same sensors and estimators,
+    /// hearing the same pings; the ASV's guidance serves `vehicle` only, and the sweep
+    /// changes only `vehicle`'s path and depth.
+    #[serde(default)]
+    pub other_vehicles: Vec<Vehicle>,
     #[serde(default)]
     pub sensors: Sensors,
     #[serde(default)]
@@ -82,6 +87,9 @@ impl PathKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Vehicle {
+    /// Name in outputs (default `auv` for `vehicle`, `auv2`, `auv3`, ... for
+    /// `other_vehicles`).
+    pub name: Option<String>,
     pub path: PathKind,
     /// Start depth, m (positive down).
     pub depth_m: f64,
@@ -102,6 +110,7 @@ pub struct Vehicle {
 impl Default for Vehicle {
     fn default() -> Self {
         Self {
+            name: None,
             path: PathKind::Circular,
             depth_m: 5.0,
             start_north_m: 0.0,
@@ -333,6 +342,20 @@ impl MovingBeacon {
 
     pub fn steps(&self) -> usize {
         (self.mission.duration_s / self.mission.dt_s).round() as usize
+    }
+
+    /// The underwater vehicles of `cell`: `vehicle` on the cell's path and depth, then
+    /// `other_vehicles`, each with its name set.
+    pub fn vehicles(&self, cell: &MovingBeaconCell) -> Vec<Vehicle> {
+        let first = Vehicle { path: cell.path, depth_m: cell.depth_m, ..self.vehicle.clone() };
+        std::iter::once(first)
+            .chain(self.other_vehicles.iter().cloned())
+            .enumerate()
+            .map(|(i, mut v)| {
+                v.name = Some(v.name.unwrap_or_else(|| if i == 0 { "auv".into() } else { format!("auv{}", i + 1) }));
+                v
+            })
+            .collect()
     }
 
     /// The vehicle's sensor noise, which the world draws from and the filters and the

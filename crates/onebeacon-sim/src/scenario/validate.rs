@@ -1,5 +1,6 @@
 //! Range checks on a parsed scenario. The first violation is reported with its key.
 
+use super::moving_beacon::Vehicle;
 use super::{FixedBeacon, MovingBeacon, Scenario};
 
 pub(crate) struct Violation {
@@ -71,26 +72,30 @@ fn check_steps(duration_s: f64, dt_s: f64) -> Result<(), Violation> {
     Ok(())
 }
 
-/// At least one estimator; names of ASCII letters, digits and + - _ . , all different.
-fn check_estimator_names(names: &[String]) -> Result<(), Violation> {
+const NAME_RULE: &str = "must be non-empty ASCII letters, digits and + - _ .";
+
+fn valid_name(name: &str) -> bool {
+    !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || "+-_.".contains(c))
+}
+
+/// At least one of `section` (`estimators`, say); names of ASCII letters, digits and
+/// + - _ . , all different.
+fn check_names(section: &str, names: &[String]) -> Result<(), Violation> {
     if names.is_empty() {
         return Err(Violation {
-            key: "estimators".into(),
+            key: section.into(),
             value: "[]".into(),
-            allowed: "at least one estimator is needed".into(),
+            allowed: format!("at least one of {section} is needed"),
         });
     }
     for (k, name) in names.iter().enumerate() {
-        let violation = |allowed: &str| Violation {
-            key: format!("estimators[{k}].name"),
-            value: format!("{name:?}"),
-            allowed: allowed.into(),
-        };
-        if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || "+-_.".contains(c)) {
-            return Err(violation("must be non-empty ASCII letters, digits and + - _ ."));
+        let violation =
+            |allowed: String| Violation { key: format!("{section}[{k}].name"), value: format!("{name:?}"), allowed };
+        if !valid_name(name) {
+            return Err(violation(NAME_RULE.into()));
         }
         if names[..k].contains(name) {
-            return Err(violation("must differ from the other estimators' names (set `name`)"));
+            return Err(violation(format!("must differ from the other {section}' names (set `name`)")));
         }
     }
     Ok(())
@@ -131,6 +136,28 @@ fn check_list_nonempty<T>(key: &str, v: &Option<Vec<T>>) -> Result<(), Violation
     }
 }
 
+/// One underwater vehicle's table (`prefix`: its key).
+fn check_vehicle(prefix: &str, v: &Vehicle) -> Result<(), Violation> {
+    use Rule::*;
+    for (field, value, rule) in [
+        ("depth_m", v.depth_m, NonNegative),
+        ("start_north_m", v.start_north_m, Finite),
+        ("start_east_m", v.start_east_m, Finite),
+        ("heading_deg", v.heading_deg, Finite),
+        ("speed_m_s", v.speed_m_s, NonNegative),
+        ("circle_radius_m", v.circle_radius_m, Positive),
+        ("spiral_descent_m_s", v.spiral_descent_m_s, NonNegative),
+        ("leg_length_m", v.leg_length_m, Positive),
+        ("leg_spacing_m", v.leg_spacing_m, Positive),
+    ] {
+        check(&format!("{prefix}.{field}"), value, rule)?;
+    }
+    if let Some(name) = v.name.as_ref().filter(|n| !valid_name(n)) {
+        return Err(Violation { key: format!("{prefix}.name"), value: format!("{name:?}"), allowed: NAME_RULE.into() });
+    }
+    Ok(())
+}
+
 fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
     use Rule::*;
     check_count("runs", s.runs, 1, 1_000_000)?;
@@ -138,18 +165,20 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
         dt_s: Positive,
         duration_s: Positive,
     });
-    let v = &s.vehicle;
-    check_fields!("vehicle", v, {
-        depth_m: NonNegative,
-        start_north_m: Finite,
-        start_east_m: Finite,
-        heading_deg: Finite,
-        speed_m_s: NonNegative,
-        circle_radius_m: Positive,
-        spiral_descent_m_s: NonNegative,
-        leg_length_m: Positive,
-        leg_spacing_m: Positive,
-    });
+    check_vehicle("vehicle", &s.vehicle)?;
+    check_count("other_vehicles (count)", s.other_vehicles.len(), 0, 31)?;
+    for (k, v) in s.other_vehicles.iter().enumerate() {
+        check_vehicle(&format!("other_vehicles[{k}]"), v)?;
+    }
+    let vehicles = s.vehicles(&s.base_cell());
+    let names: Vec<String> = vehicles.into_iter().filter_map(|v| v.name).collect();
+    if let Some(k) = (1..names.len()).find(|&k| names[..k].contains(&names[k])) {
+        return Err(Violation {
+            key: format!("other_vehicles[{}].name", k - 1),
+            value: format!("{:?}", names[k]),
+            allowed: "must differ from the other vehicles' names (`auv` for `vehicle`, `auvN` for the N-th)".into(),
+        });
+    }
     let n = &s.sensors;
     check_fields!("sensors", n, {
         velocity_noise_m_s: Positive,
@@ -182,7 +211,7 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
         depth_sigma_m: Positive,
         attitude_sigma_deg: Positive,
     });
-    check_estimator_names(&s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
+    check_names("estimators", &s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
     for (k, e) in s.estimators.iter().enumerate() {
         check_ukf(&format!("estimators[{k}]"), 6, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
     }
@@ -248,7 +277,7 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
         accel_sigma_m_s2: Positive,
     });
 
-    check_estimator_names(&s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
+    check_names("estimators", &s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
     for (k, e) in s.estimators.iter().enumerate() {
         let key = |f: &str| format!("estimators[{k}].{f}");
         for (j, &q) in e.q_diag.iter().enumerate() {

@@ -17,7 +17,7 @@ pub use range_6dof::{Range6DofNavigator, SensorNoise};
 pub use single_beacon::{Aiding, EkfTuning, SingleBeaconNavigator};
 
 use crate::filter::FilterError;
-use nalgebra::{Matrix2, Vector3};
+use nalgebra::{Matrix2, Matrix3, Vector3};
 
 /// What processing one measurement did.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,6 +47,8 @@ pub struct Estimate {
     /// it, so that scoring every step pays for no wrap), and its variance, rad^2.
     pub(crate) heading_state_rad: f64,
     pub(crate) heading_var_rad2: f64,
+    /// Roll and pitch, rad, when they are states (zero otherwise).
+    pub(crate) roll_pitch_rad: [f64; 2],
     /// Forward speed, m/s, when it is a state.
     pub speed_m_s: Option<f64>,
     /// Range offset b (m) and scale error k_r, odometry distance and turn scale errors.
@@ -75,6 +77,12 @@ impl Estimate {
     }
     pub fn sigma_heading_rad(&self) -> f64 {
         self.heading_var_rad2.max(0.0).sqrt()
+    }
+    /// Body-to-NED rotation of the estimated attitude (roll and pitch zero where they
+    /// are not states).
+    pub fn body_to_ned(&self) -> Matrix3<f64> {
+        let [roll, pitch] = self.roll_pitch_rad;
+        crate::models::kinematic6dof::rotation(roll, pitch, self.heading_state_rad)
     }
 }
 

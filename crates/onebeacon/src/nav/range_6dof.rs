@@ -146,6 +146,7 @@ impl Navigator for Range6DofNavigator {
             horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
             heading_state_rad: x[idx::YAW],
             heading_var_rad2: p[(idx::YAW, idx::YAW)],
+            roll_pitch_rad: [x[idx::ROLL], x[idx::PITCH]],
             speed_m_s: None,
             range_bias_m: 0.0,
             range_scale: 0.0,

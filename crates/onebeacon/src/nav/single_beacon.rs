@@ -181,6 +181,7 @@ impl Navigator for SingleBeaconNavigator {
             horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
             heading_state_rad: x[idx::PSI],
             heading_var_rad2: p[(idx::PSI, idx::PSI)],
+            roll_pitch_rad: [0.0; 2],
             speed_m_s: Some(x[idx::V]),
             range_bias_m: 0.0,
             range_scale: 0.0,

@@ -1,0 +1,119 @@
+//! The simulation engine: one loop for every world.
+//!
+//! A [`World`] moves the truth of its vehicles and beacons one step and says which
+//! measurements each underwater vehicle received during it. The engine feeds them, in
+//! order, to every estimator ([`Track`]) of that vehicle through the
+//! [`Navigator`] interface alone. Then it shows the step to the [`Observer`]s: error
+//! statistics, recording, guidance snapshots, information for the bound. A world holds
+//! no estimator or scoring code, an observer no world code, so a new estimator runs in
+//! every world and a new world scores every estimator.
+
+use crate::run::GuidanceSnapshot;
+use nalgebra::{Vector3, Vector6};
+use onebeacon::nav::{Estimate, Measurement, Navigator, Outcome};
+
+/// The truth of one underwater vehicle at one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct VehicleTruth {
+    /// NED position and roll, pitch, yaw (rad, yaw not wrapped).
+    pub eta: Vector6<f64>,
+    /// Speed over ground, m/s.
+    pub speed_m_s: f64,
+    /// Distance travelled since the start, m.
+    pub distance_m: f64,
+}
+
+/// A world: its truth, its beacons, and the acoustic channel that decides who hears
+/// what, when.
+pub(crate) trait World {
+    /// Number of underwater vehicles (each with every estimator of the scenario).
+    fn vehicles(&self) -> usize;
+    /// Steps after the start.
+    fn steps(&self) -> usize;
+    /// Time of step `k`, s.
+    fn t_s(&self, k: usize) -> f64;
+    /// The truth of vehicle `v` now.
+    fn truth(&self, v: usize) -> VehicleTruth;
+    /// Where the beacon is now.
+    fn beacon_ned_m(&self) -> Vector3<f64>;
+    /// Moves from step `k - 1` to `k` and appends to `heard[v]` what vehicle `v`
+    /// measured during the step, in the order its estimators must process it.
+    /// `reports[v]` is what vehicle `v` reports of itself (its first estimator's
+    /// estimate at step `k - 1`), for a beacon that guides itself on it. Returns the
+    /// guidance decision taken in the step, if any.
+    fn advance(&mut self, k: usize, reports: &[Estimate], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot>;
+}
+
+/// One estimator on one vehicle.
+pub(crate) struct Track {
+    pub vehicle: usize,
+    pub navigator: Box<dyn Navigator>,
+}
+
+/// What observers see of one step.
+pub(crate) struct Step<'a> {
+    pub k: usize,
+    pub t_s: f64,
+    /// Per vehicle.
+    pub truth: &'a [VehicleTruth],
+    pub heard: &'a [Vec<Measurement>],
+    pub beacon_ned_m: Vector3<f64>,
+    /// Per track: which vehicle it is on, and its estimate now.
+    pub vehicle_of: &'a [usize],
+    pub estimates: &'a [Estimate],
+}
+
+/// Something that watches a run.
+pub(crate) trait Observer {
+    fn step(&mut self, step: &Step<'_>);
+    fn guidance(&mut self, _snapshot: &GuidanceSnapshot) {}
+    /// The outcome of track `track`'s processing of one measurement.
+    fn outcome(&mut self, _track: usize, _outcome: &Outcome) {}
+}
+
+/// Runs `world` from its start to its last step with `tracks`, shown to `observers`.
+pub(crate) fn run(world: &mut dyn World, tracks: &mut [Track], observers: &mut [&mut dyn Observer]) {
+    let vehicles = world.vehicles();
+    let vehicle_of: Vec<usize> = tracks.iter().map(|t| t.vehicle).collect();
+    // the track each vehicle reports from: its first
+    let reporter: Vec<usize> = (0..vehicles)
+        .map(|v| vehicle_of.iter().position(|&w| w == v).expect("every vehicle has an estimator"))
+        .collect();
+    let mut heard = vec![Vec::new(); vehicles];
+    let mut truth: Vec<VehicleTruth> = (0..vehicles).map(|v| world.truth(v)).collect();
+    let mut estimates: Vec<Estimate> = tracks.iter().map(|t| t.navigator.estimate()).collect();
+    let mut reports = Vec::with_capacity(vehicles);
+    let mut k = 0;
+    loop {
+        let step = Step {
+            k,
+            t_s: world.t_s(k),
+            truth: &truth,
+            heard: &heard,
+            beacon_ned_m: world.beacon_ned_m(),
+            vehicle_of: &vehicle_of,
+            estimates: &estimates,
+        };
+        observers.iter_mut().for_each(|o| o.step(&step));
+        if k == world.steps() {
+            return;
+        }
+        k += 1;
+        heard.iter_mut().for_each(Vec::clear);
+        reports.clear();
+        reports.extend(reporter.iter().map(|&i| estimates[i]));
+        if let Some(g) = world.advance(k, &reports, &mut heard) {
+            observers.iter_mut().for_each(|o| o.guidance(&g));
+        }
+        for (i, t) in tracks.iter_mut().enumerate() {
+            for m in &heard[t.vehicle] {
+                let outcome = t.navigator.process(m);
+                observers.iter_mut().for_each(|o| o.outcome(i, &outcome));
+            }
+            estimates[i] = t.navigator.estimate();
+        }
+        for (v, tr) in truth.iter_mut().enumerate() {
+            *tr = world.truth(v);
+        }
+    }
+}

@@ -1,0 +1,242 @@
+//! One simulated run: the scenario's world driven by the [engine](crate::engine), every
+//! estimator on every vehicle on the same truth and the same measurement draws (a
+//! paired comparison), scored and recorded by observers. A pure function of (scenario,
+//! cell, seed, run index).
+
+use crate::engine::{self, Observer, Step, Track, VehicleTruth, World};
+use crate::metrics::{ErrorAccumulator, RunMetrics};
+use crate::scenario::{Cell, Scenario};
+use crate::world::{FixedBeaconWorld, MovingBeaconWorld, RangeInformation};
+use nalgebra::{Matrix6, Vector2, Vector3};
+use onebeacon::filter::consistency::nees;
+use onebeacon::guidance::FimPlanner;
+use onebeacon::nav::Outcome;
+
+/// One estimator's estimate at one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// The vehicle it estimates (index into the scenario's vehicles).
+    pub vehicle: usize,
+    /// NED position, m.
+    pub pos: Vector3<f64>,
+    /// Heading, rad in (-pi, pi].
+    pub psi: f64,
+    /// Forward speed, m/s, when the estimator has it as a state.
+    pub speed: Option<f64>,
+    /// Standard deviations of north and east, m.
+    pub sigma_pos: Vector2<f64>,
+    /// Horizontal position error, m.
+    pub error_m: f64,
+    /// NEES of the horizontal position.
+    pub nees: f64,
+}
+
+impl Estimate {
+    /// The record of navigator estimate `e` of vehicle `vehicle` with its horizontal
+    /// error and NEES.
+    pub fn new(vehicle: usize, e: &onebeacon::nav::Estimate, error_m: f64, nees: Option<f64>) -> Self {
+        Self {
+            vehicle,
+            pos: e.position_ned_m,
+            psi: e.heading_rad(),
+            speed: e.speed_m_s,
+            sigma_pos: Vector2::new(e.sigma_north_m(), e.sigma_east_m()),
+            error_m,
+            nees: nees.unwrap_or(f64::NAN),
+        }
+    }
+}
+
+/// One vehicle's truth at one step (NaN where unknown: a log without ground truth).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TruthRecord {
+    /// NED position, m; heading, rad in (-pi, pi]; speed over ground, m/s.
+    pub pos: Vector3<f64>,
+    pub heading: f64,
+    pub speed: f64,
+}
+
+impl TruthRecord {
+    fn of(t: &VehicleTruth) -> Self {
+        Self {
+            pos: t.eta.fixed_rows::<3>(0).into_owned(),
+            heading: onebeacon::geo::wrap_angle(t.eta[5]),
+            speed: t.speed_m_s,
+        }
+    }
+}
+
+/// Truth and all estimates at one step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepRecord {
+    pub t_s: f64,
+    /// Every vehicle's truth, in the scenario's order.
+    pub truth: Vec<TruthRecord>,
+    /// The beacon's true position (fixed, or on the surface vehicle).
+    pub beacon: Vector3<f64>,
+    /// Whether an acoustic measurement was heard in this step.
+    pub frame: bool,
+    /// Every (vehicle, estimator) track, in the order of [`Scenario::tracks`].
+    pub estimates: Vec<Estimate>,
+}
+
+/// What the beacon vehicle's guidance knew and chose at one ping (recorded runs), so
+/// that its metric can be mapped over the reaching set (sousa Fig. 3.5, 3.7).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GuidanceSnapshot {
+    pub t_s: f64,
+    /// The planner whose metric is mapped (approach A for the baselines).
+    pub planner: FimPlanner,
+    /// The beacon's position estimate at this ping, the centre of its reaching set.
+    pub previous: Vector2<f64>,
+    pub reach_m: f64,
+    /// The vehicle's estimate now and predicted at the next ping.
+    pub target: Vector3<f64>,
+    pub target_next: Vector3<f64>,
+    /// The waypoint the guidance chose.
+    pub waypoint: Vector2<f64>,
+}
+
+/// The outcome of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutput {
+    /// One entry per track, in the order of [`Scenario::tracks`].
+    pub metrics: Vec<RunMetrics>,
+    /// Every step, when recording was asked for; empty otherwise.
+    pub trajectory: Vec<StepRecord>,
+    /// Distance travelled by each vehicle, m.
+    pub distance_m: Vec<f64>,
+    /// Acoustic measurements heard (frames decoded, ranges), all vehicles together.
+    pub frames_decoded: u64,
+    /// For bounds: the Fisher information H' R^-1 H of each range received, with the
+    /// vehicle and the step it was received in (moving-beacon runs; empty otherwise).
+    pub range_information: Vec<(usize, usize, Matrix6<f64>)>,
+    /// The guidance decisions of a recorded moving-beacon run, one per ping.
+    pub guidance: Vec<GuidanceSnapshot>,
+}
+
+/// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
+/// A cell of another world than the scenario's is a programming error.
+pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) -> RunOutput {
+    match (s, cell) {
+        (Scenario::FixedBeacon(s), Cell::FixedBeacon(c)) => {
+            let mut world = FixedBeaconWorld::new(s, c, seed, run);
+            let mut tracks = world.tracks(s, seed, run);
+            drive(&mut world, &mut tracks, None, record)
+        }
+        (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
+            let mut world = MovingBeaconWorld::new(s, c, seed, run);
+            let mut tracks = world.tracks(s, seed, run);
+            let mut info = RangeInformation::new(s.sensor_noise());
+            let mut out = drive(&mut world, &mut tracks, Some(&mut info), record);
+            out.range_information = info.into_inner();
+            out
+        }
+        _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),
+    }
+}
+
+/// Runs the engine with the scoring and recording observers (and `extra`).
+fn drive(world: &mut dyn World, tracks: &mut [Track], extra: Option<&mut dyn Observer>, record: bool) -> RunOutput {
+    let mut scoring = Scoring::new(tracks.len(), world.steps());
+    let mut recorder = Recorder { on: record, trajectory: Vec::new(), guidance: Vec::new() };
+    {
+        let mut observers: Vec<&mut dyn Observer> = vec![&mut scoring, &mut recorder];
+        if let Some(extra) = extra {
+            observers.push(extra);
+        }
+        engine::run(world, tracks, &mut observers);
+    }
+    let distance_m = scoring.distance_m.clone();
+    RunOutput {
+        metrics: scoring.acc.iter().zip(&scoring.vehicle_of).map(|(a, &v)| a.finish(distance_m[v])).collect(),
+        trajectory: recorder.trajectory,
+        distance_m,
+        frames_decoded: scoring.heard,
+        range_information: Vec::new(),
+        guidance: recorder.guidance,
+    }
+}
+
+/// The horizontal error of estimate `e` of truth `t`, and its NEES (None if the
+/// covariance is not positive definite).
+fn score(e: &onebeacon::nav::Estimate, t: &VehicleTruth) -> (f64, Option<f64>) {
+    let err = (e.position_ned_m - t.eta.fixed_rows::<3>(0)).xy();
+    (err.norm(), nees(&err, &e.horizontal_cov_m2))
+}
+
+/// Error statistics of every track, failed updates, acoustic measurements heard.
+struct Scoring {
+    acc: Vec<ErrorAccumulator>,
+    vehicle_of: Vec<usize>,
+    distance_m: Vec<f64>,
+    heard: u64,
+}
+
+impl Scoring {
+    fn new(tracks: usize, steps: usize) -> Self {
+        Self {
+            acc: vec![ErrorAccumulator::new(steps + 1); tracks],
+            vehicle_of: Vec::new(),
+            distance_m: Vec::new(),
+            heard: 0,
+        }
+    }
+}
+
+impl Observer for Scoring {
+    fn step(&mut self, s: &Step<'_>) {
+        for ((a, e), &v) in self.acc.iter_mut().zip(s.estimates).zip(s.vehicle_of) {
+            let (error_m, nees) = score(e, &s.truth[v]);
+            a.push(error_m, nees);
+        }
+        self.heard += s.heard.iter().flatten().filter(|m| m.kind.beacon().is_some()).count() as u64;
+        self.vehicle_of.clear();
+        self.vehicle_of.extend_from_slice(s.vehicle_of);
+        self.distance_m.clear();
+        self.distance_m.extend(s.truth.iter().map(|t| t.distance_m));
+    }
+
+    fn outcome(&mut self, track: usize, outcome: &Outcome) {
+        self.acc[track].count_failure(outcome);
+    }
+}
+
+/// Every step and every guidance decision, when asked for.
+struct Recorder {
+    on: bool,
+    trajectory: Vec<StepRecord>,
+    guidance: Vec<GuidanceSnapshot>,
+}
+
+impl Observer for Recorder {
+    fn step(&mut self, s: &Step<'_>) {
+        if !self.on {
+            return;
+        }
+        let estimates = s
+            .estimates
+            .iter()
+            .zip(s.vehicle_of)
+            .map(|(e, &v)| {
+                let (error_m, nees) = score(e, &s.truth[v]);
+                Estimate::new(v, e, error_m, nees)
+            })
+            .collect();
+        self.trajectory.push(StepRecord {
+            t_s: s.t_s,
+            truth: s.truth.iter().map(TruthRecord::of).collect(),
+            beacon: s.beacon_ned_m,
+            frame: s.heard.iter().flatten().any(|m| m.kind.beacon().is_some()),
+            estimates,
+        });
+    }
+
+    fn guidance(&mut self, snapshot: &GuidanceSnapshot) {
+        if self.on {
+            self.guidance.push(snapshot.clone());
+        }
+    }
+}
+
+pub use crate::world::{initial_asv_position, truth_trajectory};

@@ -1,0 +1,195 @@
+//! The fixed-beacon world (garin2024): an AUV following a boustrophedon under the
+//! feedback-linearising controller, a fixed beacon, communication frames every T_com.
+
+use crate::engine::{Track, VehicleTruth, World};
+use crate::run::GuidanceSnapshot;
+use crate::scenario::{FixedBeacon, FixedBeaconCell};
+use crate::seed::{Stream, gauss, rng};
+use crate::sensors::SensorSuite;
+use crate::vehicles::{Path, TruthState, feedback_linearising_control};
+use nalgebra::{SVector, Vector2, Vector3, Vector6};
+use onebeacon::models::unicycle::{Cov, State};
+use onebeacon::nav::{Estimate, Measurement, SingleBeaconNavigator};
+
+pub(crate) struct FixedBeaconWorld {
+    dt: f64,
+    speed: f64,
+    steps: usize,
+    t_com_s: f64,
+    path: Path,
+    beacon: Vector2<f64>,
+    truth: TruthState,
+    /// The command computed at the last step, applied over the next (eq. 2).
+    omega: f64,
+    accel: f64,
+    sensors: SensorSuite,
+    /// Frames sent so far.
+    frame_index: u64,
+    distance_m: f64,
+}
+
+impl FixedBeaconWorld {
+    pub(crate) fn new(s: &FixedBeacon, cell: &FixedBeaconCell, seed: u64, run: u64) -> Self {
+        let speed = s.mission.speed_m_s;
+        let path = s.path();
+        let r0 = path.at_time(0.0, speed);
+        let truth = TruthState { pos: r0.pos, psi: r0.vel.y.atan2(r0.vel.x), v: speed };
+        let (omega, accel) = feedback_linearising_control(&truth, &r0);
+        Self {
+            dt: s.mission.dt_s,
+            speed,
+            steps: s.steps(),
+            t_com_s: cell.t_com_s,
+            path,
+            beacon: s.beacon_ned_m(),
+            truth,
+            omega,
+            accel,
+            sensors: SensorSuite::new(&s.sensors, s.comms.frame_loss_prob, seed, run),
+            frame_index: 0,
+            distance_m: 0.0,
+        }
+    }
+
+    /// Every estimator of the scenario on the AUV, started at the truth plus one draw
+    /// (the same for all).
+    pub(crate) fn tracks(&self, s: &FixedBeacon, seed: u64, run: u64) -> Vec<Track> {
+        let i = &s.initial;
+        let sigma0 = SVector::<f64, 6>::from([
+            i.position_sigma_m,
+            i.position_sigma_m,
+            i.heading_sigma_deg.to_radians(),
+            i.speed_sigma_m_s,
+            i.yaw_rate_sigma_rad_s,
+            i.accel_sigma_m_s2,
+        ]);
+        let mut init_rng = rng(seed, run, Stream::Initial);
+        let t = &self.truth;
+        let z_true = State::from([t.pos.x, t.pos.y, t.psi, t.v, self.omega, self.accel]);
+        let z0 = z_true + sigma0.map(|sd| gauss(&mut init_rng, sd));
+        let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
+        s.estimators
+            .iter()
+            .map(|e| Track {
+                vehicle: 0,
+                navigator: Box::new(SingleBeaconNavigator::new(
+                    e.kind.aiding(),
+                    e.tuning(),
+                    e.filter_kind(),
+                    0.0,
+                    z0,
+                    p0,
+                )),
+            })
+            .collect()
+    }
+}
+
+impl World for FixedBeaconWorld {
+    fn vehicles(&self) -> usize {
+        1
+    }
+
+    fn steps(&self) -> usize {
+        self.steps
+    }
+
+    fn t_s(&self, k: usize) -> f64 {
+        k as f64 * self.dt
+    }
+
+    fn truth(&self, _v: usize) -> VehicleTruth {
+        let t = &self.truth;
+        VehicleTruth {
+            eta: Vector6::new(t.pos.x, t.pos.y, 0.0, 0.0, 0.0, t.psi),
+            speed_m_s: t.v,
+            distance_m: self.distance_m,
+        }
+    }
+
+    fn beacon_ned_m(&self) -> Vector3<f64> {
+        Vector3::new(self.beacon.x, self.beacon.y, 0.0)
+    }
+
+    fn advance(&mut self, k: usize, _: &[Estimate], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot> {
+        let t = self.t_s(k);
+        // truth moves under the command of the previous step (eq. 3-4), then a new
+        // command is computed from the reference (eq. 2)
+        self.truth = self.truth.step(self.omega, self.accel, self.dt);
+        self.distance_m += self.truth.v.abs() * self.dt;
+        (self.omega, self.accel) = feedback_linearising_control(&self.truth, &self.path.at_time(t, self.speed));
+
+        let sample = self.sensors.proprioceptive(t, &self.truth, self.omega, self.accel);
+        // a frame every T_com seconds, at the first step at or after each multiple; a
+        // frame decoded during the step is fused with the step's inertial sample
+        let due = ((t + 1e-9) / self.t_com_s).floor() as u64;
+        if due > self.frame_index {
+            self.frame_index = due;
+            if let Some(frame) = self.sensors.comm_frame(&self.truth, self.beacon) {
+                heard[0].push(Measurement::new(t, frame));
+            }
+        }
+        heard[0].push(Measurement::new(t, sample));
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::simulate;
+    use crate::scenario::Cell;
+    use crate::scenario::fixed_beacon::Sensors;
+    use crate::scenario::{Scenario, builtin, parse};
+
+    fn garin() -> FixedBeacon {
+        match parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap() {
+            Scenario::FixedBeacon(s) => s,
+            _ => unreachable!(),
+        }
+    }
+
+    #[test]
+    fn a_run_is_a_function_of_its_inputs() {
+        let mut s = garin();
+        s.mission.duration_s = Some(120.0);
+        let c = s.base_cell();
+        let a = simulate(&Scenario::FixedBeacon(s.clone()), &Cell::FixedBeacon(c), 5, 3, true);
+        let b = simulate(&Scenario::FixedBeacon(s.clone()), &Cell::FixedBeacon(c), 5, 3, true);
+        let other = simulate(&Scenario::FixedBeacon(s.clone()), &Cell::FixedBeacon(c), 5, 4, false);
+        assert_eq!(a, b);
+        assert_ne!(a.metrics, other.metrics);
+        assert_eq!(a.trajectory.len(), 481);
+        assert_eq!(a.frames_decoded, 40);
+    }
+
+    #[test]
+    fn noise_free_run_ends_with_sub_centimetre_error() {
+        let mut s = garin();
+        s.sensors = Sensors::noise_free();
+        // start on the truth (a millimetre-sized initial draw)
+        s.initial.position_sigma_m = 1e-4;
+        s.initial.heading_sigma_deg = 1e-5;
+        s.initial.speed_sigma_m_s = 1e-5;
+        s.initial.yaw_rate_sigma_rad_s = 1e-6;
+        s.initial.accel_sigma_m_s2 = 1e-6;
+        // and tell the filters their sensors are (nearly) exact
+        for e in &mut s.estimators {
+            e.r_range_m2 = 1e-6;
+            e.r_doppler_m2_s2 = 1e-8;
+            e.r_heading_rad2 = 1e-8;
+            e.r_yaw_rate_rad2_s2 = 1e-10;
+            e.r_accel_m2_s4 = 1e-10;
+        }
+        // the UKF too
+        let mut ukf = s.estimators[0].clone();
+        ukf.filter = crate::scenario::FilterName::Ukf;
+        s.estimators.push(ukf);
+        let out = simulate(&Scenario::FixedBeacon(s.clone()), &Cell::FixedBeacon(s.base_cell()), 1, 0, false);
+        assert!((out.distance_m[0] - 1567.0).abs() < 2.0, "distance {}", out.distance_m[0]);
+        for (e, m) in s.estimators.iter().zip(&out.metrics) {
+            assert!(m.final_error_m < 0.01, "{}: final error {} m", e.name(), m.final_error_m);
+            assert!(m.max_error_m < 0.01, "{}: max error {} m", e.name(), m.max_error_m);
+        }
+    }
+}

@@ -1,0 +1,9 @@
+//! The worlds the [engine](crate::engine) runs: each moves its truth and says who heard
+//! what, when; nothing else.
+
+mod fixed_beacon;
+mod moving_beacon;
+
+pub(crate) use fixed_beacon::FixedBeaconWorld;
+pub(crate) use moving_beacon::{MovingBeaconWorld, RangeInformation};
+pub use moving_beacon::{initial_asv_position, truth_trajectory};

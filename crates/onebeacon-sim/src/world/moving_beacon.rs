@@ -1,0 +1,326 @@
+//! The moving-beacon world (sousa): underwater vehicles follow their paths by body
+//! velocities; the ASV carries the beacon, pings every period and moves, between pings,
+//! to the waypoint its guidance chose at the last ping for the first vehicle; each ping
+//! reaches each vehicle when the wavefront meets it.
+
+use crate::acoustics::Ping;
+use crate::engine::{Observer, Step, Track, VehicleTruth, World};
+use crate::run::GuidanceSnapshot;
+use crate::scenario::moving_beacon::{EstimatorKind, GuidanceKind, Vehicle};
+use crate::scenario::{MovingBeacon, MovingBeaconCell};
+use crate::seed::{Stream, gauss, rng, vehicle_rng};
+use crate::vehicles::asv::{AsvLimits, AsvState};
+use crate::vehicles::rov::{body_velocity, rk4_step};
+use nalgebra::{Matrix6, SVector, Vector2, Vector3};
+use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, ReachingSet, best_standoff};
+use onebeacon::measure::ScalarModel;
+use onebeacon::models::kinematic6dof::{BodyVelocity, Cov, State, idx};
+use onebeacon::nav::{BeaconFix, Estimate, Kind, Measurement, Range6DofNavigator, SensorNoise};
+use rand_pcg::Pcg64Mcg;
+
+/// The true state of vehicle `v` (path and depth set) at every step; it does not
+/// depend on the draws.
+pub fn truth_trajectory(s: &MovingBeacon, v: &Vehicle) -> Vec<State> {
+    let dt = s.mission.dt_s;
+    let mut eta = State::from([v.start_north_m, v.start_east_m, v.depth_m, 0.0, 0.0, v.heading_deg.to_radians()]);
+    let mut out = Vec::with_capacity(s.steps() + 1);
+    out.push(eta);
+    for k in 0..s.steps() {
+        eta = rk4_step(&eta, k as f64 * dt, dt, |t| body_velocity(v, v.path, t));
+        out.push(eta);
+    }
+    out
+}
+
+/// The ASV's start: the best standoff for the vehicle's start depth and the ASV's reach
+/// (sousa Fig. 4.7), in the direction `asv.start_bearing_deg` from the vehicle.
+pub fn initial_asv_position(s: &MovingBeacon, cell: &MovingBeaconCell) -> Vector2<f64> {
+    let reach = s.asv.max_speed_m_s * s.acoustics.ping_period_s;
+    let grid = PolarGrid { radial: 20, angular: 36, refinements: 10 };
+    let d = best_standoff((cell.depth_m - s.asv.transducer_depth_m).max(0.0), reach, grid).distance_m;
+    let b = s.asv.start_bearing_deg.to_radians();
+    Vector2::new(s.vehicle.start_north_m, s.vehicle.start_east_m) + Vector2::new(b.cos(), b.sin()) * d
+}
+
+/// The ping on its way with what the vehicles will be told of its origin.
+struct InFlight {
+    ping: Ping,
+    gps: Vector3<f64>,
+    /// Which vehicles heard it already.
+    heard: Vec<bool>,
+}
+
+/// One underwater vehicle: its truth, its sensors' random streams, its last measured
+/// body velocity.
+struct Underwater {
+    spec: Vehicle,
+    truth: Vec<State>,
+    velocity_rng: Pcg64Mcg,
+    attitude_rng: Pcg64Mcg,
+    /// The range noise stream; None: the world's acoustic stream (the first vehicle's,
+    /// as in a single-vehicle world).
+    range_rng: Option<Pcg64Mcg>,
+    nu_meas: BodyVelocity,
+    distance_m: f64,
+}
+
+pub(crate) struct MovingBeaconWorld<'a> {
+    s: &'a MovingBeacon,
+    guidance_kind: GuidanceKind,
+    noise: SensorNoise,
+    vehicles: Vec<Underwater>,
+    lim: AsvLimits,
+    asv0: Vector2<f64>,
+    asv: AsvState,
+    waypoint: Vector2<f64>,
+    arrive_at: f64,
+    next_ping: f64,
+    in_flight: Vec<InFlight>,
+    /// GPS errors of the ASV (and the first vehicle's range errors).
+    acoustic_rng: Pcg64Mcg,
+    /// The current step.
+    k: usize,
+}
+
+impl<'a> MovingBeaconWorld<'a> {
+    pub(crate) fn new(s: &'a MovingBeacon, cell: &MovingBeaconCell, seed: u64, run: u64) -> Self {
+        let vehicles: Vec<Underwater> = s
+            .vehicles(cell)
+            .into_iter()
+            .enumerate()
+            .map(|(v, spec)| Underwater {
+                truth: truth_trajectory(s, &spec),
+                spec,
+                velocity_rng: vehicle_rng(seed, run, v, Stream::Imu),
+                attitude_rng: vehicle_rng(seed, run, v, Stream::Heading),
+                range_rng: (v > 0).then(|| vehicle_rng(seed, run, v, Stream::Acoustic)),
+                nu_meas: BodyVelocity::zeros(),
+                distance_m: 0.0,
+            })
+            .collect();
+        let asv0 = initial_asv_position(s, cell);
+        let start = &vehicles[0].truth[0];
+        let toward_vehicle = Vector2::new(start[idx::N], start[idx::E]) - asv0;
+        Self {
+            s,
+            guidance_kind: cell.guidance,
+            noise: s.sensor_noise(),
+            vehicles,
+            lim: AsvLimits {
+                max_speed_m_s: s.asv.max_speed_m_s,
+                max_turn_rate_rad_s: s.asv.max_turn_rate_deg_s.to_radians(),
+            },
+            asv0,
+            asv: AsvState { pos: asv0, psi: toward_vehicle.y.atan2(toward_vehicle.x) },
+            waypoint: asv0,
+            arrive_at: 0.0,
+            next_ping: 0.0,
+            in_flight: Vec::new(),
+            acoustic_rng: rng(seed, run, Stream::Acoustic),
+            k: 0,
+        }
+    }
+
+    /// Every estimator of the scenario on every vehicle, each vehicle's started at its
+    /// truth plus one draw (the same for all its estimators).
+    pub(crate) fn tracks(&self, s: &MovingBeacon, seed: u64, run: u64) -> Vec<Track> {
+        let i = &s.initial;
+        let a0 = i.attitude_sigma_deg.to_radians();
+        let sigma0 = SVector::<f64, 6>::from([i.position_sigma_m, i.position_sigma_m, i.depth_sigma_m, a0, a0, a0]);
+        let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
+        let mut tracks = Vec::new();
+        for (v, u) in self.vehicles.iter().enumerate() {
+            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
+            let eta0 = u.truth[0] + sigma0.map(|sd| gauss(&mut init_rng, sd));
+            tracks.extend(s.estimators.iter().map(|e| Track {
+                vehicle: v,
+                navigator: Box::new(Range6DofNavigator::new(
+                    self.noise,
+                    e.kind == EstimatorKind::RangeEkf,
+                    e.filter_kind(),
+                    0.0,
+                    eta0,
+                    p0,
+                )),
+            }));
+        }
+        tracks
+    }
+
+    fn planner(&self, metric: Metric) -> FimPlanner {
+        let g = &self.s.guidance;
+        FimPlanner {
+            metric,
+            grid: PolarGrid { radial: g.grid_radial, angular: g.grid_angular, refinements: 12 },
+            range_var_m2: self.s.acoustics.range_noise_m.powi(2),
+            beacon_depth_m: self.s.asv.transducer_depth_m,
+        }
+    }
+
+    /// The ASV pings, then picks where to be at the next ping (sousa 3.3) from what the
+    /// first vehicle reports.
+    fn ping(&mut self, t0: f64, report: &Estimate) -> GuidanceSnapshot {
+        let s = self.s;
+        let (period, z_tx) = (s.acoustics.ping_period_s, s.asv.transducer_depth_m);
+        let reach = s.asv.max_speed_m_s * period;
+        let gps = Vector3::new(
+            self.asv.pos.x + gauss(&mut self.acoustic_rng, s.asv.gps_noise_m),
+            self.asv.pos.y + gauss(&mut self.acoustic_rng, s.asv.gps_noise_m),
+            z_tx,
+        ); // eq. 4.3
+        self.in_flight.push(InFlight {
+            ping: Ping { t_tx: t0, origin: self.beacon_ned_m() },
+            gps,
+            heard: vec![false; self.vehicles.len()],
+        });
+        let target = report.position_ned_m;
+        let lin = self.vehicles[0].nu_meas.fixed_rows::<3>(0).into_owned();
+        let target_next = target + report.body_to_ned() * lin * period;
+        let here = gps.xy();
+        // the baselines' snapshots map approach A's metric
+        let metric = if self.guidance_kind == GuidanceKind::ApproachB { Metric::ApproachB } else { Metric::ApproachA };
+        let planner = self.planner(metric);
+        self.waypoint = match self.guidance_kind {
+            GuidanceKind::ApproachA | GuidanceKind::ApproachB => {
+                planner
+                    .next_waypoint(&ReachingSet { center: here, radius: reach }, here, &target, &target_next)
+                    .waypoint
+            }
+            GuidanceKind::Static => self.asv0,
+            GuidanceKind::Circle => {
+                let r = s.guidance.circle_radius_m;
+                let rel = here - target.xy();
+                let angle = rel.y.atan2(rel.x) + (reach / r).min(std::f64::consts::FRAC_PI_2);
+                target.xy() + Vector2::new(angle.cos(), angle.sin()) * r
+            }
+        };
+        self.arrive_at = t0 + period;
+        self.next_ping += period;
+        GuidanceSnapshot {
+            t_s: t0,
+            planner,
+            previous: here,
+            reach_m: reach,
+            target,
+            target_next,
+            waypoint: self.waypoint,
+        }
+    }
+}
+
+impl World for MovingBeaconWorld<'_> {
+    fn vehicles(&self) -> usize {
+        self.vehicles.len()
+    }
+
+    fn steps(&self) -> usize {
+        self.s.steps()
+    }
+
+    fn t_s(&self, k: usize) -> f64 {
+        k as f64 * self.s.mission.dt_s
+    }
+
+    fn truth(&self, v: usize) -> VehicleTruth {
+        let u = &self.vehicles[v];
+        let t = self.t_s(self.k);
+        VehicleTruth {
+            eta: u.truth[self.k],
+            speed_m_s: body_velocity(&u.spec, u.spec.path, t).fixed_rows::<3>(0).norm(),
+            distance_m: u.distance_m,
+        }
+    }
+
+    fn beacon_ned_m(&self) -> Vector3<f64> {
+        Vector3::new(self.asv.pos.x, self.asv.pos.y, self.s.asv.transducer_depth_m)
+    }
+
+    fn advance(&mut self, k: usize, reports: &[Estimate], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot> {
+        self.k = k;
+        let (t0, t1) = (self.t_s(k - 1), self.t_s(k));
+        let dt = self.s.mission.dt_s;
+        let c = self.s.acoustics.sound_speed_m_s;
+        let snapshot = (t0 + 1e-9 >= self.next_ping).then(|| self.ping(t0, &reports[0]));
+        let (u, r) = self.asv.command(self.waypoint, self.arrive_at - t0, &self.lim);
+        self.asv = self.asv.step(u, r, dt);
+
+        let noise = self.noise;
+        for (v, (veh, out)) in self.vehicles.iter_mut().zip(heard.iter_mut()).enumerate() {
+            // the vehicle's body velocities over the step, as measured: drawn from the
+            // process model the navigators use
+            veh.nu_meas = noise
+                .process_model(body_velocity(&veh.spec, veh.spec.path, t0 + dt / 2.0))
+                .sample_input(&mut veh.velocity_rng);
+            let (p0, p1) =
+                (veh.truth[k - 1].fixed_rows::<3>(0).into_owned(), veh.truth[k].fixed_rows::<3>(0).into_owned());
+            veh.distance_m += (p1 - p0).norm();
+            out.push(Measurement::new(t0, Kind::BodyVelocity { nu: veh.nu_meas.into() }));
+
+            // pings heard during the step, in order of arrival
+            let first = out.len();
+            for f in self.in_flight.iter_mut().filter(|f| !f.heard[v]) {
+                let Some(t_rx) = f.ping.arrival(c, t0, &p0, t1, &p1) else { continue };
+                f.heard[v] = true;
+                // the range noise of the navigators' range model (the GPS error is
+                // drawn apart, on the position the ASV reports)
+                let rng = veh.range_rng.as_mut().unwrap_or(&mut self.acoustic_rng);
+                let range_noise = noise.range_model(&BeaconFix::fixed(0, f.ping.origin)).noise(&veh.truth[k], rng);
+                let range_m = c * (t_rx - f.ping.t_tx) + range_noise;
+                let beacon = BeaconFix {
+                    id: 0,
+                    position_ned_m: f.gps,
+                    sigma_m: self.s.asv.gps_noise_m,
+                    t_tx_s: Some(f.ping.t_tx),
+                };
+                out.push(Measurement::new(t_rx, Kind::Range { beacon, range_m }));
+            }
+            out[first..].sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+
+            // depth and attitude at the step's end
+            let [d_m, roll_m, pitch_m, yaw_m] = noise.depth_attitude_models();
+            let (x, rng) = (&veh.truth[k], &mut veh.attitude_rng);
+            out.push(Measurement::new(t1, Kind::Depth { depth_m: x[idx::D] + d_m.noise(x, rng) }));
+            out.push(Measurement::new(
+                t1,
+                Kind::Attitude {
+                    roll_rad: x[idx::ROLL] + roll_m.noise(x, rng),
+                    pitch_rad: x[idx::PITCH] + pitch_m.noise(x, rng),
+                    heading_rad: onebeacon::geo::wrap_angle(x[idx::YAW] + yaw_m.noise(x, rng)),
+                },
+            ));
+        }
+        self.in_flight.retain(|f| f.heard.iter().any(|h| !h));
+        snapshot
+    }
+}
+
+/// For the bound: the Fisher information H' R^-1 H of every range each vehicle hears,
+/// from the navigators' own range model, at the truth.
+pub(crate) struct RangeInformation {
+    noise: SensorNoise,
+    info: Vec<(usize, usize, Matrix6<f64>)>,
+}
+
+impl RangeInformation {
+    pub(crate) fn new(noise: SensorNoise) -> Self {
+        Self { noise, info: Vec::new() }
+    }
+
+    pub(crate) fn into_inner(self) -> Vec<(usize, usize, Matrix6<f64>)> {
+        self.info
+    }
+}
+
+impl Observer for RangeInformation {
+    fn step(&mut self, s: &Step<'_>) {
+        for (v, (heard, truth)) in s.heard.iter().zip(s.truth).enumerate() {
+            for m in heard {
+                if let Kind::Range { beacon, .. } = m.kind {
+                    let model = self.noise.range_model(&beacon);
+                    let h = ScalarModel::<6>::jacobian(&model, &truth.eta);
+                    self.info.push((v, s.k, h.transpose() * h / model.variance(&truth.eta)));
+                }
+            }
+        }
+    }
+}
