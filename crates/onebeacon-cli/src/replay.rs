@@ -5,148 +5,14 @@ use crate::BadInput;
 use crate::output::Staging;
 use crate::{plot, report};
 use anyhow::{Context, Result};
-use onebeacon::nav::{BeaconFix, Estimate, Kind, Outcome};
+use onebeacon::io::jsonl;
+use onebeacon::nav::session::{Session, Start};
 use onebeacon_sim::replay::log::HeadingFrom;
-use onebeacon_sim::replay::{
-    Input, Item, Log, LogDescription, Session, Start, Step, TruthPose, new_session, replay as run_replay,
-    resolve_beacon,
-};
-use serde_json::{Map, Value, json};
-use std::collections::{BTreeMap, BTreeSet};
-use std::io::{BufRead, Write};
+use onebeacon_sim::replay::{Log, LogDescription, new_session, replay as run_replay};
+use serde_json::{Value, json};
+use std::collections::BTreeSet;
+use std::io::Write;
 use std::path::{Path, PathBuf};
-
-/// One stream item as a JSON line (SI units, the log's frame).
-pub fn item_json(item: &Item) -> Value {
-    let t = item.t_s;
-    match item.input {
-        Input::Measurement(m) => {
-            let mut v = match m {
-                Kind::Odometry { distance_m, heading_change_rad } => {
-                    json!({"distance_m": distance_m, "heading_change_rad": heading_change_rad})
-                }
-                Kind::Speed { speed_m_s } => json!({"speed_m_s": speed_m_s}),
-                Kind::Heading { heading_rad } => json!({"heading_rad": heading_rad}),
-                Kind::Depth { depth_m } => json!({"depth_m": depth_m}),
-                Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
-                    json!({"roll_rad": roll_rad, "pitch_rad": pitch_rad, "heading_rad": heading_rad})
-                }
-                Kind::BodyVelocity { nu } => json!({"nu": nu}),
-                Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
-                    json!({"heading_rad": heading_rad, "yaw_rate_rad_s": yaw_rate_rad_s, "accel_m_s2": accel_m_s2})
-                }
-                Kind::Range { range_m, .. } => json!({"range_m": range_m}),
-                Kind::Doppler { radial_speed_m_s, .. } => json!({"radial_speed_m_s": radial_speed_m_s}),
-                Kind::RangeDoppler { range_m, radial_speed_m_s, .. } => {
-                    json!({"range_m": range_m, "radial_speed_m_s": radial_speed_m_s})
-                }
-            };
-            v["t_s"] = json!(t);
-            v["kind"] = json!(m.name());
-            if let Some(b) = m.beacon() {
-                v["beacon"] = json!(b.id);
-                if b.sigma_m > 0.0 {
-                    v["beacon_sigma_m"] = json!(b.sigma_m);
-                }
-                if let Some(t_tx) = b.t_tx_s {
-                    v["t_tx_s"] = json!(t_tx);
-                }
-            }
-            v
-        }
-        Input::BeaconPosition { beacon_id, position } => json!({"t_s": t, "kind": "beacon_position",
-            "beacon": beacon_id, "x_m": position.x, "y_m": position.y, "z_m": position.z}),
-        Input::Truth(p) => {
-            let mut v = json!({"t_s": t, "kind": "ground_truth", "x_m": p.north_m, "y_m": p.east_m});
-            if let Some(h) = p.heading_rad {
-                v["heading_rad"] = json!(h);
-            }
-            v
-        }
-    }
-}
-
-const KINDS: &str = "odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
-    range_doppler, beacon_position, ground_truth";
-
-/// Parses one JSON line into an item; fixed beacons resolve `beacon` ids, tracked ones
-/// (`beacon_position` lines seen so far) are resolved by the session.
-fn parse_item(
-    line: &str,
-    beacons: &BTreeMap<u32, nalgebra::Vector3<f64>>,
-    tracked: &mut BTreeSet<u32>,
-) -> Result<Item, String> {
-    let v: Map<String, Value> = serde_json::from_str(line).map_err(|e| format!("not a JSON object: {e}"))?;
-    let finite = |key: &str, x: &Value| -> Result<f64, String> {
-        x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| format!("`{key}` = {x} is not a finite number"))
-    };
-    let num = |key: &str| -> Result<f64, String> {
-        v.get(key).map_or_else(|| Err(format!("missing key `{key}`")), |x| finite(key, x))
-    };
-    let optional = |key: &str| v.get(key).map(|x| finite(key, x)).transpose();
-    let kind = v.get("kind").and_then(Value::as_str).ok_or_else(|| format!("missing key `kind` (one of {KINDS})"))?;
-    let t_s = num("t_s")?;
-    let beacon_id = || -> Result<u32, String> {
-        let id = v.get("beacon").and_then(Value::as_u64).and_then(|b| u32::try_from(b).ok());
-        id.ok_or_else(|| "`beacon` must be a beacon id (a non-negative integer)".to_string())
-    };
-    let beacon = |tracked: &BTreeSet<u32>| -> Result<BeaconFix, String> {
-        let mut b = resolve_beacon(beacon_id()?, beacons, tracked)?;
-        b.sigma_m = optional("beacon_sigma_m")?.unwrap_or(0.0);
-        if b.sigma_m < 0.0 {
-            return Err(format!("`beacon_sigma_m` = {} must be >= 0", b.sigma_m));
-        }
-        b.t_tx_s = optional("t_tx_s")?;
-        Ok(b)
-    };
-    let m = Input::Measurement;
-    let input = match kind {
-        "odometry" => {
-            m(Kind::Odometry { distance_m: num("distance_m")?, heading_change_rad: num("heading_change_rad")? })
-        }
-        "speed" => m(Kind::Speed { speed_m_s: num("speed_m_s")? }),
-        "heading" => m(Kind::Heading { heading_rad: num("heading_rad")? }),
-        "depth" => m(Kind::Depth { depth_m: num("depth_m")? }),
-        "attitude" => m(Kind::Attitude {
-            roll_rad: num("roll_rad")?,
-            pitch_rad: num("pitch_rad")?,
-            heading_rad: num("heading_rad")?,
-        }),
-        "body_velocity" => {
-            let nu = v.get("nu").and_then(Value::as_array).filter(|a| a.len() == 6);
-            let nu = nu.ok_or("`nu` must be [u, v, w, p, q, r] (m/s, rad/s)")?;
-            let mut out = [0.0; 6];
-            for (o, x) in out.iter_mut().zip(nu) {
-                *o = finite("nu", x)?;
-            }
-            m(Kind::BodyVelocity { nu: out })
-        }
-        "inertial" => m(Kind::Inertial {
-            heading_rad: num("heading_rad")?,
-            yaw_rate_rad_s: num("yaw_rate_rad_s")?,
-            accel_m_s2: num("accel_m_s2")?,
-        }),
-        "range" => m(Kind::Range { beacon: beacon(tracked)?, range_m: num("range_m")? }),
-        "doppler" => m(Kind::Doppler { beacon: beacon(tracked)?, radial_speed_m_s: num("radial_speed_m_s")? }),
-        "range_doppler" => m(Kind::RangeDoppler {
-            beacon: beacon(tracked)?,
-            range_m: num("range_m")?,
-            radial_speed_m_s: num("radial_speed_m_s")?,
-        }),
-        "beacon_position" => {
-            let beacon_id = beacon_id()?;
-            tracked.insert(beacon_id);
-            let z = optional("z_m")?.unwrap_or(0.0);
-            Input::BeaconPosition { beacon_id, position: nalgebra::Vector3::new(num("x_m")?, num("y_m")?, z) }
-        }
-        "ground_truth" => {
-            let heading_rad = optional("heading_rad")?;
-            Input::Truth(TruthPose { north_m: num("x_m")?, east_m: num("y_m")?, heading_rad })
-        }
-        other => return Err(format!("unknown kind `{other}` (one of {KINDS})")),
-    };
-    Ok(Item { t_s, input })
-}
 
 /// `--beacons` checked against the log's beacons.
 fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Option<BTreeSet<u32>>> {
@@ -174,7 +40,7 @@ pub fn replay(
     if print_stream {
         let mut stdout = std::io::stdout().lock();
         for item in &log.items {
-            writeln!(stdout, "{}", item_json(item))?;
+            writeln!(stdout, "{}", jsonl::item_json(item))?;
         }
         return Ok(());
     }
@@ -240,16 +106,6 @@ pub fn replay(
     Ok(())
 }
 
-/// The range and odometry calibration states of an estimate, as output keys.
-fn calibration(e: &Estimate) -> [(&'static str, f64); 4] {
-    [
-        ("range_bias_m", e.range_bias_m),
-        ("range_scale", e.range_scale),
-        ("distance_scale", e.distance_scale),
-        ("turn_scale", e.turn_scale),
-    ]
-}
-
 fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
     let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
     let finals = s.final_estimates();
@@ -272,7 +128,7 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
                 "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
                 "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())},
             });
-            for (k, x) in calibration(e) {
+            for (k, x) in e.calibration() {
                 v[k] = num(x);
             }
             v
@@ -305,48 +161,6 @@ fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
     Ok(w.into_inner()?)
 }
 
-/// One output line: every estimator's estimate after an input line (the log's frame).
-fn step_json(line: usize, step: &Step, s: &Session, frame: onebeacon::geo::Frame) -> Value {
-    let estimates: Vec<Value> = step
-        .estimates
-        .iter()
-        .enumerate()
-        .map(|(i, e)| {
-            let (x, y, _) = frame.from_ned(&nalgebra::Vector3::new(e.north_m(), e.east_m(), 0.0));
-            let (sx, sy, _) = frame.from_ned(&nalgebra::Vector3::new(e.sigma_north_m(), e.sigma_east_m(), 0.0));
-            let mut v = json!({
-                "name": s.names[i],
-                "x_m": x,
-                "y_m": y,
-                "heading_rad": frame.heading_from_ned(e.heading_rad()),
-                "sigma_x_m": sx.abs(),
-                "sigma_y_m": sy.abs(),
-            });
-            for (k, x) in calibration(e) {
-                v[k] = json!(x);
-            }
-            if let Some(o) = step.outcomes[i] {
-                let (outcome, nis) = match o {
-                    Outcome::Applied => ("applied", None),
-                    Outcome::Accepted(n) => ("accepted", Some(n)),
-                    Outcome::Rejected(n) => ("rejected", Some(n)),
-                    Outcome::Skipped => ("skipped", None),
-                    Outcome::Failed(_) => ("failed", None),
-                };
-                v["outcome"] = json!(outcome);
-                if let Some(n) = nis {
-                    v["nis"] = json!(n);
-                }
-            }
-            if let Some((err, _)) = step.errors.as_ref().map(|e| e[i]) {
-                v["error_m"] = json!(err);
-            }
-            v
-        })
-        .collect();
-    json!({"line": line, "t_s": step.t_s, "estimates": estimates})
-}
-
 /// `onebeacon stream CONFIG.toml`: JSON Lines on stdin, one JSON line per estimate on
 /// stdout, flushed after each; bad lines are reported on stderr and skipped.
 pub fn stream(config: &Path) -> Result<()> {
@@ -367,32 +181,9 @@ pub fn stream(config: &Path) -> Result<()> {
         None => Start::FirstTruth,
     };
     let mut session = new_session(&d, start, None);
-    let mut tracked = BTreeSet::new();
-    let stdin = std::io::stdin().lock();
-    let mut stdout = std::io::stdout().lock();
-    let mut last_t = f64::NEG_INFINITY;
-    for (n, line) in stdin.lines().enumerate() {
-        let number = n + 1;
-        let line = line.context("cannot read stdin")?;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let item = match parse_item(&line, &beacons, &mut tracked) {
-            Ok(item) if item.t_s < last_t => Err(format!("time {} is before {last_t} on an earlier line", item.t_s)),
-            other => other,
-        };
-        let item = match item {
-            Ok(item) => item,
-            Err(e) => {
-                eprintln!("stdin line {number}: {e}; skipped");
-                continue;
-            }
-        };
-        last_t = item.t_s;
-        if let Some(step) = session.push(&item) {
-            writeln!(stdout, "{}", step_json(number, &step, &session, frame))?;
-            stdout.flush()?;
-        }
-    }
+    jsonl::run(&mut session, &beacons, frame, std::io::stdin().lock(), std::io::stdout().lock(), |line, e| {
+        eprintln!("stdin line {line}: {e}; skipped")
+    })
+    .context("cannot read stdin or write stdout")?;
     Ok(())
 }

@@ -6,9 +6,11 @@
 //! - [`dsp`]: receiver signal processing: matched filter, beamforming, modes;
 //! - [`models`]: process models used by the estimators;
 //! - [`measure`]: measurement models `h(x)` with their Jacobians;
-//! - [`filter`]: the generic extended Kalman filter and consistency statistics;
+//! - [`filter`]: the Gaussian filters (EKF, UKF) behind one trait, consistency statistics;
 //! - [`guidance`]: where a beacon vehicle should go next (Fisher information);
-//! - [`nav`]: navigators that put a model, measurements and a filter together.
+//! - [`nav`]: the navigator interface, measurement events, the papers' navigators and
+//!   the onboard [`nav::session`] that a vehicle's computer runs;
+//! - [`io`]: the JSON Lines codec of the session (feature `stream`, adds serde_json).
 //!
 //! Conventions: NED frame (x north, y east, z down), SI units, radians, heading from
 //! north toward east. Equation numbers in comments refer to the source papers.
@@ -17,6 +19,7 @@ pub mod dsp;
 pub mod filter;
 pub mod geo;
 pub mod guidance;
+pub mod io;
 pub mod measure;
 pub mod models;
 pub mod nav;

@@ -6,7 +6,8 @@ use crate::scenario::load::deserialize;
 use nalgebra::Vector3;
 use onebeacon::filter::FilterKind;
 use onebeacon::geo::Frame;
-use onebeacon::nav::{BeaconFix, Kind, PlanarConfig, PlanarNoise};
+use onebeacon::nav::session::{Input, Item, TruthPose, resolve_beacon};
+use onebeacon::nav::{Kind, PlanarConfig, PlanarNoise};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -351,69 +352,6 @@ pub struct LogDescription {
     pub estimators: Vec<EstimatorSpec>,
 }
 
-/// A ground-truth pose (heading when the log has one). Items hold SI values in the
-/// log's frame (x, y in `north_m`, `east_m` for NED logs) until [`Input::to_ned`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TruthPose {
-    pub north_m: f64,
-    pub east_m: f64,
-    pub heading_rad: Option<f64>,
-}
-
-/// One item of the time-ordered stream.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Input {
-    Measurement(Kind),
-    /// A beacon's position now (a moving beacon's track; fixes later measurements).
-    BeaconPosition {
-        beacon_id: u32,
-        position: Vector3<f64>,
-    },
-    Truth(TruthPose),
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Item {
-    pub t_s: f64,
-    pub input: Input,
-}
-
-impl Input {
-    /// This input, given in `frame`, in NED: the one place where logs and streams
-    /// change frame.
-    pub fn to_ned(self, frame: Frame) -> Input {
-        let point = |p: Vector3<f64>| frame.to_ned(p.x, p.y, p.z);
-        match self {
-            Input::Measurement(mut m) => {
-                if let Some(b) = m.beacon_mut() {
-                    b.position_ned_m = point(b.position_ned_m);
-                }
-                Input::Measurement(match m {
-                    Kind::Odometry { distance_m, heading_change_rad } => {
-                        Kind::Odometry { distance_m, heading_change_rad: frame.turn_to_ned(heading_change_rad) }
-                    }
-                    Kind::Heading { heading_rad } => Kind::Heading { heading_rad: frame.heading_to_ned(heading_rad) },
-                    Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
-                        Kind::Attitude { roll_rad, pitch_rad, heading_rad: frame.heading_to_ned(heading_rad) }
-                    }
-                    other => other,
-                })
-            }
-            Input::BeaconPosition { beacon_id, position } => {
-                Input::BeaconPosition { beacon_id, position: point(position) }
-            }
-            Input::Truth(p) => {
-                let n = frame.to_ned(p.north_m, p.east_m, 0.0);
-                Input::Truth(TruthPose {
-                    north_m: n.x,
-                    east_m: n.y,
-                    heading_rad: p.heading_rad.map(|h| frame.heading_to_ned(h)),
-                })
-            }
-        }
-    }
-}
-
 /// A loaded log: the description, fixed beacons and the merged stream (SI units, the
 /// log's frame).
 #[derive(Debug, Clone)]
@@ -648,24 +586,6 @@ impl Log {
             }
         };
         Ok((t0, (p0.north_m, p0.east_m, psi)))
-    }
-}
-
-/// The position of beacon `id` for a measurement (log or stream): a fixed beacon's, or
-/// NaN for a tracked one (the session supplies its latest position); otherwise the
-/// message naming the known beacons.
-pub fn resolve_beacon(
-    id: u32,
-    fixed: &BTreeMap<u32, Vector3<f64>>,
-    tracked: &BTreeSet<u32>,
-) -> Result<BeaconFix, String> {
-    match fixed.get(&id) {
-        Some(p) => Ok(BeaconFix::fixed(id, *p)),
-        None if tracked.contains(&id) => Ok(BeaconFix::fixed(id, Vector3::repeat(f64::NAN))),
-        None => {
-            let known: Vec<String> = fixed.keys().chain(tracked).map(u32::to_string).collect();
-            Err(format!("beacon {id} is not among the beacons ({})", known.join(", ")))
-        }
     }
 }
 

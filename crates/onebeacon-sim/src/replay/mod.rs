@@ -1,13 +1,13 @@
 //! Replaying real logs: a log description maps CSV files and columns to measurement
-//! kinds ([`log`]); the [`session`] runs every configured estimator over the merged,
+//! kinds ([`log`]); the onboard [`Session`] runs every configured estimator over the merged,
 //! time-ordered stream, as `onebeacon stream` does live; [`replay`] does a whole log
 //! and keeps what the outputs need.
 
 pub mod log;
-pub mod session;
 
-pub use log::{Input, Item, Log, LogDescription, LogError, TruthPose, resolve_beacon};
-pub use session::{ErrorStats, Rejection, Session, Start, Step};
+pub use log::{Log, LogDescription, LogError};
+
+use onebeacon::nav::session::{Input, Session, Start, Step};
 
 use crate::run::{Estimate, StepRecord, TruthRecord};
 use nalgebra::{Vector2, Vector3};

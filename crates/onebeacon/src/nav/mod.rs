@@ -9,6 +9,7 @@
 pub mod event;
 pub mod planar;
 pub mod range_6dof;
+pub mod session;
 pub mod single_beacon;
 
 pub use event::{BeaconFix, Kind, Measurement};
@@ -77,6 +78,15 @@ impl Estimate {
     }
     pub fn sigma_heading_rad(&self) -> f64 {
         self.heading_var_rad2.max(0.0).sqrt()
+    }
+    /// The range and odometry calibration states, as output keys.
+    pub fn calibration(&self) -> [(&'static str, f64); 4] {
+        [
+            ("range_bias_m", self.range_bias_m),
+            ("range_scale", self.range_scale),
+            ("distance_scale", self.distance_scale),
+            ("turn_scale", self.turn_scale),
+        ]
     }
     /// Body-to-NED rotation of the estimated attitude (roll and pitch zero where they
     /// are not states).

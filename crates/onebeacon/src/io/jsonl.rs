@@ -1,0 +1,326 @@
+//! JSON Lines for the onboard [`Session`] (feature `stream`): one item per input line
+//! (SI units, the source's frame), one line of every estimator's estimate out per item.
+//! What `onebeacon stream` runs, without the simulator, plotting or CSV machinery;
+//! the line format is in docs/logs.md.
+
+use crate::geo::Frame;
+use crate::nav::session::{Input, Item, Session, Step, TruthPose, resolve_beacon};
+use crate::nav::{BeaconFix, Kind, Outcome};
+use nalgebra::Vector3;
+use serde_json::{Map, Value, json};
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::{BufRead, Write};
+
+/// A line that is not a valid item: what is wrong and what is allowed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct LineError(String);
+
+/// One stream item as a JSON line (SI units, the log's frame).
+pub fn item_json(item: &Item) -> Value {
+    let t = item.t_s;
+    match item.input {
+        Input::Measurement(m) => {
+            let mut v = match m {
+                Kind::Odometry { distance_m, heading_change_rad } => {
+                    json!({"distance_m": distance_m, "heading_change_rad": heading_change_rad})
+                }
+                Kind::Speed { speed_m_s } => json!({"speed_m_s": speed_m_s}),
+                Kind::Heading { heading_rad } => json!({"heading_rad": heading_rad}),
+                Kind::Depth { depth_m } => json!({"depth_m": depth_m}),
+                Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
+                    json!({"roll_rad": roll_rad, "pitch_rad": pitch_rad, "heading_rad": heading_rad})
+                }
+                Kind::BodyVelocity { nu } => json!({"nu": nu}),
+                Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
+                    json!({"heading_rad": heading_rad, "yaw_rate_rad_s": yaw_rate_rad_s, "accel_m_s2": accel_m_s2})
+                }
+                Kind::Range { range_m, .. } => json!({"range_m": range_m}),
+                Kind::Doppler { radial_speed_m_s, .. } => json!({"radial_speed_m_s": radial_speed_m_s}),
+                Kind::RangeDoppler { range_m, radial_speed_m_s, .. } => {
+                    json!({"range_m": range_m, "radial_speed_m_s": radial_speed_m_s})
+                }
+            };
+            v["t_s"] = json!(t);
+            v["kind"] = json!(m.name());
+            if let Some(b) = m.beacon() {
+                v["beacon"] = json!(b.id);
+                if b.sigma_m > 0.0 {
+                    v["beacon_sigma_m"] = json!(b.sigma_m);
+                }
+                if let Some(t_tx) = b.t_tx_s {
+                    v["t_tx_s"] = json!(t_tx);
+                }
+            }
+            v
+        }
+        Input::BeaconPosition { beacon_id, position } => json!({"t_s": t, "kind": "beacon_position",
+            "beacon": beacon_id, "x_m": position.x, "y_m": position.y, "z_m": position.z}),
+        Input::Truth(p) => {
+            let mut v = json!({"t_s": t, "kind": "ground_truth", "x_m": p.north_m, "y_m": p.east_m});
+            if let Some(h) = p.heading_rad {
+                v["heading_rad"] = json!(h);
+            }
+            v
+        }
+    }
+}
+
+/// The kinds a line may have.
+pub const KINDS: &str = "odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
+    range_doppler, beacon_position, ground_truth";
+
+/// Parses one JSON line into an item; `fixed` beacons resolve `beacon` ids, tracked
+/// ones (`beacon_position` lines seen so far, added to `tracked`) are resolved by the
+/// session. The error names the key at fault and what is allowed.
+pub fn parse_item(
+    line: &str,
+    fixed: &BTreeMap<u32, Vector3<f64>>,
+    tracked: &mut BTreeSet<u32>,
+) -> Result<Item, LineError> {
+    parse(line, fixed, tracked).map_err(LineError)
+}
+
+fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &mut BTreeSet<u32>) -> Result<Item, String> {
+    let v: Map<String, Value> = serde_json::from_str(line).map_err(|e| format!("not a JSON object: {e}"))?;
+    let finite = |key: &str, x: &Value| -> Result<f64, String> {
+        x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| format!("`{key}` = {x} is not a finite number"))
+    };
+    let num = |key: &str| -> Result<f64, String> {
+        v.get(key).map_or_else(|| Err(format!("missing key `{key}`")), |x| finite(key, x))
+    };
+    let optional = |key: &str| v.get(key).map(|x| finite(key, x)).transpose();
+    let kind = v.get("kind").and_then(Value::as_str).ok_or_else(|| format!("missing key `kind` (one of {KINDS})"))?;
+    let t_s = num("t_s")?;
+    let beacon_id = || -> Result<u32, String> {
+        let id = v.get("beacon").and_then(Value::as_u64).and_then(|b| u32::try_from(b).ok());
+        id.ok_or_else(|| "`beacon` must be a beacon id (a non-negative integer)".to_string())
+    };
+    let beacon = |tracked: &BTreeSet<u32>| -> Result<BeaconFix, String> {
+        let mut b = resolve_beacon(beacon_id()?, beacons, tracked)?;
+        b.sigma_m = optional("beacon_sigma_m")?.unwrap_or(0.0);
+        if b.sigma_m < 0.0 {
+            return Err(format!("`beacon_sigma_m` = {} must be >= 0", b.sigma_m));
+        }
+        b.t_tx_s = optional("t_tx_s")?;
+        Ok(b)
+    };
+    let m = Input::Measurement;
+    let input = match kind {
+        "odometry" => {
+            m(Kind::Odometry { distance_m: num("distance_m")?, heading_change_rad: num("heading_change_rad")? })
+        }
+        "speed" => m(Kind::Speed { speed_m_s: num("speed_m_s")? }),
+        "heading" => m(Kind::Heading { heading_rad: num("heading_rad")? }),
+        "depth" => m(Kind::Depth { depth_m: num("depth_m")? }),
+        "attitude" => m(Kind::Attitude {
+            roll_rad: num("roll_rad")?,
+            pitch_rad: num("pitch_rad")?,
+            heading_rad: num("heading_rad")?,
+        }),
+        "body_velocity" => {
+            let nu = v.get("nu").and_then(Value::as_array).filter(|a| a.len() == 6);
+            let nu = nu.ok_or("`nu` must be [u, v, w, p, q, r] (m/s, rad/s)")?;
+            let mut out = [0.0; 6];
+            for (o, x) in out.iter_mut().zip(nu) {
+                *o = finite("nu", x)?;
+            }
+            m(Kind::BodyVelocity { nu: out })
+        }
+        "inertial" => m(Kind::Inertial {
+            heading_rad: num("heading_rad")?,
+            yaw_rate_rad_s: num("yaw_rate_rad_s")?,
+            accel_m_s2: num("accel_m_s2")?,
+        }),
+        "range" => m(Kind::Range { beacon: beacon(tracked)?, range_m: num("range_m")? }),
+        "doppler" => m(Kind::Doppler { beacon: beacon(tracked)?, radial_speed_m_s: num("radial_speed_m_s")? }),
+        "range_doppler" => m(Kind::RangeDoppler {
+            beacon: beacon(tracked)?,
+            range_m: num("range_m")?,
+            radial_speed_m_s: num("radial_speed_m_s")?,
+        }),
+        "beacon_position" => {
+            let beacon_id = beacon_id()?;
+            tracked.insert(beacon_id);
+            let z = optional("z_m")?.unwrap_or(0.0);
+            Input::BeaconPosition { beacon_id, position: Vector3::new(num("x_m")?, num("y_m")?, z) }
+        }
+        "ground_truth" => {
+            let heading_rad = optional("heading_rad")?;
+            Input::Truth(TruthPose { north_m: num("x_m")?, east_m: num("y_m")?, heading_rad })
+        }
+        other => return Err(format!("unknown kind `{other}` (one of {KINDS})")),
+    };
+    Ok(Item { t_s, input })
+}
+
+/// One output line: every estimator's estimate (estimators `names`) after input line
+/// `line`, in `frame` (the input's).
+pub fn step_json(line: usize, step: &Step, names: &[String], frame: Frame) -> Value {
+    let estimates: Vec<Value> = step
+        .estimates
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let (x, y, _) = frame.from_ned(&Vector3::new(e.north_m(), e.east_m(), 0.0));
+            let (sx, sy, _) = frame.from_ned(&Vector3::new(e.sigma_north_m(), e.sigma_east_m(), 0.0));
+            let mut v = json!({
+                "name": names[i],
+                "x_m": x,
+                "y_m": y,
+                "heading_rad": frame.heading_from_ned(e.heading_rad()),
+                "sigma_x_m": sx.abs(),
+                "sigma_y_m": sy.abs(),
+            });
+            for (k, x) in e.calibration() {
+                v[k] = json!(x);
+            }
+            if let Some(o) = step.outcomes[i] {
+                let (outcome, nis) = match o {
+                    Outcome::Applied => ("applied", None),
+                    Outcome::Accepted(n) => ("accepted", Some(n)),
+                    Outcome::Rejected(n) => ("rejected", Some(n)),
+                    Outcome::Skipped => ("skipped", None),
+                    Outcome::Failed(_) => ("failed", None),
+                };
+                v["outcome"] = json!(outcome);
+                if let Some(n) = nis {
+                    v["nis"] = json!(n);
+                }
+            }
+            if let Some((err, _)) = step.errors.as_ref().map(|e| e[i]) {
+                v["error_m"] = json!(err);
+            }
+            v
+        })
+        .collect();
+    json!({"line": line, "t_s": step.t_s, "estimates": estimates})
+}
+
+/// Reads JSON Lines items from `input` into `session` (fixed beacons `fixed`, lines in
+/// `frame`), writing one [`step_json`] line per item to `output`, flushed after each.
+/// A bad line (not an item, or earlier than the line before) goes to `bad` with its
+/// line number and is skipped; only an I/O error stops the stream.
+pub fn run(
+    session: &mut Session,
+    fixed: &BTreeMap<u32, Vector3<f64>>,
+    frame: Frame,
+    input: impl BufRead,
+    mut output: impl Write,
+    mut bad: impl FnMut(usize, &LineError),
+) -> std::io::Result<()> {
+    let mut tracked = BTreeSet::new();
+    let mut last_t = f64::NEG_INFINITY;
+    for (n, line) in input.lines().enumerate() {
+        let number = n + 1;
+        let line = line?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let item = match parse_item(&line, fixed, &mut tracked) {
+            Ok(item) if item.t_s < last_t => {
+                Err(LineError(format!("time {} is before {last_t} on an earlier line", item.t_s)))
+            }
+            other => other,
+        };
+        match item {
+            Ok(item) => {
+                last_t = item.t_s;
+                if let Some(step) = session.push(&item) {
+                    writeln!(output, "{}", step_json(number, &step, &session.names, frame))?;
+                    output.flush()?;
+                }
+            }
+            Err(e) => bad(number, &e),
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::filter::FilterKind;
+    use crate::nav::PlanarConfig;
+    use crate::nav::session::Start;
+
+    fn fixed() -> BTreeMap<u32, Vector3<f64>> {
+        BTreeMap::from([(3, Vector3::new(10.0, -20.0, 5.0))])
+    }
+
+    /// Every kind written by `item_json` reads back as the same item.
+    #[test]
+    fn items_round_trip() {
+        let b = BeaconFix { id: 3, position_ned_m: fixed()[&3], sigma_m: 0.5, t_tx_s: Some(1.25) };
+        let kinds = [
+            Kind::Odometry { distance_m: 0.3, heading_change_rad: -0.01 },
+            Kind::Speed { speed_m_s: 1.2 },
+            Kind::Heading { heading_rad: 0.7 },
+            Kind::Depth { depth_m: 12.0 },
+            Kind::Attitude { roll_rad: 0.01, pitch_rad: -0.02, heading_rad: 2.0 },
+            Kind::BodyVelocity { nu: [1.0, 0.1, 0.0, 0.0, 0.0, 0.02] },
+            Kind::Inertial { heading_rad: 1.0, yaw_rate_rad_s: 0.01, accel_m_s2: 0.001 },
+            Kind::Range { beacon: b, range_m: 42.5 },
+            Kind::Doppler { beacon: b, radial_speed_m_s: -0.4 },
+            Kind::RangeDoppler { beacon: b, range_m: 42.5, radial_speed_m_s: -0.4 },
+        ];
+        let mut items: Vec<Item> = kinds.iter().map(|k| Item { t_s: 2.5, input: Input::Measurement(*k) }).collect();
+        items.push(Item {
+            t_s: 3.0,
+            input: Input::BeaconPosition { beacon_id: 7, position: Vector3::new(1.0, 2.0, 0.5) },
+        });
+        items.push(Item {
+            t_s: 3.5,
+            input: Input::Truth(TruthPose { north_m: 4.0, east_m: 5.0, heading_rad: Some(0.25) }),
+        });
+        let mut tracked = BTreeSet::new();
+        for item in &items {
+            let line = item_json(item).to_string();
+            assert_eq!(parse_item(&line, &fixed(), &mut tracked).as_ref(), Ok(item), "{line}");
+        }
+        assert!(tracked.contains(&7));
+    }
+
+    #[test]
+    fn bad_lines_name_the_key_and_what_is_allowed() {
+        let mut tracked = BTreeSet::new();
+        let mut err = |line: &str| parse_item(line, &fixed(), &mut tracked).unwrap_err().to_string();
+        assert!(err("{\"t_s\": 1, \"kind\": \"sonar\"}").contains("unknown kind `sonar` (one of odometry"));
+        assert!(err("{\"t_s\": 1, \"kind\": \"speed\"}").contains("missing key `speed_m_s`"));
+        assert!(err("{\"t_s\": 1, \"kind\": \"range\", \"beacon\": 9, \"range_m\": 3}").contains("beacon 9"));
+        assert!(err("{\"t_s\": 1, \"kind\": \"depth\", \"depth_m\": \"deep\"}").contains("`depth_m`"));
+        assert!(err("[1, 2]").contains("not a JSON object"));
+    }
+
+    /// A stream goes on past bad lines and lines out of time order, one output line per
+    /// good item.
+    #[test]
+    fn run_skips_bad_lines_and_answers_every_good_one() {
+        let config = PlanarConfig { use_beacons: false, ..PlanarConfig::default() };
+        let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
+        let mut session =
+            Session::new(Frame::Ned, vec![("dr".into(), config, FilterKind::Ekf)], start, (1.0, 0.1), None);
+        let input = [
+            r#"{"t_s": 0, "kind": "heading", "heading_rad": 0}"#,
+            "not json",
+            r#"{"t_s": 1, "kind": "odometry", "distance_m": 1.0, "heading_change_rad": 0}"#,
+            "",
+            r#"{"t_s": 0.5, "kind": "speed", "speed_m_s": 1}"#,
+            r#"{"t_s": 2, "kind": "odometry", "distance_m": 1.0, "heading_change_rad": 0}"#,
+        ]
+        .join("\n");
+        let mut out = Vec::new();
+        let mut bad = Vec::new();
+        run(&mut session, &fixed(), Frame::Ned, input.as_bytes(), &mut out, |n, e| bad.push((n, e.to_string())))
+            .unwrap();
+        assert_eq!(bad.iter().map(|b| b.0).collect::<Vec<_>>(), [2, 5]);
+        assert!(bad[1].1.contains("before 1"), "{}", bad[1].1);
+        let lines: Vec<Value> =
+            String::from_utf8(out).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+        assert_eq!(lines.len(), 3);
+        assert_eq!(lines[2]["line"], 6);
+        // two metres of odometry north
+        let x = lines[2]["estimates"][0]["x_m"].as_f64().unwrap();
+        assert!((x - 2.0).abs() < 1e-9, "{x}");
+    }
+}

@@ -1,0 +1,4 @@
+//! Input and output formats of the onboard crate.
+
+#[cfg(feature = "stream")]
+pub mod jsonl;
