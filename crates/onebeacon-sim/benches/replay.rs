@@ -13,7 +13,7 @@ fn bench(c: &mut Criterion) {
     let full = Log::load(&path).unwrap();
     let mut log = full.clone();
     let keep = ["dead-reckoning", "ekf-bias-gated", "ekf-cal-gated"];
-    log.description.estimators.retain(|e| keep.contains(&e.name.as_str()));
+    log.description.estimators.retain(|e| keep.contains(&e.name().as_str()));
     assert_eq!(log.description.estimators.len(), 3);
     c.bench_function("plaza1 replay, 3 estimators", |b| b.iter(|| black_box(replay(&log, None).unwrap())));
     let n = full.description.estimators.len();

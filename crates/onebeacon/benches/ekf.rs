@@ -11,7 +11,7 @@ use std::hint::black_box;
 fn navigator(filter: FilterKind) -> SingleBeaconNavigator {
     let z0 = State::from([10.0, 20.0, 1.0, 1.0, 0.01, 0.0]);
     let p0 = Cov::from_diagonal(&SVector::from([1.0, 1.0, 0.01, 0.01, 1e-4, 1e-4]));
-    SingleBeaconNavigator::new(Aiding::RangeDoppler, EkfTuning::default(), filter, 0.0, z0, p0)
+    SingleBeaconNavigator::new(Aiding::RANGE_DOPPLER, EkfTuning::default(), filter, 0.0, z0, p0)
 }
 
 fn bench(c: &mut Criterion) {

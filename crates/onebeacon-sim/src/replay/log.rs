@@ -2,12 +2,12 @@
 //! stream. Every error is one line naming the file, the line, the column or key and
 //! what was expected.
 
+use crate::scenario::EstimatorSpec;
 use crate::scenario::load::deserialize;
 use nalgebra::Vector3;
-use onebeacon::filter::FilterKind;
 use onebeacon::geo::Frame;
+use onebeacon::nav::Kind;
 use onebeacon::nav::session::{Input, Item, TruthPose, resolve_beacon};
-use onebeacon::nav::{Kind, PlanarConfig, PlanarNoise};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -58,7 +58,7 @@ pub enum SourceKind {
 
 impl SourceKind {
     /// The column keys this kind needs, and those it may have.
-    fn columns(self) -> (&'static [&'static str], &'static [&'static str]) {
+    pub(crate) fn columns(self) -> (&'static [&'static str], &'static [&'static str]) {
         match self {
             SourceKind::Odometry => (&["distance", "heading_change"], &[]),
             SourceKind::Speed => (&["speed"], &[]),
@@ -144,7 +144,7 @@ pub struct Source {
 }
 
 impl Source {
-    fn column(&self, key: &str) -> Option<&String> {
+    pub(crate) fn column(&self, key: &str) -> Option<&String> {
         match key {
             "distance" => self.distance.as_ref(),
             "heading_change" => self.heading_change.as_ref(),
@@ -162,7 +162,7 @@ impl Source {
     }
 }
 
-const COLUMN_KEYS: [&str; 11] =
+pub(crate) const COLUMN_KEYS: [&str; 11] =
     ["distance", "heading_change", "speed", "heading", "depth", "beacon", "range", "radial_speed", "x", "y", "z"];
 
 /// Fixed beacon positions from a CSV file.
@@ -223,10 +223,12 @@ pub struct Initial {
     pub x_m: Option<f64>,
     pub y_m: Option<f64>,
     pub heading_deg: Option<f64>,
-    #[serde(default = "default_sigma_position_m")]
-    pub sigma_position_m: f64,
-    #[serde(default = "default_sigma_heading_deg")]
-    pub sigma_heading_deg: f64,
+    /// Initial standard deviations (`sigma_position_m`, `sigma_heading_deg`, the old
+    /// names, are read too).
+    #[serde(default = "default_position_sigma_m", alias = "sigma_position_m")]
+    pub position_sigma_m: f64,
+    #[serde(default = "default_heading_sigma_deg", alias = "sigma_heading_deg")]
+    pub heading_sigma_deg: f64,
 }
 
 impl Initial {
@@ -243,94 +245,11 @@ impl Initial {
 fn default_track_m() -> f64 {
     2.0
 }
-fn default_sigma_position_m() -> f64 {
+fn default_position_sigma_m() -> f64 {
     1.0
 }
-fn default_sigma_heading_deg() -> f64 {
+fn default_heading_sigma_deg() -> f64 {
     5.0
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EstimatorKind {
-    /// Odometry (and heading fixes) alone.
-    DeadReckoning,
-    /// The planar EKF with ranges and Doppler speeds.
-    RangeEkf,
-}
-
-/// One estimator to run, with its noise settings (defaults: [`PlanarNoise`]).
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EstimatorSpec {
-    pub name: String,
-    pub kind: EstimatorKind,
-    #[serde(default)]
-    pub estimate_bias: bool,
-    #[serde(default)]
-    pub bias_m: f64,
-    pub bias_sigma_m: Option<f64>,
-    #[serde(default)]
-    pub estimate_range_scale: bool,
-    pub range_scale_sigma: Option<f64>,
-    #[serde(default)]
-    pub estimate_distance_scale: bool,
-    pub distance_scale_sigma: Option<f64>,
-    #[serde(default)]
-    pub estimate_turn_scale: bool,
-    pub turn_scale_sigma: Option<f64>,
-    pub nis_gate: Option<f64>,
-    pub range_sigma_m: Option<f64>,
-    pub heading_sigma_deg: Option<f64>,
-    pub doppler_sigma_m_s: Option<f64>,
-    pub distance_sigma_frac: Option<f64>,
-    pub heading_change_sigma_frac: Option<f64>,
-    pub heading_walk_deg_per_sqrt_m: Option<f64>,
-    pub speed_sigma_m_s: Option<f64>,
-    pub bias_walk_m_per_sqrt_s: Option<f64>,
-    /// `"ekf"` (default) or `"ukf"`, with the UKF's sigma-point parameters.
-    #[serde(default)]
-    pub filter: crate::scenario::FilterName,
-    pub ukf_alpha: Option<f64>,
-    pub ukf_beta: Option<f64>,
-    pub ukf_kappa: Option<f64>,
-}
-
-impl EstimatorSpec {
-    pub fn filter_kind(&self) -> FilterKind {
-        self.filter.kind(self.ukf_alpha, self.ukf_beta, self.ukf_kappa)
-    }
-
-    pub fn config(&self) -> PlanarConfig {
-        let c = PlanarConfig::default();
-        let d = c.noise;
-        let noise = PlanarNoise {
-            distance_sigma_frac: self.distance_sigma_frac.unwrap_or(d.distance_sigma_frac),
-            heading_change_sigma_frac: self.heading_change_sigma_frac.unwrap_or(d.heading_change_sigma_frac),
-            heading_walk_rad_per_sqrt_m: self
-                .heading_walk_deg_per_sqrt_m
-                .map_or(d.heading_walk_rad_per_sqrt_m, f64::to_radians),
-            speed_sigma_m_s: self.speed_sigma_m_s.unwrap_or(d.speed_sigma_m_s),
-            range_sigma_m: self.range_sigma_m.unwrap_or(d.range_sigma_m),
-            heading_sigma_rad: self.heading_sigma_deg.map_or(d.heading_sigma_rad, f64::to_radians),
-            doppler_sigma_m_s: self.doppler_sigma_m_s.unwrap_or(d.doppler_sigma_m_s),
-            bias_walk_m_per_sqrt_s: self.bias_walk_m_per_sqrt_s.unwrap_or(d.bias_walk_m_per_sqrt_s),
-        };
-        PlanarConfig {
-            use_beacons: self.kind == EstimatorKind::RangeEkf,
-            estimate_bias: self.estimate_bias,
-            bias_m: self.bias_m,
-            bias_sigma_m: self.bias_sigma_m.unwrap_or(c.bias_sigma_m),
-            estimate_range_scale: self.estimate_range_scale,
-            range_scale_sigma: self.range_scale_sigma.unwrap_or(c.range_scale_sigma),
-            estimate_distance_scale: self.estimate_distance_scale,
-            distance_scale_sigma: self.distance_scale_sigma.unwrap_or(c.distance_scale_sigma),
-            estimate_turn_scale: self.estimate_turn_scale,
-            turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
-            nis_gate: self.nis_gate,
-            noise,
-        }
-    }
 }
 
 /// The log description file.
@@ -348,7 +267,8 @@ pub struct LogDescription {
     #[serde(default, rename = "beacon")]
     pub beacon_list: Vec<BeaconEntry>,
     pub initial: Initial,
-    #[serde(rename = "estimator")]
+    /// `[[estimators]]` as in scenarios (`[[estimator]]`, the old name, is read too).
+    #[serde(alias = "estimator")]
     pub estimators: Vec<EstimatorSpec>,
 }
 
@@ -369,110 +289,9 @@ impl LogDescription {
         let text =
             std::fs::read_to_string(path).map_err(|e| LogError::File { file: name.clone(), message: e.to_string() })?;
         let d: LogDescription = deserialize(&text, &name)?;
-        d.check(&name)?;
+        crate::scenario::validate::validate_log(&d)
+            .map_err(|v| LogError::Description(crate::scenario::load::invalid(&name, v)))?;
         Ok(d)
-    }
-
-    fn check(&self, name: &str) -> Result<(), LogError> {
-        let bad = |key: String, value: String, allowed: &str| {
-            LogError::Description(crate::ScenarioError::Invalid {
-                source_name: name.to_string(),
-                key,
-                value,
-                allowed: allowed.to_string(),
-            })
-        };
-        for (i, s) in self.sources.iter().enumerate() {
-            let (required, optional) = s.kind.columns();
-            for key in required {
-                if s.column(key).is_none() {
-                    let msg = format!("a {:?} source needs the column keys {}", s.kind, required.join(", "));
-                    return Err(bad(format!("source[{i}].{key}"), "missing".into(), &msg));
-                }
-            }
-            for key in COLUMN_KEYS {
-                if s.column(key).is_some() && !required.contains(&key) && !optional.contains(&key) {
-                    let allowed: Vec<&str> = required.iter().chain(optional).copied().collect();
-                    let msg =
-                        format!("does not apply to a {:?} source (its column keys: {})", s.kind, allowed.join(", "));
-                    return Err(bad(
-                        format!("source[{i}].{key}"),
-                        format!("{:?}", s.column(key).unwrap_or(&String::new())),
-                        &msg,
-                    ));
-                }
-            }
-            if !s.time_offset_s.is_finite() {
-                return Err(bad(
-                    format!("source[{i}].time_offset_s"),
-                    s.time_offset_s.to_string(),
-                    "a finite number of seconds",
-                ));
-            }
-        }
-        if self.estimators.is_empty() {
-            return Err(bad("estimator".into(), "[]".into(), "at least one [[estimator]] table"));
-        }
-        let mut names = std::collections::BTreeSet::new();
-        for (i, e) in self.estimators.iter().enumerate() {
-            if e.name.is_empty() || e.name.contains([',', '"', '\n']) || !names.insert(e.name.as_str()) {
-                return Err(bad(
-                    format!("estimator[{i}].name"),
-                    format!("{:?}", e.name),
-                    "a unique, non-empty name without commas or quotes",
-                ));
-            }
-            let positive = [
-                ("range_sigma_m", e.range_sigma_m),
-                ("heading_sigma_deg", e.heading_sigma_deg),
-                ("doppler_sigma_m_s", e.doppler_sigma_m_s),
-                ("nis_gate", e.nis_gate),
-                ("bias_sigma_m", e.bias_sigma_m),
-                ("range_scale_sigma", e.range_scale_sigma),
-                ("distance_scale_sigma", e.distance_scale_sigma),
-                ("turn_scale_sigma", e.turn_scale_sigma),
-            ];
-            for (key, v) in positive {
-                if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
-                    return Err(bad(format!("estimator[{i}].{key}"), v.to_string(), "a number > 0"));
-                }
-            }
-            let non_negative = [
-                ("distance_sigma_frac", e.distance_sigma_frac),
-                ("heading_change_sigma_frac", e.heading_change_sigma_frac),
-                ("heading_walk_deg_per_sqrt_m", e.heading_walk_deg_per_sqrt_m),
-                ("speed_sigma_m_s", e.speed_sigma_m_s),
-                ("bias_walk_m_per_sqrt_s", e.bias_walk_m_per_sqrt_s),
-            ];
-            for (key, v) in non_negative {
-                if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
-                    return Err(bad(format!("estimator[{i}].{key}"), v.to_string(), "a finite number >= 0"));
-                }
-            }
-            crate::scenario::validate::check_ukf(&format!("estimator[{i}]"), 7, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))
-                .map_err(|v| crate::scenario::load::invalid(name, v))?;
-            if !e.bias_m.is_finite() {
-                return Err(bad(format!("estimator[{i}].bias_m"), e.bias_m.to_string(), "a finite number"));
-            }
-        }
-        let init = &self.initial;
-        if init.from == InitialFrom::Given && (init.x_m.is_none() || init.y_m.is_none() || init.heading_deg.is_none()) {
-            return Err(bad(
-                "initial.from".into(),
-                "\"given\"".into(),
-                "needs initial.x_m, initial.y_m and initial.heading_deg",
-            ));
-        }
-        for (key, v) in [
-            ("sigma_position_m", init.sigma_position_m),
-            ("sigma_heading_deg", init.sigma_heading_deg),
-            ("track_m", init.track_m),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(format!("initial.{key}"), v.to_string(), "a number > 0"));
-            }
-        }
-        Ok(())
     }
 
     /// Fixed beacons (the log's frame): the `[beacons]` file and the inline `[[beacon]]`

@@ -24,8 +24,8 @@ pub struct Replay {
 /// A session of the description's estimators, starting at `start`, restricted to
 /// `beacons` when given (replay and stream).
 pub fn new_session(d: &LogDescription, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
-    let estimators = d.estimators.iter().map(|e| (e.name.clone(), e.config(), e.filter_kind())).collect();
-    let sigmas = (d.initial.sigma_position_m, d.initial.sigma_heading_deg.to_radians());
+    let estimators = d.estimators.iter().map(|e| (e.name(), e.planar_config(), e.filter_kind())).collect();
+    let sigmas = (d.initial.position_sigma_m, d.initial.heading_sigma_deg.to_radians());
     Session::new(d.frame.into(), estimators, start, sigmas, beacons)
 }
 

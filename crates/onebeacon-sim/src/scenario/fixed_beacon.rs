@@ -1,9 +1,7 @@
 //! Scenarios of kind `fixed_beacon` (garin2024): an AUV on a boustrophedon, a fixed
 //! beacon, range and Doppler from communication frames. Unknown keys are errors.
 
-use super::{FilterName, World, default_runs, default_seed};
-use onebeacon::filter::FilterKind;
-use onebeacon::nav::{Aiding, EkfTuning};
+use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
 use serde::{Deserialize, Serialize};
 
 /// A complete fixed-beacon scenario: the world, the vehicle, its sensors, the
@@ -205,122 +203,6 @@ impl Default for Initial {
             speed_sigma_m_s: 0.05,
             yaw_rate_sigma_rad_s: 0.01,
             accel_sigma_m_s2: 0.01,
-        }
-    }
-}
-
-/// Which estimator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum EstimatorKind {
-    /// garin2024's EKF with range and Doppler speed.
-    #[serde(rename = "range+doppler")]
-    RangeDoppler,
-    /// Range-only single beacon EKF (ROSB).
-    #[serde(rename = "rosb")]
-    Rosb,
-}
-
-impl EstimatorKind {
-    pub fn aiding(self) -> Aiding {
-        match self {
-            EstimatorKind::RangeDoppler => Aiding::RangeDoppler,
-            EstimatorKind::Rosb => Aiding::RangeOnly,
-        }
-    }
-    pub fn label(self) -> &'static str {
-        match self {
-            EstimatorKind::RangeDoppler => "range+doppler",
-            EstimatorKind::Rosb => "rosb",
-        }
-    }
-}
-
-/// One estimator to run. Noise defaults are garin2024 eq. 25.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EstimatorSpec {
-    pub kind: EstimatorKind,
-    /// Name in outputs; default: the kind.
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Diagonal of Q per step, state order [x, y, psi, v, Omega, a].
-    #[serde(default = "default_q")]
-    pub q_diag: [f64; 6],
-    #[serde(default = "default_r_range")]
-    pub r_range_m2: f64,
-    #[serde(default = "default_r_doppler")]
-    pub r_doppler_m2_s2: f64,
-    #[serde(default = "default_r_heading")]
-    pub r_heading_rad2: f64,
-    #[serde(default = "default_r_yaw_rate")]
-    pub r_yaw_rate_rad2_s2: f64,
-    #[serde(default = "default_r_accel")]
-    pub r_accel_m2_s4: f64,
-    /// `"ekf"` (default) or `"ukf"`.
-    #[serde(default)]
-    pub filter: FilterName,
-    /// The UKF's sigma-point parameters (default 1, 2, 0).
-    pub ukf_alpha: Option<f64>,
-    pub ukf_beta: Option<f64>,
-    pub ukf_kappa: Option<f64>,
-}
-
-fn default_q() -> [f64; 6] {
-    EkfTuning::default().q_diag
-}
-fn default_r_range() -> f64 {
-    EkfTuning::default().r_range_m2
-}
-fn default_r_doppler() -> f64 {
-    EkfTuning::default().r_doppler_m2_s2
-}
-fn default_r_heading() -> f64 {
-    EkfTuning::default().r_heading_rad2
-}
-fn default_r_yaw_rate() -> f64 {
-    EkfTuning::default().r_yaw_rate_rad2_s2
-}
-fn default_r_accel() -> f64 {
-    EkfTuning::default().r_accel_m2_s4
-}
-
-impl EstimatorSpec {
-    /// An estimator of `kind` with the default (eq. 25) tuning.
-    pub fn new(kind: EstimatorKind) -> Self {
-        let t = EkfTuning::default();
-        Self {
-            kind,
-            name: None,
-            q_diag: t.q_diag,
-            r_range_m2: t.r_range_m2,
-            r_doppler_m2_s2: t.r_doppler_m2_s2,
-            r_heading_rad2: t.r_heading_rad2,
-            r_yaw_rate_rad2_s2: t.r_yaw_rate_rad2_s2,
-            r_accel_m2_s4: t.r_accel_m2_s4,
-            filter: FilterName::Ekf,
-            ukf_alpha: None,
-            ukf_beta: None,
-            ukf_kappa: None,
-        }
-    }
-
-    /// Name in outputs: `name`, or the kind with "-ukf" for the UKF.
-    pub fn name(&self) -> String {
-        self.name.clone().unwrap_or_else(|| format!("{}{}", self.kind.label(), self.filter.suffix()))
-    }
-
-    pub fn filter_kind(&self) -> FilterKind {
-        self.filter.kind(self.ukf_alpha, self.ukf_beta, self.ukf_kappa)
-    }
-
-    pub fn tuning(&self) -> EkfTuning {
-        EkfTuning {
-            q_diag: self.q_diag,
-            r_range_m2: self.r_range_m2,
-            r_doppler_m2_s2: self.r_doppler_m2_s2,
-            r_heading_rad2: self.r_heading_rad2,
-            r_yaw_rate_rad2_s2: self.r_yaw_rate_rad2_s2,
-            r_accel_m2_s4: self.r_accel_m2_s4,
         }
     }
 }

@@ -7,6 +7,7 @@
 //! unit in their name; angles in config are degrees (`*_deg`), radians inside.
 
 mod builtin;
+pub mod estimator;
 pub mod fixed_beacon;
 pub(crate) mod load;
 pub mod moving_beacon;
@@ -14,6 +15,7 @@ pub mod ping;
 pub(crate) mod validate;
 
 pub use builtin::{BUILTINS, Builtin, builtin};
+pub use estimator::{EstimatorKind, EstimatorSpec, Host};
 pub use fixed_beacon::{FixedBeacon, FixedBeaconCell};
 pub use load::{ScenarioError, load, parse};
 pub use moving_beacon::{MovingBeacon, MovingBeaconCell};
@@ -32,8 +34,7 @@ pub enum World {
     MovingBeacon,
 }
 
-/// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table
-/// (scenarios) and `[[estimator]]` table (log descriptions).
+/// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FilterName {

@@ -3,8 +3,7 @@
 //! steered by a guidance law, one-way travel-time ranges propagating at the speed of
 //! sound between moving ends. Unknown keys are errors.
 
-use super::{FilterName, World, default_runs, default_seed};
-use onebeacon::filter::FilterKind;
+use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -247,57 +246,6 @@ pub struct Initial {
 impl Default for Initial {
     fn default() -> Self {
         Self { position_sigma_m: 1.0, depth_sigma_m: 0.1, attitude_sigma_deg: 1.0 }
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum EstimatorKind {
-    /// EKF with attitude, depth and OWTT ranges (sousa section 3.2).
-    #[serde(rename = "range-ekf")]
-    RangeEkf,
-    /// The same filter without ranges.
-    #[serde(rename = "dead-reckoning")]
-    DeadReckoning,
-}
-
-impl EstimatorKind {
-    pub fn label(self) -> &'static str {
-        match self {
-            EstimatorKind::RangeEkf => "range-ekf",
-            EstimatorKind::DeadReckoning => "dead-reckoning",
-        }
-    }
-}
-
-/// One estimator. Its noise model is the sensors' (a matched filter).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EstimatorSpec {
-    pub kind: EstimatorKind,
-    #[serde(default)]
-    pub name: Option<String>,
-    /// `"ekf"` (default) or `"ukf"`.
-    #[serde(default)]
-    pub filter: FilterName,
-    /// The UKF's sigma-point parameters (default 1, 2, 0).
-    pub ukf_alpha: Option<f64>,
-    pub ukf_beta: Option<f64>,
-    pub ukf_kappa: Option<f64>,
-}
-
-impl EstimatorSpec {
-    /// An EKF estimator of `kind`.
-    pub fn new(kind: EstimatorKind) -> Self {
-        Self { kind, name: None, filter: FilterName::Ekf, ukf_alpha: None, ukf_beta: None, ukf_kappa: None }
-    }
-
-    /// Name in outputs: `name`, or the kind with "-ukf" for the UKF.
-    pub fn name(&self) -> String {
-        self.name.clone().unwrap_or_else(|| format!("{}{}", self.kind.label(), self.filter.suffix()))
-    }
-
-    pub fn filter_kind(&self) -> FilterKind {
-        self.filter.kind(self.ukf_alpha, self.ukf_beta, self.ukf_kappa)
     }
 }
 

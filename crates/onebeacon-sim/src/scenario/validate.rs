@@ -1,7 +1,9 @@
 //! Range checks on a parsed scenario. The first violation is reported with its key.
 
+use super::estimator::{EstimatorSpec, Host, Sign};
 use super::moving_beacon::Vehicle;
 use super::{FixedBeacon, MovingBeacon, Scenario};
+use crate::replay::log::{COLUMN_KEYS, InitialFrom, LogDescription};
 
 pub(crate) struct Violation {
     pub key: String,
@@ -96,6 +98,49 @@ fn check_names(section: &str, names: &[String]) -> Result<(), Violation> {
         }
         if names[..k].contains(name) {
             return Err(violation(format!("must differ from the other {section}' names (set `name`)")));
+        }
+    }
+    Ok(())
+}
+
+/// The `[[estimators]]` tables of `host`: names, the UKF's parameters, every tuning
+/// key that is set (it must apply to the host and be in range), and the acoustic
+/// measurements (the host must give them).
+pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Violation> {
+    check_names("estimators", &specs.iter().map(|e| e.name()).collect::<Vec<_>>())?;
+    // the planar state has 4 to 8 components; 7 bounds kappa for the common case
+    let states = if host == Host::Log { 7 } else { 6 };
+    for (k, e) in specs.iter().enumerate() {
+        let key = |f: &str| format!("estimators[{k}].{f}");
+        check_ukf(&format!("estimators[{k}]"), states, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
+        for (name, v, sign, hosts) in e.tuning_keys() {
+            if !hosts.contains(&host) {
+                let value = if name.starts_with("estimate_") { (v != 0.0).to_string() } else { format!("{v:?}") };
+                let applies: Vec<&str> = hosts.iter().map(|h| h.label()).collect();
+                return Err(Violation {
+                    key: key(name),
+                    value,
+                    allowed: format!("does not apply to a {} (it applies to: {})", host.label(), applies.join(", ")),
+                });
+            }
+            let rule = match sign {
+                Sign::Positive => Rule::Positive,
+                Sign::NonNegative => Rule::NonNegative,
+                Sign::Any => Rule::Finite,
+            };
+            check(&key(name), v, rule)?;
+        }
+        let (asked, has) = (e.aiding(host), host.acoustic());
+        if (asked.doppler && !has.doppler) || (asked.range && !has.range) {
+            let (k, value) = match &e.measurements {
+                Some(m) => (key("measurements"), format!("{m:?}").to_lowercase()),
+                None => (key("kind"), format!("{:?}", e.kind.label())),
+            };
+            return Err(Violation {
+                key: k,
+                value,
+                allowed: format!("uses Doppler speeds; a {} gives ranges only", host.label()),
+            });
         }
     }
     Ok(())
@@ -211,10 +256,7 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
         depth_sigma_m: Positive,
         attitude_sigma_deg: Positive,
     });
-    check_names("estimators", &s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
-    for (k, e) in s.estimators.iter().enumerate() {
-        check_ukf(&format!("estimators[{k}]"), 6, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
-    }
+    check_estimators(&s.estimators, Host::MovingBeacon)?;
     check_list_nonempty("sweep.path", &s.sweep.path)?;
     check_list_nonempty("sweep.guidance", &s.sweep.guidance)?;
     check_list_nonempty("sweep.depth_m", &s.sweep.depth_m)?;
@@ -277,19 +319,7 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
         accel_sigma_m_s2: Positive,
     });
 
-    check_names("estimators", &s.estimators.iter().map(|e| e.name()).collect::<Vec<_>>())?;
-    for (k, e) in s.estimators.iter().enumerate() {
-        let key = |f: &str| format!("estimators[{k}].{f}");
-        for (j, &q) in e.q_diag.iter().enumerate() {
-            check(&format!("estimators[{k}].q_diag[{j}]"), q, NonNegative)?;
-        }
-        check(&key("r_range_m2"), e.r_range_m2, Positive)?;
-        check(&key("r_doppler_m2_s2"), e.r_doppler_m2_s2, Positive)?;
-        check(&key("r_heading_rad2"), e.r_heading_rad2, Positive)?;
-        check(&key("r_yaw_rate_rad2_s2"), e.r_yaw_rate_rad2_s2, Positive)?;
-        check(&key("r_accel_m2_s4"), e.r_accel_m2_s4, Positive)?;
-        check_ukf(&format!("estimators[{k}]"), 6, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
-    }
+    check_estimators(&s.estimators, Host::FixedBeacon)?;
 
     if let Some(v) = &s.sweep.t_com_s {
         if v.is_empty() {
@@ -305,13 +335,44 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
     }
 
     // the run must be of a workable size
-    let steps = s.duration_s() / m.dt_s;
-    if steps > 1e8 {
+    check_steps(s.duration_s(), m.dt_s)
+}
+
+/// A log description: each source's column keys, the estimators, the start.
+pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
+    for (i, s) in d.sources.iter().enumerate() {
+        let (required, optional) = s.kind.columns();
+        if let Some(key) = required.iter().find(|k| s.column(k).is_none()) {
+            return Err(Violation {
+                key: format!("source[{i}].{key}"),
+                value: "missing".into(),
+                allowed: format!("a {:?} source needs the column keys {}", s.kind, required.join(", ")),
+            });
+        }
+        let known = |k: &&str| required.contains(k) || optional.contains(k);
+        if let Some(key) = COLUMN_KEYS.iter().find(|k| s.column(k).is_some() && !known(k)) {
+            let allowed: Vec<&str> = required.iter().chain(optional).copied().collect();
+            return Err(Violation {
+                key: format!("source[{i}].{key}"),
+                value: format!("{:?}", s.column(key).cloned().unwrap_or_default()),
+                allowed: format!("does not apply to a {:?} source (its column keys: {})", s.kind, allowed.join(", ")),
+            });
+        }
+        check(&format!("source[{i}].time_offset_s"), s.time_offset_s, Rule::Finite)?;
+    }
+    check_estimators(&d.estimators, Host::Log)?;
+    let init = &d.initial;
+    if init.from == InitialFrom::Given && (init.x_m.is_none() || init.y_m.is_none() || init.heading_deg.is_none()) {
         return Err(Violation {
-            key: "mission.dt_s".into(),
-            value: format!("{:?}", m.dt_s),
-            allowed: format!("gives {steps:.0} steps; at most 1e8 steps per run"),
+            key: "initial.from".into(),
+            value: "\"given\"".into(),
+            allowed: "needs initial.x_m, initial.y_m and initial.heading_deg".into(),
         });
     }
+    check_fields!("initial", init, {
+        position_sigma_m: Positive,
+        heading_sigma_deg: Positive,
+        track_m: Positive,
+    });
     Ok(())
 }

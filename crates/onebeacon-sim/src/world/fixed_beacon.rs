@@ -3,7 +3,7 @@
 
 use crate::engine::{Track, VehicleTruth, World};
 use crate::run::GuidanceSnapshot;
-use crate::scenario::{FixedBeacon, FixedBeaconCell};
+use crate::scenario::{FixedBeacon, FixedBeaconCell, Host};
 use crate::seed::{Stream, gauss, rng};
 use crate::sensors::SensorSuite;
 use crate::vehicles::{Path, TruthState, feedback_linearising_control};
@@ -73,8 +73,8 @@ impl FixedBeaconWorld {
             .map(|e| Track {
                 vehicle: 0,
                 navigator: Box::new(SingleBeaconNavigator::new(
-                    e.kind.aiding(),
-                    e.tuning(),
+                    e.aiding(Host::FixedBeacon),
+                    e.ekf_tuning(),
                     e.filter_kind(),
                     0.0,
                     z0,
@@ -175,11 +175,11 @@ mod tests {
         s.initial.accel_sigma_m_s2 = 1e-6;
         // and tell the filters their sensors are (nearly) exact
         for e in &mut s.estimators {
-            e.r_range_m2 = 1e-6;
-            e.r_doppler_m2_s2 = 1e-8;
-            e.r_heading_rad2 = 1e-8;
-            e.r_yaw_rate_rad2_s2 = 1e-10;
-            e.r_accel_m2_s4 = 1e-10;
+            e.range_sigma_m = Some(1e-3);
+            e.doppler_sigma_m_s = Some(1e-4);
+            e.heading_sigma_deg = Some(1e-4f64.to_degrees());
+            e.yaw_rate_sigma_rad_s = Some(1e-5);
+            e.accel_sigma_m_s2 = Some(1e-5);
         }
         // the UKF too
         let mut ukf = s.estimators[0].clone();

@@ -6,8 +6,8 @@
 use crate::acoustics::Ping;
 use crate::engine::{Observer, Step, Track, VehicleTruth, World};
 use crate::run::GuidanceSnapshot;
-use crate::scenario::moving_beacon::{EstimatorKind, GuidanceKind, Vehicle};
-use crate::scenario::{MovingBeacon, MovingBeaconCell};
+use crate::scenario::moving_beacon::{GuidanceKind, Vehicle};
+use crate::scenario::{Host, MovingBeacon, MovingBeaconCell};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::rov::{body_velocity, rk4_step};
@@ -135,8 +135,8 @@ impl<'a> MovingBeaconWorld<'a> {
             tracks.extend(s.estimators.iter().map(|e| Track {
                 vehicle: v,
                 navigator: Box::new(Range6DofNavigator::new(
-                    self.noise,
-                    e.kind == EstimatorKind::RangeEkf,
+                    e.sensor_noise(self.noise),
+                    e.aiding(Host::MovingBeacon),
                     e.filter_kind(),
                     0.0,
                     eta0,

@@ -296,7 +296,7 @@ mod tests {
     /// good item.
     #[test]
     fn run_skips_bad_lines_and_answers_every_good_one() {
-        let config = PlanarConfig { use_beacons: false, ..PlanarConfig::default() };
+        let config = PlanarConfig { aiding: crate::nav::Aiding::NONE, ..PlanarConfig::default() };
         let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
         let mut session =
             Session::new(Frame::Ned, vec![("dr".into(), config, FilterKind::Ekf)], start, (1.0, 0.1), None);

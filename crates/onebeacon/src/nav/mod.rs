@@ -15,10 +15,34 @@ pub mod single_beacon;
 pub use event::{BeaconFix, Kind, Measurement};
 pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
 pub use range_6dof::{Range6DofNavigator, SensorNoise};
-pub use single_beacon::{Aiding, EkfTuning, SingleBeaconNavigator};
+pub use single_beacon::{EkfTuning, SingleBeaconNavigator};
 
 use crate::filter::FilterError;
 use nalgebra::{Matrix2, Matrix3, Vector3};
+
+/// Which acoustic measurements a navigator uses: its beacon aiding. Every navigator
+/// takes one; a measurement it does not use is [`Outcome::Skipped`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Aiding {
+    /// Ranges (one-way travel times).
+    pub range: bool,
+    /// Doppler radial speeds.
+    pub doppler: bool,
+}
+
+impl Aiding {
+    /// No beacon: dead reckoning.
+    pub const NONE: Aiding = Aiding { range: false, doppler: false };
+    /// Ranges only (ROSB, range-only navigation).
+    pub const RANGE: Aiding = Aiding { range: true, doppler: false };
+    /// Ranges and Doppler speeds (garin2024's filter).
+    pub const RANGE_DOPPLER: Aiding = Aiding { range: true, doppler: true };
+
+    /// Whether any beacon measurement is used.
+    pub fn any(self) -> bool {
+        self.range || self.doppler
+    }
+}
 
 /// What processing one measurement did.
 #[derive(Debug, Clone, Copy, PartialEq)]

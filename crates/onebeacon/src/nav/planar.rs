@@ -13,7 +13,7 @@
 //! every combination. Doppler speeds are not scaled by k_r (acoustic Doppler speeds share
 //! the sound-speed error; modelling that is left for when a log needs it).
 
-use super::{Estimate, Kind, Measurement, Navigator, Outcome};
+use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::geo::wrap_angle;
 use crate::measure::{RadialSpeed2d, ScalarModel, SlantRange, StateComponent};
@@ -71,8 +71,9 @@ impl Default for PlanarNoise {
 /// What an estimator uses and how.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarConfig {
-    /// Use ranges and Doppler speeds (false: dead reckoning, heading fixes only).
-    pub use_beacons: bool,
+    /// The beacon measurements used ([`Aiding::NONE`]: dead reckoning, heading fixes
+    /// only).
+    pub aiding: Aiding,
     /// Estimate the range bias as a state.
     pub estimate_bias: bool,
     /// The range bias, m: the initial value when estimated, the known value otherwise.
@@ -100,7 +101,7 @@ pub struct PlanarConfig {
 impl Default for PlanarConfig {
     fn default() -> Self {
         Self {
-            use_beacons: true,
+            aiding: Aiding::RANGE_DOPPLER,
             estimate_bias: false,
             bias_m: 0.0,
             bias_sigma_m: 5.0,
@@ -297,7 +298,7 @@ impl Navigator for PlanarNavigator {
         let t_s = m.t_s;
         self.advance_to(t_s);
         let noise = self.config.noise;
-        let beacons = self.config.use_beacons;
+        let aiding = self.config.aiding;
         match m.kind {
             Kind::Odometry { distance_m, heading_change_rad } => {
                 if let Some(t0) = self.last_odometry_s.filter(|t0| t_s > *t0) {
@@ -322,21 +323,30 @@ impl Navigator for PlanarNavigator {
                 let var = noise.heading_sigma_rad * noise.heading_sigma_rad;
                 self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, f64::INFINITY)
             }
-            Kind::Range { beacon, range_m } if beacons => {
+            Kind::Range { beacon, range_m } if aiding.range => {
                 let model = self.range_model(beacon.position_ned_m);
                 self.correct(&model, range_m, self.gate())
             }
-            Kind::Doppler { beacon, radial_speed_m_s } if beacons => {
+            Kind::Doppler { beacon, radial_speed_m_s } if aiding.doppler => {
                 let model = self.doppler_model(beacon.position_ned_m);
                 self.correct(&model, radial_speed_m_s, self.gate())
             }
-            Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } if beacons => {
-                let range = self.correct(&self.range_model(beacon.position_ned_m), range_m, self.gate());
-                let doppler = self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, self.gate());
+            Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } if aiding.any() => {
+                let range = if aiding.range {
+                    self.correct(&self.range_model(beacon.position_ned_m), range_m, self.gate())
+                } else {
+                    Outcome::Skipped
+                };
+                let doppler = if aiding.doppler {
+                    self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, self.gate())
+                } else {
+                    Outcome::Skipped
+                };
                 // the worse of the two outcomes
                 match (range, doppler) {
                     (Outcome::Failed(e), _) | (_, Outcome::Failed(e)) => Outcome::Failed(e),
                     (Outcome::Rejected(n), _) | (_, Outcome::Rejected(n)) => Outcome::Rejected(n),
+                    (Outcome::Skipped, b) => b,
                     (a, _) => a,
                 }
             }
@@ -485,7 +495,7 @@ mod tests {
         let before = nav.estimate();
         assert!(matches!(nav.process(&Measurement::new(t, outlier)), Outcome::Rejected(nis) if nis > 10.83));
         assert_eq!(nav.estimate(), before);
-        let mut dr = start(PlanarConfig { use_beacons: false, ..PlanarConfig::default() });
+        let mut dr = start(PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() });
         assert_eq!(dr.process(&Measurement::new(1.0, outlier)), Outcome::Skipped);
     }
 

@@ -3,7 +3,7 @@
 //! (eq. 3.3-3.6), and OWTT range updates to a beacon whose position travels with the
 //! measurement (eq. 3.7-3.10).
 
-use super::{BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
+use super::{Aiding, BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::measure::{Range3d, StateComponent};
 use crate::models::kinematic6dof::{BodyVelocity, Cov, DIM, Kinematic6Dof, State, idx};
@@ -56,7 +56,7 @@ pub struct Range6DofNavigator {
     noise: SensorNoise,
     /// The depth sensor and AHRS models, built once.
     depth_attitude: [StateComponent; 4],
-    use_ranges: bool,
+    aiding: Aiding,
     filter: AnyFilter<DIM>,
     t_s: f64,
     nu: BodyVelocity,
@@ -64,12 +64,13 @@ pub struct Range6DofNavigator {
 }
 
 impl Range6DofNavigator {
-    /// A navigator at `t0_s` from `eta0` with covariance `p0`; `use_ranges` false is dead
-    /// reckoning (attitude and depth only).
-    pub fn new(noise: SensorNoise, use_ranges: bool, filter: FilterKind, t0_s: f64, eta0: State, p0: Cov) -> Self {
+    /// A navigator at `t0_s` from `eta0` with covariance `p0`. It uses ranges when
+    /// `aiding.range` (dead reckoning on attitude and depth otherwise); it has no
+    /// Doppler model.
+    pub fn new(noise: SensorNoise, aiding: Aiding, filter: FilterKind, t0_s: f64, eta0: State, p0: Cov) -> Self {
         let filter = AnyFilter::new(filter, eta0, p0);
         let depth_attitude = noise.depth_attitude_models();
-        Self { noise, depth_attitude, use_ranges, filter, t_s: t0_s, nu: BodyVelocity::zeros(), depth: None }
+        Self { noise, depth_attitude, aiding, filter, t_s: t0_s, nu: BodyVelocity::zeros(), depth: None }
     }
 
     pub fn state(&self) -> &State {
@@ -128,7 +129,7 @@ impl Navigator for Range6DofNavigator {
                     }
                 }
             }
-            Kind::Range { beacon, range_m } if self.use_ranges => {
+            Kind::Range { beacon, range_m } | Kind::RangeDoppler { beacon, range_m, .. } if self.aiding.range => {
                 // range update (eq. 3.7-3.10) at the receive time
                 self.advance_to(m.t_s);
                 let model = self.noise.range_model(&beacon);
@@ -178,8 +179,8 @@ mod tests {
         start[idx::E] -= 4.0;
         let p0 = Cov::from_diagonal(&SVector::from([25.0, 25.0, 0.01, 1e-3, 1e-3, 1e-3]));
         for kind in [FilterKind::Ekf, FilterKind::Ukf(UkfParams::default())] {
-            let mut f = Range6DofNavigator::new(noise(), true, kind, 0.0, start, p0);
-            let mut dr = Range6DofNavigator::new(noise(), false, kind, 0.0, start, p0);
+            let mut f = Range6DofNavigator::new(noise(), Aiding::RANGE, kind, 0.0, start, p0);
+            let mut dr = Range6DofNavigator::new(noise(), Aiding::NONE, kind, 0.0, start, p0);
             for k in 0..600 {
                 let t = (k + 1) as f64 * 0.1;
                 let mut events = vec![
@@ -211,7 +212,7 @@ mod tests {
     #[test]
     fn prediction_maps_input_noise() {
         let eta = State::from([1.0, 2.0, 3.0, 0.1, -0.1, 1.0]);
-        let mut f = Range6DofNavigator::new(noise(), true, FilterKind::Ekf, 0.0, eta, Cov::zeros());
+        let mut f = Range6DofNavigator::new(noise(), Aiding::RANGE, FilterKind::Ekf, 0.0, eta, Cov::zeros());
         let nu = [1.0, 0.0, 0.1, 0.0, 0.0, 0.05];
         f.process(&Measurement::new(0.0, Kind::BodyVelocity { nu }));
         f.process(&Measurement::new(0.5, Kind::Depth { depth_m: 3.0 })); // held, no motion

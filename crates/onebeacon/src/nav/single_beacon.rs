@@ -3,24 +3,15 @@
 //! Every time step the vehicle predicts with the unicycle model (eq. 7) and updates with
 //! its proprioceptive sensors: heading, yaw rate, acceleration (eq. 18 right, 24). When a
 //! communication frame from the beacon is decoded it adds the one-way travel-time range
-//! (eq. 19) and, for [`Aiding::RangeDoppler`], the Doppler radial speed (eq. 13-15, 20),
-//! stacked into one update (eq. 18 left, 22). [`Aiding::RangeOnly`] is the ROSB baseline:
-//! the same filter without the Doppler speed.
+//! (eq. 19) and the Doppler radial speed (eq. 13-15, 20), stacked into one update
+//! (eq. 18 left, 22). [`Aiding::RANGE`] is the ROSB baseline: the same filter without
+//! the Doppler speed; [`Aiding::NONE`] is dead reckoning on the inertial sensors.
 
-use super::{Estimate, Kind, Measurement, Navigator, Outcome};
+use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::filter::{AnyFilter, FilterError, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::measure::{RadialSpeed2d, Range2d, ScalarModel, StateComponent};
 use crate::models::unicycle::{Cov, DIM, State, UnicycleAccel, idx};
 use nalgebra::{SVector, Vector2, Vector3};
-
-/// Which beacon measurements the filter uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Aiding {
-    /// Range and Doppler radial speed (garin2024's proposed filter).
-    RangeDoppler,
-    /// Range only (ROSB, the state-of-the-art baseline of garin2024 Table 4).
-    RangeOnly,
-}
 
 /// Process and measurement noise of the filter. [`Default`] is garin2024 eq. 25.
 ///
@@ -62,12 +53,13 @@ impl Default for EkfTuning {
     }
 }
 
-/// A frame waiting for the next inertial sample: its beacon (NED, m), range, Doppler.
+/// A frame waiting for the next inertial sample: its beacon (NED, m), and the range and
+/// Doppler speed the navigator uses from it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Frame {
     beacon: Vector2<f64>,
-    range_m: f64,
-    radial_speed_m_s: f64,
+    range_m: Option<f64>,
+    radial_speed_m_s: Option<f64>,
 }
 
 /// The single-beacon navigator of garin2024 (or its range-only ROSB variant) over the
@@ -109,6 +101,15 @@ impl SingleBeaconNavigator {
         self.aiding
     }
 
+    /// Holds a frame's range and Doppler speed (those the aiding uses) for the next
+    /// inertial sample.
+    fn hold(&mut self, beacon: Vector2<f64>, range_m: Option<f64>, radial_speed_m_s: Option<f64>) -> Outcome {
+        let range_m = range_m.filter(|_| self.aiding.range);
+        let radial_speed_m_s = radial_speed_m_s.filter(|_| self.aiding.doppler);
+        self.pending = Some(Frame { beacon, range_m, radial_speed_m_s });
+        Outcome::Applied
+    }
+
     /// The state estimate [x, y, psi, v, Omega, a].
     pub fn state(&self) -> &State {
         self.filter.mean()
@@ -124,18 +125,22 @@ impl SingleBeaconNavigator {
         }
         let (t, f) = (&self.tuning, &mut self.filter);
         let [heading_m, yaw_rate_m, accel_m] = &self.inertial;
-        match (self.pending.take(), self.aiding) {
-            (None, _) => update(f, &self.inertial, [heading, yaw_rate, accel]),
-            (Some(fr), Aiding::RangeOnly) => {
-                let range = Range2d { beacon: fr.beacon, var: t.r_range_m2 };
+        let Some(fr) = self.pending.take() else { return update(f, &self.inertial, [heading, yaw_rate, accel]) };
+        let range = Range2d { beacon: fr.beacon, var: t.r_range_m2 };
+        let doppler = RadialSpeed2d { beacon: fr.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
+        match (fr.range_m, fr.radial_speed_m_s) {
+            (None, None) => update(f, &self.inertial, [heading, yaw_rate, accel]),
+            (Some(r), None) => {
                 let models: [&dyn ScalarModel<DIM>; 4] = [&range, heading_m, yaw_rate_m, accel_m];
-                update(f, &models, [fr.range_m, heading, yaw_rate, accel])
+                update(f, &models, [r, heading, yaw_rate, accel])
             }
-            (Some(fr), Aiding::RangeDoppler) => {
-                let range = Range2d { beacon: fr.beacon, var: t.r_range_m2 };
-                let doppler = RadialSpeed2d { beacon: fr.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
+            (None, Some(v)) => {
+                let models: [&dyn ScalarModel<DIM>; 4] = [&doppler, heading_m, yaw_rate_m, accel_m];
+                update(f, &models, [v, heading, yaw_rate, accel])
+            }
+            (Some(r), Some(v)) => {
                 let models: [&dyn ScalarModel<DIM>; 5] = [&range, &doppler, heading_m, yaw_rate_m, accel_m]; // eq. 18, 20
-                update(f, &models, [fr.range_m, fr.radial_speed_m_s, heading, yaw_rate, accel])
+                update(f, &models, [r, v, heading, yaw_rate, accel])
             }
         }
     }
@@ -160,14 +165,14 @@ impl Navigator for SingleBeaconNavigator {
                     Err(e) => Outcome::Failed(e),
                 }
             }
-            Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } => {
-                self.pending = Some(Frame { beacon: beacon.position_ned_m.xy(), range_m, radial_speed_m_s });
-                Outcome::Applied
+            Kind::Range { beacon, range_m } if self.aiding.range => {
+                self.hold(beacon.position_ned_m.xy(), Some(range_m), None)
             }
-            Kind::Range { beacon, range_m } if self.aiding == Aiding::RangeOnly => {
-                let radial_speed_m_s = f64::NAN; // not used by the range-only filter
-                self.pending = Some(Frame { beacon: beacon.position_ned_m.xy(), range_m, radial_speed_m_s });
-                Outcome::Applied
+            Kind::Doppler { beacon, radial_speed_m_s } if self.aiding.doppler => {
+                self.hold(beacon.position_ned_m.xy(), None, Some(radial_speed_m_s))
+            }
+            Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } if self.aiding.any() => {
+                self.hold(beacon.position_ned_m.xy(), Some(range_m), Some(radial_speed_m_s))
             }
             _ => Outcome::Skipped,
         }
@@ -221,11 +226,12 @@ mod tests {
         let p0 = Cov::from_diagonal(&SVector::from([1.0, 1.0, 1e-3, 0.1, 1e-4, 1e-4]));
         for kind in [FilterKind::Ekf, FilterKind::Ukf(UkfParams::default())] {
             let mut filters = [
-                SingleBeaconNavigator::new(Aiding::RangeDoppler, tuning, kind, 0.0, start, p0),
-                SingleBeaconNavigator::new(Aiding::RangeOnly, tuning, kind, 0.0, start, p0),
+                SingleBeaconNavigator::new(Aiding::RANGE_DOPPLER, tuning, kind, 0.0, start, p0),
+                SingleBeaconNavigator::new(Aiding::RANGE, tuning, kind, 0.0, start, p0),
+                SingleBeaconNavigator::new(Aiding { range: false, doppler: true }, tuning, kind, 0.0, start, p0),
             ];
             let mut truth = truth0;
-            let (mut speed_err, mut speed_err_sum) = ([0.0; 2], [0.0; 2]);
+            let (mut speed_err, mut speed_err_sum) = ([0.0; 3], [0.0; 3]);
             let truth_model = UnicycleAccel::default();
             for k in 1..=120 {
                 let t = k as f64 * dt;
@@ -250,6 +256,8 @@ mod tests {
             assert!(speed_err[0] < 0.01, "{kind:?}: range+doppler speed error {}", speed_err[0]);
             // range-only keeps the speed error longer: a larger mean over the run
             assert!(speed_err_sum[0] < speed_err_sum[1], "{kind:?}: {speed_err_sum:?}");
+            // Doppler alone observes the speed too
+            assert!(speed_err[2] < 0.01, "{kind:?}: doppler-only speed error {}", speed_err[2]);
             let e = filters[0].estimate();
             assert_abs_diff_eq!(e.north_m(), truth[0], epsilon = 0.5);
             assert_abs_diff_eq!(e.east_m(), truth[1], epsilon = 0.5);

@@ -1,0 +1,358 @@
+//! One estimator description for every world and every log: the `[[estimators]]`
+//! table of scenarios and log descriptions alike. An estimator is its short name
+//! (`kind`), the acoustic measurements it uses, its filter (EKF or UKF with its
+//! sigma-point parameters) and its tuning. The process model is the host's: the
+//! unicycle with acceleration in `fixed_beacon` worlds (garin2024 eq. 3-7), 6-DOF
+//! kinematics in `moving_beacon` worlds (sousa 3.1), planar odometry on logs.
+
+use super::FilterName;
+use onebeacon::filter::FilterKind;
+use onebeacon::nav::{Aiding, EkfTuning, PlanarConfig, PlanarNoise, SensorNoise};
+use serde::{Deserialize, Serialize};
+
+/// Where an estimator runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Host {
+    FixedBeacon,
+    MovingBeacon,
+    Log,
+}
+
+impl Host {
+    pub fn label(self) -> &'static str {
+        match self {
+            Host::FixedBeacon => "fixed_beacon world",
+            Host::MovingBeacon => "moving_beacon world",
+            Host::Log => "log",
+        }
+    }
+
+    /// The acoustic measurements the host gives.
+    pub fn acoustic(self) -> Aiding {
+        match self {
+            Host::FixedBeacon | Host::Log => Aiding::RANGE_DOPPLER,
+            Host::MovingBeacon => Aiding::RANGE,
+        }
+    }
+}
+
+/// The short names of estimators.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum EstimatorKind {
+    /// Ranges and Doppler speeds (garin2024's filter).
+    #[serde(rename = "range+doppler")]
+    RangeDoppler,
+    /// Ranges only (ROSB, garin2024's baseline).
+    #[serde(rename = "rosb")]
+    Rosb,
+    /// Every acoustic measurement the host gives (ranges in a moving-beacon world).
+    #[serde(rename = "range-ekf", alias = "range_ekf")]
+    RangeEkf,
+    /// No acoustic measurement.
+    #[serde(rename = "dead-reckoning", alias = "dead_reckoning")]
+    DeadReckoning,
+}
+
+impl EstimatorKind {
+    pub fn label(self) -> &'static str {
+        match self {
+            EstimatorKind::RangeDoppler => "range+doppler",
+            EstimatorKind::Rosb => "rosb",
+            EstimatorKind::RangeEkf => "range-ekf",
+            EstimatorKind::DeadReckoning => "dead-reckoning",
+        }
+    }
+
+    /// The acoustic measurements the name stands for in `host`.
+    pub fn aiding(self, host: Host) -> Aiding {
+        match self {
+            EstimatorKind::RangeDoppler => Aiding::RANGE_DOPPLER,
+            EstimatorKind::Rosb => Aiding::RANGE,
+            EstimatorKind::RangeEkf => host.acoustic(),
+            EstimatorKind::DeadReckoning => Aiding::NONE,
+        }
+    }
+}
+
+/// An acoustic measurement an estimator may use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Acoustic {
+    Range,
+    Doppler,
+}
+
+/// One `[[estimators]]` table. Every key but `kind` is optional; tuning keys apply to
+/// the hosts named beside them (validation refuses the others).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EstimatorSpec {
+    pub kind: EstimatorKind,
+    /// Name in outputs (default: the kind, with "-ukf" for the UKF).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// The acoustic measurements used (default: the kind's): `["range"]`,
+    /// `["range", "doppler"]`, `[]`...
+    #[serde(default)]
+    pub measurements: Option<Vec<Acoustic>>,
+    /// `"ekf"` (default) or `"ukf"`, with the UKF's sigma-point parameters (1, 2, 0).
+    #[serde(default)]
+    pub filter: FilterName,
+    pub ukf_alpha: Option<f64>,
+    pub ukf_beta: Option<f64>,
+    pub ukf_kappa: Option<f64>,
+    // Measurement noise the filter assumes (standard deviations). Default: garin2024
+    // eq. 25 (fixed_beacon), the sensors' (moving_beacon), PlanarNoise (logs).
+    /// Range, m (every host).
+    pub range_sigma_m: Option<f64>,
+    /// Doppler radial speed, m/s (fixed_beacon, log).
+    pub doppler_sigma_m_s: Option<f64>,
+    /// Heading, deg (fixed_beacon, log).
+    pub heading_sigma_deg: Option<f64>,
+    /// Yaw rate, rad/s, and forward acceleration, m/s^2 (fixed_beacon).
+    pub yaw_rate_sigma_rad_s: Option<f64>,
+    pub accel_sigma_m_s2: Option<f64>,
+    /// Diagonal of Q per step, state order [x, y, psi, v, Omega, a] (fixed_beacon).
+    pub q_diag: Option<[f64; 6]>,
+    // Planar odometry model and calibration states (log).
+    pub distance_sigma_frac: Option<f64>,
+    pub heading_change_sigma_frac: Option<f64>,
+    pub heading_walk_deg_per_sqrt_m: Option<f64>,
+    pub speed_sigma_m_s: Option<f64>,
+    pub bias_walk_m_per_sqrt_s: Option<f64>,
+    pub nis_gate: Option<f64>,
+    pub estimate_bias: Option<bool>,
+    pub bias_m: Option<f64>,
+    pub bias_sigma_m: Option<f64>,
+    pub estimate_range_scale: Option<bool>,
+    pub range_scale_sigma: Option<f64>,
+    pub estimate_distance_scale: Option<bool>,
+    pub distance_scale_sigma: Option<f64>,
+    pub estimate_turn_scale: Option<bool>,
+    pub turn_scale_sigma: Option<f64>,
+}
+
+/// What a numeric key must be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Sign {
+    Positive,
+    NonNegative,
+    Any,
+}
+
+impl EstimatorSpec {
+    /// An estimator of `kind` with every other key at its default.
+    pub fn new(kind: EstimatorKind) -> Self {
+        Self {
+            kind,
+            name: None,
+            measurements: None,
+            filter: FilterName::Ekf,
+            ukf_alpha: None,
+            ukf_beta: None,
+            ukf_kappa: None,
+            range_sigma_m: None,
+            doppler_sigma_m_s: None,
+            heading_sigma_deg: None,
+            yaw_rate_sigma_rad_s: None,
+            accel_sigma_m_s2: None,
+            q_diag: None,
+            distance_sigma_frac: None,
+            heading_change_sigma_frac: None,
+            heading_walk_deg_per_sqrt_m: None,
+            speed_sigma_m_s: None,
+            bias_walk_m_per_sqrt_s: None,
+            nis_gate: None,
+            estimate_bias: None,
+            bias_m: None,
+            bias_sigma_m: None,
+            estimate_range_scale: None,
+            range_scale_sigma: None,
+            estimate_distance_scale: None,
+            distance_scale_sigma: None,
+            estimate_turn_scale: None,
+            turn_scale_sigma: None,
+        }
+    }
+
+    /// Name in outputs: `name`, or the kind with "-ukf" for the UKF.
+    pub fn name(&self) -> String {
+        self.name.clone().unwrap_or_else(|| format!("{}{}", self.kind.label(), self.filter.suffix()))
+    }
+
+    pub fn filter_kind(&self) -> FilterKind {
+        self.filter.kind(self.ukf_alpha, self.ukf_beta, self.ukf_kappa)
+    }
+
+    /// The acoustic measurements used in `host`: `measurements`, or the kind's.
+    pub fn aiding(&self, host: Host) -> Aiding {
+        match &self.measurements {
+            Some(list) => Aiding { range: list.contains(&Acoustic::Range), doppler: list.contains(&Acoustic::Doppler) },
+            None => self.kind.aiding(host),
+        }
+    }
+
+    /// The numeric tuning keys that are set, with their rule and their hosts.
+    pub(crate) fn tuning_keys(&self) -> Vec<(&'static str, f64, Sign, &'static [Host])> {
+        use Host::*;
+        use Sign::*;
+        const ALL: &[Host] = &[FixedBeacon, MovingBeacon, Log];
+        const FIXED_LOG: &[Host] = &[FixedBeacon, Log];
+        let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
+        let mut keys = vec![
+            ("range_sigma_m", self.range_sigma_m, Positive, ALL),
+            ("doppler_sigma_m_s", self.doppler_sigma_m_s, Positive, FIXED_LOG),
+            ("heading_sigma_deg", self.heading_sigma_deg, Positive, FIXED_LOG),
+            ("yaw_rate_sigma_rad_s", self.yaw_rate_sigma_rad_s, Positive, &[FixedBeacon]),
+            ("accel_sigma_m_s2", self.accel_sigma_m_s2, Positive, &[FixedBeacon]),
+            ("distance_sigma_frac", self.distance_sigma_frac, NonNegative, &[Log]),
+            ("heading_change_sigma_frac", self.heading_change_sigma_frac, NonNegative, &[Log]),
+            ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, NonNegative, &[Log]),
+            ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[Log]),
+            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, &[Log]),
+            ("nis_gate", self.nis_gate, Positive, &[Log]),
+            ("estimate_bias", flag(self.estimate_bias), Any, &[Log]),
+            ("bias_m", self.bias_m, Any, &[Log]),
+            ("bias_sigma_m", self.bias_sigma_m, Positive, &[Log]),
+            ("estimate_range_scale", flag(self.estimate_range_scale), Any, &[Log]),
+            ("range_scale_sigma", self.range_scale_sigma, Positive, &[Log]),
+            ("estimate_distance_scale", flag(self.estimate_distance_scale), Any, &[Log]),
+            ("distance_scale_sigma", self.distance_scale_sigma, Positive, &[Log]),
+            ("estimate_turn_scale", flag(self.estimate_turn_scale), Any, &[Log]),
+            ("turn_scale_sigma", self.turn_scale_sigma, Positive, &[Log]),
+        ];
+        for q in self.q_diag.iter().flatten() {
+            keys.push(("q_diag", Some(*q), NonNegative, &[FixedBeacon]));
+        }
+        keys.into_iter().filter_map(|(k, v, s, h)| v.map(|v| (k, v, s, h))).collect()
+    }
+
+    /// garin2024's filter tuning (fixed_beacon): eq. 25 where a key is absent.
+    pub fn ekf_tuning(&self) -> EkfTuning {
+        let d = EkfTuning::default();
+        let var = |sigma: Option<f64>, default: f64| sigma.map_or(default, |s| s * s);
+        EkfTuning {
+            q_diag: self.q_diag.unwrap_or(d.q_diag),
+            r_range_m2: var(self.range_sigma_m, d.r_range_m2),
+            r_doppler_m2_s2: var(self.doppler_sigma_m_s, d.r_doppler_m2_s2),
+            r_heading_rad2: var(self.heading_sigma_deg.map(f64::to_radians), d.r_heading_rad2),
+            r_yaw_rate_rad2_s2: var(self.yaw_rate_sigma_rad_s, d.r_yaw_rate_rad2_s2),
+            r_accel_m2_s4: var(self.accel_sigma_m_s2, d.r_accel_m2_s4),
+        }
+    }
+
+    /// The noise the 6-DOF filter assumes (moving_beacon): the sensors', with
+    /// `range_sigma_m` when given.
+    pub fn sensor_noise(&self, sensors: SensorNoise) -> SensorNoise {
+        SensorNoise { range_m: self.range_sigma_m.unwrap_or(sensors.range_m), ..sensors }
+    }
+
+    /// The planar navigator's configuration (logs): [`PlanarConfig::default`] where a
+    /// key is absent.
+    pub fn planar_config(&self) -> PlanarConfig {
+        let c = PlanarConfig::default();
+        let d = c.noise;
+        let noise = PlanarNoise {
+            distance_sigma_frac: self.distance_sigma_frac.unwrap_or(d.distance_sigma_frac),
+            heading_change_sigma_frac: self.heading_change_sigma_frac.unwrap_or(d.heading_change_sigma_frac),
+            heading_walk_rad_per_sqrt_m: self
+                .heading_walk_deg_per_sqrt_m
+                .map_or(d.heading_walk_rad_per_sqrt_m, f64::to_radians),
+            speed_sigma_m_s: self.speed_sigma_m_s.unwrap_or(d.speed_sigma_m_s),
+            range_sigma_m: self.range_sigma_m.unwrap_or(d.range_sigma_m),
+            heading_sigma_rad: self.heading_sigma_deg.map_or(d.heading_sigma_rad, f64::to_radians),
+            doppler_sigma_m_s: self.doppler_sigma_m_s.unwrap_or(d.doppler_sigma_m_s),
+            bias_walk_m_per_sqrt_s: self.bias_walk_m_per_sqrt_s.unwrap_or(d.bias_walk_m_per_sqrt_s),
+        };
+        PlanarConfig {
+            aiding: self.aiding(Host::Log),
+            estimate_bias: self.estimate_bias.unwrap_or(c.estimate_bias),
+            bias_m: self.bias_m.unwrap_or(c.bias_m),
+            bias_sigma_m: self.bias_sigma_m.unwrap_or(c.bias_sigma_m),
+            estimate_range_scale: self.estimate_range_scale.unwrap_or(c.estimate_range_scale),
+            range_scale_sigma: self.range_scale_sigma.unwrap_or(c.range_scale_sigma),
+            estimate_distance_scale: self.estimate_distance_scale.unwrap_or(c.estimate_distance_scale),
+            distance_scale_sigma: self.distance_scale_sigma.unwrap_or(c.distance_scale_sigma),
+            estimate_turn_scale: self.estimate_turn_scale.unwrap_or(c.estimate_turn_scale),
+            turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
+            nis_gate: self.nis_gate,
+            noise,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::validate::check_estimators;
+
+    fn spec(text: &str) -> EstimatorSpec {
+        toml::from_str(text).unwrap()
+    }
+
+    fn error(text: &str, host: Host) -> String {
+        match check_estimators(&[spec(text)], host) {
+            Ok(()) => String::new(),
+            Err(v) => format!("{} = {}: {}", v.key, v.value, v.allowed),
+        }
+    }
+
+    /// The short names and what they stand for in each host (written out by hand).
+    #[test]
+    fn short_names_expand_per_host() {
+        use EstimatorKind::*;
+        let (rd, r, none) = (Aiding::RANGE_DOPPLER, Aiding::RANGE, Aiding::NONE);
+        for (kind, fixed, moving, log) in
+            [(RangeDoppler, rd, rd, rd), (Rosb, r, r, r), (RangeEkf, rd, r, rd), (DeadReckoning, none, none, none)]
+        {
+            let e = EstimatorSpec::new(kind);
+            assert_eq!(
+                [e.aiding(Host::FixedBeacon), e.aiding(Host::MovingBeacon), e.aiding(Host::Log)],
+                [fixed, moving, log]
+            );
+        }
+        // old spellings and the full form
+        assert_eq!(spec("kind = \"range_ekf\"").kind, RangeEkf);
+        assert_eq!(spec("kind = \"dead_reckoning\"").kind, DeadReckoning);
+        let doppler_only = spec("kind = \"range-ekf\"\nmeasurements = [\"doppler\"]");
+        assert_eq!(doppler_only.aiding(Host::Log), Aiding { range: false, doppler: true });
+    }
+
+    /// One table means the same in every host where its keys apply, and is refused by
+    /// name where they do not.
+    #[test]
+    fn one_table_every_host() {
+        let shared = "kind = \"rosb\"\nname = \"r\"\nrange_sigma_m = 2.0\nfilter = \"ukf\"\nukf_alpha = 0.5";
+        for host in [Host::FixedBeacon, Host::MovingBeacon, Host::Log] {
+            assert_eq!(error(shared, host), "", "{host:?}");
+        }
+        let e = spec(shared);
+        assert_eq!(e.ekf_tuning().r_range_m2, 4.0);
+        assert_eq!(e.planar_config().noise.range_sigma_m, 2.0);
+        let sensors =
+            SensorNoise { velocity_m_s: 0.1, rate_rad_s: 0.01, depth_m: 0.1, attitude_rad: 0.02, range_m: 1.0 };
+        assert_eq!(e.sensor_noise(sensors).range_m, 2.0);
+        assert_eq!(e.sensor_noise(sensors).velocity_m_s, 0.1);
+
+        assert_eq!(
+            error("kind = \"rosb\"\nnis_gate = 3.0", Host::FixedBeacon),
+            "estimators[0].nis_gate = 3.0: does not apply to a fixed_beacon world (it applies to: log)"
+        );
+        assert_eq!(
+            error("kind = \"range+doppler\"", Host::MovingBeacon),
+            "estimators[0].kind = \"range+doppler\": uses Doppler speeds; a moving_beacon world gives ranges only"
+        );
+        assert!(error("kind = \"rosb\"\nq_diag = [1, 1, 1, 1, -1, 1]", Host::FixedBeacon).contains(">= 0"));
+        assert!(error("kind = \"rosb\"\nrange_sigma_m = 0.0", Host::Log).contains("> 0"));
+    }
+
+    /// Left out, garin2024's noise keys are eq. 25's variances exactly (no square root
+    /// and square in between).
+    #[test]
+    fn fixed_beacon_defaults_are_eq_25() {
+        let t = EstimatorSpec::new(EstimatorKind::RangeDoppler).ekf_tuning();
+        assert_eq!((t.r_heading_rad2, t.r_yaw_rate_rad2_s2, t.r_accel_m2_s4), (1.0, 0.005, 0.005));
+        assert_eq!((t.r_range_m2, t.r_doppler_m2_s2), (12.0, 0.2));
+        assert_eq!(t.q_diag, [0.25f64.powi(8); 6]);
+    }
+}
