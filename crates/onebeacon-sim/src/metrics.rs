@@ -244,8 +244,9 @@ mod tests {
     }
 
     #[test]
-    fn nees_band_matches_acoustics_md() {
-        // ../shared/acoustics.md: N = 50, n = 2: [1.48, 2.59]; N = 100, n = 2: [1.63, 2.41]
+    fn nees_band_matches_chi_square_quantiles() {
+        // N x ANEES ~ chi2(N n) (Bar-Shalom et al. 2001, 5.4): N = 50, n = 2: [1.48, 2.59];
+        // N = 100, n = 2: [1.63, 2.41]
         let b = nees_band(50, 2);
         assert!((b[0] - 1.48).abs() < 0.01 && (b[1] - 2.59).abs() < 0.01, "{b:?}");
         let b = nees_band(100, 2);

@@ -27,6 +27,17 @@ fn with_sweep(
     Scenario::MovingBeacon(s)
 }
 
+/// Nearly exact sensors, ranges and GPS.
+fn nearly_noise_free(mut s: MovingBeacon) -> MovingBeacon {
+    s.sensors.velocity_noise_m_s = 1e-5;
+    s.sensors.rate_noise_rad_s = 1e-7;
+    s.sensors.depth_noise_m = 1e-4;
+    s.sensors.attitude_noise_deg = 1e-4;
+    s.acoustics.range_noise_m = 1e-3;
+    s.asv.gps_noise_m = 0.0;
+    s
+}
+
 fn range_ekf(c: &CellResult) -> &onebeacon_sim::metrics::CellSummary {
     &c.estimators[0].1
 }
@@ -35,13 +46,7 @@ fn range_ekf(c: &CellResult) -> &onebeacon_sim::metrics::CellSummary {
 /// to the truth from its 1 m initial error.
 #[test]
 fn nearly_noise_free_stationary_vehicle_converges() {
-    let mut s = sousa();
-    s.sensors.velocity_noise_m_s = 1e-5;
-    s.sensors.rate_noise_rad_s = 1e-7;
-    s.sensors.depth_noise_m = 1e-4;
-    s.sensors.attitude_noise_deg = 1e-4;
-    s.acoustics.range_noise_m = 1e-3;
-    s.asv.gps_noise_m = 0.0;
+    let mut s = nearly_noise_free(sousa());
     s.mission.duration_s = 600.0;
     let scenario = Scenario::MovingBeacon(s);
     let cell = match scenario.base_cell() {
@@ -144,13 +149,7 @@ fn a_second_vehicle_changes_nothing_for_the_first() {
 /// first vehicle's arrival would be tens of metres off).
 #[test]
 fn nearly_noise_free_pair_converges() {
-    let mut s = pair();
-    s.sensors.velocity_noise_m_s = 1e-5;
-    s.sensors.rate_noise_rad_s = 1e-7;
-    s.sensors.depth_noise_m = 1e-4;
-    s.sensors.attitude_noise_deg = 1e-4;
-    s.acoustics.range_noise_m = 1e-3;
-    s.asv.gps_noise_m = 0.0;
+    let mut s = nearly_noise_free(pair());
     s.mission.duration_s = 900.0;
     let scenario = Scenario::MovingBeacon(s);
     let out = simulate(&scenario, &scenario.base_cell(), 3, 0, false);

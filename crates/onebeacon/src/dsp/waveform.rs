@@ -1,4 +1,4 @@
-//! Transmitted waveforms (../shared/acoustics.md, "Waveforms and reception").
+//! Transmitted waveforms (rypkema section 3.2: 20 ms LFM chirps, one band per mode).
 
 use super::Complex;
 use std::f64::consts::{PI, TAU};
@@ -245,7 +245,7 @@ mod tests {
     #[test]
     fn chirp_sweeps_its_band() {
         let c = Lfm::new(7e3, 9e3, 0.02);
-        assert_eq!(c.samples(37_500.0).len(), 750); // acoustics.md
+        assert_eq!(c.samples(37_500.0).len(), 750); // 20 ms at 37.5 kS/s
         // instantaneous frequency from the phase: f0 + k t
         let inst = |t: f64| 7e3 + (2e3 / 0.02) * t;
         for t in [0.001, 0.009, 0.017] {
