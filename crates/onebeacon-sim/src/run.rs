@@ -138,7 +138,7 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
 
 /// Runs the engine with the scoring and recording observers (and `extra`).
 fn drive(world: &mut dyn World, tracks: &mut [Track], extra: Option<&mut dyn Observer>, record: bool) -> RunOutput {
-    let mut scoring = Scoring::new(tracks.len(), world.steps());
+    let mut scoring = Scoring::new(tracks.iter().map(|t| t.vehicle).collect(), world.steps());
     let mut recorder = Recorder { on: record, trajectory: Vec::new(), guidance: Vec::new() };
     {
         let mut observers: Vec<&mut dyn Observer> = vec![&mut scoring, &mut recorder];
@@ -147,11 +147,10 @@ fn drive(world: &mut dyn World, tracks: &mut [Track], extra: Option<&mut dyn Obs
         }
         engine::run(world, tracks, &mut observers);
     }
-    let distance_m = scoring.distance_m.clone();
     RunOutput {
-        metrics: scoring.acc.iter().zip(&scoring.vehicle_of).map(|(a, &v)| a.finish(distance_m[v])).collect(),
+        metrics: scoring.acc.iter().zip(&scoring.vehicle_of).map(|(a, &v)| a.finish(scoring.distance_m[v])).collect(),
         trajectory: recorder.trajectory,
-        distance_m,
+        distance_m: scoring.distance_m,
         frames_decoded: scoring.heard,
         range_information: Vec::new(),
         guidance: recorder.guidance,
@@ -165,34 +164,30 @@ fn score(e: &onebeacon::nav::Estimate, t: &VehicleTruth) -> (f64, Option<f64>) {
     (err.norm(), nees(&err, &e.horizontal_cov_m2))
 }
 
-/// Error statistics of every track, failed updates, acoustic measurements heard.
+/// Error statistics of every track, failed updates, acoustic measurements heard, and
+/// each vehicle's distance travelled so far.
 struct Scoring {
     acc: Vec<ErrorAccumulator>,
+    /// The vehicle of each track.
     vehicle_of: Vec<usize>,
     distance_m: Vec<f64>,
     heard: u64,
 }
 
 impl Scoring {
-    fn new(tracks: usize, steps: usize) -> Self {
-        Self {
-            acc: vec![ErrorAccumulator::new(steps + 1); tracks],
-            vehicle_of: Vec::new(),
-            distance_m: Vec::new(),
-            heard: 0,
-        }
+    fn new(vehicle_of: Vec<usize>, steps: usize) -> Self {
+        let acc = vec![ErrorAccumulator::new(steps + 1); vehicle_of.len()];
+        Self { acc, vehicle_of, distance_m: Vec::new(), heard: 0 }
     }
 }
 
 impl Observer for Scoring {
     fn step(&mut self, s: &Step<'_>) {
-        for ((a, e), &v) in self.acc.iter_mut().zip(s.estimates).zip(s.vehicle_of) {
+        for ((a, e), &v) in self.acc.iter_mut().zip(s.estimates).zip(&self.vehicle_of) {
             let (error_m, nees) = score(e, &s.truth[v]);
             a.push(error_m, nees);
         }
         self.heard += s.heard.iter().flatten().filter(|m| m.kind.beacon().is_some()).count() as u64;
-        self.vehicle_of.clear();
-        self.vehicle_of.extend_from_slice(s.vehicle_of);
         self.distance_m.clear();
         self.distance_m.extend(s.truth.iter().map(|t| t.distance_m));
     }

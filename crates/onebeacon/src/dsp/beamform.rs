@@ -1,6 +1,5 @@
 //! Direction of arrival by wideband beamforming (rypkema eq. 9-11) and by sensor-pair
-//! decomposition beamforming, SPD-BF (Rypkema, Fischell, Schmidt, JASA 2020;
-//! Rypkema, Fischell and Schmidt, JASA 2020).
+//! decomposition beamforming, SPD-BF (Rypkema, Fischell and Schmidt, JASA 2020).
 //!
 //! Directions are unit vectors `u` toward the source in the array frame (x forward,
 //! y starboard, z down). Element m at `r_m` hears the wave `tau_m = -r_m . u / c` after
