@@ -264,7 +264,7 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
     let _ = writeln!(t);
     let _ = writeln!(
         t,
-        "{:<14} {:<24} {:>10} {:>5} {:>10} {:>8} {:>9} {:>10} {:>8} {:>15} {:>10}",
+        "{:<width$} {:<24} {:>10} {:>5} {:>10} {:>8} {:>9} {:>10} {:>8} {:>15} {:>10} {:>9}",
         "sweep",
         "estimator",
         "mean_m",
@@ -275,7 +275,8 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
         "etd_mean%",
         "nees",
         "nees_band95",
-        "nees_all"
+        "nees_all",
+        "pcrb_m"
     );
     for c in &r.cells {
         for (track, m) in &c.estimators {
