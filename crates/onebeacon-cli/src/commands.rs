@@ -59,10 +59,10 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, out: Option<Pat
     }
     let files = staging.commit()?;
 
-    print!("{}", report::run_table(&s, seed, run, &cell, &result));
-    println!("wrote:");
+    out!("{}", report::run_table(&s, seed, run, &cell, &result));
+    outln!("wrote:");
     for f in files {
-        println!("  {}", f.display());
+        outln!("  {}", f.display());
     }
     Ok(())
 }
@@ -111,9 +111,9 @@ pub fn mc(
         }
     }
     if json {
-        println!("{json_text}");
+        outln!("{json_text}");
     } else {
-        print!("{}", report::mc_table(&s, &result, wall_s));
+        out!("{}", report::mc_table(&s, &result, wall_s));
     }
     Ok(())
 }
@@ -131,12 +131,12 @@ pub fn standoff(speed_m_s: f64, depths_m: &[f64], period_s: f64, json: bool) -> 
                 "depth_m": s.depth_m, "distance_m": s.distance_m, "det_fim": s.det_fim,
             })).collect::<Vec<_>>(),
         });
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("ASV at {speed_m_s} m/s, ping every {period_s} s: reach {reach} m (range noise 1 m)");
-        println!("{:>9} {:>12} {:>14}", "depth_m", "standoff_m", "det_fim_1/m4");
+        outln!("ASV at {speed_m_s} m/s, ping every {period_s} s: reach {reach} m (range noise 1 m)");
+        outln!("{:>9} {:>12} {:>14}", "depth_m", "standoff_m", "det_fim_1/m4");
         for s in rows {
-            println!("{:>9.2} {:>12.2} {:>14.5}", s.depth_m, s.distance_m, s.det_fim);
+            outln!("{:>9.2} {:>12.2} {:>14.5}", s.depth_m, s.distance_m, s.det_fim);
         }
     }
     Ok(())

@@ -69,7 +69,7 @@ pub fn simulate(config: Option<&str>, out: &Path) -> Result<()> {
     staging.write(&json_name, (serde_json::to_string_pretty(&truth)? + "\n").as_bytes())?;
     let moved = staging.move_files_to(&dir)?;
     for f in moved {
-        println!("wrote {}", f.display());
+        outln!("wrote {}", f.display());
     }
     Ok(())
 }
@@ -169,9 +169,9 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
         }
     }
     if as_json {
-        println!("{result}");
+        outln!("{result}");
     } else {
-        println!(
+        outln!(
             "mode {}, range {:.2} m, azimuth {:.1} deg, inclination {:.1} deg{}",
             mode + 1,
             est.range.range_m,
@@ -212,9 +212,9 @@ fn process_frame(c: &PingConfig, captures: &[Vec<f64>], staging: Option<Staging>
         }
     }
     if as_json {
-        println!("{result}");
+        outln!("{result}");
     } else {
-        println!(
+        outln!(
             "garin frame: range {range_m:.2} m, Doppler speed {v:.3} m/s (closing positive){}",
             if elements.len() > 1 {
                 format!(", azimuth {:.1} deg, inclination {:.1} deg", az.to_degrees(), inc.to_degrees())

@@ -1,5 +1,20 @@
 //! `onebeacon`: single-beacon underwater navigation, from scenario to table and plot.
 
+/// `print!` and `println!` that return an error (one line, exit status 1) where stdout
+/// cannot be written (a full disk, `> /dev/full`) instead of panicking.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*).map_err(crate::stdout_error)?
+    }};
+}
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*).map_err(crate::stdout_error)?
+    }};
+}
+
 mod commands;
 mod dsp;
 mod output;
@@ -8,6 +23,11 @@ mod replay;
 mod report;
 
 use clap::{Parser, Subcommand};
+
+/// The error of a failed write to stdout.
+fn stdout_error(e: std::io::Error) -> anyhow::Error {
+    anyhow::anyhow!("cannot write to stdout: {e}")
+}
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -221,6 +241,8 @@ fn main() -> ExitCode {
             commands::standoff(speed_m_s, &depths_m, period_s, json)
         }
     };
+    // what is still buffered must reach stdout too
+    let result = result.and_then(|()| std::io::Write::flush(&mut std::io::stdout()).map_err(stdout_error));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

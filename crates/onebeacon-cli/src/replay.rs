@@ -6,7 +6,7 @@ use crate::output::Staging;
 use crate::{plot, report};
 use anyhow::{Context, Result};
 use onebeacon::io::jsonl;
-use onebeacon::nav::session::{Session, Start};
+use onebeacon::nav::session::{Limits, Session, Start};
 use onebeacon_sim::replay::log::HeadingFrom;
 use onebeacon_sim::replay::{Log, LogDescription, new_session, replay as run_replay};
 use serde_json::{Value, json};
@@ -72,10 +72,10 @@ pub fn replay(
     let files = staging.commit()?;
 
     if as_json {
-        println!("{summary}");
+        outln!("{summary}");
         return Ok(());
     }
-    println!("{title}: {} measurements, replayed in {:.1} ms", log.items.len(), wall_s * 1e3);
+    outln!("{title}: {} measurements, replayed in {:.1} ms", log.items.len(), wall_s * 1e3);
     // (header, summary key, decimals)
     const COLUMNS: [(&str, &str, usize); 11] = [
         ("rmse_m", "rmse_m", 3),
@@ -91,17 +91,17 @@ pub fn replay(
         ("in95_%", "nees_within_95_pct", 0),
     ];
     let header: String = COLUMNS.iter().map(|(h, _, _)| format!(" {h:>9}")).collect();
-    println!("{:<20}{header}", "estimator");
+    outln!("{:<20}{header}", "estimator");
     for e in summary["estimators"].as_array().into_iter().flatten() {
         let cells: String = COLUMNS
             .iter()
             .map(|(_, k, d)| e[*k].as_f64().map_or(format!(" {:>9}", "-"), |v| format!(" {v:>9.d$}", d = *d)))
             .collect();
-        println!("{:<20}{cells}", e["name"].as_str().unwrap_or(""));
+        outln!("{:<20}{cells}", e["name"].as_str().unwrap_or(""));
     }
-    println!("wrote:");
+    outln!("wrote:");
     for f in files {
-        println!("  {}", f.display());
+        outln!("  {}", f.display());
     }
     Ok(())
 }
@@ -124,6 +124,7 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
                 "max_error_m": if st.count > 0 { num(st.max_m) } else { Value::Null },
                 "rejected": st.rejected,
                 "failed_updates": st.failed,
+                "reinitialised": st.reinitialised,
                 "nees_mean": num(st.nees_mean()),
                 "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
                 "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())},
@@ -140,6 +141,7 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
         "items": log.items.len(),
         "skipped_before_start": s.before_start,
         "left_out": s.left_out,
+        "screened": s.screened,
         "wall_s": wall_s,
         "estimators": estimators,
     })
@@ -147,15 +149,16 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
 
 fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(["estimator", "t_s", "kind", "beacon", "value", "nis"])?;
+    w.write_record(["estimator", "t_s", "kind", "beacon", "value", "nis", "reason"])?;
     for r in &s.rejected {
         w.write_record([
-            s.names[r.estimator].clone(),
+            r.estimator.map_or_else(|| "*".to_string(), |i| s.names[i].clone()),
             format!("{:.6}", r.t_s),
             r.kind.to_string(),
             r.beacon_id.to_string(),
             format!("{:.6}", r.value),
             format!("{:.3}", r.nis),
+            r.reason.clone(),
         ])?;
     }
     Ok(w.into_inner()?)
@@ -180,9 +183,12 @@ pub fn stream(config: &Path) -> Result<()> {
         }
         None => Start::FirstTruth,
     };
-    let mut session = new_session(&d, start, None);
-    jsonl::run(&mut session, &beacons, frame, std::io::stdin().lock(), std::io::stdout().lock(), |line, e| {
-        eprintln!("stdin line {line}: {e}; skipped")
+    let session = new_session(&d, start, None);
+    // the stream reports on the fly: the session keeps no rejection log
+    let limits = Limits { max_rejections: 0, ..*session.limits() };
+    let mut session = session.with_limits(limits);
+    jsonl::run(&mut session, &beacons, frame, std::io::stdin().lock(), std::io::stdout().lock(), |line, m| {
+        eprintln!("stdin line {line}: {m}")
     })
     .context("cannot read stdin or write stdout")?;
     Ok(())

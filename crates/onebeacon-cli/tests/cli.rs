@@ -170,6 +170,8 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
     let negative = write("neg.toml", "name = \"g\"\n[sensors]\ndoppler_noise_m_s = -0.1\n");
     let sweep = write("sweep.toml", "name = \"s\"\n[sweep]\nt_com_s = [3.0, -6.0]\n");
     let not_a_dir = write("file.txt", "x");
+    let escape = write("escape.toml", "name = \"../../x\"\n");
+    let estimator = write("est.toml", "name = \"e\"\n[[estimators]]\nkind = \"rosb\"\nnis_gate = 3.0\n");
     let out_dir = dir.join("should-not-exist");
     let out = out_dir.to_str().unwrap();
 
@@ -193,6 +195,8 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["guidance", "standoff", "--speed-m-s", "2", "--depths-m", "5,nan"], &["--depths-m", "nan"]),
         (vec!["guidance", "standoff", "--speed-m-s", "2"], &["--depths-m"]),
         (vec!["fly"], &["fly"]),
+        (vec!["run", &escape], &["escape.toml", "name", "a name, not a path"]),
+        (vec!["run", &estimator, "--out", out], &["est.toml", "estimators[0].nis_gate", "applies to: log"]),
     ];
     for (args, needles) in cases {
         let o = run(&args);
@@ -375,4 +379,24 @@ fn dsp_garin_frame_gives_range_and_doppler_speed() {
     let o = run(&["dsp", "simulate", "--config", cfg.to_str().unwrap(), "--out", wav.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("capture.fs_hz"));
+}
+
+/// A stdout that cannot be written (a full disk) is one line of error and exit 1, not
+/// a panic.
+#[test]
+fn full_stdout_is_an_error_not_a_panic() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else { return };
+    let dir = scratch("full");
+    let out = dir.join("o");
+    for args in [
+        vec!["scenarios"],
+        vec!["guidance", "standoff", "--speed-m-s", "2", "--depths-m", "1,5"],
+        vec!["run", "garin2024", "--out", out.to_str().unwrap()],
+    ] {
+        let o = bin().args(&args).stdout(full.try_clone().unwrap()).output().unwrap();
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("cannot write to stdout") || err.contains("No space left"), "{args:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+    }
 }

@@ -18,7 +18,7 @@ fn replay_is_the_session_fed_item_by_item() {
     let r = replay(&l, None).unwrap();
     let mut s = onebeacon_sim::replay::session_for(&l, None).unwrap();
     for item in &l.items {
-        s.push(item);
+        s.push(item).expect("no plaza item is screened out");
     }
     assert_eq!(s.stats, r.session.stats);
     assert_eq!(s.final_estimates(), r.session.final_estimates());

@@ -26,7 +26,7 @@ pub struct Replay {
 pub fn new_session(d: &LogDescription, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
     let estimators = d.estimators.iter().map(|e| (e.name(), e.planar_config(), e.filter_kind())).collect();
     let sigmas = (d.initial.position_sigma_m, d.initial.heading_sigma_deg.to_radians());
-    Session::new(d.frame.into(), estimators, start, sigmas, beacons)
+    Session::new(d.frame.into(), estimators, start, sigmas, beacons).with_limits(d.limits.limits())
 }
 
 /// The session a log describes, started at its initial pose.
@@ -42,7 +42,8 @@ pub fn replay(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Replay, LogEr
     let mut trajectory = Vec::new();
     let mut heard = false;
     for item in &log.items {
-        let Some(step) = session.push(item) else { continue };
+        // a screened item is counted and logged by the session; the replay goes on
+        let Ok(Some(step)) = session.push(item) else { continue };
         heard |= step.outcomes.iter().any(|o| matches!(o, Some(onebeacon::nav::Outcome::Accepted(_))));
         if has_truth && step.truth.is_none() || !has_truth && !matches!(item.input, Input::Measurement(_)) {
             continue;

@@ -80,6 +80,20 @@ fn valid_name(name: &str) -> bool {
     !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || "+-_.".contains(c))
 }
 
+/// A name that output directories are made of: a name, not a path (no separator, not
+/// `.` or `..`), at most 100 characters.
+fn check_file_name(key: &str, name: &str) -> Result<(), Violation> {
+    if valid_name(name) && name.len() <= 100 && name != "." && name != ".." {
+        Ok(())
+    } else {
+        Err(Violation {
+            key: key.into(),
+            value: format!("{name:?}"),
+            allowed: format!("{NAME_RULE}, at most 100 characters, not `.` or `..` (a name, not a path)"),
+        })
+    }
+}
+
 /// At least one of `section` (`estimators`, say); names of ASCII letters, digits and
 /// + - _ . , all different.
 fn check_names(section: &str, names: &[String]) -> Result<(), Violation> {
@@ -205,6 +219,7 @@ fn check_vehicle(prefix: &str, v: &Vehicle) -> Result<(), Violation> {
 
 fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
     use Rule::*;
+    check_file_name("name", &s.name)?;
     check_count("runs", s.runs, 1, 1_000_000)?;
     check_fields!("mission", s.mission, {
         dt_s: Positive,
@@ -268,6 +283,7 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
 
 fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
     use Rule::*;
+    check_file_name("name", &s.name)?;
     check_count("runs", s.runs, 1, 1_000_000)?;
 
     let m = &s.mission;
@@ -340,6 +356,7 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
 
 /// A log description: each source's column keys, the estimators, the start.
 pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
+    check_file_name("name", &d.name)?;
     for (i, s) in d.sources.iter().enumerate() {
         let (required, optional) = s.kind.columns();
         if let Some(key) = required.iter().find(|k| s.column(k).is_none()) {
@@ -374,5 +391,16 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
         heading_sigma_deg: Positive,
         track_m: Positive,
     });
+    let l = &d.limits;
+    check_fields!("limits", l, {
+        max_range_m: Positive,
+        max_speed_m_s: Positive,
+        max_rate_rad_s: Positive,
+        max_depth_m: Positive,
+        max_time_gap_s: Positive,
+    });
+    check_count("limits.max_beacons", l.max_beacons, 1, 1 << 20)?;
+    check_count("limits.max_rejections", l.max_rejections, 0, 100_000_000)?;
+    check_count("limits.max_line_bytes", l.max_line_bytes, 64, 1 << 26)?;
     Ok(())
 }

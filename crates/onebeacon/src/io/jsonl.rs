@@ -70,18 +70,14 @@ pub fn item_json(item: &Item) -> Value {
 pub const KINDS: &str = "odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
     range_doppler, beacon_position, ground_truth";
 
-/// Parses one JSON line into an item; `fixed` beacons resolve `beacon` ids, tracked
-/// ones (`beacon_position` lines seen so far, added to `tracked`) are resolved by the
-/// session. The error names the key at fault and what is allowed.
-pub fn parse_item(
-    line: &str,
-    fixed: &BTreeMap<u32, Vector3<f64>>,
-    tracked: &mut BTreeSet<u32>,
-) -> Result<Item, LineError> {
+/// Parses one JSON line into an item; `fixed` beacons resolve `beacon` ids, `tracked`
+/// ones (the ids of the `beacon_position` items the session took so far) are resolved
+/// by the session. The error names the key at fault and what is allowed.
+pub fn parse_item(line: &str, fixed: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u32>) -> Result<Item, LineError> {
     parse(line, fixed, tracked).map_err(LineError)
 }
 
-fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &mut BTreeSet<u32>) -> Result<Item, String> {
+fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u32>) -> Result<Item, String> {
     let v: Map<String, Value> = serde_json::from_str(line).map_err(|e| format!("not a JSON object: {e}"))?;
     let finite = |key: &str, x: &Value| -> Result<f64, String> {
         x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| format!("`{key}` = {x} is not a finite number"))
@@ -141,7 +137,6 @@ fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &mut BTreeS
         }),
         "beacon_position" => {
             let beacon_id = beacon_id()?;
-            tracked.insert(beacon_id);
             let z = optional("z_m")?.unwrap_or(0.0);
             Input::BeaconPosition { beacon_id, position: Vector3::new(num("x_m")?, num("y_m")?, z) }
         }
@@ -199,42 +194,111 @@ pub fn step_json(line: usize, step: &Step, names: &[String], frame: Frame) -> Va
 
 /// Reads JSON Lines items from `input` into `session` (fixed beacons `fixed`, lines in
 /// `frame`), writing one [`step_json`] line per item to `output`, flushed after each.
-/// A bad line (not an item, or earlier than the line before) goes to `bad` with its
-/// line number and is skipped; only an I/O error stops the stream.
+/// Nothing a line holds stops the stream: a line that is not UTF-8, longer than
+/// `limits.max_line_bytes`, not an item, or screened out by the session (time order,
+/// limits, unknown beacon) is skipped, and `report` gets its line number and why; so do
+/// an estimator started again and a stream that never reaches its start. Memory stays
+/// flat: one line is held at a time. Only an I/O error stops the stream.
 pub fn run(
     session: &mut Session,
     fixed: &BTreeMap<u32, Vector3<f64>>,
     frame: Frame,
-    input: impl BufRead,
+    mut input: impl BufRead,
     mut output: impl Write,
-    mut bad: impl FnMut(usize, &LineError),
+    mut report: impl FnMut(usize, &str),
 ) -> std::io::Result<()> {
+    let max_line = session.limits().max_line_bytes;
     let mut tracked = BTreeSet::new();
-    let mut last_t = f64::NEG_INFINITY;
-    for (n, line) in input.lines().enumerate() {
-        let number = n + 1;
-        let line = line?;
+    let mut buf = Vec::new();
+    let (mut number, mut waiting_told) = (0, false);
+    loop {
+        let (read, too_long) = read_line(&mut input, &mut buf, max_line)?;
+        if read == 0 {
+            break;
+        }
+        number += 1;
+        if too_long {
+            report(number, &format!("longer than {max_line} bytes (limits.max_line_bytes); skipped"));
+            continue;
+        }
+        let Ok(line) = std::str::from_utf8(&buf) else {
+            report(number, "not UTF-8 text; skipped");
+            continue;
+        };
         if line.trim().is_empty() {
             continue;
         }
-        let item = match parse_item(&line, fixed, &mut tracked) {
-            Ok(item) if item.t_s < last_t => {
-                Err(LineError(format!("time {} is before {last_t} on an earlier line", item.t_s)))
+        let item = match parse_item(line, fixed, &tracked) {
+            Ok(item) => item,
+            Err(e) => {
+                report(number, &format!("{e}; skipped"));
+                continue;
             }
-            other => other,
         };
-        match item {
-            Ok(item) => {
-                last_t = item.t_s;
-                if let Some(step) = session.push(&item) {
-                    writeln!(output, "{}", step_json(number, &step, &session.names, frame))?;
-                    output.flush()?;
+        match session.push(&item) {
+            Ok(step) => {
+                if let Input::BeaconPosition { beacon_id, .. } = item.input {
+                    tracked.insert(beacon_id);
                 }
+                let Some(step) = step else {
+                    if !std::mem::replace(&mut waiting_told, true) {
+                        report(number, &format!("before the start: waiting for {}", session.waiting_for()));
+                    }
+                    continue;
+                };
+                for &i in &step.reinitialised {
+                    let name = &session.names[i];
+                    report(
+                        number,
+                        &format!(
+                            "{name}: its state stopped being finite and positive definite; started again from its last sound estimate"
+                        ),
+                    );
+                }
+                writeln!(output, "{}", step_json(number, &step, &session.names, frame))?;
+                output.flush()?;
             }
-            Err(e) => bad(number, &e),
+            Err(screened) => report(number, &format!("{screened}; screened out")),
         }
     }
+    if !session.started() {
+        report(
+            number,
+            &format!("the stream ended before the start ({}); no estimate was given", session.waiting_for()),
+        );
+    }
     Ok(())
+}
+
+/// Reads one line (without its end) into `buf`, keeping at most `max` bytes: the bytes
+/// read (0 at the end of the input) and whether the line was longer than `max`.
+fn read_line(input: &mut impl BufRead, buf: &mut Vec<u8>, max: usize) -> std::io::Result<(usize, bool)> {
+    buf.clear();
+    let (mut read, mut too_long) = (0, false);
+    loop {
+        let available = match input.fill_buf() {
+            Ok(a) => a,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if available.is_empty() {
+            return Ok((read, too_long));
+        }
+        let end = available.iter().position(|&b| b == b'\n');
+        let chunk = &available[..end.unwrap_or(available.len())];
+        if too_long || buf.len() + chunk.len() > max {
+            too_long = true;
+            buf.clear();
+        } else {
+            buf.extend_from_slice(chunk);
+        }
+        let used = end.map_or(available.len(), |i| i + 1);
+        read += used;
+        input.consume(used);
+        if end.is_some() {
+            return Ok((read, too_long));
+        }
+    }
 }
 
 #[cfg(test)]
@@ -273,18 +337,16 @@ mod tests {
             t_s: 3.5,
             input: Input::Truth(TruthPose { north_m: 4.0, east_m: 5.0, heading_rad: Some(0.25) }),
         });
-        let mut tracked = BTreeSet::new();
+        let tracked = BTreeSet::new();
         for item in &items {
             let line = item_json(item).to_string();
-            assert_eq!(parse_item(&line, &fixed(), &mut tracked).as_ref(), Ok(item), "{line}");
+            assert_eq!(parse_item(&line, &fixed(), &tracked).as_ref(), Ok(item), "{line}");
         }
-        assert!(tracked.contains(&7));
     }
 
     #[test]
     fn bad_lines_name_the_key_and_what_is_allowed() {
-        let mut tracked = BTreeSet::new();
-        let mut err = |line: &str| parse_item(line, &fixed(), &mut tracked).unwrap_err().to_string();
+        let err = |line: &str| parse_item(line, &fixed(), &BTreeSet::new()).unwrap_err().to_string();
         assert!(err("{\"t_s\": 1, \"kind\": \"sonar\"}").contains("unknown kind `sonar` (one of odometry"));
         assert!(err("{\"t_s\": 1, \"kind\": \"speed\"}").contains("missing key `speed_m_s`"));
         assert!(err("{\"t_s\": 1, \"kind\": \"range\", \"beacon\": 9, \"range_m\": 3}").contains("beacon 9"));
@@ -314,7 +376,7 @@ mod tests {
         run(&mut session, &fixed(), Frame::Ned, input.as_bytes(), &mut out, |n, e| bad.push((n, e.to_string())))
             .unwrap();
         assert_eq!(bad.iter().map(|b| b.0).collect::<Vec<_>>(), [2, 5]);
-        assert!(bad[1].1.contains("before 1"), "{}", bad[1].1);
+        assert!(bad[1].1.contains("before the previous item's; screened out"), "{}", bad[1].1);
         let lines: Vec<Value> =
             String::from_utf8(out).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
         assert_eq!(lines.len(), 3);
@@ -322,5 +384,75 @@ mod tests {
         // two metres of odometry north
         let x = lines[2]["estimates"][0]["x_m"].as_f64().unwrap();
         assert!((x - 2.0).abs() < 1e-9, "{x}");
+    }
+
+    /// Every fault a line can carry is skipped with its reason, and the estimators end
+    /// exactly where the stream without the faulty lines ends.
+    #[test]
+    fn faulty_lines_change_nothing() {
+        let session = || {
+            let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
+            let config = PlanarConfig::default();
+            Session::new(Frame::Ned, vec![("ekf".into(), config, FilterKind::Ekf)], start, (1.0, 0.1), None)
+        };
+        let mut good: Vec<Vec<u8>> = Vec::new();
+        for k in 0..40 {
+            let t = k as f64;
+            good.push(
+                format!(r#"{{"t_s": {t}, "kind": "odometry", "distance_m": 1.0, "heading_change_rad": 0.0}}"#).into(),
+            );
+            if k % 5 == 4 {
+                let r = ((10.0 - (k + 1) as f64).powi(2) + 20.0f64.powi(2) + 25.0).sqrt();
+                good.push(format!(r#"{{"t_s": {t}, "kind": "range", "beacon": 3, "range_m": {r}}}"#).into());
+            }
+        }
+        let faults: Vec<(Vec<u8>, &str)> = vec![
+            (b"{\"t_s\": 20.5, \"kind\": \"speed\", \"speed_m_s\": \xff1}".to_vec(), "not UTF-8"),
+            (vec![b'x'; 70_000], "longer than 65536 bytes"),
+            (br#"{"t_s": 1e15, "kind": "speed", "speed_m_s": 1}"#.to_vec(), "jumps"),
+            (br#"{"t_s": 20.5, "kind": "speed", "speed_m_s": 1e308}"#.to_vec(), "speed_m_s 1e308 is outside"),
+            (br#"{"t_s": 20.5, "kind": "range", "beacon": 3, "range_m": 1e308}"#.to_vec(), "range 1e308 m"),
+            (br#"{"t_s": 20.5, "kind": "doppler", "beacon": 3, "radial_speed_m_s": 1e308}"#.to_vec(), "outside"),
+            (br#"{"t_s": 20.5, "kind": "beacon_position", "beacon": 8, "x_m": "far", "y_m": 0}"#.to_vec(), "`x_m`"),
+            (br#"{"t_s": 20.5, "kind": "range", "beacon": 8, "range_m": 10}"#.to_vec(), "beacon 8"),
+            (br#"{"t_s": 1.0, "kind": "speed", "speed_m_s": 1}"#.to_vec(), "before the previous"),
+        ];
+        let run_on = |lines: &[Vec<u8>]| {
+            let mut s = session();
+            let (mut out, mut told) = (Vec::new(), Vec::new());
+            let input = lines.join(&b'\n');
+            run(&mut s, &fixed(), Frame::Ned, input.as_slice(), &mut out, |_, m| told.push(m.to_string())).unwrap();
+            (s.final_estimates()[0], String::from_utf8(out).unwrap().lines().count(), told)
+        };
+        let (clean, clean_lines, clean_told) = run_on(&good);
+        assert!(clean_told.is_empty(), "{clean_told:?}");
+        let mut faulty = good.clone();
+        let at = faulty.iter().position(|l| l.starts_with(br#"{"t_s": 20,"#)).unwrap() + 1;
+        for (i, (line, _)) in faults.iter().enumerate() {
+            faulty.insert(at + i, line.clone());
+        }
+        let (end, lines, told) = run_on(&faulty);
+        assert_eq!(lines, clean_lines);
+        assert_eq!(told.len(), faults.len(), "{told:?}");
+        for ((_, expected), message) in faults.iter().zip(&told) {
+            assert!(message.contains(expected), "{message:?} should say {expected:?}");
+        }
+        assert_eq!(end, clean);
+        // the ranges pulled the estimate onto the truth (40 m north, beacon at 10, -20, 5)
+        assert!((end.north_m() - 40.0).abs() < 1.0 && end.east_m().abs() < 1.0, "{:?}", end.position_ned_m);
+    }
+
+    /// A stream that starts from ground truth and never gets one says so.
+    #[test]
+    fn a_stream_that_never_starts_says_so() {
+        let mut s = Session::new(Frame::Ned, vec![], Start::FirstTruth, (1.0, 0.1), None);
+        let input = r#"{"t_s": 0, "kind": "speed", "speed_m_s": 1}
+{"t_s": 1, "kind": "speed", "speed_m_s": 1}"#;
+        let mut told = Vec::new();
+        run(&mut s, &fixed(), Frame::Ned, input.as_bytes(), std::io::sink(), |n, m| told.push((n, m.to_string())))
+            .unwrap();
+        assert_eq!(told.len(), 2, "{told:?}");
+        assert!(told[0].1.contains("waiting for the first ground_truth item"));
+        assert!(told[1].1.contains("ended before the start"));
     }
 }

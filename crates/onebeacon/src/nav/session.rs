@@ -100,15 +100,141 @@ pub enum Start {
     FirstTruth,
 }
 
-/// A measurement an estimator's gate rejected.
+/// A measurement an estimator's gate rejected, or an item screened out for every
+/// estimator (`estimator` None, `nis` NaN) with its reason.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rejection {
-    pub estimator: usize,
+    pub estimator: Option<usize>,
     pub t_s: f64,
     pub kind: &'static str,
     pub beacon_id: u32,
     pub value: f64,
     pub nis: f64,
+    pub reason: String,
+}
+
+/// Physical limits every item must respect before any estimator sees it. An item out
+/// of them (a faulty sensor, a corrupt line) is screened out with its reason, and the
+/// session goes on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Largest plausible range, m.
+    pub max_range_m: f64,
+    /// Largest plausible speed, m/s: speed inputs, Doppler speeds, body velocities and
+    /// odometry distance per second.
+    pub max_speed_m_s: f64,
+    /// Largest plausible angular rate, rad/s (gyros, body rates).
+    pub max_rate_rad_s: f64,
+    /// Deepest plausible depth, m.
+    pub max_depth_m: f64,
+    /// Largest plausible jump forward in time from one item to the next, s.
+    pub max_time_gap_s: f64,
+    /// Most tracked beacons (`beacon_position` ids).
+    pub max_beacons: usize,
+    /// Most rejections kept in [`Session::rejected`] (the counts go on).
+    pub max_rejections: usize,
+    /// Longest stream line, bytes.
+    pub max_line_bytes: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            max_range_m: 20_000.0,
+            max_speed_m_s: 20.0,
+            max_rate_rad_s: 10.0,
+            max_depth_m: 12_000.0,
+            max_time_gap_s: 3600.0,
+            max_beacons: 4096,
+            max_rejections: 100_000,
+            max_line_bytes: 1 << 16,
+        }
+    }
+}
+
+impl Limits {
+    /// Whether `input`, `dt_s` after the previous item, is within the limits; the
+    /// reason otherwise.
+    pub fn check(&self, input: &Input, dt_s: Option<f64>) -> Result<(), String> {
+        let within = |what: &str, v: f64, lo: f64, hi: f64, key: &str| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(format!("{what} {v:?} is outside [{lo}, {hi}] (limits.{key})"))
+            }
+        };
+        let speed = |what: &str, v: f64| within(what, v, -self.max_speed_m_s, self.max_speed_m_s, "max_speed_m_s");
+        let rate = |what: &str, v: f64| within(what, v, -self.max_rate_rad_s, self.max_rate_rad_s, "max_rate_rad_s");
+        let angle = |what: &str, v: f64| within(what, v, -1e3, 1e3, "angle");
+        let range = |v: f64| {
+            if v.is_finite() && v > 0.0 && v <= self.max_range_m {
+                Ok(())
+            } else {
+                Err(format!("range {v:?} m is outside (0, {}] (limits.max_range_m)", self.max_range_m))
+            }
+        };
+        let far = 1e8;
+        match *input {
+            Input::Measurement(m) => {
+                if let Some(b) = m.beacon() {
+                    within("beacon_sigma_m", b.sigma_m, 0.0, 1e4, "beacon_sigma_m")?;
+                }
+                match m {
+                    Kind::Odometry { distance_m, heading_change_rad } => {
+                        // at least a second's travel, so that close items are not refused
+                        let most = self.max_speed_m_s * dt_s.unwrap_or(1.0).max(1.0);
+                        within("odometry distance_m", distance_m, -most, most, "max_speed_m_s x the time step")?;
+                        within(
+                            "heading_change_rad",
+                            heading_change_rad,
+                            -std::f64::consts::PI,
+                            std::f64::consts::PI,
+                            "pi",
+                        )
+                    }
+                    Kind::Speed { speed_m_s } => speed("speed_m_s", speed_m_s),
+                    Kind::Heading { heading_rad } => angle("heading_rad", heading_rad),
+                    Kind::Depth { depth_m } => within("depth_m", depth_m, -100.0, self.max_depth_m, "max_depth_m"),
+                    Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
+                        angle("roll_rad", roll_rad)?;
+                        angle("pitch_rad", pitch_rad)?;
+                        angle("heading_rad", heading_rad)
+                    }
+                    Kind::BodyVelocity { nu } => {
+                        nu[..3].iter().try_for_each(|&v| speed("body velocity", v))?;
+                        nu[3..].iter().try_for_each(|&v| rate("body rate", v))
+                    }
+                    Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
+                        angle("heading_rad", heading_rad)?;
+                        rate("yaw_rate_rad_s", yaw_rate_rad_s)?;
+                        within("accel_m_s2", accel_m_s2, -100.0, 100.0, "100 m/s^2")
+                    }
+                    Kind::Range { range_m, .. } => range(range_m),
+                    Kind::Doppler { radial_speed_m_s, .. } => speed("radial_speed_m_s", radial_speed_m_s),
+                    Kind::RangeDoppler { range_m, radial_speed_m_s, .. } => {
+                        range(range_m)?;
+                        speed("radial_speed_m_s", radial_speed_m_s)
+                    }
+                }
+            }
+            Input::BeaconPosition { position, .. } => {
+                position.iter().try_for_each(|&v| within("beacon position", v, -far, far, "1e8 m"))
+            }
+            Input::Truth(p) => {
+                within("ground truth x", p.north_m, -far, far, "1e8 m")?;
+                within("ground truth y", p.east_m, -far, far, "1e8 m")?;
+                p.heading_rad.map_or(Ok(()), |h| angle("ground truth heading", h))
+            }
+        }
+    }
+}
+
+/// An item that no estimator saw: out of time order, out of the [`Limits`], or naming a
+/// beacon whose position is not known.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{reason}")]
+pub struct Screened {
+    pub reason: String,
 }
 
 /// Error statistics of one estimator against the ground truth.
@@ -121,6 +247,9 @@ pub struct ErrorStats {
     pub final_m: f64,
     pub rejected: usize,
     pub failed: usize,
+    /// Times the estimator's state or covariance stopped being finite and positive
+    /// definite and it was started again from its last sound estimate.
+    pub reinitialised: usize,
     /// Position NEES (2 dof): sum and count of the finite ones, and how many were within
     /// the 95 % chi-square quantile.
     pub nees_sum: f64,
@@ -171,6 +300,29 @@ pub struct Step {
     pub estimates: Vec<Estimate>,
     pub truth: Option<TruthPose>,
     pub errors: Option<Vec<(f64, f64)>>,
+    /// The estimators started again from their last sound estimate during this item.
+    pub reinitialised: Vec<usize>,
+}
+
+/// The value of a measurement that rejection logs show (range, else radial speed).
+fn measured_value(m: &Kind) -> f64 {
+    match *m {
+        Kind::Range { range_m, .. } | Kind::RangeDoppler { range_m, .. } => range_m,
+        Kind::Doppler { radial_speed_m_s, .. } => radial_speed_m_s,
+        _ => f64::NAN,
+    }
+}
+
+/// Whether an estimate is sound: finite, with a positive definite horizontal covariance
+/// and a finite heading variance.
+fn sound(e: &Estimate) -> bool {
+    let p = &e.horizontal_cov_m2;
+    e.position_ned_m.iter().all(|v| v.is_finite())
+        && e.heading_state_rad.is_finite()
+        && e.heading_var_rad2.is_finite()
+        && p.iter().all(|v| v.is_finite())
+        && p[(0, 0)] > 0.0
+        && p.determinant() > 0.0
 }
 
 /// Horizontal error and its NEES against `truth` (NaN when the covariance is singular).
@@ -194,13 +346,20 @@ pub struct Session {
     beacons: Option<BTreeSet<u32>>,
     tracked: BTreeMap<u32, Vector3<f64>>,
     pub stats: Vec<ErrorStats>,
+    /// Gate rejections and screened items, the first `limits.max_rejections` of them.
     pub rejected: Vec<Rejection>,
-    /// Items before the start, and beacon measurements left out by the beacon filter
-    /// or naming a beacon whose position is not known yet.
+    /// Items before the start, beacon measurements left out by the beacon filter, and
+    /// items screened out (time order, limits, unknown beacon position).
     pub before_start: usize,
     pub left_out: usize,
+    pub screened: usize,
     /// The position of the last beacon heard.
     pub last_beacon: Option<Vector3<f64>>,
+    limits: Limits,
+    /// The time of the last item accepted.
+    last_t: Option<f64>,
+    /// Each estimator's last sound pose (N, E, psi), to start it again from.
+    last_sound: Vec<(f64, f64, f64)>,
 }
 
 impl Session {
@@ -227,7 +386,30 @@ impl Session {
             rejected: Vec::new(),
             before_start: 0,
             left_out: 0,
+            screened: 0,
             last_beacon: None,
+            limits: Limits::default(),
+            last_t: None,
+            last_sound: Vec::new(),
+        }
+    }
+
+    /// The session with `limits` instead of [`Limits::default`].
+    pub fn with_limits(mut self, limits: Limits) -> Self {
+        self.limits = limits;
+        self
+    }
+
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// What the session waits for before it starts.
+    pub fn waiting_for(&self) -> String {
+        match self.start {
+            Start::At { t0_s: Some(t0), .. } => format!("the start time {t0} s"),
+            Start::At { t0_s: None, .. } => "the first item".into(),
+            Start::FirstTruth => "the first ground_truth item with a heading".into(),
         }
     }
 
@@ -241,20 +423,67 @@ impl Session {
     }
 
     fn begin(&mut self, t0: f64, pose: (f64, f64, f64)) {
-        self.navs = self
-            .configs
-            .iter()
-            .map(|(c, f)| PlanarNavigator::new(*c, *f, t0, pose, self.sigma_position_m, self.sigma_heading_rad))
-            .collect();
+        self.navs = (0..self.configs.len()).map(|i| self.navigator(i, t0, pose)).collect();
+        self.last_sound = vec![pose; self.navs.len()];
     }
 
-    /// Processes one item (in the session's frame); `None` before the estimators start.
-    pub fn push(&mut self, item: &Item) -> Option<Step> {
+    fn navigator(&self, i: usize, t0: f64, pose: (f64, f64, f64)) -> PlanarNavigator {
+        let (c, f) = self.configs[i];
+        PlanarNavigator::new(c, f, t0, pose, self.sigma_position_m, self.sigma_heading_rad)
+    }
+
+    /// Records a rejection while the log has room.
+    fn log_rejection(&mut self, r: Rejection) {
+        if self.rejected.len() < self.limits.max_rejections {
+            self.rejected.push(r);
+        }
+    }
+
+    /// Screens `item` out: counted, logged, reported.
+    fn screen(&mut self, item: &Item, reason: String) -> Screened {
+        self.screened += 1;
+        let (kind, beacon_id, value) = match item.input {
+            Input::Measurement(m) => (m.name(), m.beacon().map_or(0, |b| b.id), measured_value(&m)),
+            Input::BeaconPosition { beacon_id, .. } => ("beacon_position", beacon_id, f64::NAN),
+            Input::Truth(_) => ("ground_truth", 0, f64::NAN),
+        };
+        let r = Rejection { estimator: None, t_s: item.t_s, kind, beacon_id, value, nis: f64::NAN, reason };
+        self.log_rejection(r.clone());
+        Screened { reason: r.reason }
+    }
+
+    /// Processes one item (in the session's frame): `Ok(None)` before the estimators
+    /// start, `Err` for an item screened out (no estimator saw it; the session goes on).
+    pub fn push(&mut self, item: &Item) -> Result<Option<Step>, Screened> {
         let t = item.t_s;
+        let dt = self.last_t.map(|last| t - last);
+        if !t.is_finite() {
+            return Err(self.screen(item, format!("time {t} is not a finite number")));
+        }
+        if let Some(dt) = dt.filter(|dt| *dt < 0.0) {
+            return Err(self.screen(item, format!("time {t} s is {:.6} s before the previous item's", -dt)));
+        }
+        if let Some(dt) = dt.filter(|dt| *dt > self.limits.max_time_gap_s) {
+            let most = self.limits.max_time_gap_s;
+            return Err(self.screen(
+                item,
+                format!("time {t:?} s jumps {dt:?} s past the previous item (limits.max_time_gap_s = {most})"),
+            ));
+        }
+        if let Err(reason) = self.limits.check(&item.input, dt) {
+            return Err(self.screen(item, reason));
+        }
         let item = &Item { t_s: t, input: item.input.to_ned(self.frame) };
         if let Input::BeaconPosition { beacon_id, position } = item.input {
+            if !self.tracked.contains_key(&beacon_id) && self.tracked.len() >= self.limits.max_beacons {
+                let most = self.limits.max_beacons;
+                return Err(
+                    self.screen(item, format!("beacon {beacon_id} is one too many (limits.max_beacons = {most})"))
+                );
+            }
             self.tracked.insert(beacon_id, position);
         }
+        self.last_t = Some(t);
         if !self.started() {
             match (self.start, &item.input) {
                 (Start::At { t0_s, pose }, _) if t0_s.is_none_or(|t0| t >= t0) => self.begin(t0_s.unwrap_or(t), pose),
@@ -263,38 +492,54 @@ impl Session {
                 }
                 _ => {
                     self.before_start += 1;
-                    return None;
+                    return Ok(None);
                 }
             }
         }
         let mut outcomes = vec![None; self.navs.len()];
         let mut truth = None;
+        let mut reinitialised = Vec::new();
         match item.input {
             Input::Measurement(m) => {
-                if let Some(kind) = self.resolve(m) {
+                if let Some(kind) = self.resolve(m).map_err(|reason| self.screen(item, reason))? {
                     let m = Measurement::new(t, kind);
                     for (i, nav) in self.navs.iter_mut().enumerate() {
                         let out = nav.process(&m);
                         self.stats[i].failed += usize::from(matches!(out, Outcome::Failed(_)));
-                        if let Outcome::Rejected(nis) = out {
-                            self.stats[i].rejected += 1;
-                            let (beacon_id, value) = match kind {
-                                Kind::Range { beacon, range_m } => (beacon.id, range_m),
-                                Kind::Doppler { beacon, radial_speed_m_s }
-                                | Kind::RangeDoppler { beacon, radial_speed_m_s, .. } => (beacon.id, radial_speed_m_s),
-                                _ => (0, f64::NAN),
-                            };
-                            let kind = kind.name();
-                            self.rejected.push(Rejection { estimator: i, t_s: t, kind, beacon_id, value, nis });
-                        }
                         outcomes[i] = Some(out);
+                    }
+                    for (i, out) in outcomes.iter().enumerate() {
+                        if let Some(Outcome::Rejected(nis)) = *out {
+                            self.stats[i].rejected += 1;
+                            self.log_rejection(Rejection {
+                                estimator: Some(i),
+                                t_s: t,
+                                kind: kind.name(),
+                                beacon_id: kind.beacon().map_or(0, |b| b.id),
+                                value: measured_value(&kind),
+                                nis,
+                                reason: "NIS gate".into(),
+                            });
+                        }
                     }
                 }
             }
             Input::Truth(p) => truth = Some(p),
             Input::BeaconPosition { .. } => {}
         }
-        let estimates: Vec<Estimate> = self.navs.iter().map(PlanarNavigator::estimate).collect();
+        let mut estimates: Vec<Estimate> = self.navs.iter().map(PlanarNavigator::estimate).collect();
+        // a filter whose state stops being sound starts again from its last sound
+        // estimate: reported, never silently kept
+        for (i, e) in estimates.iter_mut().enumerate() {
+            if sound(e) {
+                self.last_sound[i] = (e.north_m(), e.east_m(), e.heading_state_rad);
+            } else {
+                self.navs[i] = self.navigator(i, t, self.last_sound[i]);
+                self.stats[i].reinitialised += 1;
+                reinitialised.push(i);
+                *e = self.navs[i].estimate();
+            }
+        }
         let errors = truth.map(|p| {
             estimates
                 .iter()
@@ -306,33 +551,74 @@ impl Session {
                 })
                 .collect()
         });
-        Some(Step { t_s: t, outcomes, estimates, truth, errors })
+        Ok(Some(Step { t_s: t, outcomes, estimates, truth, errors, reinitialised }))
     }
 
-    /// A beacon measurement with its beacon's position (tracked beacons: the latest),
-    /// or `None` when the beacon is filtered out or its position is not known yet.
-    fn resolve(&mut self, mut m: Kind) -> Option<Kind> {
-        let Some(beacon) = m.beacon_mut() else { return Some(m) };
+    /// A beacon measurement with its beacon's position (tracked beacons: the latest).
+    /// A beacon left out by the beacon filter is counted in `left_out` and goes to no
+    /// estimator (`None`); a beacon whose position is not known is an error.
+    fn resolve(&mut self, mut m: Kind) -> Result<Option<Kind>, String> {
+        let Some(beacon) = m.beacon_mut() else { return Ok(Some(m)) };
         let id = beacon.id;
         let position = if beacon.position_ned_m.iter().all(|v| v.is_finite()) {
             Some(beacon.position_ned_m)
         } else {
             self.tracked.get(&id).copied()
         };
-        let allowed = self.beacons.as_ref().is_none_or(|b| b.contains(&id));
-        let Some(position) = position.filter(|_| allowed) else {
-            self.left_out += 1;
-            return None;
+        let Some(position) = position else {
+            return Err(format!("beacon {id}'s position is not known yet (no beacon_position item for it)"));
         };
+        if !self.beacons.as_ref().is_none_or(|b| b.contains(&id)) {
+            self.left_out += 1;
+            return Ok(None);
+        }
         beacon.position_ned_m = position;
         self.last_beacon = Some(position);
-        Some(m)
+        Ok(Some(m))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An estimate is sound when finite with a positive definite horizontal covariance.
+    #[test]
+    fn soundness() {
+        let pose = (1.0, 2.0, 0.5);
+        let nav = PlanarNavigator::new(PlanarConfig::default(), FilterKind::Ekf, 0.0, pose, 1.0, 0.1);
+        let good = nav.estimate();
+        assert!(sound(&good));
+        let mut e = good;
+        e.position_ned_m.x = f64::NAN;
+        assert!(!sound(&e));
+        let mut e = good;
+        e.horizontal_cov_m2[(0, 1)] = 2.0; // |rho| > 1: not positive definite
+        e.horizontal_cov_m2[(1, 0)] = 2.0;
+        assert!(!sound(&e));
+        let mut e = good;
+        e.heading_var_rad2 = f64::INFINITY;
+        assert!(!sound(&e));
+    }
+
+    /// Every plausible item passes the default limits; the implausible ones are refused
+    /// by name.
+    #[test]
+    fn limits_screen_the_implausible() {
+        let l = Limits::default();
+        let fix = BeaconFix::fixed(1, Vector3::zeros());
+        let m = |k| Input::Measurement(k);
+        assert!(l.check(&m(Kind::Range { beacon: fix, range_m: 150.0 }), Some(0.2)).is_ok());
+        assert!(l.check(&m(Kind::Odometry { distance_m: 0.3, heading_change_rad: 0.01 }), Some(0.2)).is_ok());
+        assert!(l.check(&m(Kind::Range { beacon: fix, range_m: 0.0 }), None).unwrap_err().contains("max_range_m"));
+        assert!(l.check(&m(Kind::Speed { speed_m_s: 21.0 }), None).unwrap_err().contains("max_speed_m_s"));
+        // 30 m in 1 s is too far at 20 m/s; in 2 s it is not
+        let odo = m(Kind::Odometry { distance_m: 30.0, heading_change_rad: 0.0 });
+        assert!(l.check(&odo, Some(1.0)).is_err());
+        assert!(l.check(&odo, Some(2.0)).is_ok());
+        let nu = [1.0, 0.0, 0.0, 0.0, 0.0, 11.0];
+        assert!(l.check(&m(Kind::BodyVelocity { nu }), None).unwrap_err().contains("max_rate_rad_s"));
+    }
 
     #[test]
     fn nees_quantile_and_statistics() {
