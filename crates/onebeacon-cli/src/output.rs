@@ -60,16 +60,29 @@ impl Staging {
         Ok(names)
     }
 
-    /// Moves every staged file into the target directory; returns their final paths.
+    /// Puts the staged directory in place of the target, whole: an existing target is
+    /// set aside, replaced, then removed (put back if the replacement fails), so no mix
+    /// of old and new files and no stale file is left. Returns the files' final paths.
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
-        if self.target.exists() {
-            let target = self.target.clone();
-            return self.move_files_to(&target);
-        }
         let names = self.staged_names()?;
-        std::fs::rename(&self.staging, &self.target)
-            .with_context(|| format!("cannot create {}", self.target.display()))?;
+        let old = self.target.exists().then(|| {
+            let mut name = self.staging.file_name().unwrap_or_default().to_os_string();
+            name.push(".old");
+            self.staging.with_file_name(name)
+        });
+        if let Some(old) = &old {
+            std::fs::rename(&self.target, old).with_context(|| format!("cannot replace {}", self.target.display()))?;
+        }
+        if let Err(e) = std::fs::rename(&self.staging, &self.target) {
+            if let Some(old) = &old {
+                let _ = std::fs::rename(old, &self.target);
+            }
+            return Err(e).with_context(|| format!("cannot create {}", self.target.display()));
+        }
         self.committed = true;
+        if let Some(old) = &old {
+            let _ = std::fs::remove_dir_all(old);
+        }
         Ok(names.iter().map(|n| self.target.join(n)).collect())
     }
 

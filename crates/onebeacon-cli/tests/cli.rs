@@ -171,6 +171,7 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
     let sweep = write("sweep.toml", "name = \"s\"\n[sweep]\nt_com_s = [3.0, -6.0]\n");
     let not_a_dir = write("file.txt", "x");
     let escape = write("escape.toml", "name = \"../../x\"\n");
+    let huge = write("huge.toml", "name = \"huge\"\n[mission]\nduration_s = 25000000\n");
     let estimator = write("est.toml", "name = \"e\"\n[[estimators]]\nkind = \"rosb\"\nnis_gate = 3.0\n");
     let out_dir = dir.join("should-not-exist");
     let out = out_dir.to_str().unwrap();
@@ -196,6 +197,7 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["guidance", "standoff", "--speed-m-s", "2"], &["--depths-m"]),
         (vec!["fly"], &["fly"]),
         (vec!["run", &escape], &["escape.toml", "name", "a name, not a path"]),
+        (vec!["run", &huge, "--out", out], &["huge.toml", "100000000 steps", "GB"]),
         (vec!["run", &estimator, "--out", out], &["est.toml", "estimators[0].nis_gate", "applies to: log"]),
     ];
     for (args, needles) in cases {
@@ -399,4 +401,24 @@ fn full_stdout_is_an_error_not_a_panic() {
         assert!(err.contains("cannot write to stdout") || err.contains("No space left"), "{args:?}: {err}");
         assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
     }
+}
+
+/// An existing output directory is replaced whole: no stale file of an older run stays,
+/// and no staging directory is left beside it.
+#[test]
+fn out_replaces_an_existing_directory_whole() {
+    let dir = scratch("replace");
+    let scenario = short_scenario(&dir);
+    let out = dir.join("o");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("stale.txt"), "from an older run").unwrap();
+    let o = run(&["run", &scenario, "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let mut names: Vec<String> =
+        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, ["error.png", "summary.json", "top_view.png", "trajectory.csv"]);
+    let beside: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(beside.iter().all(|n| !n.contains("partial")), "{beside:?}");
 }

@@ -115,6 +115,14 @@ pub struct RunOutput {
     pub guidance: Vec<GuidanceSnapshot>,
 }
 
+/// Bytes a recorded run of `s` holds (its trajectory), about.
+pub fn recorded_bytes(s: &Scenario) -> f64 {
+    let per_step = size_of::<StepRecord>()
+        + s.vehicle_names().len() * size_of::<TruthRecord>()
+        + s.tracks().len() * size_of::<Estimate>();
+    (s.steps() + 1) as f64 * per_step as f64
+}
+
 /// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
 /// A cell of another world than the scenario's is a programming error.
 pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) -> RunOutput {

@@ -209,6 +209,13 @@ impl Scenario {
             Scenario::MovingBeacon(s) => s.cells().into_iter().map(Cell::MovingBeacon).collect(),
         }
     }
+    /// Steps of one run after the start.
+    pub fn steps(&self) -> usize {
+        match self {
+            Scenario::FixedBeacon(s) => s.steps(),
+            Scenario::MovingBeacon(s) => s.steps(),
+        }
+    }
     /// Mission duration, s.
     pub fn duration_s(&self) -> f64 {
         match self {
