@@ -38,18 +38,29 @@ fn range_doppler_beats_rosb_and_error_grows_with_t_com() {
 
 /// Consistency of the paper's tuning (eq. 25), as measured: on the runs that do not
 /// diverge the filter is conservative (mean NEES below the chi-square band: R gives the
-/// heading 1 rad^2, far more than the simulated 2 deg); the diverged runs (the point
-/// reflection of the truth through the beacon with negative speed, an exact ambiguity of
-/// range + Doppler + heading) push the all-run NEES far above the band.
+/// heading 1 rad^2, far more than the simulated 2 deg). The filter as published
+/// sometimes locks onto the point reflection of the truth through the beacon driving
+/// backwards (an exact ambiguity of range + Doppler + heading), which pushes its all-run
+/// NEES far above the band; mirror recovery reflects those runs back, on the same draws.
 #[test]
-fn paper_tuning_is_conservative_on_inliers_and_diverged_runs_show_in_all_run_nees() {
-    let s = garin(&[3.0]);
-    let r = monte_carlo(&s, 100, 7, None, &|| {}).unwrap();
-    let rd = cell(&r, 0, "range+doppler");
+fn mirror_recovery_removes_the_reflected_divergences() {
+    let Scenario::FixedBeacon(mut s) = garin(&[3.0]) else { unreachable!() };
+    let mut published = s.estimators[0].clone();
+    published.name = Some("published".into());
+    published.mirror_recovery = Some(false);
+    s.estimators.push(published);
+    let r = monte_carlo(&Scenario::FixedBeacon(s), 100, 7, None, &|| {}).unwrap();
+    let (rd, published) = (cell(&r, 0, "range+doppler"), cell(&r, 0, "published"));
     eprintln!(
-        "NEES {:.3} band {:?}, all runs {:.1}, outliers {}",
-        rd.nees_mean, rd.nees_band, rd.nees_mean_all_runs, rd.outliers
+        "recovered: NEES {:.3} band {:?}, all runs {:.1}, outliers {}; published: all runs {:.1}, outliers {}",
+        rd.nees_mean,
+        rd.nees_band,
+        rd.nees_mean_all_runs,
+        rd.outliers,
+        published.nees_mean_all_runs,
+        published.outliers
     );
     assert!(rd.nees_mean > 0.8 && rd.nees_mean < rd.nees_band[0], "{rd:?}");
-    assert!(rd.outliers > 0 && rd.nees_mean_all_runs > rd.nees_band[1], "{rd:?}");
+    assert!(published.nees_mean_all_runs > 10.0 * rd.nees_mean_all_runs, "{published:?} against {rd:?}");
+    assert!(rd.outliers <= published.outliers);
 }

@@ -114,6 +114,10 @@ pub struct EstimatorSpec {
     pub accel_sigma_m_s2: Option<f64>,
     /// Diagonal of Q per step, state order [x, y, psi, v, Omega, a] (fixed_beacon).
     pub q_diag: Option<[f64; 6]>,
+    /// Take a state driving backwards for the mirror image of the vehicle through the
+    /// beacon and reflect it back (fixed_beacon; default true, false: garin2024's
+    /// filter as published).
+    pub mirror_recovery: Option<bool>,
     // Planar odometry model and calibration states (log).
     pub distance_sigma_frac: Option<f64>,
     pub heading_change_sigma_frac: Option<f64>,
@@ -157,6 +161,7 @@ impl EstimatorSpec {
             yaw_rate_sigma_rad_s: None,
             accel_sigma_m_s2: None,
             q_diag: None,
+            mirror_recovery: None,
             distance_sigma_frac: None,
             heading_change_sigma_frac: None,
             heading_walk_deg_per_sqrt_m: None,
@@ -211,6 +216,7 @@ impl EstimatorSpec {
             ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[Log]),
             ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("nis_gate", self.nis_gate, Positive, &[Log]),
+            ("mirror_recovery", flag(self.mirror_recovery), Any, &[FixedBeacon]),
             ("estimate_bias", flag(self.estimate_bias), Any, &[Log]),
             ("bias_m", self.bias_m, Any, &[Log]),
             ("bias_sigma_m", self.bias_sigma_m, Positive, &[Log]),

@@ -129,7 +129,8 @@ pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<()
         check_ukf(&format!("estimators[{k}]"), states, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
         for (name, v, sign, hosts) in e.tuning_keys() {
             if !hosts.contains(&host) {
-                let value = if name.starts_with("estimate_") { (v != 0.0).to_string() } else { format!("{v:?}") };
+                let flag = name.starts_with("estimate_") || name == "mirror_recovery";
+                let value = if flag { (v != 0.0).to_string() } else { format!("{v:?}") };
                 let applies: Vec<&str> = hosts.iter().map(|h| h.label()).collect();
                 return Err(Violation {
                     key: key(name),

@@ -72,14 +72,17 @@ impl FixedBeaconWorld {
             .iter()
             .map(|e| Track {
                 vehicle: 0,
-                navigator: Box::new(SingleBeaconNavigator::new(
-                    e.aiding(Host::FixedBeacon),
-                    e.ekf_tuning(),
-                    e.filter_kind(),
-                    0.0,
-                    z0,
-                    p0,
-                )),
+                navigator: Box::new(
+                    SingleBeaconNavigator::new(
+                        e.aiding(Host::FixedBeacon),
+                        e.ekf_tuning(),
+                        e.filter_kind(),
+                        0.0,
+                        z0,
+                        p0,
+                    )
+                    .with_mirror_recovery(e.mirror_recovery.unwrap_or(true)),
+                ),
             })
             .collect()
     }

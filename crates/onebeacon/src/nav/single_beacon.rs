@@ -81,6 +81,11 @@ pub struct SingleBeaconNavigator {
     filter: AnyFilter<DIM>,
     t_s: f64,
     pending: Option<Frame>,
+    /// The last beacon heard, NED, m.
+    beacon: Option<Vector2<f64>>,
+    /// Reflect a state that drives backwards back through the beacon
+    /// ([`Self::with_mirror_recovery`]).
+    unmirror: bool,
 }
 
 impl SingleBeaconNavigator {
@@ -94,11 +99,42 @@ impl SingleBeaconNavigator {
             StateComponent::value(idx::OMEGA, tuning.r_yaw_rate_rad2_s2),
             StateComponent::value(idx::ACCEL, tuning.r_accel_m2_s4),
         ];
-        Self { aiding, tuning, model, q, inertial, filter: AnyFilter::new(filter, z0, p0), t_s: t0_s, pending: None }
+        let filter = AnyFilter::new(filter, z0, p0);
+        Self { aiding, tuning, model, q, inertial, filter, t_s: t0_s, pending: None, beacon: None, unmirror: true }
+    }
+
+    /// Whether a state that drives backwards is taken for the mirror image of the
+    /// vehicle through the beacon and reflected back (default: yes; garin2024's filter
+    /// as published: no).
+    pub fn with_mirror_recovery(mut self, on: bool) -> Self {
+        self.unmirror = on;
+        self
     }
 
     pub fn aiding(&self) -> Aiding {
         self.aiding
+    }
+
+    /// Range, Doppler speed and heading from one beacon cannot tell the vehicle from its
+    /// point reflection through the beacon driving backwards (same ranges, same radial
+    /// speeds, same heading): the EKF sometimes locks onto that mirror. A survey vehicle
+    /// does not drive backwards, so a speed estimate clearly negative (below -0.25 m/s
+    /// and 3 sigma) means the mirror: the state is reflected back, x -> 2b - x, v -> -v,
+    /// P -> J P J' with J = diag(-1, -1, 1, -1, 1, 1).
+    fn unmirror(&mut self) {
+        let Some(b) = self.beacon.filter(|_| self.unmirror) else { return };
+        let (x, p) = (self.filter.mean(), self.filter.covariance());
+        let v = x[idx::V];
+        if !(v < -0.25 && v < -3.0 * p[(idx::V, idx::V)].max(0.0).sqrt()) {
+            return;
+        }
+        let j = Cov::from_diagonal(&SVector::from([-1.0, -1.0, 1.0, -1.0, 1.0, 1.0]));
+        let p = j * p * j;
+        let x = self.filter.mean_mut();
+        x[idx::X] = 2.0 * b.x - x[idx::X];
+        x[idx::Y] = 2.0 * b.y - x[idx::Y];
+        x[idx::V] = -v;
+        *self.filter.covariance_mut() = p;
     }
 
     /// Holds a frame's range and Doppler speed (those the aiding uses) for the next
@@ -126,6 +162,7 @@ impl SingleBeaconNavigator {
         let (t, f) = (&self.tuning, &mut self.filter);
         let [heading_m, yaw_rate_m, accel_m] = &self.inertial;
         let Some(fr) = self.pending.take() else { return update(f, &self.inertial, [heading, yaw_rate, accel]) };
+        self.beacon = Some(fr.beacon);
         let range = Range2d { beacon: fr.beacon, var: t.r_range_m2 };
         let doppler = RadialSpeed2d { beacon: fr.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
         match (fr.range_m, fr.radial_speed_m_s) {
@@ -160,7 +197,9 @@ impl Navigator for SingleBeaconNavigator {
     fn process(&mut self, m: &Measurement) -> Outcome {
         match m.kind {
             Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
-                match self.tick(m.t_s, heading_rad, yaw_rate_rad_s, accel_m_s2) {
+                let nis = self.tick(m.t_s, heading_rad, yaw_rate_rad_s, accel_m_s2);
+                self.unmirror();
+                match nis {
                     Ok(nis) => Outcome::Accepted(nis),
                     Err(e) => Outcome::Failed(e),
                 }
@@ -262,5 +301,48 @@ mod tests {
             assert_abs_diff_eq!(e.north_m(), truth[0], epsilon = 0.5);
             assert_abs_diff_eq!(e.east_m(), truth[1], epsilon = 0.5);
         }
+    }
+
+    /// Started on the mirror image of the truth through the beacon (driving backwards),
+    /// the published filter stays there: ranges, Doppler speeds and heading agree with
+    /// it. With mirror recovery it is reflected back onto the truth.
+    #[test]
+    fn a_state_driving_backwards_is_reflected_back_through_the_beacon() {
+        let beacon = Vector2::new(40.0, 0.0);
+        let fix = BeaconFix::fixed(0, Vector3::new(beacon.x, beacon.y, 0.0));
+        let truth0 = State::from([0.0, 0.0, FRAC_PI_2, 1.0, 0.0, 0.0]);
+        let mut mirror = truth0;
+        mirror[idx::X] = 2.0 * beacon.x;
+        mirror[idx::V] = -1.0;
+        let p0 = Cov::from_diagonal(&SVector::from([1.0, 1.0, 1e-3, 0.01, 1e-4, 1e-4]));
+        let tuning = EkfTuning { q_diag: [1e-4, 1e-4, 1e-6, 1e-4, 1e-6, 1e-6], ..EkfTuning::default() };
+        let ends: Vec<f64> = [false, true]
+            .into_iter()
+            .map(|recover| {
+                let mut nav =
+                    SingleBeaconNavigator::new(Aiding::RANGE_DOPPLER, tuning, FilterKind::Ekf, 0.0, mirror, p0)
+                        .with_mirror_recovery(recover);
+                let model = UnicycleAccel::default();
+                let mut truth = truth0;
+                for k in 1..=80 {
+                    let t = k as f64 * 0.25;
+                    truth = model.propagate(&truth, 0.25);
+                    if k % 12 == 0 {
+                        let frame = Kind::RangeDoppler {
+                            beacon: fix,
+                            range_m: ScalarModel::<DIM>::predict(&Range2d { beacon, var: 0.0 }, &truth),
+                            radial_speed_m_s: RadialSpeed2d { beacon, known_speed_m_s: None, var: 0.0 }.predict(&truth),
+                        };
+                        nav.process(&Measurement::new(t, frame));
+                    }
+                    let inertial = Kind::Inertial { heading_rad: FRAC_PI_2, yaw_rate_rad_s: 0.0, accel_m_s2: 0.0 };
+                    nav.process(&Measurement::new(t, inertial));
+                }
+                let e = nav.estimate();
+                (e.position_ned_m.xy() - truth.fixed_rows::<2>(0)).norm()
+            })
+            .collect();
+        assert!(ends[0] > 50.0, "the published filter stays on the mirror: {} m", ends[0]);
+        assert!(ends[1] < 0.5, "recovered: {} m", ends[1]);
     }
 }
