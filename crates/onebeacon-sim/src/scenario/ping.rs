@@ -249,6 +249,52 @@ impl PingConfig {
         }
         check_fields!("noise", self.noise, { snr_db: Finite });
         check_fields!("clock", self.clock, { offset_s: Finite, drift_ppm: Finite });
+        // physically meaningful values, so that a ping can neither panic nor come out
+        // as NaN or as a silent capture
+        let within = |key: &str, v: f64, lo: f64, hi: f64, what: &str| {
+            if (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(Violation {
+                    key: key.into(),
+                    value: format!("{v:?}"),
+                    allowed: format!("must be in [{lo}, {hi}] ({what})"),
+                })
+            }
+        };
+        if self.waveform.kind != WaveformKind::GarinFrame {
+            let top = self.chirp().f0_hz.max(self.chirp().f1_hz);
+            within("capture.fs_hz", self.capture.fs_hz, 2.0 * top, 1e7, "over twice the chirp's highest frequency")?;
+        }
+        within("capture.fs_hz", self.capture.fs_hz, 1.0, 1e7, "a sampling rate, Hz")?;
+        within("noise.snr_db", self.noise.snr_db, -60.0, 200.0, "2E/N0 per element, dB")?;
+        within("geometry.radial_speed_m_s", self.geometry.radial_speed_m_s, -50.0, 50.0, "m/s")?;
+        within("clock.drift_ppm", self.clock.drift_ppm, -1e4, 1e4, "ppm")?;
+        let w = &self.water;
+        for (key, v) in [
+            ("water.surface_coef", w.surface_coef),
+            ("water.bottom_coef", w.bottom_coef),
+            ("water.wall_coef", w.wall_coef),
+        ] {
+            within(key, v, -1.0, 1.0, "a reflection coefficient")?;
+        }
+        within("water.temperature_c", w.temperature_c, -2.0, 40.0, "sea water, deg C")?;
+        within("water.salinity_ppt", w.salinity_ppt, 0.0, 45.0, "sea water, ppt")?;
+        if let Some(c) = w.sound_speed_m_s {
+            within("water.sound_speed_m_s", c, 1300.0, 1700.0, "sound in water, m/s")?;
+        }
+        // the direct path must arrive inside the capture window
+        let arrival_s = (self.source() - self.receiver()).norm() / self.sound_speed_m_s() + self.clock.offset_s;
+        let window_s = self.capture.samples as f64 / self.capture.fs_hz;
+        if !(0.0..window_s).contains(&arrival_s) {
+            return Err(Violation {
+                key: "geometry".into(),
+                value: format!("the ping arrives at {arrival_s:.4} s"),
+                allowed: format!(
+                    "must arrive within the capture window, [0, {window_s:.4}) s (capture.samples / capture.fs_hz): move the source closer or capture longer"
+                ),
+            });
+        }
         Ok(())
     }
 
@@ -355,5 +401,17 @@ mod tests {
         assert!(e.contains("capture.fs_hz") && e.contains("65 kHz"), "{e}");
         let e = PingConfig::parse("[water]\ndepth_m = -5\n", "ping.toml").unwrap_err().to_string();
         assert!(e.contains("water.depth_m"), "{e}");
+        // configs that would panic, give NaN samples or a silent capture
+        for (text, key) in [
+            ("[capture]\nfs_hz = 1e-3\n", "capture.fs_hz"),
+            ("[capture]\nfs_hz = 15000\n", "capture.fs_hz"), // under twice mode 1's 9 kHz
+            ("[noise]\nsnr_db = -1000\n", "noise.snr_db"),
+            ("[water]\nbottom_coef = -3\n", "water.bottom_coef"),
+            ("[geometry]\nsource_north_m = 5000\n", "must arrive within the capture window"),
+            ("[clock]\noffset_s = -1\n", "must arrive within the capture window"),
+        ] {
+            let e = PingConfig::parse(text, "ping.toml").unwrap_err().to_string();
+            assert!(e.contains(key), "{text}: {e}");
+        }
     }
 }
