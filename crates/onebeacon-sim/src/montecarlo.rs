@@ -10,6 +10,7 @@ use crate::run::simulate;
 use crate::scenario::{Cell, Scenario, Track};
 use nalgebra::Matrix6;
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 
 /// The results of one sweep cell: one summary per estimator, in scenario order.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,10 +92,11 @@ fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: 
     let pcrb_rmse_m = match (scenario, cell) {
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let vehicles = s.vehicles(c);
-            let mut sum = vec![vec![Matrix6::zeros(); s.steps() + 1]; vehicles.len()];
+            // one entry per step with a range, not per step: memory follows the pings
+            let mut sum = vec![BTreeMap::new(); vehicles.len()];
             for (_, info) in &per_run {
                 for (v, k, m) in info {
-                    sum[*v][*k] += m;
+                    *sum[*v].entry(*k).or_insert_with(Matrix6::zeros) += m;
                 }
             }
             vehicles.iter().zip(&sum).map(|(v, sum)| horizontal_rmse_bound(s, v, sum, runs)).collect()

@@ -6,14 +6,15 @@
 //! per-run inverses). Q and R are read from the navigator's own models
 //! ([`onebeacon::nav::SensorNoise`]), so the bound and the filter share every noise.
 
-use crate::run::truth_trajectory;
 use crate::scenario::MovingBeacon;
 use crate::scenario::moving_beacon::Vehicle;
 use crate::vehicles::rov::body_velocity;
+use crate::world::TruthPath;
 use nalgebra::{Matrix6, SVector};
 use onebeacon::filter::ProcessModel;
 use onebeacon::measure::ScalarModel;
 use onebeacon::models::kinematic6dof::Cov;
+use std::collections::BTreeMap;
 
 /// One step of the recursion from the bound `c` = J^-1: the bound after a transition
 /// with Jacobian `f` and process noise `q`, and measurements of information `info`.
@@ -25,15 +26,22 @@ fn step(c: &Cov, f: &Cov, q: &Cov, info: &Cov) -> Cov {
 
 /// Root of the bound on the mean squared horizontal position error of vehicle `v`
 /// (path and depth set: [`MovingBeacon::vehicles`]) over the mission, given the sum
-/// over `runs` runs of the range information it received at each step.
-pub fn horizontal_rmse_bound(s: &MovingBeacon, v: &Vehicle, information_sum: &[Matrix6<f64>], runs: usize) -> f64 {
-    let truth = truth_trajectory(s, v);
+/// over `runs` runs of the range information it received, by step (steps without a
+/// range are absent, so that the sum holds one entry per ping, not per step).
+pub fn horizontal_rmse_bound(
+    s: &MovingBeacon,
+    v: &Vehicle,
+    information_sum: &BTreeMap<usize, Matrix6<f64>>,
+    runs: usize,
+) -> f64 {
+    let mut truth = TruthPath::new(s, v);
     let dt = s.mission.dt_s;
     let noise = s.sensor_noise();
     // depth and attitude every step: H' R^-1 H of the navigator's models
+    let x0 = *truth.state();
     let sensor_info = noise.depth_attitude_models().iter().fold(Cov::zeros(), |acc, m| {
-        let h = ScalarModel::<6>::jacobian(m, &truth[0]);
-        acc + h.transpose() * h / m.variance(&truth[0])
+        let h = ScalarModel::<6>::jacobian(m, &x0);
+        acc + h.transpose() * h / m.variance(&x0)
     });
     let i = &s.initial;
     let a0 = i.attitude_sigma_deg.to_radians().powi(2);
@@ -47,15 +55,17 @@ pub fn horizontal_rmse_bound(s: &MovingBeacon, v: &Vehicle, information_sum: &[M
     ]));
     let mut c = p0; // the bound itself, J^-1
     let mut sum = c[(0, 0)] + c[(1, 1)];
-    for k in 1..truth.len() {
+    let steps = s.steps();
+    for k in 1..=steps {
         let model = noise.process_model(body_velocity(v, v.path, (k - 1) as f64 * dt + dt / 2.0));
-        let f = model.jacobian(&truth[k - 1], dt);
-        let q = model.noise_covariance(&truth[k - 1], dt);
-        let info = information_sum.get(k).map_or(sensor_info, |i| sensor_info + i / runs as f64);
+        let f = model.jacobian(truth.state(), dt);
+        let q = model.noise_covariance(truth.state(), dt);
+        truth.step();
+        let info = information_sum.get(&k).map_or(sensor_info, |i| sensor_info + i / runs as f64);
         c = step(&c, &f, &q, &info);
         sum += c[(0, 0)] + c[(1, 1)];
     }
-    (sum / truth.len() as f64).sqrt()
+    (sum / (steps + 1) as f64).sqrt()
 }
 
 #[cfg(test)]
@@ -86,9 +96,7 @@ mod tests {
             let v = SVector::<f64, 6>::from([-b[0], -b[1], 5.0 - b[2], 0.0, 0.0, 0.0]).normalize();
             v * v.transpose()
         };
-        let mut info = vec![Matrix6::zeros(); steps + 1];
-        info[2] = h([30.0, 0.0, 0.0]) * 4.0 * 2.0;
-        info[5] = h([0.0, 40.0, 0.0]) * 4.0 * 3.0;
+        let info = BTreeMap::from([(2, h([30.0, 0.0, 0.0]) * 4.0 * 2.0), (5, h([0.0, 40.0, 0.0]) * 4.0 * 3.0)]);
         let bound = horizontal_rmse_bound(&s, &s.vehicles(&cell)[0], &info, 4);
 
         let i = &s.initial;
@@ -105,9 +113,9 @@ mod tests {
         let satt = n.attitude_noise_deg.to_radians().powi(-2);
         let sensor = Cov::from_diagonal(&SVector::from([0.0, 0.0, n.depth_noise_m.powi(-2), satt, satt, satt]));
         let mut sum = 0.0;
-        for (k, info_k) in info.iter().enumerate() {
+        for k in 0..=steps {
             if k > 0 {
-                j += sensor + info_k / 4.0;
+                j += sensor + info.get(&k).copied().unwrap_or_else(Matrix6::zeros) / 4.0;
             }
             let c = j.try_inverse().unwrap();
             sum += c[(0, 0)] + c[(1, 1)];

@@ -242,4 +242,4 @@ impl Observer for Recorder {
     }
 }
 
-pub use crate::world::{initial_asv_position, truth_trajectory};
+pub use crate::world::{TruthPath, initial_asv_position};

@@ -6,4 +6,4 @@ mod moving_beacon;
 
 pub(crate) use fixed_beacon::FixedBeaconWorld;
 pub(crate) use moving_beacon::{MovingBeaconWorld, RangeInformation};
-pub use moving_beacon::{initial_asv_position, truth_trajectory};
+pub use moving_beacon::{TruthPath, initial_asv_position};

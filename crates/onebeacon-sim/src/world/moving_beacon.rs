@@ -18,18 +18,35 @@ use onebeacon::models::kinematic6dof::{BodyVelocity, Cov, State, idx};
 use onebeacon::nav::{BeaconFix, Estimate, Kind, Measurement, Range6DofNavigator, SensorNoise};
 use rand_pcg::Pcg64Mcg;
 
-/// The true state of vehicle `v` (path and depth set) at every step; it does not
-/// depend on the draws.
-pub fn truth_trajectory(s: &MovingBeacon, v: &Vehicle) -> Vec<State> {
-    let dt = s.mission.dt_s;
-    let mut eta = State::from([v.start_north_m, v.start_east_m, v.depth_m, 0.0, 0.0, v.heading_deg.to_radians()]);
-    let mut out = Vec::with_capacity(s.steps() + 1);
-    out.push(eta);
-    for k in 0..s.steps() {
-        eta = rk4_step(&eta, k as f64 * dt, dt, |t| body_velocity(v, v.path, t));
-        out.push(eta);
+/// The true state of vehicle `v` (path and depth set), step after step: RK4 on its
+/// body velocities. It does not depend on the draws; it is computed as it goes, so a
+/// run holds one state whatever its length.
+#[derive(Debug, Clone)]
+pub struct TruthPath {
+    vehicle: Vehicle,
+    dt: f64,
+    k: usize,
+    eta: State,
+}
+
+impl TruthPath {
+    /// The vehicle at its start (step 0).
+    pub fn new(s: &MovingBeacon, v: &Vehicle) -> Self {
+        let eta = State::from([v.start_north_m, v.start_east_m, v.depth_m, 0.0, 0.0, v.heading_deg.to_radians()]);
+        Self { vehicle: v.clone(), dt: s.mission.dt_s, k: 0, eta }
     }
-    out
+
+    /// The state at the current step.
+    pub fn state(&self) -> &State {
+        &self.eta
+    }
+
+    /// Moves to the next step.
+    pub fn step(&mut self) {
+        let v = &self.vehicle;
+        self.eta = rk4_step(&self.eta, self.k as f64 * self.dt, self.dt, |t| body_velocity(v, v.path, t));
+        self.k += 1;
+    }
 }
 
 /// The ASV's start: the best standoff for the vehicle's start depth and the ASV's reach
@@ -54,7 +71,7 @@ struct InFlight {
 /// body velocity.
 struct Underwater {
     spec: Vehicle,
-    truth: Vec<State>,
+    truth: TruthPath,
     velocity_rng: Pcg64Mcg,
     attitude_rng: Pcg64Mcg,
     /// The range noise stream; None: the world's acoustic stream (the first vehicle's,
@@ -89,7 +106,7 @@ impl<'a> MovingBeaconWorld<'a> {
             .into_iter()
             .enumerate()
             .map(|(v, spec)| Underwater {
-                truth: truth_trajectory(s, &spec),
+                truth: TruthPath::new(s, &spec),
                 spec,
                 velocity_rng: vehicle_rng(seed, run, v, Stream::Imu),
                 attitude_rng: vehicle_rng(seed, run, v, Stream::Heading),
@@ -99,7 +116,7 @@ impl<'a> MovingBeaconWorld<'a> {
             })
             .collect();
         let asv0 = initial_asv_position(s, cell);
-        let start = &vehicles[0].truth[0];
+        let start = vehicles[0].truth.state();
         let toward_vehicle = Vector2::new(start[idx::N], start[idx::E]) - asv0;
         Self {
             s,
@@ -131,7 +148,7 @@ impl<'a> MovingBeaconWorld<'a> {
         let mut tracks = Vec::new();
         for (v, u) in self.vehicles.iter().enumerate() {
             let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
-            let eta0 = u.truth[0] + sigma0.map(|sd| gauss(&mut init_rng, sd));
+            let eta0 = u.truth.state() + sigma0.map(|sd| gauss(&mut init_rng, sd));
             tracks.extend(s.estimators.iter().map(|e| Track {
                 vehicle: v,
                 navigator: Box::new(Range6DofNavigator::new(
@@ -225,7 +242,7 @@ impl World for MovingBeaconWorld<'_> {
         let u = &self.vehicles[v];
         let t = self.t_s(self.k);
         VehicleTruth {
-            eta: u.truth[self.k],
+            eta: *u.truth.state(),
             speed_m_s: body_velocity(&u.spec, u.spec.path, t).fixed_rows::<3>(0).norm(),
             distance_m: u.distance_m,
         }
@@ -251,8 +268,10 @@ impl World for MovingBeaconWorld<'_> {
             veh.nu_meas = noise
                 .process_model(body_velocity(&veh.spec, veh.spec.path, t0 + dt / 2.0))
                 .sample_input(&mut veh.velocity_rng);
-            let (p0, p1) =
-                (veh.truth[k - 1].fixed_rows::<3>(0).into_owned(), veh.truth[k].fixed_rows::<3>(0).into_owned());
+            let p0 = veh.truth.state().fixed_rows::<3>(0).into_owned();
+            veh.truth.step();
+            let x = *veh.truth.state();
+            let p1 = x.fixed_rows::<3>(0).into_owned();
             veh.distance_m += (p1 - p0).norm();
             out.push(Measurement::new(t0, Kind::BodyVelocity { nu: veh.nu_meas.into() }));
 
@@ -264,7 +283,7 @@ impl World for MovingBeaconWorld<'_> {
                 // the range noise of the navigators' range model (the GPS error is
                 // drawn apart, on the position the ASV reports)
                 let rng = veh.range_rng.as_mut().unwrap_or(&mut self.acoustic_rng);
-                let range_noise = noise.range_model(&BeaconFix::fixed(0, f.ping.origin)).noise(&veh.truth[k], rng);
+                let range_noise = noise.range_model(&BeaconFix::fixed(0, f.ping.origin)).noise(&x, rng);
                 let range_m = c * (t_rx - f.ping.t_tx) + range_noise;
                 let beacon = BeaconFix {
                     id: 0,
@@ -278,7 +297,7 @@ impl World for MovingBeaconWorld<'_> {
 
             // depth and attitude at the step's end
             let [d_m, roll_m, pitch_m, yaw_m] = noise.depth_attitude_models();
-            let (x, rng) = (&veh.truth[k], &mut veh.attitude_rng);
+            let (x, rng) = (&x, &mut veh.attitude_rng);
             out.push(Measurement::new(t1, Kind::Depth { depth_m: x[idx::D] + d_m.noise(x, rng) }));
             out.push(Measurement::new(
                 t1,
