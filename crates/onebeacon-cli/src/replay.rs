@@ -156,7 +156,7 @@ fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
             format!("{:.6}", r.t_s),
             r.kind.to_string(),
             r.beacon_id.to_string(),
-            format!("{:.6}", r.value),
+            if r.value.abs() < 1e9 { format!("{:.6}", r.value) } else { format!("{:e}", r.value) },
             format!("{:.3}", r.nis),
             r.reason.clone(),
         ])?;
