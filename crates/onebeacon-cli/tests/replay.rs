@@ -201,6 +201,11 @@ fn bad_logs_exit_2_with_one_line_naming_file_line_and_column() {
             "line 2, column `id`: beacon 7 is not among the beacons (0)",
         ),
         ("missing file", bad_log(&dir, "missing file", good, "").replace("log.toml", "nope.toml"), "nope.toml"),
+        (
+            "not a CSV",
+            bad_log(&dir, "not a CSV", &format!("t,id,r\n1.5,0,{}\n", "9".repeat(2 << 20)), ""),
+            "a line longer than 1048576 bytes: not a CSV file",
+        ),
     ];
     for (label, path, expected) in cases {
         let o = run(&["replay", &path, "--out", &dir.join("out").display().to_string()]);

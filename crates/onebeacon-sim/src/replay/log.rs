@@ -460,8 +460,33 @@ impl Log {
 struct Table {
     file: String,
     header: Vec<String>,
-    reader: csv::Reader<std::fs::File>,
+    reader: csv::Reader<LineLimited<std::fs::File>>,
     record: csv::StringRecord,
+}
+
+/// Longest CSV line read, bytes: a file that is not a CSV (a device, a binary) is
+/// refused with an error instead of filling the memory.
+const MAX_CSV_LINE_BYTES: usize = 1 << 20;
+
+/// A reader that fails on a line longer than [`MAX_CSV_LINE_BYTES`].
+struct LineLimited<R> {
+    inner: R,
+    line: usize,
+}
+
+impl<R: std::io::Read> std::io::Read for LineLimited<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for &b in &buf[..n] {
+            self.line = if b == b'\n' { 0 } else { self.line + 1 };
+            if self.line > MAX_CSV_LINE_BYTES {
+                return Err(std::io::Error::other(format!(
+                    "a line longer than {MAX_CSV_LINE_BYTES} bytes: not a CSV file"
+                )));
+            }
+        }
+        Ok(n)
+    }
 }
 
 /// One row of a [`Table`].
@@ -476,7 +501,7 @@ impl Table {
         let name = path.display().to_string();
         let f = std::fs::File::open(&path)
             .map_err(|e| LogError::File { file: name.clone(), message: format!("cannot open: {e}") })?;
-        let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(f);
+        let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(LineLimited { inner: f, line: 0 });
         let header = reader
             .headers()
             .map_err(|e| LogError::File { file: name.clone(), message: format!("cannot read the header: {e}") })?
