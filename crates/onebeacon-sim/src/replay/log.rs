@@ -272,52 +272,7 @@ pub struct LogDescription {
     pub estimators: Vec<EstimatorSpec>,
     /// What an item must respect before any estimator sees it.
     #[serde(default)]
-    pub limits: LimitKeys,
-}
-
-/// The `[limits]` table: [`Limits`] with its defaults.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct LimitKeys {
-    pub max_range_m: f64,
-    pub max_speed_m_s: f64,
-    pub max_rate_rad_s: f64,
-    pub max_depth_m: f64,
-    pub max_time_gap_s: f64,
-    pub max_beacons: usize,
-    pub max_rejections: usize,
-    pub max_line_bytes: usize,
-}
-
-impl Default for LimitKeys {
-    fn default() -> Self {
-        let d = Limits::default();
-        Self {
-            max_range_m: d.max_range_m,
-            max_speed_m_s: d.max_speed_m_s,
-            max_rate_rad_s: d.max_rate_rad_s,
-            max_depth_m: d.max_depth_m,
-            max_time_gap_s: d.max_time_gap_s,
-            max_beacons: d.max_beacons,
-            max_rejections: d.max_rejections,
-            max_line_bytes: d.max_line_bytes,
-        }
-    }
-}
-
-impl LimitKeys {
-    pub fn limits(&self) -> Limits {
-        Limits {
-            max_range_m: self.max_range_m,
-            max_speed_m_s: self.max_speed_m_s,
-            max_rate_rad_s: self.max_rate_rad_s,
-            max_depth_m: self.max_depth_m,
-            max_time_gap_s: self.max_time_gap_s,
-            max_beacons: self.max_beacons,
-            max_rejections: self.max_rejections,
-            max_line_bytes: self.max_line_bytes,
-        }
-    }
+    pub limits: Limits,
 }
 
 /// A loaded log: the description, fixed beacons and the merged stream (SI units, the

@@ -26,7 +26,7 @@ pub struct Replay {
 pub fn new_session(d: &LogDescription, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
     let estimators = d.estimators.iter().map(|e| (e.name(), e.planar_config(), e.filter_kind())).collect();
     let sigmas = (d.initial.position_sigma_m, d.initial.heading_sigma_deg.to_radians());
-    Session::new(d.frame.into(), estimators, start, sigmas, beacons).with_limits(d.limits.limits())
+    Session::new(d.frame.into(), estimators, start, sigmas, beacons).with_limits(d.limits)
 }
 
 /// The session a log describes, started at its initial pose.

@@ -115,8 +115,10 @@ pub struct Rejection {
 
 /// Physical limits every item must respect before any estimator sees it. An item out
 /// of them (a faulty sensor, a corrupt line) is screened out with its reason, and the
-/// session goes on.
+/// session goes on. (With the `serde` feature it reads from a `[limits]` table, every key
+/// optional.)
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(default, deny_unknown_fields))]
 pub struct Limits {
     /// Largest plausible range, m.
     pub max_range_m: f64,
