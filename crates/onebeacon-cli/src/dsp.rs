@@ -151,13 +151,20 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
         ReceiverConfig { fs_hz: fs, capture_len: n, sound_speed_m_s: c.sound_speed_m_s(), ..ReceiverConfig::default() };
     let mut rx = Receiver::new(modes[mode], &elements, cfg);
     let est = rx.process_spectra(&captures, &spectra);
+    let detected = est.range.detected();
+    let statistic = est.range.peak_ratio();
+    let threshold = onebeacon::dsp::matched_filter::detection_threshold(est.range.distribution.len());
+    let when = |v: serde_json::Value| if detected { v } else { serde_json::Value::Null };
     let result = json!({
-        "range_m": est.range.range_m,
-        "azimuth_deg": est.azimuth.to_degrees(),
-        "inclination_deg": est.inclination.to_degrees(),
-        "mode": mode + 1,
+        "detected": detected,
+        "detection_statistic": statistic,
+        "detection_threshold": threshold,
+        "range_m": when(json!(est.range.range_m)),
+        "azimuth_deg": when(json!(est.azimuth.to_degrees())),
+        "inclination_deg": when(json!(est.inclination.to_degrees())),
+        "mode": when(json!(mode + 1)),
         "radial_speed_m_s": serde_json::Value::Null,
-        "consistent": est.range.consistent,
+        "consistent": detected && est.range.consistent,
     });
     if let Some(staging) = staging {
         let c_fs = c.sound_speed_m_s() / fs;
@@ -170,6 +177,10 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     }
     if as_json {
         outln!("{result}");
+    } else if !detected {
+        outln!(
+            "no ping detected: statistic {statistic:.4} below the threshold {threshold:.4} (false alarms under 1 in 2000 captures)"
+        );
     } else {
         outln!(
             "mode {}, range {:.2} m, azimuth {:.1} deg, inclination {:.1} deg{}",

@@ -298,11 +298,36 @@ fn dsp_simulate_then_process_recovers_the_truth() {
         assert!(!est[key].is_null() && !truth[key].is_null(), "{key}");
     }
     assert_eq!(est["mode"], truth["mode"]);
+    assert_eq!(est["detected"], true, "{est}");
     let d = |k: &str| (est[k].as_f64().unwrap() - truth[k].as_f64().unwrap()).abs();
     assert!(d("range_m") < 0.2, "{est} vs {truth}");
     assert!(d("azimuth_deg") < 5.0 && d("inclination_deg") < 5.0, "{est} vs {truth}");
     for f in ["range.csv", "range.png", "beam.png", "estimate.json"] {
         assert!(res_dir.join(f).exists(), "{f}");
+    }
+}
+
+/// Silence, a DC offset and white noise are no ping: `detected: false`, no range, not
+/// consistent (they used to give a "consistent" range).
+#[test]
+fn dsp_process_says_when_there_is_no_ping() {
+    let dir = scratch("noping");
+    let n = 5 * 8000;
+    let mut state = 12345u64;
+    let mut uniform = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f32 / (1u64 << 53) as f32 - 0.5
+    };
+    let noise: Vec<f32> = (0..n).map(|_| 0.1 * uniform()).collect();
+    for (name, samples) in [("zero", vec![0.0f32; n]), ("dc", vec![0.25f32; n]), ("noise", noise)] {
+        let wav = dir.join(format!("{name}.wav"));
+        write_wav(&wav, 5, 37_500, &samples);
+        let o = run(&["dsp", "process", wav.to_str().unwrap(), "--json"]);
+        assert!(o.status.success(), "{name}: {}", text(&o.stderr));
+        let est: serde_json::Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+        assert_eq!(est["detected"], false, "{name}: {est}");
+        assert_eq!(est["consistent"], false, "{name}: {est}");
+        assert!(est["range_m"].is_null(), "{name}: {est}");
     }
 }
 
