@@ -231,6 +231,9 @@ impl Limits {
     }
 }
 
+/// Items in a row past the time gap that are taken as a new time base.
+const JUMP_ITEMS: usize = 3;
+
 /// An item that no estimator saw: out of time order, out of the [`Limits`], or naming a
 /// beacon whose position is not known.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -360,6 +363,8 @@ pub struct Session {
     limits: Limits,
     /// The time of the last item accepted.
     last_t: Option<f64>,
+    /// Items in a row that jumped past the gap: the latest's time and their count.
+    jump: Option<(f64, usize)>,
     /// Each estimator's last sound pose (N, E, psi), to start it again from.
     last_sound: Vec<(f64, f64, f64)>,
 }
@@ -392,6 +397,7 @@ impl Session {
             last_beacon: None,
             limits: Limits::default(),
             last_t: None,
+            jump: None,
             last_sound: Vec::new(),
         }
     }
@@ -466,11 +472,23 @@ impl Session {
             return Err(self.screen(item, format!("time {t} s is {:.6} s before the previous item's", -dt)));
         }
         if let Some(dt) = dt.filter(|dt| *dt > self.limits.max_time_gap_s) {
+            // a lone jump is a corrupt time; a few items in a row on the new clock are a
+            // real gap (a vehicle back from the surface), taken as the new time base
             let most = self.limits.max_time_gap_s;
-            return Err(self.screen(
-                item,
-                format!("time {t:?} s jumps {dt:?} s past the previous item (limits.max_time_gap_s = {most})"),
-            ));
+            let seen = match self.jump {
+                Some((t_jump, n)) if (t - t_jump).abs() <= most => n + 1,
+                _ => 1,
+            };
+            self.jump = Some((t, seen));
+            if seen < JUMP_ITEMS {
+                return Err(self.screen(
+                    item,
+                    format!(
+                        "time {t:?} s jumps {dt:?} s past the previous item (limits.max_time_gap_s = {most}; \
+                         {JUMP_ITEMS} items in a row on the new clock restart it)"
+                    ),
+                ));
+            }
         }
         if let Err(reason) = self.limits.check(&item.input, dt) {
             return Err(self.screen(item, reason));
@@ -486,6 +504,7 @@ impl Session {
             self.tracked.insert(beacon_id, position);
         }
         self.last_t = Some(t);
+        self.jump = None;
         if !self.started() {
             match (self.start, &item.input) {
                 (Start::At { t0_s, pose }, _) if t0_s.is_none_or(|t0| t >= t0) => self.begin(t0_s.unwrap_or(t), pose),
@@ -601,6 +620,23 @@ mod tests {
         let mut e = good;
         e.heading_var_rad2 = f64::INFINITY;
         assert!(!sound(&e));
+    }
+
+    /// A lone jump in time is screened out; three items in a row on a new clock (a
+    /// vehicle back from a long gap) restart it, so a session never goes deaf.
+    #[test]
+    fn a_real_gap_restarts_the_clock() {
+        let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
+        let mut s = Session::new(Frame::Ned, vec![], start, (1.0, 0.1), None);
+        let item = |t: f64| Item { t_s: t, input: Input::Measurement(Kind::Speed { speed_m_s: 1.0 }) };
+        for t in [0.0, 1.0, 2.0] {
+            assert!(s.push(&item(t)).is_ok());
+        }
+        assert!(s.push(&item(1e15)).is_err());
+        assert!(s.push(&item(3.0)).is_ok(), "a lone jump leaves the clock alone");
+        let after: Vec<bool> = [10_000.0, 10_001.0, 10_002.0, 10_003.0].map(|t| s.push(&item(t)).is_ok()).to_vec();
+        assert_eq!(after, [false, false, true, true]);
+        assert_eq!(s.screened, 3);
     }
 
     /// Every plausible item passes the default limits; the implausible ones are refused
