@@ -70,19 +70,21 @@ impl FixedBeaconWorld {
         let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
         s.estimators
             .iter()
-            .map(|e| Track {
-                vehicle: 0,
-                navigator: Box::new(
-                    SingleBeaconNavigator::new(
-                        e.aiding(Host::FixedBeacon),
-                        e.ekf_tuning(),
-                        e.filter_kind(),
-                        0.0,
-                        z0,
-                        p0,
-                    )
-                    .with_mirror_recovery(e.mirror_recovery.unwrap_or(true)),
-                ),
+            .map(|e| {
+                let nav = SingleBeaconNavigator::new(
+                    e.aiding(Host::FixedBeacon),
+                    e.ekf_tuning(),
+                    e.filter_kind(),
+                    0.0,
+                    z0,
+                    p0,
+                );
+                // the navigator's own default where the key is absent
+                let nav = match e.mirror_recovery {
+                    Some(on) => nav.with_mirror_recovery(on),
+                    None => nav,
+                };
+                Track { vehicle: 0, navigator: Box::new(nav) }
             })
             .collect()
     }

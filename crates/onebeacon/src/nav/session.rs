@@ -158,16 +158,19 @@ impl Limits {
     /// Whether `input`, `dt_s` after the previous item, is within the limits; the
     /// reason otherwise.
     pub fn check(&self, input: &Input, dt_s: Option<f64>) -> Result<(), String> {
-        let within = |what: &str, v: f64, lo: f64, hi: f64, key: &str| {
+        // `why` names the limit: a `[limits]` key, or the fixed bound of a physical value
+        let within = |what: &str, v: f64, lo: f64, hi: f64, why: &str| {
             if v.is_finite() && (lo..=hi).contains(&v) {
                 Ok(())
             } else {
-                Err(format!("{what} {v:?} is outside [{lo}, {hi}] (limits.{key})"))
+                Err(format!("{what} {v:?} is outside [{lo}, {hi}] ({why})"))
             }
         };
-        let speed = |what: &str, v: f64| within(what, v, -self.max_speed_m_s, self.max_speed_m_s, "max_speed_m_s");
-        let rate = |what: &str, v: f64| within(what, v, -self.max_rate_rad_s, self.max_rate_rad_s, "max_rate_rad_s");
-        let angle = |what: &str, v: f64| within(what, v, -1e3, 1e3, "angle");
+        let speed =
+            |what: &str, v: f64| within(what, v, -self.max_speed_m_s, self.max_speed_m_s, "limits.max_speed_m_s");
+        let rate =
+            |what: &str, v: f64| within(what, v, -self.max_rate_rad_s, self.max_rate_rad_s, "limits.max_rate_rad_s");
+        let angle = |what: &str, v: f64| within(what, v, -1e3, 1e3, "an angle in radians");
         let range = |v: f64| {
             if v.is_finite() && v > 0.0 && v <= self.max_range_m {
                 Ok(())
@@ -179,24 +182,26 @@ impl Limits {
         match *input {
             Input::Measurement(m) => {
                 if let Some(b) = m.beacon() {
-                    within("beacon_sigma_m", b.sigma_m, 0.0, 1e4, "beacon_sigma_m")?;
+                    within("beacon_sigma_m", b.sigma_m, 0.0, 1e4, "a position error in metres")?;
                 }
                 match m {
                     Kind::Odometry { distance_m, heading_change_rad } => {
                         // at least a second's travel, so that close items are not refused
                         let most = self.max_speed_m_s * dt_s.unwrap_or(1.0).max(1.0);
-                        within("odometry distance_m", distance_m, -most, most, "max_speed_m_s x the time step")?;
+                        within("odometry distance_m", distance_m, -most, most, "limits.max_speed_m_s x the time step")?;
                         within(
                             "heading_change_rad",
                             heading_change_rad,
                             -std::f64::consts::PI,
                             std::f64::consts::PI,
-                            "pi",
+                            "a turn of at most pi per step",
                         )
                     }
                     Kind::Speed { speed_m_s } => speed("speed_m_s", speed_m_s),
                     Kind::Heading { heading_rad } => angle("heading_rad", heading_rad),
-                    Kind::Depth { depth_m } => within("depth_m", depth_m, -100.0, self.max_depth_m, "max_depth_m"),
+                    Kind::Depth { depth_m } => {
+                        within("depth_m", depth_m, -100.0, self.max_depth_m, "limits.max_depth_m")
+                    }
                     Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
                         angle("roll_rad", roll_rad)?;
                         angle("pitch_rad", pitch_rad)?;
@@ -209,7 +214,7 @@ impl Limits {
                     Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
                         angle("heading_rad", heading_rad)?;
                         rate("yaw_rate_rad_s", yaw_rate_rad_s)?;
-                        within("accel_m_s2", accel_m_s2, -100.0, 100.0, "100 m/s^2")
+                        within("accel_m_s2", accel_m_s2, -100.0, 100.0, "an acceleration in m/s^2")
                     }
                     Kind::Range { range_m, .. } => range(range_m),
                     Kind::Doppler { radial_speed_m_s, .. } => speed("radial_speed_m_s", radial_speed_m_s),
@@ -220,11 +225,11 @@ impl Limits {
                 }
             }
             Input::BeaconPosition { position, .. } => {
-                position.iter().try_for_each(|&v| within("beacon position", v, -far, far, "1e8 m"))
+                position.iter().try_for_each(|&v| within("beacon position", v, -far, far, "a position in metres"))
             }
             Input::Truth(p) => {
-                within("ground truth x", p.north_m, -far, far, "1e8 m")?;
-                within("ground truth y", p.east_m, -far, far, "1e8 m")?;
+                within("ground truth x", p.north_m, -far, far, "a position in metres")?;
+                within("ground truth y", p.east_m, -far, far, "a position in metres")?;
                 p.heading_rad.map_or(Ok(()), |h| angle("ground truth heading", h))
             }
         }

@@ -111,10 +111,6 @@ impl SingleBeaconNavigator {
         self
     }
 
-    pub fn aiding(&self) -> Aiding {
-        self.aiding
-    }
-
     /// Range, Doppler speed and heading from one beacon cannot tell the vehicle from its
     /// point reflection through the beacon driving backwards (same ranges, same radial
     /// speeds, same heading): the EKF sometimes locks onto that mirror. A survey vehicle
