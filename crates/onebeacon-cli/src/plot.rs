@@ -98,6 +98,41 @@ fn line(
     Ok(())
 }
 
+/// The records a plot of a trajectory of any length needs: every record until there
+/// are `2 * cap`, then every second one of those and of what follows, and so on, so at
+/// most `2 * cap` evenly spaced records are held.
+pub struct Thinned {
+    records: Vec<StepRecord>,
+    cap: usize,
+    stride: usize,
+    seen: usize,
+}
+
+impl Thinned {
+    pub fn new(cap: usize) -> Self {
+        Self { records: Vec::new(), cap: cap.max(1), stride: 1, seen: 0 }
+    }
+
+    pub fn push(&mut self, r: StepRecord) {
+        if self.seen.is_multiple_of(self.stride) {
+            self.records.push(r);
+            if self.records.len() >= 2 * self.cap {
+                let mut k = 0;
+                self.records.retain(|_| {
+                    k += 1;
+                    k % 2 == 1
+                });
+                self.stride *= 2;
+            }
+        }
+        self.seen += 1;
+    }
+
+    pub fn records(&self) -> &[StepRecord] {
+        &self.records
+    }
+}
+
 /// Top view: every vehicle's truth (`vehicles`), every estimate (`names`, in the
 /// records' order), the beacons: `fixed_beacons` when given (replayed logs), else the
 /// records' beacon (its track when it moves). East to the right, north up, equal scales.

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use onebeacon::io::jsonl;
 use onebeacon::nav::session::{Limits, Session, Start};
 use onebeacon_sim::replay::log::HeadingFrom;
-use onebeacon_sim::replay::{Log, LogDescription, new_session, replay as run_replay};
+use onebeacon_sim::replay::{Log, LogDescription, Replay, new_session, replay as run_replay};
 use serde_json::{Value, json};
 use std::collections::BTreeSet;
 use std::io::Write;
@@ -38,10 +38,11 @@ pub fn replay(
 ) -> Result<()> {
     let log = Log::load(path)?;
     if print_stream {
-        let mut stdout = std::io::stdout().lock();
-        for item in &log.items {
-            writeln!(stdout, "{}", jsonl::item_json(item))?;
+        let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
+        for item in log.items()? {
+            writeln!(stdout, "{}", jsonl::item_json(&item?))?;
         }
+        stdout.flush()?;
         return Ok(());
     }
     let known = log.beacon_ids();
@@ -54,20 +55,30 @@ pub fn replay(
     let staging = Staging::new(&dir)?;
 
     let started = std::time::Instant::now();
-    let r = run_replay(&log, filter)?;
+    let vehicles = ["auv".to_string()];
+    let names: Vec<String> = log.description.estimators.iter().map(|e| e.name()).collect();
+    let file = std::fs::File::create(staging.file("trajectory.csv")).context("cannot write trajectory.csv")?;
+    let mut trajectory = report::TrajectoryWriter::new(std::io::BufWriter::new(file), &vehicles, &names)?;
+    // the trajectory is written as it comes; the plots get at most 20 000 evenly spaced rows
+    let mut plotted = plot::Thinned::new(10_000);
+    let r = run_replay(&log, filter, |record| -> Result<()> {
+        trajectory.write(&record)?;
+        plotted.push(record);
+        Ok(())
+    })?;
+    trajectory.finish()?.flush().context("cannot write trajectory.csv")?;
     let wall_s = started.elapsed().as_secs_f64();
     let s = &r.session;
-    let summary = summary_json(&log, &used, s, wall_s);
+    let summary = summary_json(&log, &used, &r, wall_s);
 
-    staging.write("trajectory.csv", &report::trajectory_csv(&["auv".into()], &s.names, &r.trajectory)?)?;
     staging.write("summary.json", serde_json::to_string_pretty(&summary)?.as_bytes())?;
     staging.write("rejected.csv", &rejected_csv(s)?)?;
     let fixed: Vec<_> =
         used.iter().filter_map(|b| log.beacons.get(b)).map(|p| log.frame.to_ned(p.x, p.y, p.z)).collect();
     let title = format!("{name}, beacons {}", used.iter().map(u32::to_string).collect::<Vec<_>>().join(", "));
-    plot::top_view(&staging.file("top_view.png"), &["auv".into()], &s.names, &title, &r.trajectory, Some(&fixed))
+    plot::top_view(&staging.file("top_view.png"), &vehicles, &s.names, &title, plotted.records(), Some(&fixed))
         .context("cannot draw top_view.png")?;
-    plot::error_vs_time(&staging.file("error.png"), &s.names, &title, &r.trajectory)
+    plot::error_vs_time(&staging.file("error.png"), &s.names, &title, plotted.records())
         .context("cannot draw error.png")?;
     let files = staging.commit()?;
 
@@ -75,7 +86,7 @@ pub fn replay(
         outln!("{summary}");
         return Ok(());
     }
-    outln!("{title}: {} measurements, replayed in {:.1} ms", log.items.len(), wall_s * 1e3);
+    outln!("{title}: {} measurements, replayed in {:.1} ms", r.items, wall_s * 1e3);
     // (header, summary key, decimals)
     const COLUMNS: [(&str, &str, usize); 11] = [
         ("rmse_m", "rmse_m", 3),
@@ -106,7 +117,8 @@ pub fn replay(
     Ok(())
 }
 
-fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
+fn summary_json(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
+    let s = &r.session;
     let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
     let finals = s.final_estimates();
     let estimators: Vec<Value> = s
@@ -138,7 +150,7 @@ fn summary_json(log: &Log, used: &[u32], s: &Session, wall_s: f64) -> Value {
     json!({
         "log": log.description.name,
         "beacons": used,
-        "items": log.items.len(),
+        "items": r.items,
         "skipped_before_start": s.before_start,
         "left_out": s.left_out,
         "screened": s.screened,

@@ -25,33 +25,52 @@ fn sweep_json(cell: &Cell) -> Value {
 /// columns prefixed with its name when there are several) and every track's estimate
 /// (`names`, in the records' order), standard deviations, error and NEES.
 pub fn trajectory_csv(vehicles: &[String], names: &[String], trajectory: &[StepRecord]) -> Result<Vec<u8>> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header = vec!["t_s".to_string()];
-    for v in vehicles {
-        let prefix = if vehicles.len() > 1 { format!("{v}_") } else { String::new() };
-        for col in ["truth_north_m", "truth_east_m", "truth_down_m", "truth_heading_deg", "truth_speed_m_s"] {
-            header.push(format!("{prefix}{col}"));
-        }
-    }
-    header.extend(["beacon_north_m", "beacon_east_m", "beacon_down_m", "frame"].map(String::from));
-    for name in names {
-        for col in [
-            "north_m",
-            "east_m",
-            "down_m",
-            "heading_deg",
-            "speed_m_s",
-            "sigma_north_m",
-            "sigma_east_m",
-            "error_m",
-            "nees",
-        ] {
-            header.push(format!("{name}_{col}"));
-        }
-    }
-    w.write_record(&header)?;
-    let f = |v: f64| format!("{v:.4}");
+    let mut w = TrajectoryWriter::new(Vec::new(), vehicles, names)?;
     for r in trajectory {
+        w.write(r)?;
+    }
+    w.finish()
+}
+
+/// trajectory.csv written row by row as the steps come ([`trajectory_csv`]).
+pub struct TrajectoryWriter<W: std::io::Write> {
+    w: csv::Writer<W>,
+}
+
+impl<W: std::io::Write> TrajectoryWriter<W> {
+    /// Writes the header.
+    pub fn new(out: W, vehicles: &[String], names: &[String]) -> Result<Self> {
+        let mut w = csv::Writer::from_writer(out);
+        let mut header = vec!["t_s".to_string()];
+        for v in vehicles {
+            let prefix = if vehicles.len() > 1 { format!("{v}_") } else { String::new() };
+            for col in ["truth_north_m", "truth_east_m", "truth_down_m", "truth_heading_deg", "truth_speed_m_s"] {
+                header.push(format!("{prefix}{col}"));
+            }
+        }
+        header.extend(["beacon_north_m", "beacon_east_m", "beacon_down_m", "frame"].map(String::from));
+        for name in names {
+            for col in [
+                "north_m",
+                "east_m",
+                "down_m",
+                "heading_deg",
+                "speed_m_s",
+                "sigma_north_m",
+                "sigma_east_m",
+                "error_m",
+                "nees",
+            ] {
+                header.push(format!("{name}_{col}"));
+            }
+        }
+        w.write_record(&header)?;
+        Ok(Self { w })
+    }
+
+    /// Writes one step's row.
+    pub fn write(&mut self, r: &StepRecord) -> Result<()> {
+        let f = |v: f64| format!("{v:.4}");
         let mut row = vec![format!("{:.2}", r.t_s)];
         for t in &r.truth {
             row.extend([t.pos.x, t.pos.y, t.pos.z].map(f));
@@ -66,9 +85,14 @@ pub fn trajectory_csv(vehicles: &[String], names: &[String], trajectory: &[StepR
             row.push(e.speed.map(f).unwrap_or_default());
             row.extend([e.sigma_pos.x, e.sigma_pos.y, e.error_m, e.nees].map(f));
         }
-        w.write_record(&row)?;
+        self.w.write_record(&row)?;
+        Ok(())
     }
-    Ok(w.into_inner()?)
+
+    /// Flushes and returns the writer.
+    pub fn finish(self) -> Result<W> {
+        self.w.into_inner().map_err(|e| anyhow::anyhow!("{}", e.error()))
+    }
 }
 
 /// summary.json of one run.

@@ -189,6 +189,12 @@ fn bad_logs_exit_2_with_one_line_naming_file_line_and_column() {
             bad_log(&dir, "not a number", "t,id,r\n1.5,0,ten\n", ""),
             "line 2, column `r`: `ten` is not a number",
         ),
+        (
+            // found while replaying, not when loading: the files are read as streams
+            "bad row late in the file",
+            bad_log(&dir, "late row", "t,id,r\n1.5,0,10.0\n1.7,0,10.0\n1.9,0,ten\n", ""),
+            "line 4, column `r`: `ten` is not a number",
+        ),
         ("NaN cell", bad_log(&dir, "NaN cell", "t,id,r\n1.5,0,NaN\n", ""), "line 2, column `r`: `NaN` is not finite"),
         (
             "time backwards",

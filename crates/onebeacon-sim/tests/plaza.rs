@@ -1,7 +1,7 @@
 //! The real plaza logs (data/plaza) through the replay engine. The table of the closing
 //! note: `cargo test --release -p onebeacon-sim --test plaza -- --ignored --nocapture`.
 
-use onebeacon_sim::replay::{Log, replay};
+use onebeacon_sim::replay::{Log, LogError, replay};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
@@ -15,14 +15,20 @@ fn log(n: u8) -> Log {
 #[test]
 fn replay_is_the_session_fed_item_by_item() {
     let l = log(2);
-    let r = replay(&l, None).unwrap();
+    let mut rows = 0;
+    let r = replay(&l, None, |_| {
+        rows += 1;
+        Ok::<_, LogError>(())
+    })
+    .unwrap();
     let mut s = onebeacon_sim::replay::session_for(&l, None).unwrap();
-    for item in &l.items {
-        s.push(item).expect("no plaza item is screened out");
+    for item in l.items().unwrap() {
+        s.push(&item.unwrap()).expect("no plaza item is screened out");
     }
     assert_eq!(s.stats, r.session.stats);
     assert_eq!(s.final_estimates(), r.session.final_estimates());
-    assert_eq!(r.trajectory.len(), 4091); // one row per ground-truth pose
+    assert_eq!(rows, 4091); // one row per ground-truth pose (4092 lines less the header)
+    assert_eq!(r.items, 4091 + 4090 + 1816); // every CSV row of the three sources
 }
 
 #[test]
@@ -30,10 +36,10 @@ fn replay_is_the_session_fed_item_by_item() {
 fn measure_plaza_table() {
     for n in [1, 2] {
         let l = log(n);
-        let names = replay(&l, None).unwrap().session.names;
+        let names = replay(&l, None, |_| Ok::<_, LogError>(())).unwrap().session.names;
         eprintln!("| plaza{n} beacons | {} |", names.join(" | "));
         for b in [None, Some(0), Some(1), Some(5), Some(6)] {
-            let r = replay(&l, b.map(|b| BTreeSet::from([b]))).unwrap();
+            let r = replay(&l, b.map(|b| BTreeSet::from([b])), |_| Ok::<_, LogError>(())).unwrap();
             let cells: Vec<String> = r
                 .session
                 .stats

@@ -275,14 +275,17 @@ pub struct LogDescription {
     pub limits: Limits,
 }
 
-/// A loaded log: the description, fixed beacons and the merged stream (SI units, the
-/// log's frame).
+/// A loaded log: the description and its fixed beacons (SI units, the log's frame). Its
+/// CSV files are read as streams by [`Log::items`], never held whole (but for sources
+/// with `sort = true`), so a log of any length replays in bounded memory.
 #[derive(Debug, Clone)]
 pub struct Log {
     pub description: LogDescription,
     pub frame: Frame,
     pub beacons: BTreeMap<u32, Vector3<f64>>,
-    pub items: Vec<Item>,
+    /// Beacons with a `beacon_track` source.
+    tracked: BTreeSet<u32>,
+    base: PathBuf,
 }
 
 impl LogDescription {
@@ -328,79 +331,111 @@ impl LogDescription {
 }
 
 impl Log {
-    /// Loads a log description and every file it names (relative to its directory).
+    /// Loads a log description, its fixed beacons and the beacon ids of its tracks,
+    /// and opens every file it names (relative to its directory): headers, columns and
+    /// first rows are checked here; a later bad row is an error of [`Log::items`].
     pub fn load(path: &Path) -> Result<Self, LogError> {
         let description = LogDescription::load(path)?;
-        let base = path.parent().unwrap_or(Path::new("."));
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let frame = Frame::from(description.frame);
-        let beacons = description.fixed_beacons(base)?;
-        let mut tracked = BTreeSet::new();
-        let mut keyed: Vec<((f64, u8, usize, usize), Item)> = Vec::new();
+        let beacons = description.fixed_beacons(&base)?;
         // beacon tracks first, so that ranges may name tracked beacons
-        let order: Vec<usize> = (0..description.sources.len())
-            .filter(|&i| description.sources[i].kind == SourceKind::BeaconTrack)
-            .chain((0..description.sources.len()).filter(|&i| description.sources[i].kind != SourceKind::BeaconTrack))
-            .collect();
-        for i in order {
-            let s = &description.sources[i];
-            let rows = read_source(base, s, &beacons, &mut tracked)?;
-            for (r, item) in rows.into_iter().enumerate() {
-                // at equal times: beacon positions, then measurements, then the truth
-                let rank = match item.input {
-                    Input::BeaconPosition { .. } => 0,
-                    Input::Measurement(_) => 1,
-                    Input::Truth(_) => 2,
-                };
-                keyed.push(((item.t_s, rank, i, r), item));
+        let (mut tracked, none) = (BTreeSet::new(), BTreeSet::new());
+        for s in description.sources.iter().filter(|s| s.kind == SourceKind::BeaconTrack) {
+            let mut rows = SourceRows::open(&base, s, &beacons, &none)?;
+            while let Some(item) = rows.next_item()? {
+                if let Input::BeaconPosition { beacon_id, .. } = item.input {
+                    tracked.insert(beacon_id);
+                }
             }
         }
-        keyed.sort_by(|a, b| {
-            let (ka, kb) = (a.0, b.0);
-            ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1)).then(ka.2.cmp(&kb.2)).then(ka.3.cmp(&kb.3))
-        });
-        Ok(Self { description, frame, beacons, items: keyed.into_iter().map(|(_, item)| item).collect() })
+        let log = Self { description, frame, beacons, tracked, base };
+        log.items()?;
+        Ok(log)
+    }
+
+    /// The merged, time-ordered stream of every source. At equal times: beacon
+    /// positions, then measurements, then the truth; then in the order of the sources.
+    pub fn items(&self) -> Result<Items<'_>, LogError> {
+        let (mut heads, mut rows) = (Vec::new(), Vec::new());
+        for s in &self.description.sources {
+            let mut source = SourceRows::open(&self.base, s, &self.beacons, &self.tracked)?;
+            let head = source
+                .next_item()?
+                .ok_or_else(|| LogError::File { file: source.table.file.clone(), message: "no rows".into() })?;
+            if s.sort {
+                let mut all = vec![head];
+                while let Some(item) = source.next_item()? {
+                    all.push(item);
+                }
+                all.sort_by(|a, b| a.t_s.total_cmp(&b.t_s)); // stable: equal times keep their rows' order
+                let mut all = all.into_iter();
+                heads.push(all.next());
+                rows.push(Rows::Sorted(all));
+            } else {
+                heads.push(Some(head));
+                rows.push(Rows::Streamed(Box::new(source)));
+            }
+        }
+        let rank = |s: &Source| match s.kind {
+            SourceKind::BeaconTrack => 0,
+            SourceKind::GroundTruth => 2,
+            _ => 1,
+        };
+        let ranks = self.description.sources.iter().map(rank).collect();
+        Ok(Items { heads, rows, ranks, failed: false })
     }
 
     /// Every beacon of the log: fixed ones and those with a track.
     pub fn beacon_ids(&self) -> BTreeSet<u32> {
-        let tracked = self.items.iter().filter_map(|i| match i.input {
-            Input::BeaconPosition { beacon_id, .. } => Some(beacon_id),
-            _ => None,
-        });
-        self.beacons.keys().copied().chain(tracked).collect()
+        self.beacons.keys().chain(&self.tracked).copied().collect()
+    }
+
+    /// Whether the log has a ground truth.
+    pub fn has_truth(&self) -> bool {
+        self.description.sources.iter().any(|s| s.kind == SourceKind::GroundTruth)
     }
 
     /// The initial pose (NED) and time, from the description: given, or the first
-    /// ground-truth pose (heading from its column or its track).
+    /// ground-truth pose (heading from its column or its track). Reads the log only as
+    /// far as it needs.
     pub fn initial_pose(&self) -> Result<(f64, (f64, f64, f64)), LogError> {
         let init = &self.description.initial;
-        let truth: Vec<(f64, TruthPose)> = self
-            .items
-            .iter()
-            .filter_map(|i| match i.input.to_ned(self.frame) {
-                Input::Truth(p) => Some((i.t_s, p)),
-                _ => None,
-            })
-            .collect();
-        let first_t = self.items.first().map_or(0.0, |i| i.t_s);
+        let mut items = self.items()?;
+        let first = items.next().transpose()?;
+        let first_t = first.as_ref().map_or(0.0, |i| i.t_s);
         if let Some(pose) = init.given_pose(self.frame) {
             return Ok((first_t, pose));
         }
+        let mut truth = first.into_iter().map(Ok).chain(items).filter_map(|i| match i {
+            Ok(i) => match i.input.to_ned(self.frame) {
+                Input::Truth(p) => Some(Ok((i.t_s, p))),
+                _ => None,
+            },
+            Err(e) => Some(Err(e)),
+        });
         let no_truth = || {
             LogError::File {
             file: self.description.name.clone(),
             message: "initial.from = \"ground_truth\" but the log has no ground_truth source (give the pose with from = \"given\")".into(),
         }
         };
-        let (t0, p0) = *truth.first().ok_or_else(no_truth)?;
+        let (t0, p0) = truth.next().transpose()?.ok_or_else(no_truth)?;
         let psi = match init.heading_from {
             HeadingFrom::Column => p0.heading_rad.ok_or_else(|| LogError::File {
                 file: self.description.name.clone(),
                 message: "initial.heading_from = \"column\" but the ground_truth source has no heading column (use \"track\")".into(),
             })?,
             HeadingFrom::Track => {
-                let far = truth.iter().find(|(_, p)| (p.north_m - p0.north_m).hypot(p.east_m - p0.east_m) >= init.track_m);
-                let (_, p) = far.ok_or_else(|| LogError::File {
+                let mut far = None;
+                for pose in truth {
+                    let (_, p) = pose?;
+                    if (p.north_m - p0.north_m).hypot(p.east_m - p0.east_m) >= init.track_m {
+                        far = Some(p);
+                        break;
+                    }
+                }
+                let p = far.ok_or_else(|| LogError::File {
                     file: self.description.name.clone(),
                     message: format!("the ground truth never moves {} m from its start (initial.track_m)", init.track_m),
                 })?;
@@ -408,6 +443,50 @@ impl Log {
             }
         };
         Ok((t0, (p0.north_m, p0.east_m, psi)))
+    }
+}
+
+/// The rows of one source still to come.
+enum Rows<'a> {
+    Streamed(Box<SourceRows<'a>>),
+    /// A source with `sort = true`, read whole and sorted.
+    Sorted(std::vec::IntoIter<Item>),
+}
+
+/// The merged stream of a log's sources ([`Log::items`]): each source is read as the
+/// merge needs its next row. After an error the stream ends.
+pub struct Items<'a> {
+    /// The next item of each source (in the description's order), None once it is done.
+    heads: Vec<Option<Item>>,
+    rows: Vec<Rows<'a>>,
+    /// 0 beacon positions, 1 measurements, 2 ground truth.
+    ranks: Vec<u8>,
+    failed: bool,
+}
+
+impl Iterator for Items<'_> {
+    type Item = Result<Item, LogError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.failed {
+            return None;
+        }
+        let key = |i: usize| self.heads[i].as_ref().map(|h| (h.t_s, self.ranks[i], i));
+        let next = (0..self.heads.len())
+            .filter_map(key)
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)))?
+            .2;
+        let refill = match &mut self.rows[next] {
+            Rows::Streamed(rows) => rows.next_item(),
+            Rows::Sorted(rows) => Ok(rows.next()),
+        };
+        match refill {
+            Ok(head) => std::mem::replace(&mut self.heads[next], head).map(Ok),
+            Err(e) => {
+                self.failed = true;
+                Some(Err(e))
+            }
+        }
     }
 }
 
@@ -515,24 +594,44 @@ impl Row<'_> {
     }
 }
 
-/// Reads one source into stream items (NED, SI), in time order.
-fn read_source(
-    base: &Path,
-    s: &Source,
-    beacons: &BTreeMap<u32, Vector3<f64>>,
-    tracked: &mut BTreeSet<u32>,
-) -> Result<Vec<Item>, LogError> {
-    let mut table = Table::open(base, &s.file)?;
-    let time = table.index(&s.time)?;
-    let col = |key: &str, table: &Table| s.column(key).map(|c| table.index(c)).transpose();
-    let cols: BTreeMap<&str, usize> = COLUMN_KEYS
-        .iter()
-        .filter_map(|k| col(k, &table).transpose().map(|r| r.map(|c| (*k, c))))
-        .collect::<Result<_, _>>()?;
-    let (len, ang) = (s.length_unit.metres(), s.angle_unit.radians());
-    let mut items = Vec::new();
-    let mut previous: Option<f64> = None;
-    while let Some(row) = table.next_row()? {
+/// One source read row by row into stream items (the log's frame, SI units).
+struct SourceRows<'a> {
+    source: &'a Source,
+    table: Table,
+    time: usize,
+    cols: BTreeMap<&'static str, usize>,
+    beacons: &'a BTreeMap<u32, Vector3<f64>>,
+    tracked: &'a BTreeSet<u32>,
+    previous: Option<f64>,
+    /// The second item of a `speed_heading` row.
+    pending: Option<Item>,
+}
+
+impl<'a> SourceRows<'a> {
+    fn open(
+        base: &Path,
+        source: &'a Source,
+        beacons: &'a BTreeMap<u32, Vector3<f64>>,
+        tracked: &'a BTreeSet<u32>,
+    ) -> Result<Self, LogError> {
+        let table = Table::open(base, &source.file)?;
+        let time = table.index(&source.time)?;
+        let cols = COLUMN_KEYS
+            .iter()
+            .filter_map(|k| source.column(k).map(|c| table.index(c).map(|c| (*k, c))))
+            .collect::<Result<_, _>>()?;
+        Ok(Self { source, table, time, cols, beacons, tracked, previous: None, pending: None })
+    }
+
+    /// The next item, None at the end of the file.
+    fn next_item(&mut self) -> Result<Option<Item>, LogError> {
+        if let Some(item) = self.pending.take() {
+            return Ok(Some(item));
+        }
+        let (s, cols, time) = (self.source, &self.cols, self.time);
+        let (beacons, tracked) = (self.beacons, self.tracked);
+        let previous = self.previous;
+        let Some(row) = self.table.next_row()? else { return Ok(None) };
         let t = row.number(time)? + s.time_offset_s;
         if let Some(p) = previous.filter(|p| t < *p && !s.sort) {
             return Err(row.error(
@@ -540,49 +639,44 @@ fn read_source(
                 format!("time {t} is before {p} on the row above; rows must be in time order (or set sort = true on this source)"),
             ));
         }
-        previous = Some(t);
+        let (len, ang) = (s.length_unit.metres(), s.angle_unit.radians());
         let num = |k: &str| row.number(cols[k]);
-        let beacon = |tracked: &BTreeSet<u32>| {
+        let beacon = || {
             let id = row.beacon_id(cols["beacon"])?;
             resolve_beacon(id, beacons, tracked).map_err(|m| row.error(cols["beacon"], m))
         };
-        let mut push = |m: Kind| items.push(Item { t_s: t, input: Input::Measurement(m) });
-        match s.kind {
-            SourceKind::Odometry => push(Kind::Odometry {
+        let measurement = |m: Kind| Item { t_s: t, input: Input::Measurement(m) };
+        let mut pending = None;
+        let item = match s.kind {
+            SourceKind::Odometry => measurement(Kind::Odometry {
                 distance_m: num("distance")? * len,
                 heading_change_rad: num("heading_change")? * ang,
             }),
-            SourceKind::Speed => push(Kind::Speed { speed_m_s: num("speed")? * len }),
-            SourceKind::Heading => push(Kind::Heading { heading_rad: num("heading")? * ang }),
+            SourceKind::Speed => measurement(Kind::Speed { speed_m_s: num("speed")? * len }),
+            SourceKind::Heading => measurement(Kind::Heading { heading_rad: num("heading")? * ang }),
             SourceKind::SpeedHeading => {
-                push(Kind::Speed { speed_m_s: num("speed")? * len });
-                push(Kind::Heading { heading_rad: num("heading")? * ang });
+                pending = Some(measurement(Kind::Heading { heading_rad: num("heading")? * ang }));
+                measurement(Kind::Speed { speed_m_s: num("speed")? * len })
             }
-            SourceKind::Depth => push(Kind::Depth { depth_m: num("depth")? * len }),
-            SourceKind::Range => {
-                let beacon = beacon(tracked)?;
-                push(Kind::Range { beacon, range_m: num("range")? * len })
-            }
+            SourceKind::Depth => measurement(Kind::Depth { depth_m: num("depth")? * len }),
+            SourceKind::Range => measurement(Kind::Range { beacon: beacon()?, range_m: num("range")? * len }),
             SourceKind::Doppler => {
-                let beacon = beacon(tracked)?;
-                push(Kind::Doppler { beacon, radial_speed_m_s: num("radial_speed")? * len })
+                measurement(Kind::Doppler { beacon: beacon()?, radial_speed_m_s: num("radial_speed")? * len })
             }
             SourceKind::BeaconTrack => {
                 let beacon_id = row.beacon_id(cols["beacon"])?;
                 let z = cols.get("z").map_or(Ok(0.0), |&c| row.number(c))?;
                 let position = Vector3::new(num("x")?, num("y")?, z) * len;
-                tracked.insert(beacon_id);
-                items.push(Item { t_s: t, input: Input::BeaconPosition { beacon_id, position } });
+                Item { t_s: t, input: Input::BeaconPosition { beacon_id, position } }
             }
             SourceKind::GroundTruth => {
                 let heading_rad = cols.get("heading").map(|&c| row.number(c)).transpose()?.map(|h| h * ang);
                 let pose = TruthPose { north_m: num("x")? * len, east_m: num("y")? * len, heading_rad };
-                items.push(Item { t_s: t, input: Input::Truth(pose) });
+                Item { t_s: t, input: Input::Truth(pose) }
             }
-        }
+        };
+        self.previous = Some(t);
+        self.pending = pending;
+        Ok(Some(item))
     }
-    if items.is_empty() {
-        return Err(LogError::File { file: table.file.clone(), message: "no rows".into() });
-    }
-    Ok(items)
 }

@@ -13,12 +13,12 @@ use crate::run::{Estimate, StepRecord, TruthRecord};
 use nalgebra::{Vector2, Vector3};
 use std::collections::BTreeSet;
 
-/// A replayed log: one record per ground-truth pose (per measurement when the log
-/// has no ground truth), and the session with its statistics and rejections.
+/// A replayed log: the session with its statistics and rejections, and how many
+/// items the log had.
 #[derive(Debug, Clone)]
 pub struct Replay {
-    pub trajectory: Vec<StepRecord>,
     pub session: Session,
+    pub items: usize,
 }
 
 /// A session of the description's estimators, starting at `start`, restricted to
@@ -35,27 +35,35 @@ pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session,
     Ok(new_session(&log.description, Start::At { t0_s: Some(t0), pose }, beacons))
 }
 
-/// Runs every estimator of `log` over its stream.
-pub fn replay(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Replay, LogError> {
+/// Runs every estimator of `log` over its stream, giving `record` one trajectory row
+/// per ground-truth pose (per measurement when the log has no ground truth) as it goes:
+/// nothing grows with the log's length but the bounded rejection log.
+pub fn replay<E: From<LogError>>(
+    log: &Log,
+    beacons: Option<BTreeSet<u32>>,
+    mut record: impl FnMut(StepRecord) -> Result<(), E>,
+) -> Result<Replay, E> {
     let mut session = session_for(log, beacons)?;
-    let has_truth = log.items.iter().any(|i| matches!(i.input, Input::Truth(_)));
-    let mut trajectory = Vec::new();
+    let has_truth = log.has_truth();
     let mut heard = false;
-    for item in &log.items {
+    let mut items = 0;
+    for item in log.items()? {
+        let item = item?;
+        items += 1;
         // a screened item is counted and logged by the session; the replay goes on
-        let Ok(Some(step)) = session.push(item) else { continue };
+        let Ok(Some(step)) = session.push(&item) else { continue };
         heard |= step.outcomes.iter().any(|o| matches!(o, Some(onebeacon::nav::Outcome::Accepted(_))));
         if has_truth && step.truth.is_none() || !has_truth && !matches!(item.input, Input::Measurement(_)) {
             continue;
         }
-        trajectory.push(record(&step, session.last_beacon, heard));
+        record(to_record(&step, session.last_beacon, heard))?;
         heard = false;
     }
-    Ok(Replay { trajectory, session })
+    Ok(Replay { session, items })
 }
 
 /// A trajectory row (NED) from a step.
-fn record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord {
+fn to_record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord {
     let truth = step.truth;
     let estimates = step
         .estimates
