@@ -3,12 +3,11 @@
 use crate::output::Staging;
 use crate::{BadInput, plot, report};
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 use onebeacon::guidance::{PolarGrid, best_standoff};
 use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::run::simulate;
 use onebeacon_sim::scenario::{self, BUILTINS};
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -96,18 +95,7 @@ pub fn mc(
     let staging = out.as_deref().map(Staging::new).transpose()?;
 
     let total = (runs * s.cells().len()) as u64;
-    let bar = if std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(total);
-        bar.set_style(
-            ProgressStyle::with_template("{msg} {pos}/{len} runs [{wide_bar}] eta {eta}")
-                .expect("static template")
-                .progress_chars("=> "),
-        );
-        bar.set_message(format!("mc {}", s.name()));
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
+    let bar = crate::progress_bar(total, "runs", format!("mc {}", s.name()));
     let start = Instant::now();
     let result = monte_carlo(&s, runs, seed, threads, &|| bar.inc(1))?;
     let wall_s = start.elapsed().as_secs_f64();

@@ -78,181 +78,316 @@ fn bad(path: &Path, what: impl std::fmt::Display) -> anyhow::Error {
     BadInput(format!("{}: {what}", path.display())).into()
 }
 
-/// Reads a WAV into one capture per channel, checking it against the configuration.
-fn read_wav(path: &Path, channels: usize, fs_hz: f64) -> Result<Vec<Vec<f64>>> {
-    let mut r = hound::WavReader::open(path).map_err(|e| bad(path, format!("not a readable WAV file ({e})")))?;
-    let spec = r.spec();
-    if spec.channels as usize != channels {
-        return Err(bad(
-            path,
-            format!("{} channels; the array has {channels} elements (set [array] in --config)", spec.channels),
-        ));
-    }
-    if (spec.sample_rate as f64 - fs_hz).abs() > 0.5 {
-        return Err(bad(
-            path,
-            format!("sample rate {} Hz; expected {fs_hz} Hz (set capture.fs_hz in --config)", spec.sample_rate),
-        ));
-    }
-    let (samples, full_scale): (Vec<f64>, f64) = match spec.sample_format {
-        hound::SampleFormat::Float => (
-            r.samples::<f32>()
-                .map(|s| s.map(f64::from))
-                .collect::<Result<_, _>>()
-                .map_err(|e| bad(path, format!("truncated or corrupt ({e})")))?,
-            1.0,
-        ),
-        hound::SampleFormat::Int => {
-            let fs = (1i64 << (spec.bits_per_sample - 1)) as f64;
-            (
-                r.samples::<i32>()
-                    .map(|s| s.map(|v| v as f64 / fs))
-                    .collect::<Result<_, _>>()
-                    .map_err(|e| bad(path, format!("truncated or corrupt ({e})")))?,
-                1.0 - 1.0 / fs,
-            )
+/// A WAV being read capture by capture: frames of one sample per channel, scaled to
+/// full scale 1. Nothing but one capture is held, however long the recording.
+struct Recording {
+    path: PathBuf,
+    reader: hound::WavReader<std::io::BufReader<std::fs::File>>,
+    channels: usize,
+    /// Integer samples are divided by this; None for float samples.
+    int_scale: Option<f64>,
+    /// Frames read so far.
+    read: usize,
+}
+
+impl Recording {
+    /// Opens `path` and checks its header against the array and the sampling rate.
+    fn open(path: &Path, channels: usize, fs_hz: f64) -> Result<Self> {
+        let reader = hound::WavReader::open(path).map_err(|e| bad(path, format!("not a readable WAV file ({e})")))?;
+        let spec = reader.spec();
+        if spec.channels as usize != channels {
+            return Err(bad(
+                path,
+                format!("{} channels; the array has {channels} elements (set [array] in --config)", spec.channels),
+            ));
         }
-    };
-    if samples.is_empty() {
+        if (spec.sample_rate as f64 - fs_hz).abs() > 0.5 {
+            return Err(bad(
+                path,
+                format!("sample rate {} Hz; expected {fs_hz} Hz (set capture.fs_hz in --config)", spec.sample_rate),
+            ));
+        }
+        let int_scale = (spec.sample_format == hound::SampleFormat::Int)
+            .then(|| (1i64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f64);
+        Ok(Self { path: path.to_path_buf(), reader, channels, int_scale, read: 0 })
+    }
+
+    /// Full scale: a sample this large was clipped.
+    fn full_scale(&self) -> f64 {
+        self.int_scale.map_or(1.0, |fs| 1.0 - 1.0 / fs)
+    }
+
+    /// The next `len` frames, one vector per channel (fewer at the end of the file;
+    /// empty after it). A truncated file or a sample that is not a number is an error.
+    fn next_capture(&mut self, len: usize) -> Result<Vec<Vec<f64>>> {
+        let mut out = vec![Vec::with_capacity(len); self.channels];
+        let samples: Box<dyn Iterator<Item = hound::Result<f64>>> = match self.int_scale {
+            None => Box::new(self.reader.samples::<f32>().map(|s| s.map(f64::from))),
+            Some(fs) => Box::new(self.reader.samples::<i32>().map(move |s| s.map(|v| v as f64 / fs))),
+        };
+        for (i, v) in samples.take(len * self.channels).enumerate() {
+            let v = v.map_err(|e| bad(&self.path, format!("truncated or corrupt ({e})")))?;
+            let (frame, channel) = (self.read + i / self.channels, i % self.channels);
+            if !v.is_finite() {
+                return Err(bad(&self.path, format!("sample {frame} of channel {channel} is not a number")));
+            }
+            out[channel].push(v);
+        }
+        self.read += out[self.channels - 1].len();
+        Ok(out)
+    }
+}
+
+/// Reads the whole WAV once, holding one capture at a time, so that a bad sample is
+/// found before any result is given: its frames per channel.
+fn check_wav(path: &Path, channels: usize, fs_hz: f64) -> Result<usize> {
+    let mut r = Recording::open(path, channels, fs_hz)?;
+    let full_scale = r.full_scale();
+    let mut clipped = 0;
+    loop {
+        let capture = r.next_capture(1 << 16)?;
+        if capture[0].is_empty() {
+            break;
+        }
+        clipped += capture.iter().flatten().filter(|v| v.abs() >= full_scale * 0.9999).count();
+    }
+    if r.read == 0 {
         return Err(bad(path, "no samples"));
     }
-    if let Some(i) = samples.iter().position(|v| !v.is_finite()) {
-        return Err(bad(path, format!("sample {} of channel {} is not a number", i / channels, i % channels)));
-    }
-    let clipped = samples.iter().filter(|v| v.abs() >= full_scale * 0.9999).count();
     if clipped > 0 {
         return Err(bad(path, format!("{clipped} samples at full scale (clipped); record with less gain")));
     }
-    let n = samples.len() / channels;
-    Ok((0..channels).map(|c| (0..n).map(|i| samples[i * channels + c]).collect()).collect())
+    Ok(r.read)
 }
 
-/// `onebeacon dsp process ping.wav [--config FILE] [--out DIR] [--json]`
+/// What the receiver found in one capture, and what its output files need.
+struct Found {
+    result: serde_json::Value,
+    text: String,
+    distribution: Vec<f64>,
+    metres_per_lag: f64,
+    offset_m: f64,
+    range_m: f64,
+    /// The mode, azimuth and inclination (chirps), for beam.png.
+    beam: Option<(usize, f64, f64)>,
+}
+
+/// The receiver chain for captures of one length: the mode bank, then the receiver of
+/// the identified mode (chirps), or [`receive_frame`] (garin frames).
+struct Chain {
+    config: PingConfig,
+    elements: Vec<Vector3<f64>>,
+    receiver: ReceiverConfig,
+    /// Chirps: the bank and the receivers of the modes met so far.
+    bank: Option<(ModeBank, Vec<Option<Receiver>>)>,
+}
+
+impl Chain {
+    fn new(config: PingConfig, len: usize) -> Self {
+        let elements = config.elements();
+        let fs = config.capture.fs_hz;
+        let receiver = ReceiverConfig {
+            fs_hz: fs,
+            capture_len: len,
+            sound_speed_m_s: config.sound_speed_m_s(),
+            ..ReceiverConfig::default()
+        };
+        let bank = (config.waveform.kind == WaveformKind::Chirp).then(|| {
+            let modes = rypkema_modes();
+            let filters = modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, len)).collect();
+            let centres = modes.iter().map(|m| (m.f0_hz + m.f1_hz) / 2.0).collect();
+            let bank = ModeBank::with_array(filters, centres, elements.clone(), config.sound_speed_m_s());
+            (bank, modes.iter().map(|_| None).collect())
+        });
+        Self { config, elements, receiver, bank }
+    }
+
+    fn process(&mut self, captures: &[Vec<f64>]) -> Found {
+        let Some((bank, receivers)) = &mut self.bank else { return self.frame(captures) };
+        let spectra = bank.spectra(captures);
+        let mode = bank.identify(&spectra);
+        let rx = receivers[mode]
+            .get_or_insert_with(|| Receiver::new(rypkema_modes()[mode], &self.elements, self.receiver.clone()));
+        let est = rx.process_spectra(captures, &spectra);
+        let detected = est.range.detected();
+        let statistic = est.range.peak_ratio();
+        let threshold = onebeacon::dsp::matched_filter::detection_threshold(est.range.distribution.len());
+        let when = |v: serde_json::Value| if detected { v } else { serde_json::Value::Null };
+        let result = json!({
+            "detected": detected,
+            "detection_statistic": statistic,
+            "detection_threshold": threshold,
+            "range_m": when(json!(est.range.range_m)),
+            "azimuth_deg": when(json!(est.azimuth.to_degrees())),
+            "inclination_deg": when(json!(est.inclination.to_degrees())),
+            "mode": when(json!(mode + 1)),
+            "radial_speed_m_s": serde_json::Value::Null,
+            "consistent": detected && est.range.consistent,
+        });
+        let text = if !detected {
+            format!(
+                "no ping detected: statistic {statistic:.4} below the threshold {threshold:.4} (false alarms under 1 in 2000 captures)"
+            )
+        } else {
+            format!(
+                "mode {}, range {:.2} m, azimuth {:.1} deg, inclination {:.1} deg{}",
+                mode + 1,
+                est.range.range_m,
+                est.azimuth.to_degrees(),
+                est.inclination.to_degrees(),
+                if est.range.consistent { "" } else { " (elements disagree: range suspect)" }
+            )
+        };
+        Found {
+            result,
+            text,
+            metres_per_lag: self.config.sound_speed_m_s() / self.config.capture.fs_hz,
+            offset_m: 0.0,
+            range_m: est.range.range_m,
+            beam: Some((mode, est.azimuth, est.inclination)),
+            distribution: est.range.distribution,
+        }
+    }
+
+    /// A garin frame through [`receive_frame`]: range, Doppler speed, direction.
+    fn frame(&self, captures: &[Vec<f64>]) -> Found {
+        let est = receive_frame(&self.config.frame(), &self.elements, &self.receiver, captures);
+        let (range_m, v) = (est.range_m, est.radial_speed_m_s);
+        let (az, inc) = est.direction.unwrap_or((f64::NAN, f64::NAN));
+        let num = |x: f64| if x.is_finite() { json!(x) } else { serde_json::Value::Null };
+        let result = json!({
+            "range_m": range_m,
+            "azimuth_deg": num(az.to_degrees()),
+            "inclination_deg": num(inc.to_degrees()),
+            "mode": serde_json::Value::Null,
+            "radial_speed_m_s": v,
+            "consistent": est.sync.consistent,
+        });
+        let direction = if self.elements.len() > 1 {
+            format!(", azimuth {:.1} deg, inclination {:.1} deg", az.to_degrees(), inc.to_degrees())
+        } else {
+            String::new()
+        };
+        Found {
+            result,
+            text: format!("garin frame: range {range_m:.2} m, Doppler speed {v:.3} m/s (closing positive){direction}"),
+            // lags in metres, scaled by the Doppler compensation, less the pilots' offset
+            distribution: est.sync.distribution,
+            metres_per_lag: est.metres_per_lag,
+            offset_m: est.offset_m,
+            range_m,
+            beam: None,
+        }
+    }
+}
+
+/// `onebeacon dsp process ping.wav [--config FILE] [--out DIR] [--json]`: one capture,
+/// or a recording longer than `capture.samples` cut into captures of that length (the
+/// last one padded with zeros), each processed on its own.
 pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: bool) -> Result<()> {
     let c = PingConfig::load(config)?;
-    let elements = c.elements();
+    let channels = c.elements().len();
     let fs = c.capture.fs_hz;
-    let captures = read_wav(wav, elements.len(), fs)?;
-    let n = captures[0].len();
-    let modes = rypkema_modes();
-    if n < (modes[0].duration_s * fs) as usize {
-        return Err(bad(wav, format!("{n} samples per channel; at least one 20 ms pulse is needed")));
+    let frames = check_wav(wav, channels, fs)?;
+    let len = if frames <= c.capture.samples { frames } else { c.capture.samples };
+    let pulse = (rypkema_modes()[0].duration_s * fs) as usize;
+    if len < pulse {
+        return Err(bad(
+            wav,
+            format!("{len} samples per capture; at least one 20 ms pulse ({pulse} samples) is needed"),
+        ));
     }
     let staging = out.as_deref().map(Staging::new).transpose()?;
-    if c.waveform.kind == WaveformKind::GarinFrame {
-        return process_frame(&c, &captures, staging, as_json);
-    }
-    let filters = modes.iter().map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, n)).collect();
-    let centres = modes.iter().map(|m| (m.f0_hz + m.f1_hz) / 2.0).collect();
-    let bank = ModeBank::with_array(filters, centres, elements.clone(), c.sound_speed_m_s());
-    let spectra = bank.spectra(&captures);
-    let mode = bank.identify(&spectra);
-    let cfg =
-        ReceiverConfig { fs_hz: fs, capture_len: n, sound_speed_m_s: c.sound_speed_m_s(), ..ReceiverConfig::default() };
-    let mut rx = Receiver::new(modes[mode], &elements, cfg);
-    let est = rx.process_spectra(&captures, &spectra);
-    let detected = est.range.detected();
-    let statistic = est.range.peak_ratio();
-    let threshold = onebeacon::dsp::matched_filter::detection_threshold(est.range.distribution.len());
-    let when = |v: serde_json::Value| if detected { v } else { serde_json::Value::Null };
-    let result = json!({
-        "detected": detected,
-        "detection_statistic": statistic,
-        "detection_threshold": threshold,
-        "range_m": when(json!(est.range.range_m)),
-        "azimuth_deg": when(json!(est.azimuth.to_degrees())),
-        "inclination_deg": when(json!(est.inclination.to_degrees())),
-        "mode": when(json!(mode + 1)),
-        "radial_speed_m_s": serde_json::Value::Null,
-        "consistent": detected && est.range.consistent,
-    });
-    if let Some(staging) = staging {
-        let c_fs = c.sound_speed_m_s() / fs;
-        write_range_outputs(&staging, &est.range.distribution, c_fs, 0.0, est.range.range_m, &result)?;
-        plot::beam_map(&staging.file("beam.png"), |u: &Vector3<f64>| rx.beam_power(u), est.azimuth, est.inclination)
-            .context("cannot draw beam.png")?;
-        for f in staging.commit()? {
-            eprintln!("wrote {}", f.display());
-        }
-    }
-    if as_json {
-        outln!("{result}");
-    } else if !detected {
-        outln!(
-            "no ping detected: statistic {statistic:.4} below the threshold {threshold:.4} (false alarms under 1 in 2000 captures)"
-        );
-    } else {
-        outln!(
-            "mode {}, range {:.2} m, azimuth {:.1} deg, inclination {:.1} deg{}",
-            mode + 1,
-            est.range.range_m,
-            est.azimuth.to_degrees(),
-            est.inclination.to_degrees(),
-            if est.range.consistent { "" } else { " (elements disagree: range suspect)" }
-        );
-    }
-    Ok(())
-}
-
-/// A garin frame through [`receive_frame`]: range, Doppler speed, direction.
-fn process_frame(c: &PingConfig, captures: &[Vec<f64>], staging: Option<Staging>, as_json: bool) -> Result<()> {
-    let elements = c.elements();
-    let config = ReceiverConfig {
-        fs_hz: c.capture.fs_hz,
-        capture_len: captures[0].len(),
-        sound_speed_m_s: c.sound_speed_m_s(),
-        ..ReceiverConfig::default()
-    };
-    let est = receive_frame(&c.frame(), &elements, &config, captures);
-    let (range_m, v) = (est.range_m, est.radial_speed_m_s);
-    let (az, inc) = est.direction.unwrap_or((f64::NAN, f64::NAN));
-    let num = |x: f64| if x.is_finite() { json!(x) } else { serde_json::Value::Null };
-    let result = json!({
-        "range_m": range_m,
-        "azimuth_deg": num(az.to_degrees()),
-        "inclination_deg": num(inc.to_degrees()),
-        "mode": serde_json::Value::Null,
-        "radial_speed_m_s": v,
-        "consistent": est.sync.consistent,
-    });
-    if let Some(staging) = staging {
-        // lags in metres, scaled by the Doppler compensation, less the pilots' offset
-        write_range_outputs(&staging, &est.sync.distribution, est.metres_per_lag, est.offset_m, range_m, &result)?;
-        for f in staging.commit()? {
-            eprintln!("wrote {}", f.display());
-        }
-    }
-    if as_json {
-        outln!("{result}");
-    } else {
-        outln!(
-            "garin frame: range {range_m:.2} m, Doppler speed {v:.3} m/s (closing positive){}",
-            if elements.len() > 1 {
-                format!(", azimuth {:.1} deg, inclination {:.1} deg", az.to_degrees(), inc.to_degrees())
-            } else {
-                String::new()
+    let mut recording = Recording::open(wav, channels, fs)?;
+    let mut chain = Chain::new(c, len);
+    if frames == len {
+        let found = chain.process(&recording.next_capture(len)?);
+        if let Some(staging) = staging {
+            write_range_outputs(&staging, &found)?;
+            if let Some((mode, az, inc)) = found.beam {
+                let rx = chain.bank.as_ref().and_then(|(_, receivers)| receivers[mode].as_ref());
+                let power = |u: &Vector3<f64>| rx.map_or(0.0, |rx| rx.beam_power(u));
+                plot::beam_map(&staging.file("beam.png"), power, az, inc).context("cannot draw beam.png")?;
             }
-        );
+            for f in staging.commit()? {
+                eprintln!("wrote {}", f.display());
+            }
+        }
+        if as_json {
+            outln!("{}", found.result);
+        } else {
+            outln!("{}", found.text);
+        }
+        return Ok(());
+    }
+    // a recording: one line per capture, and captures.csv
+    let count = frames.div_ceil(len);
+    let mut table = match &staging {
+        Some(s) => Some(csv::Writer::from_path(s.file("captures.csv")).context("cannot write captures.csv")?),
+        None => None,
+    };
+    let columns = [
+        "capture",
+        "t_s",
+        "detected",
+        "range_m",
+        "azimuth_deg",
+        "inclination_deg",
+        "mode",
+        "radial_speed_m_s",
+        "consistent",
+    ];
+    if let Some(t) = &mut table {
+        t.write_record(columns)?;
+    }
+    let progress = crate::progress_bar(count as u64, "captures", "dsp process".into());
+    for k in 0..count {
+        let mut captures = recording.next_capture(len)?;
+        for ch in &mut captures {
+            ch.resize(len, 0.0);
+        }
+        let found = chain.process(&captures);
+        let t_s = (k * len) as f64 / fs;
+        let mut result = found.result;
+        result["capture"] = json!(k);
+        result["t_s"] = json!(t_s);
+        if let Some(t) = &mut table {
+            let cell = |key: &str| match &result[key] {
+                serde_json::Value::Null => String::new(),
+                v => v.to_string(),
+            };
+            let detected = result.get("detected").map_or("true".to_string(), |d| d.to_string());
+            let row: Vec<String> =
+                columns.iter().map(|&key| if key == "detected" { detected.clone() } else { cell(key) }).collect();
+            t.write_record(&row)?;
+        }
+        if as_json {
+            outln!("{result}");
+        } else {
+            outln!("capture {k} at {t_s:.3} s: {}", found.text);
+        }
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    if let (Some(staging), Some(t)) = (staging, table) {
+        t.into_inner().map_err(|e| anyhow::anyhow!("cannot write captures.csv: {}", e.error()))?;
+        for f in staging.commit()? {
+            eprintln!("wrote {}", f.display());
+        }
     }
     Ok(())
 }
 
-/// The range pseudo-distribution as CSV and PNG (range = lag x `metres_per_sample` -
-/// `offset_m`) and the estimates as JSON.
-fn write_range_outputs(
-    staging: &Staging,
-    distribution: &[f64],
-    metres_per_sample: f64,
-    offset_m: f64,
-    estimate_m: f64,
-    result: &serde_json::Value,
-) -> Result<()> {
+/// The range pseudo-distribution as CSV and PNG (range = lag x metres per lag - offset)
+/// and the estimates as JSON.
+fn write_range_outputs(staging: &Staging, found: &Found) -> Result<()> {
+    let (distribution, metres_per_lag, offset_m) = (&found.distribution, found.metres_per_lag, found.offset_m);
     let mut csv = String::from("range_m,pseudo_probability\n");
     for (i, p) in distribution.iter().enumerate() {
-        csv.push_str(&format!("{:.4},{p:.6e}\n", i as f64 * metres_per_sample - offset_m));
+        csv.push_str(&format!("{:.4},{p:.6e}\n", i as f64 * metres_per_lag - offset_m));
     }
     staging.write("range.csv", csv.as_bytes())?;
-    staging.write("estimate.json", (serde_json::to_string_pretty(result)? + "\n").as_bytes())?;
-    plot::range_distribution(&staging.file("range.png"), distribution, metres_per_sample, offset_m, estimate_m)
+    staging.write("estimate.json", (serde_json::to_string_pretty(&found.result)? + "\n").as_bytes())?;
+    plot::range_distribution(&staging.file("range.png"), distribution, metres_per_lag, offset_m, found.range_m)
         .context("cannot draw range.png")
 }

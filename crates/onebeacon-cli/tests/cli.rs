@@ -331,6 +331,51 @@ fn dsp_process_says_when_there_is_no_ping() {
     }
 }
 
+/// A recording longer than `capture.samples` is cut into captures processed one by one,
+/// each as the single capture would be; a bad sample anywhere is refused before any
+/// line is given.
+#[test]
+fn dsp_process_cuts_a_recording_into_captures() {
+    let dir = scratch("recording");
+    let wav = dir.join("ping.wav");
+    assert!(run(&["dsp", "simulate", "--out", wav.to_str().unwrap()]).status.success());
+    let single = run(&["dsp", "process", wav.to_str().unwrap(), "--json"]);
+    let single: serde_json::Value = serde_json::from_str(&text(&single.stdout)).unwrap();
+    let ping: Vec<f32> = hound::WavReader::open(&wav).unwrap().samples::<f32>().map(Result::unwrap).collect();
+    // ping, silence, ping, and half a capture of silence (padded with zeros)
+    let mut recording = ping.clone();
+    recording.extend(vec![0.0; ping.len()]);
+    recording.extend(&ping);
+    recording.extend(vec![0.0; ping.len() / 2]);
+    let long = dir.join("recording.wav");
+    write_wav(&long, 5, 37_500, &recording);
+    let out_dir = dir.join("out");
+    let o = run(&["dsp", "process", long.to_str().unwrap(), "--json", "--out", out_dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let lines: Vec<serde_json::Value> = text(&o.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 4);
+    for (k, line) in lines.iter().enumerate() {
+        assert_eq!(line["capture"], k);
+        assert!((line["t_s"].as_f64().unwrap() - k as f64 * 8000.0 / 37_500.0).abs() < 1e-12);
+        assert_eq!(line["detected"], k % 2 == 0, "{line}");
+        if k % 2 == 0 {
+            for key in ["range_m", "azimuth_deg", "inclination_deg", "mode", "consistent"] {
+                assert_eq!(line[key], single[key], "{key}");
+            }
+        }
+    }
+    let csv = std::fs::read_to_string(out_dir.join("captures.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 5);
+    // a sample that is not a number in the third capture (frame 2 x 8000 + 7 / 5, channel
+    // 7 % 5): exit 2, and no line at all
+    recording[2 * ping.len() + 7] = f32::NAN;
+    write_wav(&long, 5, 37_500, &recording);
+    let o = run(&["dsp", "process", long.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("sample 16001 of channel 2 is not a number"), "{}", text(&o.stderr));
+    assert!(o.stdout.is_empty());
+}
+
 #[test]
 fn bad_wav_input_exits_2_with_one_line() {
     let dir = scratch("badwav");
