@@ -4,6 +4,38 @@
 use crate::BadInput;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Staging directories not yet committed or dropped: what a signal must remove. Held
+/// while a staging directory is committed, so that a signal waits for the swap.
+static STAGED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn staged() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    STAGED.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// On SIGINT, SIGTERM or SIGHUP: removes every staging directory (an output directory
+/// is then either the old one, whole, or the new one, whole), says so on stderr and
+/// exits with 128 + the signal number, as the default action's status reads.
+pub fn remove_staging_on_signals() {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else { return };
+        std::thread::spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                let dirs = staged();
+                for dir in dirs.iter() {
+                    let _ = std::fs::remove_dir_all(dir);
+                }
+                if !dirs.is_empty() {
+                    eprintln!("interrupted: nothing written");
+                }
+                std::process::exit(128 + signal);
+            }
+        });
+    }
+}
 
 /// A staging directory for the files of one output directory.
 pub struct Staging {
@@ -30,6 +62,7 @@ impl Staging {
         let _ = std::fs::remove_dir_all(&staging);
         std::fs::create_dir(&staging)
             .map_err(|e| BadInput(format!("--out {}: cannot write in {}: {e}", target.display(), parent.display())))?;
+        staged().push(staging.clone());
         Ok(Self { target: target.to_path_buf(), staging, committed: false })
     }
 
@@ -40,6 +73,7 @@ impl Staging {
         let staging = dir.join(format!(".{name}.partial-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&staging);
         std::fs::create_dir(&staging).map_err(|e| BadInput(format!("cannot write in {}: {e}", dir.display())))?;
+        staged().push(staging.clone());
         Ok(Self { target: dir.to_path_buf(), staging, committed: false })
     }
 
@@ -64,6 +98,8 @@ impl Staging {
     /// set aside, replaced, then removed (put back if the replacement fails), so no mix
     /// of old and new files and no stale file is left. Returns the files' final paths.
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
+        let mut pending = staged();
+        pending.retain(|d| d != &self.staging);
         let names = self.staged_names()?;
         let old = self.target.exists().then(|| {
             let mut name = self.staging.file_name().unwrap_or_default().to_os_string();
@@ -88,6 +124,8 @@ impl Staging {
 
     /// Moves every staged file into the existing directory `dir`.
     pub fn move_files_to(mut self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let mut pending = staged();
+        pending.retain(|d| d != &self.staging);
         let names = self.staged_names()?;
         for n in &names {
             std::fs::rename(self.staging.join(n), dir.join(n))
@@ -102,7 +140,9 @@ impl Staging {
 impl Drop for Staging {
     fn drop(&mut self) {
         if !self.committed {
+            let mut pending = staged();
             let _ = std::fs::remove_dir_all(&self.staging);
+            pending.retain(|d| d != &self.staging);
         }
     }
 }

@@ -492,3 +492,35 @@ fn out_replaces_an_existing_directory_whole() {
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(beside.iter().all(|n| !n.contains("partial")), "{beside:?}");
 }
+
+/// A signal while `--out` is being computed removes the staging directory and leaves
+/// the existing output directory as it was (exit status 128 + the signal).
+#[cfg(unix)]
+#[test]
+fn a_signal_leaves_no_partial_output() {
+    for (signal, name) in [(libc::SIGINT, "int"), (libc::SIGTERM, "term")] {
+        let dir = scratch(&format!("signal-{name}"));
+        let out = dir.join("res");
+        std::fs::create_dir_all(&out).unwrap();
+        std::fs::write(out.join("keep.txt"), "old run").unwrap();
+        let mut child = bin()
+            .args(["mc", "garin2024", "--runs", "2000", "--out", out.to_str().unwrap()])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let partial = dir.join(format!(".res.partial-{}", child.id()));
+        let waited = std::time::Instant::now();
+        while !partial.exists() {
+            assert!(waited.elapsed().as_secs() < 60, "no staging directory appeared");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        // SAFETY: kill(2) on our own child's pid
+        assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
+        let o = child.wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(128 + signal), "{name}: {}", text(&o.stderr));
+        assert!(!partial.exists(), "{name}: the staging directory is removed");
+        assert_eq!(std::fs::read_to_string(out.join("keep.txt")).unwrap(), "old run");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "{name}: nothing else beside the output");
+    }
+}
