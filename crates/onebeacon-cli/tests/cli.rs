@@ -503,7 +503,7 @@ fn a_signal_leaves_no_partial_output() {
         let out = dir.join("res");
         std::fs::create_dir_all(&out).unwrap();
         std::fs::write(out.join("keep.txt"), "old run").unwrap();
-        let mut child = bin()
+        let child = bin()
             .args(["mc", "garin2024", "--runs", "2000", "--out", out.to_str().unwrap()])
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::piped())
