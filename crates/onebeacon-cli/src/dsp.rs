@@ -11,6 +11,7 @@ use onebeacon::dsp::modes::ModeBank;
 use onebeacon::dsp::receiver::{Receiver, ReceiverConfig, receive_frame};
 use onebeacon::dsp::waveform::rypkema_modes;
 use onebeacon_sim::acoustics::channel::simulate_ping;
+use onebeacon_sim::acoustics::wav::Recording;
 use onebeacon_sim::scenario::ping::{PingConfig, WaveformKind};
 use onebeacon_sim::seed::{Stream, rng};
 use serde_json::json;
@@ -76,88 +77,6 @@ pub fn simulate(config: Option<&str>, out: &Path) -> Result<()> {
 
 fn bad(path: &Path, what: impl std::fmt::Display) -> anyhow::Error {
     BadInput(format!("{}: {what}", path.display())).into()
-}
-
-/// A WAV being read capture by capture: frames of one sample per channel, scaled to
-/// full scale 1. Nothing but one capture is held, however long the recording.
-struct Recording {
-    path: PathBuf,
-    reader: hound::WavReader<std::io::BufReader<std::fs::File>>,
-    channels: usize,
-    /// Integer samples are divided by this; None for float samples.
-    int_scale: Option<f64>,
-    /// Frames read so far.
-    read: usize,
-}
-
-impl Recording {
-    /// Opens `path` and checks its header against the array and the sampling rate.
-    fn open(path: &Path, channels: usize, fs_hz: f64) -> Result<Self> {
-        let reader = hound::WavReader::open(path).map_err(|e| bad(path, format!("not a readable WAV file ({e})")))?;
-        let spec = reader.spec();
-        if spec.channels as usize != channels {
-            return Err(bad(
-                path,
-                format!("{} channels; the array has {channels} elements (set [array] in --config)", spec.channels),
-            ));
-        }
-        if (spec.sample_rate as f64 - fs_hz).abs() > 0.5 {
-            return Err(bad(
-                path,
-                format!("sample rate {} Hz; expected {fs_hz} Hz (set capture.fs_hz in --config)", spec.sample_rate),
-            ));
-        }
-        let int_scale = (spec.sample_format == hound::SampleFormat::Int)
-            .then(|| (1i64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f64);
-        Ok(Self { path: path.to_path_buf(), reader, channels, int_scale, read: 0 })
-    }
-
-    /// Full scale: a sample this large was clipped.
-    fn full_scale(&self) -> f64 {
-        self.int_scale.map_or(1.0, |fs| 1.0 - 1.0 / fs)
-    }
-
-    /// The next `len` frames, one vector per channel (fewer at the end of the file;
-    /// empty after it). A truncated file or a sample that is not a number is an error.
-    fn next_capture(&mut self, len: usize) -> Result<Vec<Vec<f64>>> {
-        let mut out = vec![Vec::with_capacity(len); self.channels];
-        let samples: Box<dyn Iterator<Item = hound::Result<f64>>> = match self.int_scale {
-            None => Box::new(self.reader.samples::<f32>().map(|s| s.map(f64::from))),
-            Some(fs) => Box::new(self.reader.samples::<i32>().map(move |s| s.map(|v| v as f64 / fs))),
-        };
-        for (i, v) in samples.take(len * self.channels).enumerate() {
-            let v = v.map_err(|e| bad(&self.path, format!("truncated or corrupt ({e})")))?;
-            let (frame, channel) = (self.read + i / self.channels, i % self.channels);
-            if !v.is_finite() {
-                return Err(bad(&self.path, format!("sample {frame} of channel {channel} is not a number")));
-            }
-            out[channel].push(v);
-        }
-        self.read += out[self.channels - 1].len();
-        Ok(out)
-    }
-}
-
-/// Reads the whole WAV once, holding one capture at a time, so that a bad sample is
-/// found before any result is given: its frames per channel.
-fn check_wav(path: &Path, channels: usize, fs_hz: f64) -> Result<usize> {
-    let mut r = Recording::open(path, channels, fs_hz)?;
-    let full_scale = r.full_scale();
-    let mut clipped = 0;
-    loop {
-        let capture = r.next_capture(1 << 16)?;
-        if capture[0].is_empty() {
-            break;
-        }
-        clipped += capture.iter().flatten().filter(|v| v.abs() >= full_scale * 0.9999).count();
-    }
-    if r.read == 0 {
-        return Err(bad(path, "no samples"));
-    }
-    if clipped > 0 {
-        return Err(bad(path, format!("{clipped} samples at full scale (clipped); record with less gain")));
-    }
-    Ok(r.read)
 }
 
 /// What the receiver found in one capture, and what its output files need.
@@ -288,7 +207,8 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     let c = PingConfig::load(config)?;
     let channels = c.elements().len();
     let fs = c.capture.fs_hz;
-    let frames = check_wav(wav, channels, fs)?;
+    let open = || Recording::open(wav, channels, fs).map_err(|e| bad(wav, e));
+    let frames = open()?.check().map_err(|e| bad(wav, e))?;
     let len = if frames <= c.capture.samples { frames } else { c.capture.samples };
     let pulse = (rypkema_modes()[0].duration_s * fs) as usize;
     if len < pulse {
@@ -298,10 +218,10 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
         ));
     }
     let staging = out.as_deref().map(Staging::new).transpose()?;
-    let mut recording = Recording::open(wav, channels, fs)?;
+    let mut recording = open()?;
     let mut chain = Chain::new(c, len);
     if frames == len {
-        let found = chain.process(&recording.next_capture(len)?);
+        let found = chain.process(&recording.next_capture(len).map_err(|e| bad(wav, e))?);
         if let Some(staging) = staging {
             write_range_outputs(&staging, &found)?;
             if let Some((mode, az, inc)) = found.beam {
@@ -342,7 +262,7 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     }
     let progress = crate::progress_bar(count as u64, "captures", "dsp process".into());
     for k in 0..count {
-        let mut captures = recording.next_capture(len)?;
+        let mut captures = recording.next_capture(len).map_err(|e| bad(wav, e))?;
         for ch in &mut captures {
             ch.resize(len, 0.0);
         }

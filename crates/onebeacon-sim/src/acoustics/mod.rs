@@ -1,7 +1,9 @@
 //! The acoustic world: pings propagating between moving ends, and the signal-level
-//! channel from a transducer to the elements of a receiving array.
+//! channel from a transducer to the elements of a receiving array; multichannel WAV
+//! recordings read a capture at a time.
 
 pub mod channel;
 pub mod propagation;
+pub mod wav;
 
 pub use propagation::Ping;
