@@ -1,6 +1,6 @@
 //! Replaying plaza1 (22 844 items: 9657 odometry increments, 3529 ranges, 9658
 //! ground-truth poses) with 3 estimators: dead reckoning, EKF with bias and gating, EKF
-//! with calibration states and gating (target: under 50 ms); then with all 7 of
+//! with calibration states and gating (target: under 50 ms); then with all 8 of
 //! plaza1.toml. The CSV files are read as the replay goes, so their parsing is part of
 //! it; `Log::load` (the description, the beacons, and each file's header and first row)
 //! is measured apart.

@@ -294,9 +294,14 @@ impl LogDescription {
         let name = path.display().to_string();
         let text =
             std::fs::read_to_string(path).map_err(|e| LogError::File { file: name.clone(), message: e.to_string() })?;
-        let d: LogDescription = deserialize(&text, &name)?;
+        Self::parse(&text, &name)
+    }
+
+    /// Parses and checks the text of a log description; `name` names it in errors.
+    pub fn parse(text: &str, name: &str) -> Result<Self, LogError> {
+        let d: LogDescription = deserialize(text, name)?;
         crate::scenario::validate::validate_log(&d)
-            .map_err(|v| LogError::Description(crate::scenario::load::invalid(&name, v)))?;
+            .map_err(|v| LogError::Description(crate::scenario::load::invalid(name, v)))?;
         Ok(d)
     }
 
