@@ -170,7 +170,9 @@ impl Limits {
             |what: &str, v: f64| within(what, v, -self.max_speed_m_s, self.max_speed_m_s, "limits.max_speed_m_s");
         let rate =
             |what: &str, v: f64| within(what, v, -self.max_rate_rad_s, self.max_rate_rad_s, "limits.max_rate_rad_s");
-        let angle = |what: &str, v: f64| within(what, v, -1e3, 1e3, "an angle in radians");
+        // unwrapped angles too (an INS counting turns: 1e6 rad is 160 000 turns, still
+        // resolved to 1e-10 rad)
+        let angle = |what: &str, v: f64| within(what, v, -1e6, 1e6, "an angle in radians");
         let range = |v: f64| {
             if v.is_finite() && v > 0.0 && v <= self.max_range_m {
                 Ok(())
@@ -661,6 +663,31 @@ mod tests {
         assert!(l.check(&odo, Some(2.0)).is_ok());
         let nu = [1.0, 0.0, 0.0, 0.0, 0.0, 11.0];
         assert!(l.check(&m(Kind::BodyVelocity { nu }), None).unwrap_err().contains("max_rate_rad_s"));
+    }
+
+    /// An unwrapped heading (an INS that counts turns: 500 turns here) is the heading it
+    /// wraps to: same estimates as the wrapped one.
+    #[test]
+    fn unwrapped_headings_are_taken() {
+        let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
+        let est = vec![("ekf".to_string(), PlanarConfig::default(), FilterKind::Ekf)];
+        let turns = 500.0 * std::f64::consts::TAU;
+        let finals: Vec<Estimate> = [0.0, turns]
+            .into_iter()
+            .map(|offset| {
+                let mut s = Session::new(Frame::Ned, est.clone(), start, (1.0, 0.1), None);
+                for k in 0..50 {
+                    let t = k as f64;
+                    let odo = Kind::Odometry { distance_m: 1.0, heading_change_rad: 0.02 };
+                    s.push(&Item { t_s: t, input: Input::Measurement(odo) }).unwrap();
+                    let heading = Kind::Heading { heading_rad: offset + 0.3 + 0.02 * t };
+                    s.push(&Item { t_s: t + 0.5, input: Input::Measurement(heading) }).unwrap();
+                }
+                s.final_estimates()[0]
+            })
+            .collect();
+        assert!(turns > 1e3, "beyond the old 1000 rad bound");
+        approx::assert_abs_diff_eq!(finals[0].position_ned_m, finals[1].position_ned_m, epsilon = 1e-9);
     }
 
     #[test]
