@@ -118,6 +118,9 @@ pub struct EstimatorSpec {
     /// beacon and reflect it back (fixed_beacon; default true, false: garin2024's
     /// filter as published).
     pub mirror_recovery: Option<bool>,
+    /// The slowest the vehicle goes ahead, m/s: a speed estimate below it is projected
+    /// onto it with the states correlated with it (fixed_beacon; default none).
+    pub min_speed_m_s: Option<f64>,
     // Planar odometry model and calibration states (log).
     pub distance_sigma_frac: Option<f64>,
     pub heading_change_sigma_frac: Option<f64>,
@@ -162,6 +165,7 @@ impl EstimatorSpec {
             accel_sigma_m_s2: None,
             q_diag: None,
             mirror_recovery: None,
+            min_speed_m_s: None,
             distance_sigma_frac: None,
             heading_change_sigma_frac: None,
             heading_walk_deg_per_sqrt_m: None,
@@ -217,6 +221,7 @@ impl EstimatorSpec {
             ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("nis_gate", self.nis_gate, Positive, &[Log]),
             ("mirror_recovery", flag(self.mirror_recovery), Any, &[FixedBeacon]),
+            ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
             ("estimate_bias", flag(self.estimate_bias), Any, &[Log]),
             ("bias_m", self.bias_m, Any, &[Log]),
             ("bias_sigma_m", self.bias_sigma_m, Positive, &[Log]),

@@ -83,7 +83,8 @@ impl FixedBeaconWorld {
                 let nav = match e.mirror_recovery {
                     Some(on) => nav.with_mirror_recovery(on),
                     None => nav,
-                };
+                }
+                .with_min_speed(e.min_speed_m_s);
                 Track { vehicle: 0, navigator: Box::new(nav) }
             })
             .collect()

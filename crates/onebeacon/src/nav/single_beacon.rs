@@ -86,6 +86,8 @@ pub struct SingleBeaconNavigator {
     /// Reflect a state that drives backwards back through the beacon
     /// ([`Self::with_mirror_recovery`]).
     unmirror: bool,
+    /// [`Self::with_min_speed`].
+    min_speed_m_s: Option<f64>,
 }
 
 impl SingleBeaconNavigator {
@@ -100,7 +102,44 @@ impl SingleBeaconNavigator {
             StateComponent::value(idx::ACCEL, tuning.r_accel_m2_s4),
         ];
         let filter = AnyFilter::new(filter, z0, p0);
-        Self { aiding, tuning, model, q, inertial, filter, t_s: t0_s, pending: None, beacon: None, unmirror: true }
+        Self {
+            aiding,
+            tuning,
+            model,
+            q,
+            inertial,
+            filter,
+            t_s: t0_s,
+            pending: None,
+            beacon: None,
+            unmirror: true,
+            min_speed_m_s: None,
+        }
+    }
+
+    /// The slowest the vehicle goes ahead, m/s: a speed estimate below it is projected
+    /// onto it (default: none, as published).
+    pub fn with_min_speed(mut self, min_speed_m_s: Option<f64>) -> Self {
+        self.min_speed_m_s = min_speed_m_s;
+        self
+    }
+
+    /// A survey vehicle keeps going: a speed estimate below the floor is projected onto
+    /// it, and the states correlated with the speed (the along-track position above all)
+    /// move with it, x -> x - P e_v (v - v_min) / P_vv (estimate projection for an
+    /// active inequality constraint; P is kept, so the filter can still move v).
+    fn floor_speed(&mut self) {
+        let Some(floor) = self.min_speed_m_s else { return };
+        let (x, p) = (self.filter.mean(), self.filter.covariance());
+        let (v, p_vv) = (x[idx::V], p[(idx::V, idx::V)]);
+        // a speed clearly negative is the mirror's, left to `unmirror` (and NaN is neither)
+        let under = v < floor && v >= -0.25;
+        if !under || !(p_vv.is_finite() && p_vv > 0.0) {
+            return;
+        }
+        let shift = p.column(idx::V) * ((v - floor) / p_vv);
+        *self.filter.mean_mut() -= shift;
+        self.filter.mean_mut()[idx::V] = floor;
     }
 
     /// Whether a state that drives backwards is taken for the mirror image of the
@@ -195,6 +234,7 @@ impl Navigator for SingleBeaconNavigator {
             Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
                 let nis = self.tick(m.t_s, heading_rad, yaw_rate_rad_s, accel_m_s2);
                 self.unmirror();
+                self.floor_speed();
                 match nis {
                     Ok(nis) => Outcome::Accepted(nis),
                     Err(e) => Outcome::Failed(e),
@@ -340,5 +380,39 @@ mod tests {
             .collect();
         assert!(ends[0] > 50.0, "the published filter stays on the mirror: {} m", ends[0]);
         assert!(ends[1] < 0.5, "recovered: {} m", ends[1]);
+    }
+
+    /// A speed under the floor is projected onto it, the correlated states moving by
+    /// P e_v (v_min - v) / P_vv (the closed form of the projection), P unchanged; a
+    /// speed above the floor, or clearly negative (the mirror's), is left alone.
+    #[test]
+    fn a_speed_under_the_floor_is_projected_with_its_correlated_states() {
+        let x0 = State::from([3.0, -2.0, 0.4, 0.2, 0.01, 0.0]);
+        let mut p0 = Cov::from_diagonal(&SVector::from([4.0, 9.0, 0.01, 0.04, 1e-4, 1e-4]));
+        // along-track position and speed correlated (rho 0.5), heading a little
+        p0[(idx::X, idx::V)] = 0.2;
+        p0[(idx::V, idx::X)] = 0.2;
+        p0[(idx::PSI, idx::V)] = -0.005;
+        p0[(idx::V, idx::PSI)] = -0.005;
+        let nav = |x: State| {
+            SingleBeaconNavigator::new(Aiding::RANGE_DOPPLER, EkfTuning::default(), FilterKind::Ekf, 0.0, x, p0)
+                .with_min_speed(Some(0.5))
+        };
+        let mut n = nav(x0);
+        n.floor_speed();
+        let x = n.state();
+        // (0.5 - 0.2) / 0.04 = 7.5 per unit of P's v column
+        assert_abs_diff_eq!(x[idx::V], 0.5, epsilon = 1e-12);
+        assert_abs_diff_eq!(x[idx::X], 3.0 + 0.2 * 7.5, epsilon = 1e-12);
+        assert_abs_diff_eq!(x[idx::Y], -2.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(x[idx::PSI], 0.4 - 0.005 * 7.5, epsilon = 1e-12);
+        assert_eq!(*n.filter.covariance(), p0);
+        for v in [0.7, -0.3] {
+            let mut x = x0;
+            x[idx::V] = v;
+            let mut n = nav(x);
+            n.floor_speed();
+            assert_eq!(*n.state(), x, "v = {v}");
+        }
     }
 }
