@@ -134,7 +134,8 @@ impl SingleBeaconNavigator {
         let (v, p_vv) = (x[idx::V], p[(idx::V, idx::V)]);
         // a speed clearly negative is the mirror's, left to `unmirror` (and NaN is neither)
         let under = v < floor && v >= -0.25;
-        if !under || !(p_vv.is_finite() && p_vv > 0.0) {
+        let projectable = under && p_vv.is_finite() && p_vv > 0.0;
+        if !projectable {
             return;
         }
         let shift = p.column(idx::V) * ((v - floor) / p_vv);
