@@ -168,28 +168,42 @@ impl Chain {
         }
     }
 
-    /// A garin frame through [`receive_frame`]: range, Doppler speed, direction.
+    /// A garin frame through [`receive_frame`]: range, Doppler speed, direction, when
+    /// the pilots' synchronisation passes the same detection test as a chirp.
     fn frame(&self, captures: &[Vec<f64>]) -> Found {
         let est = receive_frame(&self.config.frame(), &self.elements, &self.receiver, captures);
+        let detected = est.sync.detected();
+        let statistic = est.sync.peak_ratio();
+        let threshold = onebeacon::dsp::matched_filter::detection_threshold(est.sync.distribution.len());
         let (range_m, v) = (est.range_m, est.radial_speed_m_s);
         let (az, inc) = est.direction.unwrap_or((f64::NAN, f64::NAN));
-        let num = |x: f64| if x.is_finite() { json!(x) } else { serde_json::Value::Null };
+        let num = |x: f64| if detected && x.is_finite() { json!(x) } else { serde_json::Value::Null };
         let result = json!({
-            "range_m": range_m,
+            "detected": detected,
+            "detection_statistic": statistic,
+            "detection_threshold": threshold,
+            "range_m": num(range_m),
             "azimuth_deg": num(az.to_degrees()),
             "inclination_deg": num(inc.to_degrees()),
             "mode": serde_json::Value::Null,
-            "radial_speed_m_s": v,
-            "consistent": est.sync.consistent,
+            "radial_speed_m_s": num(v),
+            "consistent": detected && est.sync.consistent,
         });
         let direction = if self.elements.len() > 1 {
             format!(", azimuth {:.1} deg, inclination {:.1} deg", az.to_degrees(), inc.to_degrees())
         } else {
             String::new()
         };
+        let text = if detected {
+            format!("garin frame: range {range_m:.2} m, Doppler speed {v:.3} m/s (closing positive){direction}")
+        } else {
+            format!(
+                "no frame detected: statistic {statistic:.4} below the threshold {threshold:.4} (false alarms under 1 in 1000 captures)"
+            )
+        };
         Found {
             result,
-            text: format!("garin frame: range {range_m:.2} m, Doppler speed {v:.3} m/s (closing positive){direction}"),
+            text,
             // lags in metres, scaled by the Doppler compensation, less the pilots' offset
             distribution: est.sync.distribution,
             metres_per_lag: est.metres_per_lag,

@@ -329,6 +329,20 @@ fn dsp_process_says_when_there_is_no_ping() {
         assert_eq!(est["consistent"], false, "{name}: {est}");
         assert!(est["range_m"].is_null(), "{name}: {est}");
     }
+    // nor for a garin frame (silence gave range -2.3 m, "consistent"), which is found
+    // at 40 dB with the truth's range
+    let cfg = dir.join("frame.toml");
+    std::fs::write(&cfg, "[waveform]\nkind = \"garin_frame\"\n[capture]\nfs_hz = 96153\nsamples = 52000\n").unwrap();
+    let n = 5 * 52000;
+    for (name, samples) in [("zero", vec![0.0f32; n]), ("noise", (0..n).map(|_| 0.1 * uniform()).collect())] {
+        let wav = dir.join(format!("frame-{name}.wav"));
+        write_wav(&wav, 5, 96153, &samples);
+        let o = run(&["dsp", "process", wav.to_str().unwrap(), "--config", cfg.to_str().unwrap(), "--json"]);
+        assert!(o.status.success(), "{name}: {}", text(&o.stderr));
+        let est: serde_json::Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+        assert_eq!(est["detected"], false, "frame {name}: {est}");
+        assert!(est["range_m"].is_null() && est["radial_speed_m_s"].is_null(), "frame {name}: {est}");
+    }
 }
 
 /// A recording longer than `capture.samples` is cut into captures processed one by one,
@@ -443,6 +457,7 @@ fn dsp_garin_frame_gives_range_and_doppler_speed() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     let est: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
     assert!(est["mode"].is_null());
+    assert_eq!(est["detected"], true, "{est}");
     let d = |k: &str| (est[k].as_f64().unwrap() - truth[k].as_f64().unwrap()).abs();
     assert!(d("range_m") < 0.1, "{est} vs {truth}");
     assert!(d("radial_speed_m_s") < 0.05, "{est} vs {truth}");

@@ -358,3 +358,92 @@ fn measure_detection_statistic() {
         );
     }
 }
+
+/// The detection statistic of garin2024's frame synchronisation (the peak of the
+/// combined, unit-energy output of the pilots' matched filter) on noise-only captures
+/// and on frames at falling SNR (2E/N0 of the whole frame: the pilots hold 7 % of it),
+/// against the threshold the chirps use; and peak over mean, an alternative.
+#[test]
+#[ignore]
+fn measure_frame_detection_statistic() {
+    use onebeacon::dsp::matched_filter::detection_threshold;
+    use onebeacon::dsp::receiver::receive_frame;
+    use onebeacon_sim::scenario::ping::PingConfig;
+    let config_text = |snr: f64, v: f64| {
+        format!(
+            "[waveform]\nkind = \"garin_frame\"\n[capture]\nfs_hz = 96153\nsamples = 52000\n\
+             [geometry]\nradial_speed_m_s = {v}\n[noise]\nsnr_db = {snr}\n"
+        )
+    };
+    let c = PingConfig::parse(&config_text(20.0, 0.0), "frame.toml").unwrap();
+    let elements = c.elements();
+    let config = ReceiverConfig {
+        fs_hz: c.capture.fs_hz,
+        capture_len: c.capture.samples,
+        sound_speed_m_s: c.sound_speed_m_s(),
+        ..ReceiverConfig::default()
+    };
+    let mut noise = rng(9, 0, Stream::Acoustic);
+    let mut stats = Vec::new();
+    let mut psr = Vec::new();
+    let mut lags = 0;
+    for _ in 0..100 {
+        let caps: Vec<Vec<f64>> =
+            (0..elements.len()).map(|_| (0..c.capture.samples).map(|_| gauss(&mut noise, 1.0)).collect()).collect();
+        let sync = receive_frame(&c.frame(), &elements, &config, &caps).sync;
+        lags = sync.distribution.len();
+        stats.push(sync.peak_ratio());
+        psr.push(peak_to_mean(&sync.distribution));
+    }
+    eprintln!(
+        "noise only ({lags} lags, threshold {:.4}): median {:.4}, 99 % {:.4}, 99.9 % {:.4}, max {:.4}",
+        detection_threshold(lags),
+        percentile(&stats, 0.5),
+        percentile(&stats, 0.99),
+        percentile(&stats, 0.999),
+        percentile(&stats, 1.0)
+    );
+    eprintln!(
+        "noise only, peak / mean: median {:.2}, 99 % {:.2}, 99.9 % {:.2}, max {:.2}",
+        percentile(&psr, 0.5),
+        percentile(&psr, 0.99),
+        percentile(&psr, 0.999),
+        percentile(&psr, 1.0)
+    );
+    let mut geo = rng(9, 0, Stream::Initial);
+    for snr in [10.0, 20.0, 30.0, 40.0] {
+        let (mut s, mut p, mut synced) = (Vec::new(), Vec::new(), 0);
+        for _ in 0..100 {
+            let v = -2.0 + 4.0 * geo.random::<f64>();
+            let c = PingConfig::parse(&config_text(snr, v), "frame.toml").unwrap();
+            let caps = simulate_ping(
+                &c.signal(),
+                &c.source(),
+                &c.receiver(),
+                &c.attitude(),
+                &elements,
+                &c.channel(),
+                &mut noise,
+            );
+            let est = receive_frame(&c.frame(), &elements, &config, &caps);
+            synced += usize::from((est.range_m - (c.source() - c.receiver()).norm()).abs() < 1.0);
+            let sync = est.sync;
+            s.push(sync.peak_ratio());
+            p.push(peak_to_mean(&sync.distribution));
+        }
+        eprintln!(
+            "{snr} dB: {synced} of 100 synchronised within 1 m; 1 % {:.4}, 5 % {:.4}, median {:.4}; peak / mean: 1 % {:.2}, 5 % {:.2}, median {:.2}",
+            percentile(&s, 0.01),
+            percentile(&s, 0.05),
+            percentile(&s, 0.5),
+            percentile(&p, 0.01),
+            percentile(&p, 0.05),
+            percentile(&p, 0.5)
+        );
+    }
+}
+
+fn peak_to_mean(d: &[f64]) -> f64 {
+    let mean = d.iter().sum::<f64>() / d.len() as f64;
+    d.iter().copied().fold(0.0, f64::max) / mean
+}
