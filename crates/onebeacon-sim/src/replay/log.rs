@@ -388,7 +388,7 @@ impl Log {
             _ => 1,
         };
         let ranks = self.description.sources.iter().map(rank).collect();
-        Ok(Items { heads, rows, ranks, failed: false })
+        Ok(Items { heads, rows, ranks, error: None })
     }
 
     /// Every beacon of the log: fixed ones and those with a track.
@@ -459,22 +459,25 @@ enum Rows<'a> {
 }
 
 /// The merged stream of a log's sources ([`Log::items`]): each source is read as the
-/// merge needs its next row. After an error the stream ends.
+/// merge needs its next row. A bad row ends the stream with its error, given right after
+/// the row above it.
 pub struct Items<'a> {
     /// The next item of each source (in the description's order), None once it is done.
     heads: Vec<Option<Item>>,
     rows: Vec<Rows<'a>>,
     /// 0 beacon positions, 1 measurements, 2 ground truth.
     ranks: Vec<u8>,
-    failed: bool,
+    /// A source's error, given after the item in hand.
+    error: Option<LogError>,
 }
 
 impl Iterator for Items<'_> {
     type Item = Result<Item, LogError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        if self.failed {
-            return None;
+        if let Some(e) = self.error.take() {
+            self.heads.iter_mut().for_each(|h| *h = None);
+            return Some(Err(e));
         }
         let key = |i: usize| self.heads[i].as_ref().map(|h| (h.t_s, self.ranks[i], i));
         let next = (0..self.heads.len())
@@ -488,8 +491,9 @@ impl Iterator for Items<'_> {
         match refill {
             Ok(head) => std::mem::replace(&mut self.heads[next], head).map(Ok),
             Err(e) => {
-                self.failed = true;
-                Some(Err(e))
+                // the item in hand first, the error at the next call, then the end
+                self.error = Some(e);
+                self.heads[next].take().map(Ok)
             }
         }
     }
@@ -683,5 +687,257 @@ impl<'a> SourceRows<'a> {
         self.previous = Some(t);
         self.pending = pending;
         Ok(Some(item))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+    use onebeacon::nav::BeaconFix;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    /// A log description (`body`, then a dead-reckoning estimator) and its CSV files in
+    /// a directory of their own, loaded.
+    fn load(name: &str, body: &str, files: &[(&str, &str)]) -> Result<Log, LogError> {
+        let dir = std::env::temp_dir().join(format!("onebeacon-log-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (file, text) in files {
+            std::fs::write(dir.join(file), text).unwrap();
+        }
+        let toml = format!(
+            "name = \"{name}\"\n{body}\n[initial]\nfrom = \"given\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n\
+             [[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n"
+        );
+        std::fs::write(dir.join("log.toml"), toml).unwrap();
+        Log::load(&dir.join("log.toml"))
+    }
+
+    fn items(log: &Log) -> Vec<Item> {
+        log.items().unwrap().map(Result::unwrap).collect()
+    }
+
+    fn measurement(item: &Item) -> Kind {
+        match item.input {
+            Input::Measurement(m) => m,
+            other => panic!("not a measurement: {other:?}"),
+        }
+    }
+
+    /// Every source kind, with every unit key and a time offset, read into SI units in
+    /// the log's frame, values worked out by hand.
+    #[test]
+    fn every_kind_and_unit_is_read_to_si() {
+        let body = r#"frame = "ned"
+[[source]]
+kind = "odometry"
+file = "odo.csv"
+time = "t"
+distance = "d"
+heading_change = "dh"
+length_unit = "cm"
+angle_unit = "deg"
+[[source]]
+kind = "speed"
+file = "speed.csv"
+time = "t"
+speed = "v"
+length_unit = "km"
+[[source]]
+kind = "heading"
+file = "heading.csv"
+time = "t"
+heading = "h"
+angle_unit = "deg"
+[[source]]
+kind = "speed_heading"
+file = "sh.csv"
+time = "t"
+speed = "v"
+heading = "h"
+[[source]]
+kind = "depth"
+file = "depth.csv"
+time = "t"
+depth = "z"
+length_unit = "mm"
+[[source]]
+kind = "range"
+file = "range.csv"
+time = "t"
+beacon = "id"
+range = "r"
+length_unit = "cm"
+[[source]]
+kind = "doppler"
+file = "doppler.csv"
+time = "t"
+beacon = "id"
+radial_speed = "vr"
+time_offset_s = 0.5
+[[source]]
+kind = "beacon_track"
+file = "track.csv"
+time = "t"
+beacon = "id"
+x = "x"
+y = "y"
+z = "z"
+length_unit = "km"
+[[source]]
+kind = "ground_truth"
+file = "truth.csv"
+time = "t"
+x = "x"
+y = "y"
+heading = "h"
+angle_unit = "deg"
+[[beacon]]
+id = 3
+x_m = 10.0
+y_m = -5.0
+z_m = 2.0
+"#;
+        let files = [
+            ("odo.csv", "t,d,dh\n1.0,150,90\n"),
+            ("speed.csv", "t,v\n2.0,0.002\n"),
+            ("heading.csv", "t,h\n3.0,-45\n"),
+            ("sh.csv", "t,v,h\n4.0,1.25,0.5\n"),
+            ("depth.csv", "t,z\n5.0,12500\n"),
+            ("range.csv", "t,id,r\n6.0,3,4210\n7.0,8,100\n"),
+            ("doppler.csv", "t,id,vr\n7.5,3,-0.4\n"),
+            ("track.csv", "t,id,x,y,z\n6.5,8,0.1,-0.2,0.003\n"),
+            ("truth.csv", "t,x,y,h\n9.0,3.5,-1.5,180\n"),
+        ];
+        let log = load("kinds", body, &files).unwrap();
+        assert_eq!(log.beacon_ids(), BTreeSet::from([3, 8]));
+        let items = items(&log);
+        let times: Vec<f64> = items.iter().map(|i| i.t_s).collect();
+        assert_eq!(times, [1.0, 2.0, 3.0, 4.0, 4.0, 5.0, 6.0, 6.5, 7.0, 8.0, 9.0]);
+        let Kind::Odometry { distance_m, heading_change_rad } = measurement(&items[0]) else { panic!() };
+        assert_abs_diff_eq!(distance_m, 1.5, epsilon = 1e-12);
+        assert_abs_diff_eq!(heading_change_rad, FRAC_PI_2, epsilon = 1e-12);
+        assert_eq!(measurement(&items[1]), Kind::Speed { speed_m_s: 2.0 });
+        let Kind::Heading { heading_rad } = measurement(&items[2]) else { panic!() };
+        assert_abs_diff_eq!(heading_rad, -PI / 4.0, epsilon = 1e-12);
+        // a speed_heading row: the speed, then the heading, at its time
+        assert_eq!(measurement(&items[3]), Kind::Speed { speed_m_s: 1.25 });
+        assert_eq!(measurement(&items[4]), Kind::Heading { heading_rad: 0.5 });
+        assert_eq!(measurement(&items[5]), Kind::Depth { depth_m: 12.5 });
+        let Kind::Range { beacon, range_m } = measurement(&items[6]) else { panic!() };
+        assert_abs_diff_eq!(range_m, 42.1, epsilon = 1e-12);
+        assert_eq!(beacon, BeaconFix::fixed(3, Vector3::new(10.0, -5.0, 2.0)));
+        let Input::BeaconPosition { beacon_id, position } = items[7].input else { panic!() };
+        assert_eq!(beacon_id, 8);
+        assert_abs_diff_eq!(position, Vector3::new(100.0, -200.0, 3.0), epsilon = 1e-9);
+        // a range to a tracked beacon: its position comes from the session (NaN here)
+        let Kind::Range { beacon, range_m } = measurement(&items[8]) else { panic!() };
+        assert_eq!((beacon.id, range_m), (8, 1.0));
+        assert!(beacon.position_ned_m.x.is_nan());
+        // the Doppler row at 7.5 s with time_offset_s = 0.5
+        let Kind::Doppler { beacon, radial_speed_m_s } = measurement(&items[9]) else { panic!() };
+        assert_eq!((beacon.id, radial_speed_m_s), (3, -0.4));
+        let Input::Truth(p) = items[10].input else { panic!() };
+        assert_eq!((p.north_m, p.east_m), (3.5, -1.5));
+        assert_abs_diff_eq!(p.heading_rad.unwrap(), PI, epsilon = 1e-12);
+    }
+
+    /// At equal times: beacon positions, then measurements, then the truth, whatever the
+    /// order of the sources; equal ranks in the order of the sources; a sorted source
+    /// keeps its rows' order at equal times.
+    #[test]
+    fn equal_times_follow_the_documented_order() {
+        let body = r#"[[source]]
+kind = "ground_truth"
+file = "truth.csv"
+time = "t"
+x = "x"
+y = "y"
+[[source]]
+kind = "speed"
+file = "speed.csv"
+time = "t"
+speed = "v"
+sort = true
+[[source]]
+kind = "heading"
+file = "heading.csv"
+time = "t"
+heading = "h"
+[[source]]
+kind = "beacon_track"
+file = "track.csv"
+time = "t"
+beacon = "id"
+x = "x"
+y = "y"
+"#;
+        let files = [
+            ("truth.csv", "t,x,y\n1.0,0,0\n"),
+            ("speed.csv", "t,v\n1.0,0.3\n0.5,0.1\n1.0,0.4\n"),
+            ("heading.csv", "t,h\n1.0,0.2\n"),
+            ("track.csv", "t,id,x,y\n1.0,4,5,6\n"),
+        ];
+        let log = load("order", body, &files).unwrap();
+        let order: Vec<String> = items(&log)
+            .iter()
+            .map(|i| match i.input {
+                Input::Measurement(Kind::Speed { speed_m_s }) => format!("speed {speed_m_s}"),
+                Input::Measurement(Kind::Heading { heading_rad }) => format!("heading {heading_rad}"),
+                Input::BeaconPosition { .. } => "beacon".into(),
+                Input::Truth(_) => "truth".into(),
+                other => panic!("{other:?}"),
+            })
+            .collect();
+        assert_eq!(order, ["speed 0.1", "beacon", "speed 0.3", "speed 0.4", "heading 0.2", "truth"]);
+    }
+
+    /// An ENU log stays in its frame through the reader; the session converts it: x east,
+    /// y north, z up, heading counter-clockwise from east.
+    #[test]
+    fn an_enu_log_is_converted_once_at_the_session() {
+        let body = r#"frame = "enu"
+[[source]]
+kind = "ground_truth"
+file = "truth.csv"
+time = "t"
+x = "x"
+y = "y"
+heading = "h"
+[[source]]
+kind = "beacon_track"
+file = "track.csv"
+time = "t"
+beacon = "id"
+x = "x"
+y = "y"
+z = "z"
+"#;
+        let files = [("truth.csv", "t,x,y,h\n1.0,3.0,4.0,0.0\n"), ("track.csv", "t,id,x,y,z\n1.0,1,3.0,4.0,-2.0\n")];
+        let log = load("enu", body, &files).unwrap();
+        let items = items(&log);
+        let Input::BeaconPosition { position, .. } = items[0].input.to_ned(log.frame) else { panic!() };
+        assert_eq!(position, Vector3::new(4.0, 3.0, 2.0));
+        let Input::Truth(p) = items[1].input.to_ned(log.frame) else { panic!() };
+        assert_eq!((p.north_m, p.east_m), (4.0, 3.0));
+        assert_abs_diff_eq!(p.heading_rad.unwrap(), FRAC_PI_2, epsilon = 1e-12);
+    }
+
+    /// Rows out of time order are refused with the line, unless the source sorts; a
+    /// source without rows and a range to an unknown beacon are refused when loading.
+    #[test]
+    fn bad_sources_are_refused_by_line() {
+        let body = "[[source]]\nkind = \"speed\"\nfile = \"speed.csv\"\ntime = \"t\"\nspeed = \"v\"\n";
+        let log = load("backwards", body, &[("speed.csv", "t,v\n2.0,1\n1.0,1\n")]).unwrap();
+        let e = log.items().unwrap().nth(1).unwrap().unwrap_err().to_string();
+        assert!(e.contains("line 3, column `t`: time 1 is before 2"), "{e}");
+        let sorted = body.replace("speed = \"v\"", "speed = \"v\"\nsort = true");
+        let log = load("sorted", &sorted, &[("speed.csv", "t,v\n2.0,1\n1.0,1\n")]).unwrap();
+        assert_eq!(items(&log).iter().map(|i| i.t_s).collect::<Vec<_>>(), [1.0, 2.0]);
+        let e = load("empty", body, &[("speed.csv", "t,v\n")]).unwrap_err().to_string();
+        assert!(e.ends_with("speed.csv: no rows"), "{e}");
+        let range = "[[source]]\nkind = \"range\"\nfile = \"r.csv\"\ntime = \"t\"\nbeacon = \"id\"\nrange = \"r\"\n";
+        let e = load("unknown", range, &[("r.csv", "t,id,r\n1.0,9,5\n")]).unwrap_err().to_string();
+        assert!(e.contains("line 2, column `id`: beacon 9 is not among the beacons ()"), "{e}");
     }
 }
