@@ -231,6 +231,22 @@ pub struct Initial {
     pub heading_sigma_deg: f64,
 }
 
+/// Left out, `[initial]` starts from the first ground-truth pose and its heading column.
+impl Default for Initial {
+    fn default() -> Self {
+        Self {
+            from: InitialFrom::default(),
+            heading_from: HeadingFrom::default(),
+            track_m: default_track_m(),
+            x_m: None,
+            y_m: None,
+            heading_deg: None,
+            position_sigma_m: default_position_sigma_m(),
+            heading_sigma_deg: default_heading_sigma_deg(),
+        }
+    }
+}
+
 impl Initial {
     /// The given pose in NED (N, E, psi) when `from = "given"`.
     pub fn given_pose(&self, frame: Frame) -> Option<(f64, f64, f64)> {
@@ -266,6 +282,7 @@ pub struct LogDescription {
     pub beacons: Option<BeaconTable>,
     #[serde(default, rename = "beacon")]
     pub beacon_list: Vec<BeaconEntry>,
+    #[serde(default)]
     pub initial: Initial,
     /// `[[estimators]]` as in scenarios (`[[estimator]]`, the old name, is read too).
     #[serde(alias = "estimator")]
@@ -890,6 +907,23 @@ y = "y"
             })
             .collect();
         assert_eq!(order, ["speed 0.1", "beacon", "speed 0.3", "speed 0.4", "heading 0.2", "truth"]);
+    }
+
+    /// Without `[initial]`, a log starts at its first ground-truth pose and heading (the
+    /// documented defaults), with the default sigmas.
+    #[test]
+    fn initial_is_optional() {
+        let toml = "name = \"no-initial\"\n[[source]]\nkind = \"ground_truth\"\nfile = \"t.csv\"\ntime = \"t\"\n\
+                    x = \"x\"\ny = \"y\"\nheading = \"h\"\n[[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n";
+        let d = LogDescription::parse(toml, "no-initial.toml").unwrap();
+        assert_eq!((d.initial.from, d.initial.heading_from), (InitialFrom::GroundTruth, HeadingFrom::Column));
+        assert_eq!((d.initial.position_sigma_m, d.initial.heading_sigma_deg, d.initial.track_m), (1.0, 5.0, 2.0));
+        let dir = std::env::temp_dir().join(format!("onebeacon-log-{}-no-initial", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("t.csv"), "t,x,y,h\n4.0,1.0,2.0,0.25\n5.0,1.5,2.0,0.25\n").unwrap();
+        std::fs::write(dir.join("log.toml"), toml).unwrap();
+        let log = Log::load(&dir.join("log.toml")).unwrap();
+        assert_eq!(log.initial_pose().unwrap(), (4.0, (1.0, 2.0, 0.25)));
     }
 
     /// An ENU log stays in its frame through the reader; the session converts it: x east,
