@@ -46,6 +46,7 @@ impl From<FrameKey> for Frame {
 #[serde(rename_all = "snake_case")]
 pub enum SourceKind {
     Odometry,
+    BodyOdometry,
     Speed,
     Heading,
     SpeedHeading,
@@ -61,6 +62,7 @@ impl SourceKind {
     pub(crate) fn columns(self) -> (&'static [&'static str], &'static [&'static str]) {
         match self {
             SourceKind::Odometry => (&["distance", "heading_change"], &[]),
+            SourceKind::BodyOdometry => (&["forward", "lateral", "heading_change"], &[]),
             SourceKind::Speed => (&["speed"], &[]),
             SourceKind::Heading => (&["heading"], &[]),
             SourceKind::SpeedHeading => (&["speed", "heading"], &[]),
@@ -132,6 +134,8 @@ pub struct Source {
     pub sort: bool,
     pub distance: Option<String>,
     pub heading_change: Option<String>,
+    pub forward: Option<String>,
+    pub lateral: Option<String>,
     pub speed: Option<String>,
     pub heading: Option<String>,
     pub depth: Option<String>,
@@ -148,6 +152,8 @@ impl Source {
         match key {
             "distance" => self.distance.as_ref(),
             "heading_change" => self.heading_change.as_ref(),
+            "forward" => self.forward.as_ref(),
+            "lateral" => self.lateral.as_ref(),
             "speed" => self.speed.as_ref(),
             "heading" => self.heading.as_ref(),
             "depth" => self.depth.as_ref(),
@@ -162,8 +168,21 @@ impl Source {
     }
 }
 
-pub(crate) const COLUMN_KEYS: [&str; 11] =
-    ["distance", "heading_change", "speed", "heading", "depth", "beacon", "range", "radial_speed", "x", "y", "z"];
+pub(crate) const COLUMN_KEYS: [&str; 13] = [
+    "distance",
+    "heading_change",
+    "forward",
+    "lateral",
+    "speed",
+    "heading",
+    "depth",
+    "beacon",
+    "range",
+    "radial_speed",
+    "x",
+    "y",
+    "z",
+];
 
 /// Fixed beacon positions from a CSV file.
 #[derive(Debug, Clone, Deserialize)]
@@ -678,6 +697,11 @@ impl<'a> SourceRows<'a> {
                 distance_m: num("distance")? * len,
                 heading_change_rad: num("heading_change")? * ang,
             }),
+            SourceKind::BodyOdometry => measurement(Kind::BodyOdometry {
+                forward_m: num("forward")? * len,
+                lateral_m: num("lateral")? * len,
+                heading_change_rad: num("heading_change")? * ang,
+            }),
             SourceKind::Speed => measurement(Kind::Speed { speed_m_s: num("speed")? * len }),
             SourceKind::Heading => measurement(Kind::Heading { heading_rad: num("heading")? * ang }),
             SourceKind::SpeedHeading => {
@@ -907,6 +931,21 @@ y = "y"
             })
             .collect();
         assert_eq!(order, ["speed 0.1", "beacon", "speed 0.3", "speed 0.4", "heading 0.2", "truth"]);
+    }
+
+    /// Body-frame odometry: forward, lateral and heading-change columns in the source's
+    /// units.
+    #[test]
+    fn body_odometry_is_read_to_si() {
+        let body = "[[source]]\nkind = \"body_odometry\"\nfile = \"b.csv\"\ntime = \"t\"\nforward = \"dx\"\n\
+                    lateral = \"dy\"\nheading_change = \"dh\"\nlength_unit = \"cm\"\nangle_unit = \"deg\"\n";
+        let log = load("body", body, &[("b.csv", "t,dx,dy,dh\n1.0,120,-15,-30\n")]).unwrap();
+        let Kind::BodyOdometry { forward_m, lateral_m, heading_change_rad } = measurement(&items(&log)[0]) else {
+            panic!()
+        };
+        assert_abs_diff_eq!(forward_m, 1.2, epsilon = 1e-12);
+        assert_abs_diff_eq!(lateral_m, -0.15, epsilon = 1e-12);
+        assert_abs_diff_eq!(heading_change_rad, -PI / 6.0, epsilon = 1e-12);
     }
 
     /// Without `[initial]`, a log starts at its first ground-truth pose and heading (the

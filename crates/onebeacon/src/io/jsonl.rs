@@ -25,6 +25,9 @@ pub fn item_json(item: &Item) -> Value {
                 Kind::Odometry { distance_m, heading_change_rad } => {
                     json!({"distance_m": distance_m, "heading_change_rad": heading_change_rad})
                 }
+                Kind::BodyOdometry { forward_m, lateral_m, heading_change_rad } => {
+                    json!({"forward_m": forward_m, "lateral_m": lateral_m, "heading_change_rad": heading_change_rad})
+                }
                 Kind::Speed { speed_m_s } => json!({"speed_m_s": speed_m_s}),
                 Kind::Heading { heading_rad } => json!({"heading_rad": heading_rad}),
                 Kind::Depth { depth_m } => json!({"depth_m": depth_m}),
@@ -67,7 +70,7 @@ pub fn item_json(item: &Item) -> Value {
 }
 
 /// The kinds a line may have.
-pub const KINDS: &str = "odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
+pub const KINDS: &str = "odometry, body_odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
     range_doppler, beacon_position, ground_truth";
 
 /// Parses one JSON line into an item; `fixed` beacons resolve `beacon` ids, `tracked`
@@ -106,6 +109,11 @@ fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u
         "odometry" => {
             m(Kind::Odometry { distance_m: num("distance_m")?, heading_change_rad: num("heading_change_rad")? })
         }
+        "body_odometry" => m(Kind::BodyOdometry {
+            forward_m: num("forward_m")?,
+            lateral_m: num("lateral_m")?,
+            heading_change_rad: num("heading_change_rad")?,
+        }),
         "speed" => m(Kind::Speed { speed_m_s: num("speed_m_s")? }),
         "heading" => m(Kind::Heading { heading_rad: num("heading_rad")? }),
         "depth" => m(Kind::Depth { depth_m: num("depth_m")? }),

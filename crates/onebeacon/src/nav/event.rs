@@ -29,6 +29,10 @@ impl BeaconFix {
 pub enum Kind {
     /// Distance travelled and heading change since the previous increment (wheels, DVL).
     Odometry { distance_m: f64, heading_change_rad: f64 },
+    /// Body-frame increments since the previous one: forward and lateral distance (body
+    /// y: starboard in NED; in an ENU log's items, left) and heading change (an INS's or
+    /// DVL's dead reckoning; a crabbing vehicle moves sideways too).
+    BodyOdometry { forward_m: f64, lateral_m: f64, heading_change_rad: f64 },
     /// Forward speed, held until the next one (DVL, propeller model).
     Speed { speed_m_s: f64 },
     /// Heading from a compass or AHRS.
@@ -76,6 +80,7 @@ impl Kind {
     pub fn name(&self) -> &'static str {
         match self {
             Kind::Odometry { .. } => "odometry",
+            Kind::BodyOdometry { .. } => "body_odometry",
             Kind::Speed { .. } => "speed",
             Kind::Heading { .. } => "heading",
             Kind::Depth { .. } => "depth",

@@ -17,7 +17,7 @@ use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::geo::wrap_angle;
 use crate::measure::{RadialSpeed2d, ScalarModel, SlantRange, StateComponent};
-use nalgebra::{SMatrix, SVector, Vector1, Vector2, Vector3};
+use nalgebra::{SMatrix, SVector, Vector1, Vector3};
 
 /// Number of state components.
 pub const STATES: usize = 7;
@@ -117,70 +117,86 @@ impl Default for PlanarConfig {
     }
 }
 
-/// An odometry step with measured distance `d` and heading change `dpsi`, corrected by
-/// the scale states: (1 + k_d) d along the mid-increment heading, then the heading
-/// change (1 + k_t) dpsi (second-order odometry model), with distance error `sigma_d`
-/// and the configured heading noise.
+/// An odometry step with measured body-frame increments, forward `d` and starboard
+/// `lat` (0 for distance-only odometry), and heading change `dpsi`, corrected by the
+/// scale states: the increment (1 + k_d) (d, lat) rotated by the mid-increment heading,
+/// then the heading change (1 + k_t) dpsi (second-order odometry model, composed on
+/// SE(2)), with errors `sigma_d` (forward), `sigma_lat` (starboard) and the configured
+/// heading noise.
 #[derive(Debug, Clone, Copy)]
 struct OdometryStep {
     d: f64,
+    lat: f64,
     dpsi: f64,
     sigma_d: f64,
+    sigma_lat: f64,
     noise: PlanarNoise,
 }
 
 impl OdometryStep {
-    /// Input Jacobian G (columns d and dpsi) at `x`.
-    fn input_jacobian(&self, x: &State) -> SMatrix<f64, STATES, 2> {
+    /// The corrected increments (forward, starboard, heading change) and the sine and
+    /// cosine of the mid-increment heading at `x`.
+    fn corrected(&self, x: &State) -> (f64, f64, f64, f64, f64) {
         let (gain_d, gain_t) = (1.0 + x[idx::DISTANCE_SCALE], 1.0 + x[idx::TURN_SCALE]);
-        let (dc, dpsic) = (gain_d * self.d, gain_t * self.dpsi);
+        let (dc, lc, dpsic) = (gain_d * self.d, gain_d * self.lat, gain_t * self.dpsi);
         let (s, c) = (x[idx::PSI] + dpsic / 2.0).sin_cos();
-        let mut g = SMatrix::<f64, STATES, 2>::zeros();
+        (dc, lc, dpsic, s, c)
+    }
+
+    /// Input Jacobian G (columns d, lat and dpsi) at `x`.
+    fn input_jacobian(&self, x: &State) -> SMatrix<f64, STATES, 3> {
+        let (gain_d, gain_t) = (1.0 + x[idx::DISTANCE_SCALE], 1.0 + x[idx::TURN_SCALE]);
+        let (dc, lc, _, s, c) = self.corrected(x);
+        let mut g = SMatrix::<f64, STATES, 3>::zeros();
         g[(idx::N, 0)] = gain_d * c;
         g[(idx::E, 0)] = gain_d * s;
-        g[(idx::N, 1)] = -dc * s * gain_t / 2.0;
-        g[(idx::E, 1)] = dc * c * gain_t / 2.0;
-        g[(idx::PSI, 1)] = gain_t;
+        g[(idx::N, 1)] = -gain_d * s;
+        g[(idx::E, 1)] = gain_d * c;
+        g[(idx::N, 2)] = (-dc * s - lc * c) * gain_t / 2.0;
+        g[(idx::E, 2)] = (dc * c - lc * s) * gain_t / 2.0;
+        g[(idx::PSI, 2)] = gain_t;
         g
     }
 }
 
 impl ProcessModel<STATES> for OdometryStep {
     fn propagate(&self, x: &State, _dt: f64) -> State {
-        let (gain_d, gain_t) = (1.0 + x[idx::DISTANCE_SCALE], 1.0 + x[idx::TURN_SCALE]);
-        let (dc, dpsic) = (gain_d * self.d, gain_t * self.dpsi);
-        let (s, c) = (x[idx::PSI] + dpsic / 2.0).sin_cos();
+        let (dc, lc, dpsic, s, c) = self.corrected(x);
         let mut n = *x;
-        n[idx::N] += dc * c;
-        n[idx::E] += dc * s;
+        // forward along the heading, starboard to its right (NED)
+        n[idx::N] += dc * c - lc * s;
+        n[idx::E] += dc * s + lc * c;
         n[idx::PSI] = wrap_angle(x[idx::PSI] + dpsic);
         n
     }
 
     fn jacobian(&self, x: &State, _dt: f64) -> Cov {
-        let (d, dpsi) = (self.d, self.dpsi);
-        let (gain_d, gain_t) = (1.0 + x[idx::DISTANCE_SCALE], 1.0 + x[idx::TURN_SCALE]);
-        let (dc, dpsic) = (gain_d * d, gain_t * dpsi);
-        let (s, c) = (x[idx::PSI] + dpsic / 2.0).sin_cos();
+        let (d, lat, dpsi) = (self.d, self.lat, self.dpsi);
+        let (dc, lc, _, s, c) = self.corrected(x);
         let mut f = Cov::identity();
-        f[(idx::N, idx::PSI)] = -dc * s;
-        f[(idx::E, idx::PSI)] = dc * c;
-        f[(idx::N, idx::DISTANCE_SCALE)] = d * c;
-        f[(idx::E, idx::DISTANCE_SCALE)] = d * s;
-        f[(idx::N, idx::TURN_SCALE)] = -dc * s * dpsi / 2.0;
-        f[(idx::E, idx::TURN_SCALE)] = dc * c * dpsi / 2.0;
+        f[(idx::N, idx::PSI)] = -dc * s - lc * c;
+        f[(idx::E, idx::PSI)] = dc * c - lc * s;
+        f[(idx::N, idx::DISTANCE_SCALE)] = d * c - lat * s;
+        f[(idx::E, idx::DISTANCE_SCALE)] = d * s + lat * c;
+        f[(idx::N, idx::TURN_SCALE)] = (-dc * s - lc * c) * dpsi / 2.0;
+        f[(idx::E, idx::TURN_SCALE)] = (dc * c - lc * s) * dpsi / 2.0;
         f[(idx::PSI, idx::TURN_SCALE)] = dpsi;
         f
     }
 
-    /// G Q_u G' with the distance error and the heading-change error (its fraction plus
-    /// the random walk per metre).
+    /// G Q_u G' with the forward and starboard errors and the heading-change error (its
+    /// fraction plus the random walk per metre travelled).
     fn noise_covariance(&self, x: &State, _dt: f64) -> Cov {
         let n = self.noise;
         let g = self.input_jacobian(x);
+        let travelled = self.d.hypot(self.lat);
         let var_dpsi =
-            (n.heading_change_sigma_frac * self.dpsi).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * self.d.abs();
-        let q_u = SMatrix::<f64, 2, 2>::from_diagonal(&Vector2::new(self.sigma_d * self.sigma_d, var_dpsi));
+            (n.heading_change_sigma_frac * self.dpsi).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * travelled;
+        let q_u = SMatrix::<f64, 3, 3>::from_diagonal(&Vector3::new(
+            self.sigma_d * self.sigma_d,
+            self.sigma_lat * self.sigma_lat,
+            var_dpsi,
+        ));
         g * q_u * g.transpose()
     }
 
@@ -265,7 +281,7 @@ impl PlanarNavigator {
         }
         if self.coasting {
             let n = self.config.noise;
-            self.motion(self.speed_m_s * dt, 0.0, n.speed_sigma_m_s * dt);
+            self.motion(self.speed_m_s * dt, 0.0, 0.0, n.speed_sigma_m_s * dt, 0.0);
         }
         if self.config.estimate_bias {
             self.filter.covariance_mut()[(idx::BIAS, idx::BIAS)] +=
@@ -273,8 +289,10 @@ impl PlanarNavigator {
         }
     }
 
-    fn motion(&mut self, d: f64, dpsi: f64, sigma_d: f64) {
-        let step = OdometryStep { d, dpsi, sigma_d, noise: self.config.noise };
+    /// Forward `d` and starboard `lat` increments with a heading change `dpsi` and the
+    /// errors of the two increments.
+    fn motion(&mut self, d: f64, lat: f64, dpsi: f64, sigma_d: f64, sigma_lat: f64) {
+        let step = OdometryStep { d, lat, dpsi, sigma_d, sigma_lat, noise: self.config.noise };
         let q = step.noise_covariance(self.filter.mean(), 0.0);
         self.filter.predict(&step, 0.0, &q);
     }
@@ -307,7 +325,17 @@ impl Navigator for PlanarNavigator {
                 self.last_odometry_s = Some(t_s);
                 self.coasting = false;
                 let sd = noise.distance_sigma_frac * distance_m.abs();
-                self.motion(distance_m, heading_change_rad, sd);
+                self.motion(distance_m, 0.0, heading_change_rad, sd, 0.0);
+                Outcome::Applied
+            }
+            Kind::BodyOdometry { forward_m, lateral_m, heading_change_rad } => {
+                if let Some(t0) = self.last_odometry_s.filter(|t0| t_s > *t0) {
+                    self.speed_m_s = forward_m / (t_s - t0);
+                }
+                self.last_odometry_s = Some(t_s);
+                self.coasting = false;
+                let frac = noise.distance_sigma_frac;
+                self.motion(forward_m, lateral_m, heading_change_rad, frac * forward_m.abs(), frac * lateral_m.abs());
                 Outcome::Applied
             }
             Kind::Speed { speed_m_s } => {
@@ -376,6 +404,7 @@ impl Navigator for PlanarNavigator {
 mod tests {
     use super::*;
     use crate::nav::BeaconFix;
+    use crate::nav::session::Input;
     use approx::assert_abs_diff_eq;
     use std::f64::consts::FRAC_PI_2;
 
@@ -426,31 +455,64 @@ mod tests {
         nav.filter.mean_mut()[idx::TURN_SCALE] = -0.05;
         let p0 = *nav.filter.covariance();
         let x0 = *nav.filter.mean();
-        let (d, dpsi) = (1.7, 0.3);
-        nav.motion(d, dpsi, 0.1);
-        let step = |x: State, d: f64, dpsi: f64| {
-            let (d, dpsi) = ((1.0 + x[5]) * d, (1.0 + x[6]) * dpsi);
+        // forward, lateral (starboard) and turn increments, with their errors
+        let u0 = Vector3::new(1.7, -0.4, 0.3);
+        nav.motion(u0[0], u0[1], u0[2], 0.1, 0.05);
+        // the step written out on its own: the increment rotated by the mid heading
+        let step = |x: State, u: Vector3<f64>| {
+            let (d, lat, dpsi) = ((1.0 + x[5]) * u[0], (1.0 + x[5]) * u[1], (1.0 + x[6]) * u[2]);
             let m = x[2] + dpsi / 2.0;
-            State::from([x[0] + d * m.cos(), x[1] + d * m.sin(), x[2] + dpsi, x[3], x[4], x[5], x[6]])
+            let (n, e) = (d * m.cos() - lat * m.sin(), d * m.sin() + lat * m.cos());
+            State::from([x[0] + n, x[1] + e, x[2] + dpsi, x[3], x[4], x[5], x[6]])
         };
         let eps = 1e-6;
         let f = Cov::from_fn(|i, j| {
             let mut e = State::zeros();
             e[j] = eps;
-            (step(x0 + e, d, dpsi)[i] - step(x0 - e, d, dpsi)[i]) / (2.0 * eps)
+            (step(x0 + e, u0)[i] - step(x0 - e, u0)[i]) / (2.0 * eps)
         });
-        let g = SMatrix::<f64, STATES, 2>::from_fn(|i, j| {
-            let (dd, dp) = if j == 0 { (eps, 0.0) } else { (0.0, eps) };
-            (step(x0, d + dd, dpsi + dp)[i] - step(x0, d - dd, dpsi - dp)[i]) / (2.0 * eps)
+        let g = SMatrix::<f64, STATES, 3>::from_fn(|i, j| {
+            let mut du = Vector3::zeros();
+            du[j] = eps;
+            (step(x0, u0 + du)[i] - step(x0, u0 - du)[i]) / (2.0 * eps)
         });
         let n = config.noise;
-        let q = SMatrix::<f64, 2, 2>::from_diagonal(&Vector2::new(
+        let q = SMatrix::<f64, 3, 3>::from_diagonal(&Vector3::new(
             0.01,
-            (n.heading_change_sigma_frac * dpsi).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * d,
+            0.0025,
+            (n.heading_change_sigma_frac * u0[2]).powi(2) + n.heading_walk_rad_per_sqrt_m.powi(2) * u0[0].hypot(u0[1]),
         ));
         let expected = f * p0 * f.transpose() + g * q * g.transpose();
         assert_abs_diff_eq!(*nav.filter.covariance(), expected, epsilon = 1e-8);
-        assert_abs_diff_eq!(*nav.filter.mean(), step(x0, d, dpsi), epsilon = 1e-12);
+        assert_abs_diff_eq!(*nav.filter.mean(), step(x0, u0), epsilon = 1e-12);
+    }
+
+    /// A vehicle heading east that crabs: body increments of 1 m forward and 0.2 m to
+    /// starboard per step move it east and south (NED); distance-only odometry of the
+    /// same forward increments loses the 0.2 m per step.
+    #[test]
+    fn body_odometry_keeps_the_sideways_part() {
+        let east = (0.0, 0.0, FRAC_PI_2);
+        let mut body = PlanarNavigator::new(PlanarConfig::default(), FilterKind::Ekf, 0.0, east, 1.0, 0.1);
+        let mut distance = body.clone();
+        for k in 1..=10 {
+            let t = k as f64;
+            body.process(&Measurement::new(
+                t,
+                Kind::BodyOdometry { forward_m: 1.0, lateral_m: 0.2, heading_change_rad: 0.0 },
+            ));
+            distance.process(&Measurement::new(t, Kind::Odometry { distance_m: 1.0, heading_change_rad: 0.0 }));
+        }
+        let (b, d) = (body.estimate(), distance.estimate());
+        assert_abs_diff_eq!(b.east_m(), 10.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(b.north_m(), -2.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(d.north_m(), 0.0, epsilon = 1e-12);
+        // and an ENU item (lateral to the left, turns counter-clockwise) converts to it
+        let enu = Input::Measurement(Kind::BodyOdometry { forward_m: 1.0, lateral_m: -0.2, heading_change_rad: 0.1 });
+        assert_eq!(
+            enu.to_ned(crate::geo::Frame::Enu),
+            Input::Measurement(Kind::BodyOdometry { forward_m: 1.0, lateral_m: 0.2, heading_change_rad: -0.1 })
+        );
     }
 
     #[test]

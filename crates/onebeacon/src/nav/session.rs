@@ -51,6 +51,12 @@ impl Input {
                     Kind::Odometry { distance_m, heading_change_rad } => {
                         Kind::Odometry { distance_m, heading_change_rad: frame.turn_to_ned(heading_change_rad) }
                     }
+                    // the body y axis flips with the sense of turns: left (FLU) in ENU
+                    Kind::BodyOdometry { forward_m, lateral_m, heading_change_rad } => Kind::BodyOdometry {
+                        forward_m,
+                        lateral_m: frame.turn_to_ned(lateral_m),
+                        heading_change_rad: frame.turn_to_ned(heading_change_rad),
+                    },
                     Kind::Heading { heading_rad } => Kind::Heading { heading_rad: frame.heading_to_ned(heading_rad) },
                     Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
                         Kind::Attitude { roll_rad, pitch_rad, heading_rad: frame.heading_to_ned(heading_rad) }
@@ -186,18 +192,27 @@ impl Limits {
                 if let Some(b) = m.beacon() {
                     within("beacon_sigma_m", b.sigma_m, 0.0, 1e4, "a position error in metres")?;
                 }
+                // at least a second's travel, so that close items are not refused
+                let most = self.max_speed_m_s * dt_s.unwrap_or(1.0).max(1.0);
+                let travel = |what: &str, v: f64| within(what, v, -most, most, "limits.max_speed_m_s x the time step");
+                let turn = |v: f64| {
+                    within(
+                        "heading_change_rad",
+                        v,
+                        -std::f64::consts::PI,
+                        std::f64::consts::PI,
+                        "a turn of at most pi per step",
+                    )
+                };
                 match m {
+                    Kind::BodyOdometry { forward_m, lateral_m, heading_change_rad } => {
+                        travel("body_odometry forward_m", forward_m)?;
+                        travel("body_odometry lateral_m", lateral_m)?;
+                        turn(heading_change_rad)
+                    }
                     Kind::Odometry { distance_m, heading_change_rad } => {
-                        // at least a second's travel, so that close items are not refused
-                        let most = self.max_speed_m_s * dt_s.unwrap_or(1.0).max(1.0);
-                        within("odometry distance_m", distance_m, -most, most, "limits.max_speed_m_s x the time step")?;
-                        within(
-                            "heading_change_rad",
-                            heading_change_rad,
-                            -std::f64::consts::PI,
-                            std::f64::consts::PI,
-                            "a turn of at most pi per step",
-                        )
+                        travel("odometry distance_m", distance_m)?;
+                        turn(heading_change_rad)
                     }
                     Kind::Speed { speed_m_s } => speed("speed_m_s", speed_m_s),
                     Kind::Heading { heading_rad } => angle("heading_rad", heading_rad),
