@@ -127,6 +127,9 @@ pub struct EstimatorSpec {
     pub heading_walk_deg_per_sqrt_m: Option<f64>,
     pub speed_sigma_m_s: Option<f64>,
     pub bias_walk_m_per_sqrt_s: Option<f64>,
+    /// Position random walk, m / sqrt(s): the motion model of a craft without inputs
+    /// (log).
+    pub position_walk_m_per_sqrt_s: Option<f64>,
     pub nis_gate: Option<f64>,
     pub estimate_bias: Option<bool>,
     pub bias_m: Option<f64>,
@@ -171,6 +174,7 @@ impl EstimatorSpec {
             heading_walk_deg_per_sqrt_m: None,
             speed_sigma_m_s: None,
             bias_walk_m_per_sqrt_s: None,
+            position_walk_m_per_sqrt_s: None,
             nis_gate: None,
             estimate_bias: None,
             bias_m: None,
@@ -219,6 +223,7 @@ impl EstimatorSpec {
             ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, NonNegative, &[Log]),
             ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[Log]),
             ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, &[Log]),
+            ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("nis_gate", self.nis_gate, Positive, &[Log]),
             ("mirror_recovery", flag(self.mirror_recovery), Any, &[FixedBeacon]),
             ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
@@ -274,6 +279,7 @@ impl EstimatorSpec {
             heading_sigma_rad: self.heading_sigma_deg.map_or(d.heading_sigma_rad, f64::to_radians),
             doppler_sigma_m_s: self.doppler_sigma_m_s.unwrap_or(d.doppler_sigma_m_s),
             bias_walk_m_per_sqrt_s: self.bias_walk_m_per_sqrt_s.unwrap_or(d.bias_walk_m_per_sqrt_s),
+            position_walk_m_per_sqrt_s: self.position_walk_m_per_sqrt_s.unwrap_or(d.position_walk_m_per_sqrt_s),
         };
         PlanarConfig {
             aiding: self.aiding(Host::Log),

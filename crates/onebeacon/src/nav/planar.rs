@@ -51,6 +51,10 @@ pub struct PlanarNoise {
     pub doppler_sigma_m_s: f64,
     /// Random walk of the range bias, m / sqrt(s).
     pub bias_walk_m_per_sqrt_s: f64,
+    /// Random walk of the position, m / sqrt(s), on each axis: the motion model of a
+    /// craft with no inputs (tracked from outside, or whose navigation data is lost),
+    /// nearly constant position; 0 without it.
+    pub position_walk_m_per_sqrt_s: f64,
 }
 
 impl Default for PlanarNoise {
@@ -64,6 +68,7 @@ impl Default for PlanarNoise {
             heading_sigma_rad: 2f64.to_radians(),
             doppler_sigma_m_s: 0.1,
             bias_walk_m_per_sqrt_s: 0.005,
+            position_walk_m_per_sqrt_s: 0.0,
         }
     }
 }
@@ -272,7 +277,8 @@ impl PlanarNavigator {
         }
     }
 
-    /// Moves the clock to `t_s`: coasts at the held speed and lets the bias wander.
+    /// Moves the clock to `t_s`: coasts at the held speed, lets the bias (and, with a
+    /// position random walk, the position) wander.
     fn advance_to(&mut self, t_s: f64) {
         let dt = (t_s - self.t_s).max(0.0);
         self.t_s = self.t_s.max(t_s);
@@ -283,9 +289,15 @@ impl PlanarNavigator {
             let n = self.config.noise;
             self.motion(self.speed_m_s * dt, 0.0, 0.0, n.speed_sigma_m_s * dt, 0.0);
         }
+        let n = self.config.noise;
         if self.config.estimate_bias {
-            self.filter.covariance_mut()[(idx::BIAS, idx::BIAS)] +=
-                self.config.noise.bias_walk_m_per_sqrt_s.powi(2) * dt;
+            self.filter.covariance_mut()[(idx::BIAS, idx::BIAS)] += n.bias_walk_m_per_sqrt_s.powi(2) * dt;
+        }
+        if n.position_walk_m_per_sqrt_s > 0.0 {
+            let q = n.position_walk_m_per_sqrt_s.powi(2) * dt;
+            let p = self.filter.covariance_mut();
+            p[(idx::N, idx::N)] += q;
+            p[(idx::E, idx::E)] += q;
         }
     }
 
@@ -485,6 +497,23 @@ mod tests {
         let expected = f * p0 * f.transpose() + g * q * g.transpose();
         assert_abs_diff_eq!(*nav.filter.covariance(), expected, epsilon = 1e-8);
         assert_abs_diff_eq!(*nav.filter.mean(), step(x0, u0), epsilon = 1e-12);
+    }
+
+    /// With no inputs at all, the position variance grows as sigma^2 t per axis under a
+    /// position random walk (a closed form), and stays put without one.
+    #[test]
+    fn a_position_random_walk_grows_the_variance_with_time() {
+        let mut config = PlanarConfig::default();
+        config.noise.position_walk_m_per_sqrt_s = 0.3;
+        let mut walk = PlanarNavigator::new(config, FilterKind::Ekf, 0.0, (0.0, 0.0, 0.0), 1.0, 0.1);
+        let mut still = start(PlanarConfig::default());
+        for nav in [&mut walk, &mut still] {
+            nav.process(&Measurement::new(100.0, Kind::Depth { depth_m: 5.0 }));
+        }
+        let (w, s) = (walk.estimate(), still.estimate());
+        assert_abs_diff_eq!(w.sigma_north_m().powi(2), 1.0 + 0.09 * 100.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(w.sigma_east_m().powi(2), 1.0 + 0.09 * 100.0, epsilon = 1e-9);
+        assert_eq!(s.horizontal_cov_m2, start(PlanarConfig::default()).estimate().horizontal_cov_m2);
     }
 
     /// A vehicle heading east that crabs: body increments of 1 m forward and 0.2 m to
