@@ -274,7 +274,12 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     if let Some(t) = &mut table {
         t.write_record(columns)?;
     }
-    let progress = crate::progress_bar(count as u64, "captures", "dsp process".into());
+    // the lines show the progress on a terminal; a bar when they go to a file or a pipe
+    let progress = if std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+        indicatif::ProgressBar::hidden()
+    } else {
+        crate::progress_bar(count as u64, "captures", "dsp process".into())
+    };
     for k in 0..count {
         let mut captures = recording.next_capture(len).map_err(|e| bad(wav, e))?;
         for ch in &mut captures {
