@@ -130,6 +130,9 @@ pub struct EstimatorSpec {
     /// Position random walk, m / sqrt(s): the motion model of a craft without inputs
     /// (log).
     pub position_walk_m_per_sqrt_s: Option<f64>,
+    /// Track the craft with a constant-velocity model, white acceleration of this
+    /// standard deviation, m/s^2 per sqrt(s); no motion inputs are used (log).
+    pub track_accel_sigma_m_s2: Option<f64>,
     pub nis_gate: Option<f64>,
     pub estimate_bias: Option<bool>,
     pub bias_m: Option<f64>,
@@ -175,6 +178,7 @@ impl EstimatorSpec {
             speed_sigma_m_s: None,
             bias_walk_m_per_sqrt_s: None,
             position_walk_m_per_sqrt_s: None,
+            track_accel_sigma_m_s2: None,
             nis_gate: None,
             estimate_bias: None,
             bias_m: None,
@@ -224,6 +228,7 @@ impl EstimatorSpec {
             ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[Log]),
             ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
+            ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
             ("nis_gate", self.nis_gate, Positive, &[Log]),
             ("mirror_recovery", flag(self.mirror_recovery), Any, &[FixedBeacon]),
             ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
@@ -294,6 +299,7 @@ impl EstimatorSpec {
             turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
             nis_gate: self.nis_gate,
             noise,
+            track_accel_sigma_m_s2: self.track_accel_sigma_m_s2,
         }
     }
 }

@@ -11,11 +11,13 @@ pub mod planar;
 pub mod range_6dof;
 pub mod session;
 pub mod single_beacon;
+pub mod tracking;
 
 pub use event::{BeaconFix, Kind, Measurement};
 pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
 pub use range_6dof::{Range6DofNavigator, SensorNoise};
 pub use single_beacon::{EkfTuning, SingleBeaconNavigator};
+pub use tracking::TrackingNavigator;
 
 use crate::filter::FilterError;
 use nalgebra::{Matrix2, Matrix3, Vector3};

@@ -101,6 +101,11 @@ pub struct PlanarConfig {
     /// 3.84 at 95 %, 6.63 at 99 %, 10.83 at 99.9 %); `None` accepts everything.
     pub nis_gate: Option<f64>,
     pub noise: PlanarNoise,
+    /// Track a craft without motion inputs with a constant-velocity model driven by
+    /// white acceleration of this standard deviation, m/s^2 per sqrt(s)
+    /// ([`super::TrackingNavigator`]: position, velocity, range offset and scale); `None`
+    /// for this navigator.
+    pub track_accel_sigma_m_s2: Option<f64>,
 }
 
 impl Default for PlanarConfig {
@@ -118,6 +123,7 @@ impl Default for PlanarConfig {
             turn_scale_sigma: 0.05,
             nis_gate: None,
             noise: PlanarNoise::default(),
+            track_accel_sigma_m_s2: None,
         }
     }
 }

@@ -6,7 +6,9 @@
 use crate::filter::FilterKind;
 use crate::filter::consistency::nees;
 use crate::geo::Frame;
-use crate::nav::{BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, PlanarConfig, PlanarNavigator};
+use crate::nav::{
+    BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, PlanarConfig, PlanarNavigator, TrackingNavigator,
+};
 use nalgebra::{Vector2, Vector3};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -358,6 +360,30 @@ fn error_and_nees(e: &Estimate, truth: &TruthPose) -> (f64, f64) {
     (d.norm(), nees(&d, &e.horizontal_cov_m2).unwrap_or(f64::NAN))
 }
 
+/// One estimator of a session: the planar navigator, or the constant-velocity tracker
+/// of a craft without motion inputs ([`PlanarConfig::track_accel_sigma_m_s2`]).
+#[derive(Debug, Clone, PartialEq)]
+enum Estimator {
+    Planar(PlanarNavigator),
+    Tracking(TrackingNavigator),
+}
+
+impl Estimator {
+    fn navigator(&mut self) -> &mut dyn Navigator {
+        match self {
+            Estimator::Planar(n) => n,
+            Estimator::Tracking(n) => n,
+        }
+    }
+
+    fn estimate(&self) -> Estimate {
+        match self {
+            Estimator::Planar(n) => n.estimate(),
+            Estimator::Tracking(n) => n.estimate(),
+        }
+    }
+}
+
 /// Every estimator on one stream. Estimates and errors are in NED.
 #[derive(Debug, Clone)]
 pub struct Session {
@@ -365,7 +391,7 @@ pub struct Session {
     /// The frame of the items pushed.
     frame: Frame,
     configs: Vec<(PlanarConfig, FilterKind)>,
-    navs: Vec<PlanarNavigator>,
+    navs: Vec<Estimator>,
     start: Start,
     sigma_position_m: f64,
     sigma_heading_rad: f64,
@@ -445,7 +471,7 @@ impl Session {
 
     /// Every estimator's latest estimate (empty before the start).
     pub fn final_estimates(&self) -> Vec<Estimate> {
-        self.navs.iter().map(PlanarNavigator::estimate).collect()
+        self.navs.iter().map(Estimator::estimate).collect()
     }
 
     pub fn started(&self) -> bool {
@@ -457,9 +483,16 @@ impl Session {
         self.last_sound = vec![pose; self.navs.len()];
     }
 
-    fn navigator(&self, i: usize, t0: f64, pose: (f64, f64, f64)) -> PlanarNavigator {
+    fn navigator(&self, i: usize, t0: f64, pose: (f64, f64, f64)) -> Estimator {
         let (c, f) = self.configs[i];
-        PlanarNavigator::new(c, f, t0, pose, self.sigma_position_m, self.sigma_heading_rad)
+        match c.track_accel_sigma_m_s2 {
+            Some(a) => {
+                Estimator::Tracking(TrackingNavigator::new(c, a, f, t0, (pose.0, pose.1), self.sigma_position_m))
+            }
+            None => {
+                Estimator::Planar(PlanarNavigator::new(c, f, t0, pose, self.sigma_position_m, self.sigma_heading_rad))
+            }
+        }
     }
 
     /// Records a rejection while the log has room.
@@ -547,7 +580,7 @@ impl Session {
                 if let Some(kind) = self.resolve(m).map_err(|reason| self.screen(item, reason))? {
                     let m = Measurement::new(t, kind);
                     for (i, nav) in self.navs.iter_mut().enumerate() {
-                        let out = nav.process(&m);
+                        let out = nav.navigator().process(&m);
                         self.stats[i].failed += usize::from(matches!(out, Outcome::Failed(_)));
                         outcomes[i] = Some(out);
                     }
@@ -570,7 +603,7 @@ impl Session {
             Input::Truth(p) => truth = Some(p),
             Input::BeaconPosition { .. } => {}
         }
-        let mut estimates: Vec<Estimate> = self.navs.iter().map(PlanarNavigator::estimate).collect();
+        let mut estimates: Vec<Estimate> = self.navs.iter().map(Estimator::estimate).collect();
         // a filter whose state stops being sound starts again from its last sound
         // estimate: reported, never silently kept
         for (i, e) in estimates.iter_mut().enumerate() {
@@ -678,6 +711,26 @@ mod tests {
         assert!(l.check(&odo, Some(2.0)).is_ok());
         let nu = [1.0, 0.0, 0.0, 0.0, 0.0, 11.0];
         assert!(l.check(&m(Kind::BodyVelocity { nu }), None).unwrap_err().contains("max_rate_rad_s"));
+    }
+
+    /// An estimator with `track_accel_sigma_m_s2` is the constant-velocity tracker: it
+    /// ignores odometry (a planar navigator moves with it) and reports a speed.
+    #[test]
+    fn a_track_config_runs_the_constant_velocity_tracker() {
+        let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
+        let track = PlanarConfig { track_accel_sigma_m_s2: Some(0.1), ..PlanarConfig::default() };
+        let est = vec![
+            ("cv".to_string(), track, FilterKind::Ekf),
+            ("dr".to_string(), PlanarConfig::default(), FilterKind::Ekf),
+        ];
+        let mut s = Session::new(Frame::Ned, est, start, (1.0, 0.1), None);
+        for t in [0.0, 1.0, 2.0] {
+            let odo = Kind::Odometry { distance_m: 1.0, heading_change_rad: 0.0 };
+            s.push(&Item { t_s: t, input: Input::Measurement(odo) }).unwrap();
+        }
+        let [cv, dr] = [s.final_estimates()[0], s.final_estimates()[1]];
+        assert_eq!((cv.north_m(), cv.speed_m_s), (0.0, Some(0.0)));
+        assert_eq!((dr.north_m(), dr.speed_m_s), (3.0, None));
     }
 
     /// An unwrapped heading (an INS that counts turns: 500 turns here) is the heading it
