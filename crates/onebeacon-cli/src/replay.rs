@@ -88,7 +88,7 @@ pub fn replay(
     }
     outln!("{title}: {} measurements, replayed in {:.1} ms", r.items, wall_s * 1e3);
     // (header, summary key, decimals)
-    const COLUMNS: [(&str, &str, usize); 11] = [
+    const COLUMNS: [(&str, &str, usize); 12] = [
         ("rmse_m", "rmse_m", 3),
         ("mean_m", "mean_error_m", 3),
         ("final_m", "final_error_m", 3),
@@ -100,6 +100,7 @@ pub fn replay(
         ("k_turn", "turn_scale", 3),
         ("nees", "nees_mean", 1),
         ("in95_%", "nees_within_95_pct", 0),
+        ("nis", "nis_mean", 2),
     ];
     let header: String = COLUMNS.iter().map(|(h, _, _)| format!(" {h:>9}")).collect();
     outln!("{:<20}{header}", "estimator");
@@ -139,6 +140,9 @@ fn summary_json(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
                 "reinitialised": st.reinitialised,
                 "nees_mean": num(st.nees_mean()),
                 "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
+                "nis_mean": num(st.nis_mean()),
+                "nis_band": onebeacon_sim::metrics::nees_band(st.nis_count, 1).map(num),
+                "nis_within_95_pct": num(100.0 * st.nis_within_95_fraction()),
                 "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())},
             });
             for (k, x) in e.calibration() {

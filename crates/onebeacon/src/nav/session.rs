@@ -284,10 +284,18 @@ pub struct ErrorStats {
     pub nees_sum: f64,
     pub nees_count: usize,
     pub nees_within_95: usize,
+    /// NIS (1 dof) of every scalar correction the estimator weighed, accepted or gated
+    /// out: sum, count, and how many were within the 95 % chi-square quantile.
+    pub nis_sum: f64,
+    pub nis_count: usize,
+    pub nis_within_95: usize,
 }
 
 /// The 95 % quantile of chi-square with 2 degrees of freedom, -2 ln 0.05.
 pub const NEES_95_2DOF: f64 = 5.991464547107982;
+
+/// The 95 % quantile of chi-square with 1 degree of freedom, 1.96^2.
+pub const NIS_95_1DOF: f64 = 3.841458820694124;
 
 impl ErrorStats {
     pub fn rmse_m(&self) -> f64 {
@@ -303,6 +311,23 @@ impl ErrorStats {
     /// Fraction of the NEES values within the 95 % quantile (0.95 when consistent).
     pub fn nees_within_95_fraction(&self) -> f64 {
         self.nees_within_95 as f64 / self.nees_count as f64
+    }
+
+    /// Mean NIS: 1 for a consistent filter (its innovations as large as it expects).
+    pub fn nis_mean(&self) -> f64 {
+        self.nis_sum / self.nis_count as f64
+    }
+    /// Fraction of the NIS values within the 95 % quantile (0.95 when consistent).
+    pub fn nis_within_95_fraction(&self) -> f64 {
+        self.nis_within_95 as f64 / self.nis_count as f64
+    }
+
+    fn push_nis(&mut self, nis: f64) {
+        if nis.is_finite() {
+            self.nis_sum += nis;
+            self.nis_count += 1;
+            self.nis_within_95 += usize::from(nis <= NIS_95_1DOF);
+        }
     }
 
     fn push(&mut self, err: f64, nees: f64) {
@@ -582,6 +607,9 @@ impl Session {
                     for (i, nav) in self.navs.iter_mut().enumerate() {
                         let out = nav.navigator().process(&m);
                         self.stats[i].failed += usize::from(matches!(out, Outcome::Failed(_)));
+                        if let Outcome::Accepted(nis) | Outcome::Rejected(nis) = out {
+                            self.stats[i].push_nis(nis);
+                        }
                         outcomes[i] = Some(out);
                     }
                     for (i, out) in outcomes.iter().enumerate() {
@@ -711,6 +739,41 @@ mod tests {
         assert!(l.check(&odo, Some(2.0)).is_ok());
         let nu = [1.0, 0.0, 0.0, 0.0, 0.0, 11.0];
         assert!(l.check(&m(Kind::BodyVelocity { nu }), None).unwrap_err().contains("max_rate_rad_s"));
+    }
+
+    /// A filter whose noise matches the measurements' has a mean NIS of 1: a vehicle at
+    /// rest ranged 4000 times from three beacons with Gaussian noise of the sigma the
+    /// filter assumes gives a mean NIS within the chi-square(4000)/4000 band
+    /// [0.957, 1.044] and about 95 % of the values under the 95 % quantile; with the
+    /// noise twice the assumed, about 4.
+    #[test]
+    fn nis_is_one_for_a_matched_filter() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let beacons = [Vector3::new(30.0, 0.0, 0.0), Vector3::new(0.0, 40.0, 0.0), Vector3::new(-25.0, -25.0, 0.0)];
+        let means: Vec<(f64, f64)> = [1.0, 2.0]
+            .into_iter()
+            .map(|scale| {
+                let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
+                let noise = Normal::new(0.0, 1.5 * scale).unwrap();
+                let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
+                let mut config = PlanarConfig::default(); // range sigma 1.5 m
+                config.noise.position_walk_m_per_sqrt_s = 0.0;
+                let est = vec![("ekf".to_string(), config, FilterKind::Ekf)];
+                // from the truth with a tiny initial sigma, so the state error stays small
+                let mut s = Session::new(Frame::Ned, est, start, (1e-3, 0.1), None);
+                for k in 0..4000 {
+                    let b = beacons[k % 3];
+                    let range = b.norm() + noise.sample(&mut rng);
+                    let m = Kind::Range { beacon: BeaconFix::fixed(k as u32 % 3, b), range_m: range };
+                    s.push(&Item { t_s: k as f64, input: Input::Measurement(m) }).unwrap();
+                }
+                (s.stats[0].nis_mean(), s.stats[0].nis_within_95_fraction())
+            })
+            .collect();
+        assert!((0.957..1.044).contains(&means[0].0), "{means:?}");
+        assert!((means[0].1 - 0.95).abs() < 0.015, "{means:?}");
+        assert!((means[1].0 - 4.0).abs() < 0.4, "{means:?}");
     }
 
     /// An estimator with `track_accel_sigma_m_s2` is the constant-velocity tracker: it
