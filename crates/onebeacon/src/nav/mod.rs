@@ -19,8 +19,25 @@ pub use range_6dof::{Range6DofNavigator, SensorNoise};
 pub use single_beacon::{EkfTuning, SingleBeaconNavigator};
 pub use tracking::TrackingNavigator;
 
-use crate::filter::FilterError;
-use nalgebra::{Matrix2, Matrix3, Vector3};
+use crate::filter::{AnyFilter, FilterError, Gated, GaussianFilter, MeasurementModel};
+use nalgebra::{Matrix2, Matrix3, SVector, Vector3};
+
+/// One update of `filter` with the stacked `models` and their values `z`, gated at
+/// `gate` (NIS): accepted or rejected with its NIS, or failed (the filter left as it
+/// was).
+pub(crate) fn gated_update<const N: usize, const M: usize, H: MeasurementModel<N, M>>(
+    filter: &mut AnyFilter<N>,
+    models: &H,
+    z: SVector<f64, M>,
+    gate: f64,
+) -> Outcome {
+    let r = models.covariance(filter.mean());
+    match filter.update_gated(models, &z, &r, gate) {
+        Ok(Gated::Accepted(nis)) => Outcome::Accepted(nis),
+        Ok(Gated::Rejected(nis)) => Outcome::Rejected(nis),
+        Err(e) => Outcome::Failed(e),
+    }
+}
 
 /// Which acoustic measurements a navigator uses: its beacon aiding. Every navigator
 /// takes one; a measurement it does not use is [`Outcome::Skipped`].

@@ -14,7 +14,7 @@
 //! the sound-speed error; modelling that is left for when a log needs it).
 
 use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome};
-use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
+use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::geo::wrap_angle;
 use crate::measure::{RadialSpeed2d, ScalarModel, SlantRange, StateComponent};
 use nalgebra::{SMatrix, SVector, Vector1, Vector3};
@@ -274,13 +274,7 @@ impl PlanarNavigator {
     }
 
     fn correct(&mut self, model: &dyn ScalarModel<STATES>, z: f64, gate: f64) -> Outcome {
-        let model = [model];
-        let r = model.covariance(self.filter.mean());
-        match self.filter.update_gated(&model, &Vector1::new(z), &r, gate) {
-            Ok(Gated::Accepted(nis)) => Outcome::Accepted(nis),
-            Ok(Gated::Rejected(nis)) => Outcome::Rejected(nis),
-            Err(e) => Outcome::Failed(e),
-        }
+        super::gated_update(&mut self.filter, &[model], Vector1::new(z), gate)
     }
 
     /// Moves the clock to `t_s`: coasts at the held speed, lets the bias (and, with a

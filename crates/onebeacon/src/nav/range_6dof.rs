@@ -4,7 +4,7 @@
 //! measurement (eq. 3.7-3.10).
 
 use super::{Aiding, BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
-use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
+use crate::filter::{AnyFilter, FilterKind, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::measure::{Range3d, StateComponent};
 use crate::models::kinematic6dof::{BodyVelocity, Cov, DIM, Kinematic6Dof, State, idx};
 use nalgebra::{SVector, Vector1};
@@ -99,11 +99,7 @@ fn update<const M: usize, H: MeasurementModel<DIM, M>>(
     models: &H,
     z: SVector<f64, M>,
 ) -> Outcome {
-    let r = models.covariance(filter.mean());
-    match filter.update_gated(models, &z, &r, f64::INFINITY) {
-        Ok(g) => Outcome::Accepted(Gated::nis(g)),
-        Err(e) => Outcome::Failed(e),
-    }
+    super::gated_update(filter, models, z, f64::INFINITY)
 }
 
 impl Navigator for Range6DofNavigator {

@@ -7,7 +7,7 @@
 //! range offset b (m) and scale error k_r (ranges read (1 + k_r) r + b).
 
 use super::{Estimate, Kind, Measurement, Navigator, Outcome, PlanarConfig};
-use crate::filter::{AnyFilter, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
+use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::measure::{ScalarModel, SlantRange};
 use nalgebra::{SMatrix, SVector, Vector1, Vector3};
 
@@ -142,13 +142,8 @@ impl Navigator for TrackingNavigator {
                 if self.config.aiding.range =>
             {
                 let model: [&dyn ScalarModel<STATES>; 1] = [&range(beacon.position_ned_m, self.depth_m, &self.config)];
-                let r = model.covariance(self.filter.mean());
                 let gate = self.config.nis_gate.unwrap_or(f64::INFINITY);
-                match self.filter.update_gated(&model, &Vector1::new(range_m), &r, gate) {
-                    Ok(Gated::Accepted(nis)) => Outcome::Accepted(nis),
-                    Ok(Gated::Rejected(nis)) => Outcome::Rejected(nis),
-                    Err(e) => Outcome::Failed(e),
-                }
+                super::gated_update(&mut self.filter, &model, Vector1::new(range_m), gate)
             }
             _ => Outcome::Skipped,
         }
