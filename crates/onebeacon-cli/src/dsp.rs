@@ -79,6 +79,11 @@ fn bad(path: &Path, what: impl std::fmt::Display) -> anyhow::Error {
     BadInput(format!("{}: {what}", path.display())).into()
 }
 
+/// Whether a matched-filter output shows a pulse, its statistic and the threshold.
+fn detection(r: &onebeacon::dsp::matched_filter::RangeEstimate) -> (bool, f64, f64) {
+    (r.detected(), r.peak_ratio(), onebeacon::dsp::matched_filter::detection_threshold(r.distribution.len()))
+}
+
 /// What the receiver found in one capture, and what its output files need.
 struct Found {
     result: serde_json::Value,
@@ -128,9 +133,7 @@ impl Chain {
         let rx = receivers[mode]
             .get_or_insert_with(|| Receiver::new(rypkema_modes()[mode], &self.elements, self.receiver.clone()));
         let est = rx.process_spectra(captures, &spectra);
-        let detected = est.range.detected();
-        let statistic = est.range.peak_ratio();
-        let threshold = onebeacon::dsp::matched_filter::detection_threshold(est.range.distribution.len());
+        let (detected, statistic, threshold) = detection(&est.range);
         let when = |v: serde_json::Value| if detected { v } else { serde_json::Value::Null };
         let result = json!({
             "detected": detected,
@@ -172,9 +175,7 @@ impl Chain {
     /// the pilots' synchronisation passes the same detection test as a chirp.
     fn frame(&self, captures: &[Vec<f64>]) -> Found {
         let est = receive_frame(&self.config.frame(), &self.elements, &self.receiver, captures);
-        let detected = est.sync.detected();
-        let statistic = est.sync.peak_ratio();
-        let threshold = onebeacon::dsp::matched_filter::detection_threshold(est.sync.distribution.len());
+        let (detected, statistic, threshold) = detection(&est.sync);
         let (range_m, v) = (est.range_m, est.radial_speed_m_s);
         let (az, inc) = est.direction.unwrap_or((f64::NAN, f64::NAN));
         let num = |x: f64| if detected && x.is_finite() { json!(x) } else { serde_json::Value::Null };

@@ -301,6 +301,20 @@ impl PlanarNavigator {
         }
     }
 
+    /// An odometry increment at `t_s` (forward `d`, lateral `lat`, turn `dpsi`), each
+    /// distance with the configured fraction of itself as its error; the forward speed
+    /// it implies is held for Doppler, and coasting stops.
+    fn odometry(&mut self, t_s: f64, d: f64, lat: f64, dpsi: f64) -> Outcome {
+        if let Some(t0) = self.last_odometry_s.filter(|t0| t_s > *t0) {
+            self.speed_m_s = d / (t_s - t0);
+        }
+        self.last_odometry_s = Some(t_s);
+        self.coasting = false;
+        let frac = self.config.noise.distance_sigma_frac;
+        self.motion(d, lat, dpsi, frac * d.abs(), frac * lat.abs());
+        Outcome::Applied
+    }
+
     /// Forward `d` and starboard `lat` increments with a heading change `dpsi` and the
     /// errors of the two increments.
     fn motion(&mut self, d: f64, lat: f64, dpsi: f64, sigma_d: f64, sigma_lat: f64) {
@@ -331,24 +345,10 @@ impl Navigator for PlanarNavigator {
         let aiding = self.config.aiding;
         match m.kind {
             Kind::Odometry { distance_m, heading_change_rad } => {
-                if let Some(t0) = self.last_odometry_s.filter(|t0| t_s > *t0) {
-                    self.speed_m_s = distance_m / (t_s - t0);
-                }
-                self.last_odometry_s = Some(t_s);
-                self.coasting = false;
-                let sd = noise.distance_sigma_frac * distance_m.abs();
-                self.motion(distance_m, 0.0, heading_change_rad, sd, 0.0);
-                Outcome::Applied
+                self.odometry(t_s, distance_m, 0.0, heading_change_rad)
             }
             Kind::BodyOdometry { forward_m, lateral_m, heading_change_rad } => {
-                if let Some(t0) = self.last_odometry_s.filter(|t0| t_s > *t0) {
-                    self.speed_m_s = forward_m / (t_s - t0);
-                }
-                self.last_odometry_s = Some(t_s);
-                self.coasting = false;
-                let frac = noise.distance_sigma_frac;
-                self.motion(forward_m, lateral_m, heading_change_rad, frac * forward_m.abs(), frac * lateral_m.abs());
-                Outcome::Applied
+                self.odometry(t_s, forward_m, lateral_m, heading_change_rad)
             }
             Kind::Speed { speed_m_s } => {
                 self.speed_m_s = speed_m_s;
