@@ -83,7 +83,7 @@ file = "crab_ranges.csv"
 time = "t_s"
 beacon = "beacon_id"
 range = "range_m"
-sort = true
+time_order = "sort"
 
 [[source]]
 kind = "ground_truth"

@@ -87,6 +87,9 @@ pub fn replay(
         return Ok(());
     }
     outln!("{title}: {} measurements, replayed in {:.1} ms", r.items, wall_s * 1e3);
+    for (file, n) in r.dropped.iter().filter(|(_, n)| *n > 0) {
+        outln!("{file}: {n} rows out of time order dropped (time_order = \"drop\")");
+    }
     // (header, summary key, decimals)
     const COLUMNS: [(&str, &str, usize); 12] = [
         ("rmse_m", "rmse_m", 3),
@@ -127,7 +130,8 @@ fn summary_json(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
         .iter()
         .zip(&s.stats)
         .zip(&finals)
-        .map(|((name, st), e)| {
+        .zip(s.beacon_offsets())
+        .map(|(((name, st), e), offsets)| {
             let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m(), e.east_m(), 0.0));
             let mut v = json!({
                 "name": name,
@@ -148,6 +152,11 @@ fn summary_json(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
             for (k, x) in e.calibration() {
                 v[k] = num(x);
             }
+            if !offsets.is_empty() {
+                let per_beacon =
+                    offsets.iter().map(|(b, o, sigma)| (b.to_string(), json!({"offset_m": o, "sigma_m": sigma})));
+                v["beacon_offsets"] = Value::Object(per_beacon.collect());
+            }
             v
         })
         .collect();
@@ -158,6 +167,7 @@ fn summary_json(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
         "skipped_before_start": s.before_start,
         "left_out": s.left_out,
         "screened": s.screened,
+        "dropped_rows": r.dropped.iter().map(|(f, n)| (f.clone(), json!(n))).collect::<serde_json::Map<_, _>>(),
         "wall_s": wall_s,
         "estimators": estimators,
     })

@@ -279,3 +279,112 @@ fn closed_pipe_ends_quietly() {
         assert!(o.status.success() || o.status.code().is_none(), "{args:?}: {:?}", o.status);
     }
 }
+
+/// Plaza 1 as loggers write it: odometry stamped with the UTC time of day (and a date),
+/// ranges in UNIX milliseconds, the ground truth in ISO 8601, truth and beacons in
+/// latitude and longitude about a point near Pittsburgh (converted with WGS-84 by
+/// `map_3d`, the reverse of what the reader does). Every estimator's figures and final
+/// position agree with the metric log to 1 cm.
+#[test]
+fn plaza_with_clock_times_and_latitudes_replays_as_the_metric_log() {
+    let dir = scratch("latlon");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/plaza");
+    let (lat0, lon0) = (40.4433f64, -79.9436f64);
+    let day_s = 1_623_628_800.0; // 2021-06-14 00:00:00 UTC
+    let to_latlon = |x: f64, y: f64| {
+        let (lat, lon, _) =
+            map_3d::ned2geodetic(y, x, 0.0, lat0.to_radians(), lon0.to_radians(), 0.0, map_3d::Ellipsoid::WGS84);
+        (lat.to_degrees(), lon.to_degrees())
+    };
+    let clock = |t: f64| {
+        let (whole, frac) = (t.floor(), t - t.floor());
+        let w = whole as u64;
+        format!("{:02}:{:02}:{:02}.{:06}", w / 3600, w / 60 % 60, w % 60, (frac * 1e6).round() as u64)
+    };
+    let rows = |file: &str| -> Vec<Vec<f64>> {
+        let text = std::fs::read_to_string(data.join(file)).unwrap();
+        text.lines().skip(1).map(|l| l.split(',').map(|c| c.trim().parse().unwrap()).collect()).collect()
+    };
+    let mut odo = String::from("utc,d,dh\n");
+    for r in rows("plaza1_odometry.csv") {
+        odo += &format!("{},{},{}\n", clock(r[0]), r[1], r[2]);
+    }
+    let mut ranges = String::from("unix_ms,id,r\n");
+    for r in rows("plaza1_ranges.csv") {
+        ranges += &format!("{},{},{}\n", ((day_s + r[0]) * 1e3).round() as u64, r[1], r[2]);
+    }
+    let mut truth = String::from("time,lat,lon,yaw\n");
+    for r in rows("plaza1_ground_truth.csv") {
+        let (lat, lon) = to_latlon(r[1], r[2]);
+        truth += &format!("2021-06-14T{}Z,{lat:.11},{lon:.11},{}\n", clock(r[0]), r[3]);
+    }
+    let mut beacons = String::from("id,lat,lon\n");
+    for r in rows("plaza1_beacons.csv") {
+        let (lat, lon) = to_latlon(r[1], r[2]);
+        beacons += &format!("{},{lat:.11},{lon:.11}\n", r[0]);
+    }
+    for (f, t) in [("odo.csv", odo), ("ranges.csv", ranges), ("truth.csv", truth), ("beacons.csv", beacons)] {
+        std::fs::write(dir.join(f), t).unwrap();
+    }
+    let metric = std::fs::read_to_string(plaza(1)).unwrap();
+    let rest = &metric[metric.find("[initial]").unwrap()..];
+    let toml = format!(
+        r#"name = "plaza1-latlon"
+frame = "enu"
+[origin]
+lat_deg = {lat0}
+lon_deg = {lon0}
+[[source]]
+kind = "odometry"
+file = "odo.csv"
+time = "utc"
+time_format = "%H:%M:%S%.f"
+date = "2021-06-14"
+distance = "d"
+heading_change = "dh"
+[[source]]
+kind = "range"
+file = "ranges.csv"
+time = "unix_ms"
+time_unit = "ms"
+beacon = "id"
+range = "r"
+time_order = "sort"
+[[source]]
+kind = "ground_truth"
+file = "truth.csv"
+time = "time"
+time_format = "%Y-%m-%dT%H:%M:%S%.fZ"
+lat = "lat"
+lon = "lon"
+heading = "yaw"
+[beacons]
+file = "beacons.csv"
+id = "id"
+lat = "lat"
+lon = "lon"
+{rest}"#
+    );
+    let log = dir.join("plaza1-latlon.toml");
+    std::fs::write(&log, toml).unwrap();
+    let a = replay_json(&plaza(1), None, &dir.join("metric"));
+    let b = replay_json(&log.display().to_string(), None, &dir.join("latlon"));
+    assert_eq!(a.len(), b.len());
+    let mut worst: f64 = 0.0;
+    for (a, b) in a.iter().zip(&b) {
+        assert_eq!(a["name"], b["name"]);
+        let pairs = [
+            (&a["rmse_m"], &b["rmse_m"]),
+            (&a["final_error_m"], &b["final_error_m"]),
+            (&a["max_error_m"], &b["max_error_m"]),
+            (&a["final"]["x_m"], &b["final"]["x_m"]),
+            (&a["final"]["y_m"], &b["final"]["y_m"]),
+        ];
+        for (x, y) in pairs {
+            let d = (x.as_f64().unwrap() - y.as_f64().unwrap()).abs();
+            assert!(d < 0.01, "{}: {x} against {y}", a["name"]);
+            worst = worst.max(d);
+        }
+    }
+    eprintln!("plaza1 metric against clock times and latitudes: largest difference {worst:.2e} m");
+}

@@ -69,9 +69,14 @@ impl SourceKind {
             SourceKind::Depth => (&["depth"], &[]),
             SourceKind::Range => (&["beacon", "range"], &[]),
             SourceKind::Doppler => (&["beacon", "radial_speed"], &[]),
-            SourceKind::BeaconTrack => (&["beacon", "x", "y"], &["z"]),
-            SourceKind::GroundTruth => (&["x", "y"], &["heading"]),
+            SourceKind::BeaconTrack => (&["beacon"], &["z"]),
+            SourceKind::GroundTruth => (&[], &["heading"]),
         }
+    }
+
+    /// Whether the kind holds a position: `x` and `y`, or `lat` and `lon`.
+    pub(crate) fn positioned(self) -> bool {
+        matches!(self, SourceKind::BeaconTrack | SourceKind::GroundTruth)
     }
 }
 
@@ -113,6 +118,90 @@ impl AngleUnit {
     }
 }
 
+/// The unit of a numeric time column (`time_unit`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeUnit {
+    #[default]
+    S,
+    Ms,
+    Us,
+    Ns,
+}
+
+impl TimeUnit {
+    fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Us => 1e-6,
+            TimeUnit::Ns => 1e-9,
+        }
+    }
+}
+
+/// What to do with a row whose time is before the row above (`time_order`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeOrder {
+    /// Stop with an error naming the line (the default).
+    Refuse,
+    /// Read the whole file and sort it by time (a log written out of order).
+    Sort,
+    /// Drop the rows out of order, counted in the replay's summary: a row behind the
+    /// last row kept, or a row ahead of both its neighbours (a glitched time stamp).
+    Drop,
+}
+
+/// How latitudes and longitudes are written (`latlon_unit`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LatLonUnit {
+    #[default]
+    Deg,
+    /// Integers of 1e-7 degree (degrees times 1e7), as many GNSS receivers write them.
+    Deg1e7,
+    Rad,
+}
+
+impl LatLonUnit {
+    fn radians(self) -> f64 {
+        match self {
+            LatLonUnit::Deg => std::f64::consts::PI / 180.0,
+            LatLonUnit::Deg1e7 => std::f64::consts::PI / 180.0 * 1e-7,
+            LatLonUnit::Rad => 1.0,
+        }
+    }
+}
+
+/// The point about which latitudes and longitudes become local north and east
+/// (`[origin]`); without it, the log's first latitude and longitude.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Origin {
+    pub lat_deg: f64,
+    pub lon_deg: f64,
+}
+
+/// Latitude and longitude to the log's local frame: north and east on the plane tangent
+/// to the WGS-84 ellipsoid at the origin (through ECEF, `map_3d`), in the log's frame.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Geodetic {
+    lat0_rad: f64,
+    lon0_rad: f64,
+    frame: Frame,
+}
+
+impl Geodetic {
+    /// (x, y) in the log's frame of a point at (lat, lon) radians, on the ellipsoid.
+    fn local(&self, lat_rad: f64, lon_rad: f64) -> (f64, f64) {
+        let (n, e, _) =
+            map_3d::geodetic2ned(lat_rad, lon_rad, 0.0, self.lat0_rad, self.lon0_rad, 0.0, map_3d::Ellipsoid::WGS84);
+        let (x, y, _) = self.frame.from_ned(&Vector3::new(n, e, 0.0));
+        (x, y)
+    }
+}
+
 /// One CSV file: its kind, the time column and the column of each quantity.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -120,18 +209,39 @@ pub struct Source {
     pub kind: SourceKind,
     /// Relative to the log description's directory.
     pub file: PathBuf,
-    /// The time column, seconds.
+    /// The time column: a number (seconds since any origin, or a UNIX epoch) in
+    /// `time_unit`, or text read with `time_format`.
     pub time: String,
+    #[serde(default)]
+    pub time_unit: TimeUnit,
+    /// A strftime pattern for times written as text (`%H:%M:%S%.f` with `date`, or
+    /// `%Y-%m-%dT%H:%M:%S%.fZ`): times become UNIX seconds, UTC unless the pattern has
+    /// `%z`.
+    pub time_format: Option<String>,
+    /// `YYYY-MM-DD`, the day of the first row when `time_format` has no date; a time more
+    /// than 12 h before the row above is on the next day.
+    pub date: Option<String>,
     /// Added to every time of this file, s.
     #[serde(default)]
     pub time_offset_s: f64,
+    /// Rows out of time order: `refuse` (default), `sort` or `drop`.
+    pub time_order: Option<TimeOrder>,
     #[serde(default)]
     pub length_unit: LengthUnit,
     #[serde(default)]
     pub angle_unit: AngleUnit,
-    /// Sort the rows by time instead of refusing rows out of order.
+    /// `sort = true` is `time_order = "sort"` (the older key).
     #[serde(default)]
     pub sort: bool,
+    /// Headings of this file in the log's frame: `heading_offset_deg` plus the column
+    /// turned the frame's way, or the other way when `heading_clockwise` says so (a
+    /// compass, clockwise from north, in an ENU log: `heading_clockwise = true`,
+    /// `heading_offset_deg = 90`). Heading changes and the lateral axis follow the sense.
+    #[serde(default)]
+    pub heading_offset_deg: f64,
+    pub heading_clockwise: Option<bool>,
+    #[serde(default)]
+    pub latlon_unit: LatLonUnit,
     pub distance: Option<String>,
     pub heading_change: Option<String>,
     pub forward: Option<String>,
@@ -145,9 +255,16 @@ pub struct Source {
     pub x: Option<String>,
     pub y: Option<String>,
     pub z: Option<String>,
+    pub lat: Option<String>,
+    pub lon: Option<String>,
 }
 
 impl Source {
+    /// The policy for rows out of time order.
+    pub fn time_order(&self) -> TimeOrder {
+        self.time_order.unwrap_or(if self.sort { TimeOrder::Sort } else { TimeOrder::Refuse })
+    }
+
     pub(crate) fn column(&self, key: &str) -> Option<&String> {
         match key {
             "distance" => self.distance.as_ref(),
@@ -163,12 +280,14 @@ impl Source {
             "x" => self.x.as_ref(),
             "y" => self.y.as_ref(),
             "z" => self.z.as_ref(),
+            "lat" => self.lat.as_ref(),
+            "lon" => self.lon.as_ref(),
             _ => None,
         }
     }
 }
 
-pub(crate) const COLUMN_KEYS: [&str; 13] = [
+pub(crate) const COLUMN_KEYS: [&str; 15] = [
     "distance",
     "heading_change",
     "forward",
@@ -182,6 +301,8 @@ pub(crate) const COLUMN_KEYS: [&str; 13] = [
     "x",
     "y",
     "z",
+    "lat",
+    "lon",
 ];
 
 /// Fixed beacon positions from a CSV file.
@@ -190,11 +311,16 @@ pub(crate) const COLUMN_KEYS: [&str; 13] = [
 pub struct BeaconTable {
     pub file: PathBuf,
     pub id: String,
-    pub x: String,
-    pub y: String,
+    /// `x` and `y`, or `lat` and `lon` (in `latlon_unit`).
+    pub x: Option<String>,
+    pub y: Option<String>,
+    pub lat: Option<String>,
+    pub lon: Option<String>,
     pub z: Option<String>,
     #[serde(default)]
     pub length_unit: LengthUnit,
+    #[serde(default)]
+    pub latlon_unit: LatLonUnit,
 }
 
 /// One fixed beacon given inline.
@@ -202,8 +328,11 @@ pub struct BeaconTable {
 #[serde(deny_unknown_fields)]
 pub struct BeaconEntry {
     pub id: u32,
-    pub x_m: f64,
-    pub y_m: f64,
+    /// `x_m` and `y_m`, or `lat_deg` and `lon_deg`.
+    pub x_m: Option<f64>,
+    pub y_m: Option<f64>,
+    pub lat_deg: Option<f64>,
+    pub lon_deg: Option<f64>,
     #[serde(default)]
     pub z_m: f64,
 }
@@ -296,6 +425,8 @@ pub struct LogDescription {
     pub description: String,
     #[serde(default)]
     pub frame: FrameKey,
+    /// Where latitudes and longitudes are 0 m north and east.
+    pub origin: Option<Origin>,
     #[serde(default, rename = "source")]
     pub sources: Vec<Source>,
     pub beacons: Option<BeaconTable>,
@@ -321,6 +452,8 @@ pub struct Log {
     pub beacons: BTreeMap<u32, Vector3<f64>>,
     /// Beacons with a `beacon_track` source.
     tracked: BTreeSet<u32>,
+    /// Latitude and longitude to local positions, when the log has them.
+    geodetic: Option<Geodetic>,
     base: PathBuf,
 }
 
@@ -341,26 +474,80 @@ impl LogDescription {
         Ok(d)
     }
 
+    /// The geodetic origin: `[origin]`, or the first latitude and longitude of the log
+    /// (the `[beacons]` file, the `[[beacon]]` entries, then the sources in their order,
+    /// each file's first row); None when the log has no latitude or longitude.
+    fn geodetic(&self, base: &Path) -> Result<Option<Geodetic>, LogError> {
+        let deg = std::f64::consts::PI / 180.0;
+        let mut first = self.origin.map(|o| (o.lat_deg * deg, o.lon_deg * deg));
+        let first_row = |file: &Path, lat: &str, lon: &str, unit: LatLonUnit| -> Result<Option<(f64, f64)>, LogError> {
+            let mut table = Table::open(base, file)?;
+            let (lat, lon) = (table.index(lat)?, table.index(lon)?);
+            let Some(row) = table.next_row()? else { return Ok(None) };
+            Ok(Some((row.number(lat)? * unit.radians(), row.number(lon)? * unit.radians())))
+        };
+        if let Some(t) = self.beacons.as_ref().filter(|_| first.is_none())
+            && let (Some(lat), Some(lon)) = (&t.lat, &t.lon)
+        {
+            first = first_row(&t.file, lat, lon, t.latlon_unit)?;
+        }
+        if first.is_none() {
+            first = self.beacon_list.iter().find_map(|b| Some((b.lat_deg? * deg, b.lon_deg? * deg)));
+        }
+        for s in &self.sources {
+            if first.is_some() {
+                break;
+            }
+            if let (Some(lat), Some(lon)) = (&s.lat, &s.lon) {
+                first = first_row(&s.file, lat, lon, s.latlon_unit)?;
+            }
+        }
+        let frame = Frame::from(self.frame);
+        Ok(first.map(|(lat0_rad, lon0_rad)| Geodetic { lat0_rad, lon0_rad, frame }))
+    }
+
     /// Fixed beacons (the log's frame): the `[beacons]` file and the inline `[[beacon]]`
-    /// entries.
+    /// entries; `base` is the description's directory.
     pub fn fixed_beacons(&self, base: &Path) -> Result<BTreeMap<u32, Vector3<f64>>, LogError> {
+        self.beacons_about(base, self.geodetic(base)?.as_ref())
+    }
+
+    fn beacons_about(&self, base: &Path, geo: Option<&Geodetic>) -> Result<BTreeMap<u32, Vector3<f64>>, LogError> {
         let mut out = BTreeMap::new();
         if let Some(t) = &self.beacons {
             let mut table = Table::open(base, &t.file)?;
-            let (id, x, y) = (table.index(&t.id)?, table.index(&t.x)?, table.index(&t.y)?);
+            let id = table.index(&t.id)?;
+            let columns = |a: &Option<String>, b: &Option<String>| match (a, b) {
+                (Some(a), Some(b)) => Ok(Some((table.index(a)?, table.index(b)?))),
+                _ => Ok::<_, LogError>(None),
+            };
+            let (xy, latlon) = (columns(&t.x, &t.y)?, columns(&t.lat, &t.lon)?);
             let z = t.z.as_ref().map(|z| table.index(z)).transpose()?;
             let scale = t.length_unit.metres();
             while let Some(row) = table.next_row()? {
                 let b = row.beacon_id(id)?;
-                let z = z.map_or(Ok(0.0), |z| row.number(z))?;
-                let p = Vector3::new(row.number(x)?, row.number(y)?, z) * scale;
-                if out.insert(b, p).is_some() {
+                let z = z.map_or(Ok(0.0), |z| row.number(z))? * scale;
+                let (x, y) = match (xy, latlon, geo) {
+                    (Some((x, y)), _, _) => (row.number(x)? * scale, row.number(y)? * scale),
+                    (None, Some((lat, lon)), Some(geo)) => {
+                        let unit = t.latlon_unit.radians();
+                        geo.local(row.number(lat)? * unit, row.number(lon)? * unit)
+                    }
+                    _ => unreachable!("validated: x and y, or lat and lon"),
+                };
+                if out.insert(b, Vector3::new(x, y, z)).is_some() {
                     return Err(row.error(id, format!("beacon {b} appears twice")));
                 }
             }
         }
+        let deg = std::f64::consts::PI / 180.0;
         for b in &self.beacon_list {
-            if out.insert(b.id, Vector3::new(b.x_m, b.y_m, b.z_m)).is_some() {
+            let (x, y) = match (b.x_m.zip(b.y_m), b.lat_deg.zip(b.lon_deg), geo) {
+                (Some(xy), _, _) => xy,
+                (None, Some((lat, lon)), Some(geo)) => geo.local(lat * deg, lon * deg),
+                _ => unreachable!("validated: x_m and y_m, or lat_deg and lon_deg"),
+            };
+            if out.insert(b.id, Vector3::new(x, y, b.z_m)).is_some() {
                 return Err(LogError::File {
                     file: "[[beacon]]".into(),
                     message: format!("beacon {} is given twice", b.id),
@@ -379,18 +566,20 @@ impl Log {
         let description = LogDescription::load(path)?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let frame = Frame::from(description.frame);
-        let beacons = description.fixed_beacons(&base)?;
+        let geodetic = description.geodetic(&base)?;
+        let beacons = description.beacons_about(&base, geodetic.as_ref())?;
         // beacon tracks first, so that ranges may name tracked beacons
-        let (mut tracked, none) = (BTreeSet::new(), BTreeSet::new());
-        for s in description.sources.iter().filter(|s| s.kind == SourceKind::BeaconTrack) {
-            let mut rows = SourceRows::open(&base, s, &beacons, &none)?;
+        let mut log = Self { description, frame, beacons, tracked: BTreeSet::new(), geodetic, base };
+        let mut tracked = BTreeSet::new();
+        for s in log.description.sources.iter().filter(|s| s.kind == SourceKind::BeaconTrack) {
+            let mut rows = SourceRows::open(&log, s)?;
             while let Some(item) = rows.next_item()? {
                 if let Input::BeaconPosition { beacon_id, .. } = item.input {
                     tracked.insert(beacon_id);
                 }
             }
         }
-        let log = Self { description, frame, beacons, tracked, base };
+        log.tracked = tracked;
         log.items()?;
         Ok(log)
     }
@@ -400,11 +589,11 @@ impl Log {
     pub fn items(&self) -> Result<Items<'_>, LogError> {
         let (mut heads, mut rows) = (Vec::new(), Vec::new());
         for s in &self.description.sources {
-            let mut source = SourceRows::open(&self.base, s, &self.beacons, &self.tracked)?;
+            let mut source = SourceRows::open(self, s)?;
             let head = source
                 .next_item()?
                 .ok_or_else(|| LogError::File { file: source.table.file.clone(), message: "no rows".into() })?;
-            if s.sort {
+            if s.time_order() == TimeOrder::Sort {
                 let mut all = vec![head];
                 while let Some(item) = source.next_item()? {
                     all.push(item);
@@ -505,6 +694,19 @@ pub struct Items<'a> {
     ranks: Vec<u8>,
     /// A source's error, given after the item in hand.
     error: Option<LogError>,
+}
+
+impl Items<'_> {
+    /// The rows dropped so far by sources with `time_order = "drop"`: (file, count).
+    pub fn dropped(&self) -> Vec<(String, usize)> {
+        self.rows
+            .iter()
+            .filter_map(|r| match r {
+                Rows::Streamed(rows) if rows.order == TimeOrder::Drop => Some((rows.table.file.clone(), rows.dropped)),
+                _ => None,
+            })
+            .collect()
+    }
 }
 
 impl Iterator for Items<'_> {
@@ -647,25 +849,124 @@ struct SourceRows<'a> {
     cols: BTreeMap<&'static str, usize>,
     beacons: &'a BTreeMap<u32, Vector3<f64>>,
     tracked: &'a BTreeSet<u32>,
+    geodetic: Option<Geodetic>,
+    clock: Clock,
+    order: TimeOrder,
+    /// +1, or -1 when the file's headings turn against the log frame's sense.
+    sense: f64,
+    /// The time of the row above.
     previous: Option<f64>,
     /// The second item of a `speed_heading` row.
     pending: Option<Item>,
+    /// `time_order = "drop"`: the row read ahead, the time of the last row kept, the rows
+    /// dropped, and an error met while reading ahead (given after the row in hand).
+    ahead: Option<RowItems>,
+    kept: Option<f64>,
+    dropped: usize,
+    error: Option<LogError>,
+}
+
+/// The one or two items of a row.
+type RowItems = (Item, Option<Item>);
+
+/// How a source's time cells become seconds.
+enum Clock {
+    Number(f64),
+    /// A strftime pattern for a date and time (with an offset when `zoned`).
+    DateTime {
+        format: String,
+        zoned: bool,
+    },
+    /// A strftime pattern for a time of day, the day of the first row (UNIX seconds),
+    /// and the days passed since (a time of day 12 h before the one above is the next
+    /// day's).
+    TimeOfDay {
+        format: String,
+        day_s: f64,
+        days: f64,
+        last_s: Option<f64>,
+    },
+}
+
+impl Clock {
+    fn new(s: &Source) -> Self {
+        match (&s.time_format, &s.date) {
+            (None, _) => Clock::Number(s.time_unit.seconds()),
+            (Some(format), None) => Clock::DateTime { format: format.clone(), zoned: format.contains('z') },
+            (Some(format), Some(date)) => {
+                let day = chrono::NaiveDate::parse_from_str(date, "%Y-%m-%d").expect("validated: date is YYYY-MM-DD");
+                let day_s = day.and_time(chrono::NaiveTime::MIN).and_utc().timestamp() as f64;
+                Clock::TimeOfDay { format: format.clone(), day_s, days: 0.0, last_s: None }
+            }
+        }
+    }
+
+    /// The time of a cell, seconds; an error message when it cannot be read.
+    fn read(&mut self, cell: &str) -> Result<f64, String> {
+        let unix =
+            |t: chrono::DateTime<chrono::Utc>| t.timestamp() as f64 + f64::from(t.timestamp_subsec_nanos()) * 1e-9;
+        let explain = |format: &str, e: chrono::ParseError| {
+            let hint = if e.kind() == chrono::format::ParseErrorKind::NotEnough {
+                " (a time of day needs the source's `date` key)"
+            } else {
+                ""
+            };
+            format!("`{cell}` does not match time_format `{format}`: {e}{hint}")
+        };
+        match self {
+            Clock::Number(unit) => match cell.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v * *unit),
+                Ok(_) => Err(format!("`{cell}` is not finite; a finite number is expected")),
+                Err(_) => Err(format!("`{cell}` is not a number (set time_format for times written as text)")),
+            },
+            Clock::DateTime { format, zoned: false } => chrono::NaiveDateTime::parse_from_str(cell, format)
+                .map(|t| unix(t.and_utc()))
+                .map_err(|e| explain(format, e)),
+            Clock::DateTime { format, zoned: true } => {
+                chrono::DateTime::parse_from_str(cell, format).map(|t| unix(t.to_utc())).map_err(|e| explain(format, e))
+            }
+            Clock::TimeOfDay { format, day_s, days, last_s } => {
+                let t = chrono::NaiveTime::parse_from_str(cell, format).map_err(|e| explain(format, e))?;
+                use chrono::Timelike;
+                let s = f64::from(t.num_seconds_from_midnight()) + f64::from(t.nanosecond()) * 1e-9;
+                if last_s.is_some_and(|last| s < last - 43_200.0) {
+                    *days += 1.0;
+                }
+                *last_s = Some(s);
+                Ok(*day_s + *days * 86_400.0 + s)
+            }
+        }
+    }
 }
 
 impl<'a> SourceRows<'a> {
-    fn open(
-        base: &Path,
-        source: &'a Source,
-        beacons: &'a BTreeMap<u32, Vector3<f64>>,
-        tracked: &'a BTreeSet<u32>,
-    ) -> Result<Self, LogError> {
-        let table = Table::open(base, &source.file)?;
+    fn open(log: &'a Log, source: &'a Source) -> Result<Self, LogError> {
+        let table = Table::open(&log.base, &source.file)?;
         let time = table.index(&source.time)?;
         let cols = COLUMN_KEYS
             .iter()
             .filter_map(|k| source.column(k).map(|c| table.index(c).map(|c| (*k, c))))
             .collect::<Result<_, _>>()?;
-        Ok(Self { source, table, time, cols, beacons, tracked, previous: None, pending: None })
+        let frame_clockwise = log.frame == Frame::Ned;
+        let sense = if source.heading_clockwise.is_some_and(|c| c != frame_clockwise) { -1.0 } else { 1.0 };
+        Ok(Self {
+            source,
+            table,
+            time,
+            cols,
+            beacons: &log.beacons,
+            tracked: &log.tracked,
+            geodetic: log.geodetic,
+            clock: Clock::new(source),
+            order: source.time_order(),
+            sense,
+            previous: None,
+            pending: None,
+            ahead: None,
+            kept: None,
+            dropped: 0,
+            error: None,
+        })
     }
 
     /// The next item, None at the end of the file.
@@ -673,39 +974,91 @@ impl<'a> SourceRows<'a> {
         if let Some(item) = self.pending.take() {
             return Ok(Some(item));
         }
+        let row = if self.order == TimeOrder::Drop { self.next_in_order()? } else { self.read_row()? };
+        Ok(row.map(|(item, second)| {
+            self.pending = second;
+            item
+        }))
+    }
+
+    /// `time_order = "drop"`: the next row in time order, with one row read ahead so that
+    /// a time stamp glitched forward drops its row, not every row after it.
+    fn next_in_order(&mut self) -> Result<Option<RowItems>, LogError> {
+        loop {
+            if let Some(e) = self.error.take() {
+                return Err(e);
+            }
+            let row = match self.ahead.take() {
+                Some(row) => row,
+                None => match self.read_row()? {
+                    Some(row) => row,
+                    None => return Ok(None),
+                },
+            };
+            let t = row.0.t_s;
+            if self.kept.is_some_and(|k| t < k) {
+                self.dropped += 1; // behind the last row kept
+                continue;
+            }
+            match self.read_row() {
+                Ok(next) => self.ahead = next,
+                Err(e) => self.error = Some(e),
+            }
+            let next_t = self.ahead.as_ref().map(|(next, _)| next.t_s);
+            if next_t.is_some_and(|n| n < t && self.kept.is_none_or(|k| n >= k)) {
+                self.dropped += 1; // ahead of both neighbours
+                continue;
+            }
+            self.kept = Some(t);
+            return Ok(Some(row));
+        }
+    }
+
+    /// The next row's items, None at the end of the file.
+    fn read_row(&mut self) -> Result<Option<RowItems>, LogError> {
         let (s, cols, time) = (self.source, &self.cols, self.time);
-        let (beacons, tracked) = (self.beacons, self.tracked);
+        let (beacons, tracked, geodetic, sense) = (self.beacons, self.tracked, self.geodetic, self.sense);
         let previous = self.previous;
         let Some(row) = self.table.next_row()? else { return Ok(None) };
-        let t = row.number(time)? + s.time_offset_s;
-        if let Some(p) = previous.filter(|p| t < *p && !s.sort) {
+        let t = self.clock.read(row.cell(time)).map_err(|m| row.error(time, m))? + s.time_offset_s;
+        if let Some(p) = previous.filter(|p| t < *p && self.order == TimeOrder::Refuse) {
             return Err(row.error(
                 time,
-                format!("time {t} is before {p} on the row above; rows must be in time order (or set sort = true on this source)"),
+                format!("time {t} is before {p} on the row above; rows must be in time order (or set time_order = \"sort\" or \"drop\" on this source)"),
             ));
         }
         let (len, ang) = (s.length_unit.metres(), s.angle_unit.radians());
         let num = |k: &str| row.number(cols[k]);
+        let heading = |k: &str| Ok::<_, LogError>(sense * num(k)? * ang + s.heading_offset_deg.to_radians());
+        let turn = |k: &str| Ok::<_, LogError>(sense * num(k)? * ang);
         let beacon = || {
             let id = row.beacon_id(cols["beacon"])?;
             resolve_beacon(id, beacons, tracked).map_err(|m| row.error(cols["beacon"], m))
         };
+        let position = || match (cols.get("x").zip(cols.get("y")), geodetic) {
+            (Some((&x, &y)), _) => Ok::<_, LogError>((row.number(x)? * len, row.number(y)? * len)),
+            (None, Some(geo)) => {
+                let unit = s.latlon_unit.radians();
+                Ok(geo.local(num("lat")? * unit, num("lon")? * unit))
+            }
+            (None, None) => unreachable!("validated: x and y, or lat and lon (which make the origin)"),
+        };
         let measurement = |m: Kind| Item { t_s: t, input: Input::Measurement(m) };
-        let mut pending = None;
+        let mut second = None;
         let item = match s.kind {
             SourceKind::Odometry => measurement(Kind::Odometry {
                 distance_m: num("distance")? * len,
-                heading_change_rad: num("heading_change")? * ang,
+                heading_change_rad: turn("heading_change")?,
             }),
             SourceKind::BodyOdometry => measurement(Kind::BodyOdometry {
                 forward_m: num("forward")? * len,
-                lateral_m: num("lateral")? * len,
-                heading_change_rad: num("heading_change")? * ang,
+                lateral_m: sense * num("lateral")? * len,
+                heading_change_rad: turn("heading_change")?,
             }),
             SourceKind::Speed => measurement(Kind::Speed { speed_m_s: num("speed")? * len }),
-            SourceKind::Heading => measurement(Kind::Heading { heading_rad: num("heading")? * ang }),
+            SourceKind::Heading => measurement(Kind::Heading { heading_rad: heading("heading")? }),
             SourceKind::SpeedHeading => {
-                pending = Some(measurement(Kind::Heading { heading_rad: num("heading")? * ang }));
+                second = Some(measurement(Kind::Heading { heading_rad: heading("heading")? }));
                 measurement(Kind::Speed { speed_m_s: num("speed")? * len })
             }
             SourceKind::Depth => measurement(Kind::Depth { depth_m: num("depth")? * len }),
@@ -715,19 +1068,18 @@ impl<'a> SourceRows<'a> {
             }
             SourceKind::BeaconTrack => {
                 let beacon_id = row.beacon_id(cols["beacon"])?;
-                let z = cols.get("z").map_or(Ok(0.0), |&c| row.number(c))?;
-                let position = Vector3::new(num("x")?, num("y")?, z) * len;
-                Item { t_s: t, input: Input::BeaconPosition { beacon_id, position } }
+                let z = cols.get("z").map_or(Ok(0.0), |&c| row.number(c))? * len;
+                let (x, y) = position()?;
+                Item { t_s: t, input: Input::BeaconPosition { beacon_id, position: Vector3::new(x, y, z) } }
             }
             SourceKind::GroundTruth => {
-                let heading_rad = cols.get("heading").map(|&c| row.number(c)).transpose()?.map(|h| h * ang);
-                let pose = TruthPose { north_m: num("x")? * len, east_m: num("y")? * len, heading_rad };
-                Item { t_s: t, input: Input::Truth(pose) }
+                let heading_rad = cols.contains_key("heading").then(|| heading("heading")).transpose()?;
+                let (north_m, east_m) = position()?;
+                Item { t_s: t, input: Input::Truth(TruthPose { north_m, east_m, heading_rad }) }
             }
         };
         self.previous = Some(t);
-        self.pending = pending;
-        Ok(Some(item))
+        Ok(Some((item, second)))
     }
 }
 
@@ -1012,5 +1364,178 @@ z = "z"
         let range = "[[source]]\nkind = \"range\"\nfile = \"r.csv\"\ntime = \"t\"\nbeacon = \"id\"\nrange = \"r\"\n";
         let e = load("unknown", range, &[("r.csv", "t,id,r\n1.0,9,5\n")]).unwrap_err().to_string();
         assert!(e.contains("line 2, column `id`: beacon 9 is not among the beacons ()"), "{e}");
+    }
+
+    /// Times as loggers write them, against epochs worked out by hand: 2021-06-14 00:00:00
+    /// UTC is UNIX 1623628800 s. A time of day with a date rolls over at midnight; a
+    /// date-time with `Z` or an offset; UNIX milliseconds.
+    #[test]
+    fn clock_times_become_unix_seconds() {
+        let body = r#"[[source]]
+kind = "speed"
+file = "clock.csv"
+time = "t"
+time_format = "%H:%M:%S%.f"
+date = "2021-06-14"
+speed = "v"
+[[source]]
+kind = "heading"
+file = "iso.csv"
+time = "t"
+time_format = "%Y-%m-%dT%H:%M:%S%.f%:z"
+heading = "h"
+[[source]]
+kind = "depth"
+file = "ms.csv"
+time = "t"
+time_unit = "ms"
+depth = "d"
+"#;
+        let files = [
+            ("clock.csv", "t,v\n23:59:59.5,1\n00:00:00.25,2\n"),
+            ("iso.csv", "t,h\n2021-06-15T02:00:01.5+02:00,0\n"),
+            ("ms.csv", "t,d\n1623628800123,4\n"),
+        ];
+        let log = load("clock", body, &files).unwrap();
+        let day = 1_623_628_800.0;
+        let times: Vec<f64> = items(&log).iter().map(|i| i.t_s - day).collect();
+        assert_eq!(times.len(), 4);
+        let expected = [0.123, 86_399.5, 86_400.25, 86_400.0 + 1.5];
+        for (t, e) in times.iter().zip(expected) {
+            assert_abs_diff_eq!(*t, e, epsilon = 1e-6);
+        }
+        // a cell that does not match, and a time of day without its date
+        let e = load("clock-bad", body, &[files[0], ("iso.csv", "t,h\n12:00:00,0\n"), files[2]]).unwrap_err();
+        assert!(e.to_string().contains("line 2, column `t`: `12:00:00` does not match time_format"), "{e}");
+        let no_date = body.replace("date = \"2021-06-14\"\n", "");
+        let e = load("clock-nodate", &no_date, &files).unwrap_err().to_string();
+        assert!(e.contains("needs the source's `date` key"), "{e}");
+    }
+
+    /// `time_order = "drop"`: a row stamped before the one above (a GPS row at .000
+    /// between .800 and 13.100) and a row stamped far ahead are dropped and counted; the
+    /// rest keep their order.
+    #[test]
+    fn rows_out_of_order_are_dropped_and_counted() {
+        let body =
+            "[[source]]\nkind = \"speed\"\nfile = \"s.csv\"\ntime = \"t\"\nspeed = \"v\"\ntime_order = \"drop\"\n";
+        let csv = "t,v\n12.6,1\n12.8,2\n12.0,3\n13.1,4\n99.0,5\n13.3,6\n13.5,7\n";
+        let log = load("drop", body, &[("s.csv", csv)]).unwrap();
+        let mut stream = log.items().unwrap();
+        let speeds: Vec<f64> = (&mut stream)
+            .map(|i| match measurement(&i.unwrap()) {
+                Kind::Speed { speed_m_s } => speed_m_s,
+                other => panic!("{other:?}"),
+            })
+            .collect();
+        assert_eq!(speeds, [1.0, 2.0, 4.0, 6.0, 7.0]);
+        assert_eq!(stream.dropped().len(), 1);
+        assert_eq!(stream.dropped()[0].1, 2);
+    }
+
+    /// Latitude and longitude on WGS-84 about `[origin]`, against the closed-form radii of
+    /// curvature (meridian M, prime vertical N) for a small step at 45 deg: north = M dphi,
+    /// east = N cos(phi) dlambda. Scaled integers (1e-7 deg) read the same; in an ENU log
+    /// x is east.
+    #[test]
+    fn latitude_and_longitude_become_local_metres() {
+        let (a, f) = (6_378_137.0, 1.0 / 298.257_223_563);
+        let e2 = f * (2.0 - f);
+        let phi = 45f64.to_radians();
+        let w = (1.0 - e2 * phi.sin().powi(2)).sqrt();
+        let (m, n) = (a * (1.0 - e2) / w.powi(3), a / w);
+        let (dphi, dlam) = (0.0004f64.to_radians(), 0.0006f64.to_radians());
+        let (north, east) = (m * dphi, n * phi.cos() * dlam);
+        let body = r#"frame = "enu"
+[origin]
+lat_deg = 45.0
+lon_deg = 7.0
+[[source]]
+kind = "ground_truth"
+file = "gps.csv"
+time = "t"
+lat = "lat"
+lon = "lon"
+latlon_unit = "deg1e7"
+[beacons]
+file = "b.csv"
+id = "id"
+lat = "la"
+lon = "lo"
+"#;
+        let files = [("gps.csv", "t,lat,lon\n1.0,450004000,70006000\n"), ("b.csv", "id,la,lo\n3,45.0004,7.0006\n")];
+        let log = load("latlon", body, &files).unwrap();
+        let b = log.beacons[&3];
+        assert_abs_diff_eq!(b.x, east, epsilon = 2e-3);
+        assert_abs_diff_eq!(b.y, north, epsilon = 2e-3);
+        let Input::Truth(p) = items(&log)[0].input else { panic!() };
+        assert_abs_diff_eq!(p.north_m, b.x, epsilon = 1e-6); // the log frame's x: east
+        assert_abs_diff_eq!(p.east_m, b.y, epsilon = 1e-6);
+        // without [origin], the first latitude and longitude (the beacons file) is 0, 0
+        let log = load("latlon-first", &body.replace("[origin]\nlat_deg = 45.0\nlon_deg = 7.0\n", ""), &files).unwrap();
+        assert_abs_diff_eq!(log.beacons[&3].norm(), 0.0, epsilon = 1e-9);
+    }
+
+    /// Heading conventions per source: a compass (clockwise from north) in an ENU log is
+    /// `heading_clockwise = true`, `heading_offset_deg = 90`; its turns and lateral axis
+    /// flip with it, so that the session sees the same NED values as from a NED source.
+    #[test]
+    fn heading_conventions_are_keys() {
+        let body = r#"frame = "enu"
+[[source]]
+kind = "heading"
+file = "compass.csv"
+time = "t"
+heading = "h"
+angle_unit = "deg"
+heading_clockwise = true
+heading_offset_deg = 90.0
+[[source]]
+kind = "body_odometry"
+file = "odo.csv"
+time = "t"
+forward = "dx"
+lateral = "dy"
+heading_change = "dh"
+heading_clockwise = true
+"#;
+        let files = [("compass.csv", "t,h\n1.0,0\n2.0,90\n3.0,-30\n"), ("odo.csv", "t,dx,dy,dh\n4.0,1.0,0.2,0.1\n")];
+        let log = load("compass", body, &files).unwrap();
+        let ned: Vec<Kind> =
+            items(&log).iter().map(|i| measurement(&Item { t_s: i.t_s, input: i.input.to_ned(log.frame) })).collect();
+        for (k, expected_deg) in ned.iter().zip([0.0, 90.0, -30.0]) {
+            let Kind::Heading { heading_rad } = k else { panic!("{k:?}") };
+            assert_abs_diff_eq!(*heading_rad, f64::to_radians(expected_deg), epsilon = 1e-12);
+        }
+        let Kind::BodyOdometry { forward_m, lateral_m, heading_change_rad } = ned[3] else { panic!() };
+        assert_eq!((forward_m, lateral_m, heading_change_rad), (1.0, 0.2, 0.1));
+    }
+
+    /// The new keys refuse what cannot be meant, naming the key.
+    #[test]
+    fn time_and_position_keys_are_checked() {
+        let parse = |body: &str| {
+            let toml = format!("name = \"k\"\n{body}\n[[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n");
+            LogDescription::parse(&toml, "k.toml").map(|_| ()).unwrap_err().to_string()
+        };
+        let truth = "[[source]]\nkind = \"ground_truth\"\nfile = \"t.csv\"\ntime = \"t\"\n";
+        let e = parse(&format!("{truth}x = \"x\"\ny = \"y\"\nlat = \"la\"\nlon = \"lo\"\n"));
+        assert!(e.contains("source[0].x") && e.contains("one pair, not both"), "{e}");
+        let e = parse(&format!("{truth}lat = \"la\"\n"));
+        assert!(e.contains("source[0].lat"), "{e}");
+        let e = parse(&format!("{truth}x = \"x\"\ny = \"y\"\ndate = \"2021-06-14\"\n"));
+        assert!(e.contains("source[0].date"), "{e}");
+        let e = parse(&format!("{truth}x = \"x\"\ny = \"y\"\ntime_format = \"%H:%Q\"\n"));
+        assert!(e.contains("source[0].time_format"), "{e}");
+        let e = parse(&format!("{truth}x = \"x\"\ny = \"y\"\nsort = true\ntime_order = \"drop\"\n"));
+        assert!(e.contains("source[0].sort"), "{e}");
+        let e = parse(
+            "[[source]]\nkind = \"speed\"\nfile = \"s.csv\"\ntime = \"t\"\nspeed = \"v\"\nheading_clockwise = true\n",
+        );
+        assert!(e.contains("source[0].heading_clockwise"), "{e}");
+        let e = parse("[[beacon]]\nid = 1\nx_m = 1.0\n");
+        assert!(e.contains("beacon[0].x_m"), "{e}");
+        let e = parse("[origin]\nlat_deg = 95.0\nlon_deg = 0.0\n");
+        assert!(e.contains("origin"), "{e}");
     }
 }

@@ -19,6 +19,8 @@ use std::collections::BTreeSet;
 pub struct Replay {
     pub session: Session,
     pub items: usize,
+    /// Rows dropped by sources with `time_order = "drop"`: (file, count).
+    pub dropped: Vec<(String, usize)>,
 }
 
 /// A session of the description's estimators, starting at `start`, restricted to
@@ -47,7 +49,8 @@ pub fn replay<E: From<LogError>>(
     let has_truth = log.has_truth();
     let mut heard = false;
     let mut items = 0;
-    for item in log.items()? {
+    let mut stream = log.items()?;
+    for item in &mut stream {
         let item = item?;
         items += 1;
         // a screened item is counted and logged by the session; the replay goes on
@@ -59,7 +62,7 @@ pub fn replay<E: From<LogError>>(
         record(to_record(&step, session.last_beacon, heard))?;
         heard = false;
     }
-    Ok(Replay { session, items })
+    Ok(Replay { session, items, dropped: stream.dropped() })
 }
 
 /// A trajectory row (NED) from a step.

@@ -7,8 +7,18 @@
 
 use super::FilterName;
 use onebeacon::filter::FilterKind;
-use onebeacon::nav::{Aiding, EkfTuning, PlanarConfig, PlanarNoise, SensorNoise};
+use onebeacon::nav::{Aiding, EkfTuning, PlanarConfig, PlanarNoise, Robust, SensorNoise};
 use serde::{Deserialize, Serialize};
+
+/// A heavy-tailed update (`robust` key).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RobustName {
+    /// Huber's weight, threshold `huber_k` standard deviations (default 1.345).
+    Huber,
+    /// A Student-t likelihood with `student_t_dof` degrees of freedom (default 4).
+    StudentT,
+}
 
 /// Where an estimator runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -134,7 +144,13 @@ pub struct EstimatorSpec {
     /// standard deviation, m/s^2 per sqrt(s); no motion inputs are used (log).
     pub track_accel_sigma_m_s2: Option<f64>,
     pub nis_gate: Option<f64>,
+    /// A heavy-tailed update (log): `"huber"` or `"student_t"`, Gaussian when absent.
+    pub robust: Option<RobustName>,
+    pub huber_k: Option<f64>,
+    pub student_t_dof: Option<f64>,
     pub estimate_bias: Option<bool>,
+    /// An offset per beacon instead of one shared (log).
+    pub estimate_beacon_offsets: Option<bool>,
     pub bias_m: Option<f64>,
     pub bias_sigma_m: Option<f64>,
     pub estimate_range_scale: Option<bool>,
@@ -180,7 +196,11 @@ impl EstimatorSpec {
             position_walk_m_per_sqrt_s: None,
             track_accel_sigma_m_s2: None,
             nis_gate: None,
+            robust: None,
+            huber_k: None,
+            student_t_dof: None,
             estimate_bias: None,
+            estimate_beacon_offsets: None,
             bias_m: None,
             bias_sigma_m: None,
             estimate_range_scale: None,
@@ -230,9 +250,12 @@ impl EstimatorSpec {
             ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
             ("nis_gate", self.nis_gate, Positive, &[Log]),
+            ("huber_k", self.huber_k, Positive, &[Log]),
+            ("student_t_dof", self.student_t_dof, Positive, &[Log]),
             ("mirror_recovery", flag(self.mirror_recovery), Any, &[FixedBeacon]),
             ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
             ("estimate_bias", flag(self.estimate_bias), Any, &[Log]),
+            ("estimate_beacon_offsets", flag(self.estimate_beacon_offsets), Any, &[Log]),
             ("bias_m", self.bias_m, Any, &[Log]),
             ("bias_sigma_m", self.bias_sigma_m, Positive, &[Log]),
             ("estimate_range_scale", flag(self.estimate_range_scale), Any, &[Log]),
@@ -289,6 +312,7 @@ impl EstimatorSpec {
         PlanarConfig {
             aiding: self.aiding(Host::Log),
             estimate_bias: self.estimate_bias.unwrap_or(c.estimate_bias),
+            estimate_beacon_offsets: self.estimate_beacon_offsets.unwrap_or(c.estimate_beacon_offsets),
             bias_m: self.bias_m.unwrap_or(c.bias_m),
             bias_sigma_m: self.bias_sigma_m.unwrap_or(c.bias_sigma_m),
             estimate_range_scale: self.estimate_range_scale.unwrap_or(c.estimate_range_scale),
@@ -298,6 +322,10 @@ impl EstimatorSpec {
             estimate_turn_scale: self.estimate_turn_scale.unwrap_or(c.estimate_turn_scale),
             turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
             nis_gate: self.nis_gate,
+            robust: self.robust.map(|r| match r {
+                RobustName::Huber => Robust::Huber { k: self.huber_k.unwrap_or(1.345) },
+                RobustName::StudentT => Robust::StudentT { dof: self.student_t_dof.unwrap_or(4.0) },
+            }),
             noise,
             track_accel_sigma_m_s2: self.track_accel_sigma_m_s2,
         }

@@ -3,7 +3,7 @@
 use super::estimator::{EstimatorSpec, Host, Sign};
 use super::moving_beacon::Vehicle;
 use super::{FixedBeacon, MovingBeacon, Scenario};
-use crate::replay::log::{COLUMN_KEYS, InitialFrom, LogDescription};
+use crate::replay::log::{COLUMN_KEYS, InitialFrom, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
 
 pub(crate) struct Violation {
     pub key: String,
@@ -144,6 +144,22 @@ pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<()
                 Sign::Any => Rule::Finite,
             };
             check(&key(name), v, rule)?;
+        }
+        if e.estimate_beacon_offsets == Some(true)
+            && (e.estimate_bias == Some(true) || e.track_accel_sigma_m_s2.is_some())
+        {
+            return Err(Violation {
+                key: key("estimate_beacon_offsets"),
+                value: "true".into(),
+                allowed: "replaces the shared offset of estimate_bias (give one of the two), and does not apply to the tracker (track_accel_sigma_m_s2)".into(),
+            });
+        }
+        if e.robust.is_some() && host != Host::Log {
+            return Err(Violation {
+                key: key("robust"),
+                value: format!("{:?}", e.robust),
+                allowed: format!("does not apply to a {} (it applies to: log)", host.label()),
+            });
         }
         let (asked, has) = (e.aiding(host), host.acoustic());
         if (asked.doppler && !has.doppler) || (asked.range && !has.range) {
@@ -356,8 +372,81 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
 }
 
 /// A log description: each source's column keys, the estimators, the start.
+/// A position given as exactly one pair: `x`/`y` or `lat`/`lon` (the keys named by
+/// `keys`, at `at`).
+fn check_position(at: &str, xy: (bool, bool), latlon: (bool, bool), keys: [&str; 4]) -> Result<(), Violation> {
+    let [x, y, lat, lon] = keys;
+    let (xy_some, latlon_some) = (xy.0 || xy.1, latlon.0 || latlon.1);
+    let ok = match (xy_some, latlon_some) {
+        (true, false) => xy.0 && xy.1,
+        (false, true) => latlon.0 && latlon.1,
+        _ => false,
+    };
+    if ok {
+        return Ok(());
+    }
+    let given = [(x, xy.0), (y, xy.1), (lat, latlon.0), (lon, latlon.1)]
+        .iter()
+        .filter(|(_, g)| *g)
+        .map(|(k, _)| *k)
+        .collect::<Vec<_>>();
+    Err(Violation {
+        key: format!("{at}.{}", if xy_some { x } else { lat }),
+        value: if given.is_empty() { "missing".into() } else { format!("given: {}", given.join(", ")) },
+        allowed: format!("a position needs `{x}` and `{y}`, or `{lat}` and `{lon}` (one pair, not both)"),
+    })
+}
+
+/// The time keys of a source: a valid strftime pattern, a date only with a pattern.
+fn check_time(i: usize, s: &Source) -> Result<(), Violation> {
+    let at = |k: &str| format!("source[{i}].{k}");
+    if let Some(f) = &s.time_format {
+        let bad = chrono::format::StrftimeItems::new(f).any(|item| matches!(item, chrono::format::Item::Error));
+        if bad || f.trim().is_empty() {
+            return Err(Violation {
+                key: at("time_format"),
+                value: format!("{f:?}"),
+                allowed: "a strftime pattern such as \"%H:%M:%S%.f\" (with `date`) or \"%Y-%m-%dT%H:%M:%S%.fZ\"".into(),
+            });
+        }
+        if s.time_unit != TimeUnit::S {
+            return Err(Violation {
+                key: at("time_unit"),
+                value: format!("{:?}", s.time_unit).to_lowercase(),
+                allowed: "applies to numeric times, not with time_format".into(),
+            });
+        }
+    }
+    if let Some(date) = &s.date
+        && (s.time_format.is_none() || chrono::NaiveDate::parse_from_str(date, "%Y-%m-%d").is_err())
+    {
+        return Err(Violation {
+            key: at("date"),
+            value: format!("{date:?}"),
+            allowed: "a day YYYY-MM-DD, for a time_format that writes the time of day only".into(),
+        });
+    }
+    if s.sort && s.time_order.is_some_and(|o| o != TimeOrder::Sort) {
+        return Err(Violation {
+            key: at("sort"),
+            value: "true".into(),
+            allowed: "is the older time_order = \"sort\"; give one of the two".into(),
+        });
+    }
+    check(&at("time_offset_s"), s.time_offset_s, Rule::Finite)
+}
+
 pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
     check_file_name("name", &d.name)?;
+    if let Some(o) = &d.origin
+        && (!(-90.0..=90.0).contains(&o.lat_deg) || !(-180.0..=360.0).contains(&o.lon_deg))
+    {
+        return Err(Violation {
+            key: "origin".into(),
+            value: format!("lat_deg {}, lon_deg {}", o.lat_deg, o.lon_deg),
+            allowed: "a latitude in [-90, 90] and a longitude in [-180, 360] degrees".into(),
+        });
+    }
     for (i, s) in d.sources.iter().enumerate() {
         let (required, optional) = s.kind.columns();
         if let Some(key) = required.iter().find(|k| s.column(k).is_none()) {
@@ -367,7 +456,13 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
                 allowed: format!("a {:?} source needs the column keys {}", s.kind, required.join(", ")),
             });
         }
-        let known = |k: &&str| required.contains(k) || optional.contains(k);
+        const POSITION: [&str; 4] = ["x", "y", "lat", "lon"];
+        let positioned = s.kind.positioned();
+        if positioned {
+            let has = |k: &str| s.column(k).is_some();
+            check_position(&format!("source[{i}]"), (has("x"), has("y")), (has("lat"), has("lon")), POSITION)?;
+        }
+        let known = |k: &&str| required.contains(k) || optional.contains(k) || positioned && POSITION.contains(k);
         if let Some(key) = COLUMN_KEYS.iter().find(|k| s.column(k).is_some() && !known(k)) {
             let allowed: Vec<&str> = required.iter().chain(optional).copied().collect();
             return Err(Violation {
@@ -376,7 +471,42 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
                 allowed: format!("does not apply to a {:?} source (its column keys: {})", s.kind, allowed.join(", ")),
             });
         }
-        check(&format!("source[{i}].time_offset_s"), s.time_offset_s, Rule::Finite)?;
+        check_time(i, s)?;
+        check(&format!("source[{i}].heading_offset_deg"), s.heading_offset_deg, Rule::Finite)?;
+        let turns = matches!(
+            s.kind,
+            SourceKind::Odometry
+                | SourceKind::BodyOdometry
+                | SourceKind::Heading
+                | SourceKind::SpeedHeading
+                | SourceKind::GroundTruth
+        );
+        if !turns && (s.heading_offset_deg != 0.0 || s.heading_clockwise.is_some()) {
+            return Err(Violation {
+                key: format!("source[{i}].heading_clockwise"),
+                value: "given".into(),
+                allowed: format!("heading keys do not apply to a {:?} source (it has no heading)", s.kind),
+            });
+        }
+    }
+    if let Some(t) = &d.beacons {
+        check_position(
+            "beacons",
+            (t.x.is_some(), t.y.is_some()),
+            (t.lat.is_some(), t.lon.is_some()),
+            ["x", "y", "lat", "lon"],
+        )?;
+    }
+    for (i, b) in d.beacon_list.iter().enumerate() {
+        check_position(
+            &format!("beacon[{i}]"),
+            (b.x_m.is_some(), b.y_m.is_some()),
+            (b.lat_deg.is_some(), b.lon_deg.is_some()),
+            ["x_m", "y_m", "lat_deg", "lon_deg"],
+        )?;
+        for v in [b.x_m, b.y_m, b.lat_deg, b.lon_deg, Some(b.z_m)].into_iter().flatten() {
+            check(&format!("beacon[{i}]"), v, Rule::Finite)?;
+        }
     }
     check_estimators(&d.estimators, Host::Log)?;
     let init = &d.initial;

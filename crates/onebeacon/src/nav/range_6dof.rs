@@ -99,7 +99,7 @@ fn update<const M: usize, H: MeasurementModel<DIM, M>>(
     models: &H,
     z: SVector<f64, M>,
 ) -> Outcome {
-    super::gated_update(filter, models, z, f64::INFINITY)
+    super::gated_update(filter, models, z, f64::INFINITY, None)
 }
 
 impl Navigator for Range6DofNavigator {

@@ -6,6 +6,7 @@
 use crate::filter::FilterKind;
 use crate::filter::consistency::nees;
 use crate::geo::Frame;
+use crate::nav::planar::STATES_WITH_OFFSETS;
 use crate::nav::{
     BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, PlanarConfig, PlanarNavigator, TrackingNavigator,
 };
@@ -390,6 +391,8 @@ fn error_and_nees(e: &Estimate, truth: &TruthPose) -> (f64, f64) {
 #[derive(Debug, Clone, PartialEq)]
 enum Estimator {
     Planar(PlanarNavigator),
+    /// With an offset per beacon ([`PlanarConfig::estimate_beacon_offsets`]).
+    PlanarOffsets(Box<PlanarNavigator<STATES_WITH_OFFSETS>>),
     Tracking(TrackingNavigator),
 }
 
@@ -397,6 +400,7 @@ impl Estimator {
     fn navigator(&mut self) -> &mut dyn Navigator {
         match self {
             Estimator::Planar(n) => n,
+            Estimator::PlanarOffsets(n) => n.as_mut(),
             Estimator::Tracking(n) => n,
         }
     }
@@ -404,6 +408,7 @@ impl Estimator {
     fn estimate(&self) -> Estimate {
         match self {
             Estimator::Planar(n) => n.estimate(),
+            Estimator::PlanarOffsets(n) => n.estimate(),
             Estimator::Tracking(n) => n.estimate(),
         }
     }
@@ -499,6 +504,16 @@ impl Session {
         self.navs.iter().map(Estimator::estimate).collect()
     }
 
+    /// Each estimator's per-beacon range offsets (beacon, offset m, its sigma m); empty
+    /// for one without them.
+    pub fn beacon_offsets(&self) -> Vec<Vec<(u32, f64, f64)>> {
+        let offsets = |e: &Estimator| match e {
+            Estimator::PlanarOffsets(n) => n.beacon_offsets(),
+            _ => Vec::new(),
+        };
+        self.navs.iter().map(offsets).collect()
+    }
+
     pub fn started(&self) -> bool {
         !self.navs.is_empty()
     }
@@ -514,6 +529,9 @@ impl Session {
             Some(a) => {
                 Estimator::Tracking(TrackingNavigator::new(c, a, f, t0, (pose.0, pose.1), self.sigma_position_m))
             }
+            None if c.estimate_beacon_offsets => Estimator::PlanarOffsets(Box::new(
+                PlanarNavigator::with_beacon_offsets(c, f, t0, pose, self.sigma_position_m, self.sigma_heading_rad),
+            )),
             None => {
                 Estimator::Planar(PlanarNavigator::new(c, f, t0, pose, self.sigma_position_m, self.sigma_heading_rad))
             }

@@ -143,7 +143,7 @@ impl Navigator for TrackingNavigator {
             {
                 let model: [&dyn ScalarModel<STATES>; 1] = [&range(beacon.position_ned_m, self.depth_m, &self.config)];
                 let gate = self.config.nis_gate.unwrap_or(f64::INFINITY);
-                super::gated_update(&mut self.filter, &model, Vector1::new(range_m), gate)
+                super::gated_update(&mut self.filter, &model, Vector1::new(range_m), gate, self.config.robust)
             }
             _ => Outcome::Skipped,
         }

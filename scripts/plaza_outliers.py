@@ -1,0 +1,58 @@
+#!/usr/bin/env python3
+"""Writes plaza1 with five gross range outliers in its first minute (issue 12): ranges
+whose error is -200, -75, +50, +175 and +300 m, one every 10 s from 10 s after the
+start, to the beacons in turn. Everything else is plaza1's own files and estimators.
+
+    python3 scripts/plaza_outliers.py DIR
+    onebeacon replay DIR/plaza1_outliers.toml     # against: onebeacon replay data/plaza/plaza1.toml
+
+An error that makes the range negative is screened by the session's limits (a range
+must be in (0, limits.max_range_m]); the others reach the estimators.
+Only the standard library is used."""
+import bisect, csv, math, os, shutil, sys
+
+ERRORS_M = [-200.0, -75.0, 50.0, 175.0, 300.0]
+
+def rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: plaza_outliers.py DIR")
+    src = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "plaza")
+    out = sys.argv[1]
+    os.makedirs(out, exist_ok=True)
+    for f in ["plaza1_beacons.csv", "plaza1_ground_truth.csv", "plaza1_odometry.csv"]:
+        shutil.copy(os.path.join(src, f), os.path.join(out, f))
+    truth = rows(os.path.join(src, "plaza1_ground_truth.csv"))
+    beacons = {int(b["beacon_id"]): (float(b["x_m"]), float(b["y_m"])) for b in rows(os.path.join(src, "plaza1_beacons.csv"))}
+    tt = [float(r["t_s"]) for r in truth]
+    t0 = tt[0]
+
+    def truth_at(t):
+        i = min(max(bisect.bisect_left(tt, t), 1), len(tt) - 1)
+        a, b = truth[i - 1], truth[i]
+        w = min(max((t - tt[i - 1]) / (tt[i] - tt[i - 1]), 0.0), 1.0) if tt[i] > tt[i - 1] else 0.0
+        return (float(a["x_m"]) + w * (float(b["x_m"]) - float(a["x_m"])),
+                float(a["y_m"]) + w * (float(b["y_m"]) - float(a["y_m"])))
+
+    ranges = rows(os.path.join(src, "plaza1_ranges.csv"))
+    ids = sorted(beacons)
+    for k, e in enumerate(ERRORS_M):
+        t = t0 + 10.0 * (k + 1) + 0.0005  # between plaza's own range times
+        b = ids[k % len(ids)]
+        x, y = truth_at(t)
+        r = math.hypot(x - beacons[b][0], y - beacons[b][1]) + e
+        ranges.append({"t_s": f"{t:.6f}", "beacon_id": str(b), "range_m": f"{r:.6f}"})
+        print(f"t = {t - t0:.1f} s, beacon {b}: range {r:.1f} m (error {e:+.0f} m)")
+    with open(os.path.join(out, "plaza1_ranges.csv"), "w") as f:
+        f.write("t_s,beacon_id,range_m\n")
+        for r in ranges:  # appended at the end: the source sorts by time
+            f.write(f"{r['t_s']},{r['beacon_id']},{r['range_m']}\n")
+    with open(os.path.join(src, "plaza1.toml")) as f:
+        text = f.read().replace('name = "plaza1"', 'name = "plaza1_outliers"', 1)
+    with open(os.path.join(out, "plaza1_outliers.toml"), "w") as f:
+        f.write(text)
+
+main()
