@@ -8,6 +8,8 @@ scale of the distance, so that error model is kept).
     python3 scripts/plaza_crab.py DIR
     onebeacon replay DIR/crab_body.toml      # body_odometry with its lateral part
     onebeacon replay DIR/crab_forward.toml   # the same forward increments, no lateral part
+    onebeacon replay DIR/crab_dvl.toml       # the same motion as body_velocity (a DVL):
+                                             # speeds and yaw rate held until the next row
 
 Only the standard library is used."""
 import bisect, csv, math, os, shutil, sys
@@ -48,14 +50,27 @@ def main():
             f.write(f"{t:.6f},{float(r['x_m']):.6f},{float(r['y_m']) + drift(t):.6f},{r['heading_rad']}\n")
     # body increments: the odometry's own heading, integrated from the first truth heading
     psi, t_prev = float(truth[0]["heading_rad"]), t0
+    increments = []
     with open(os.path.join(out, "crab_odometry.csv"), "w") as f:
         f.write("t_s,forward_m,left_m,dheading_rad\n")
         for r in odo:
             t, d, dpsi = float(r["t_s"]), float(r["delta_distance_m"]), float(r["delta_heading_rad"])
             mid = psi + dpsi / 2.0
             c = CURRENT_NORTH_M_S * (t - t_prev)  # the current's displacement, north (ENU y)
-            f.write(f"{t:.6f},{d + c * math.sin(mid):.9f},{c * math.cos(mid):.9f},{dpsi:.9f}\n")
+            fwd, left = d + c * math.sin(mid), c * math.cos(mid)
+            f.write(f"{t:.6f},{fwd:.9f},{left:.9f},{dpsi:.9f}\n")
+            increments.append((t_prev, t, fwd, left, dpsi))
             psi, t_prev = psi + dpsi, t
+    # the DVL: each increment as the body velocity of its interval, stamped at its start
+    # (held until the next row); the chord of an arc is shorter than the arc by
+    # sinc(dpsi / 2), which the velocity undoes
+    with open(os.path.join(out, "crab_dvl.csv"), "w") as f:
+        f.write("t_s,u_m_s,v_left_m_s,r_rad_s\n")
+        for a, b, fwd, left, dpsi in increments:
+            if b <= a:
+                continue
+            k = math.sin(dpsi / 2) / (dpsi / 2) if abs(dpsi) > 1e-12 else 1.0
+            f.write(f"{a:.6f},{fwd / k / (b - a):.9f},{left / k / (b - a):.9f},{dpsi / (b - a):.9f}\n")
     with open(os.path.join(out, "crab_ranges.csv"), "w") as f:
         f.write("t_s,beacon_id,range_m\n")
         for r in ranges:
@@ -110,7 +125,9 @@ heading_sigma_deg = 2.0
         "{columns}", 'forward = "forward_m"\nlateral = "left_m"\nheading_change = "dheading_rad"')
     fwd = head.replace("{kind}", "odometry").replace(
         "{columns}", 'distance = "forward_m"\nheading_change = "dheading_rad"')
-    for name, text in [("crab_body", body), ("crab_forward", fwd)]:
+    dvl = head.replace("{kind}", "body_velocity").replace("crab_odometry.csv", "crab_dvl.csv").replace(
+        "{columns}", 'forward_speed = "u_m_s"\nlateral_speed = "v_left_m_s"\nyaw_rate = "r_rad_s"')
+    for name, text in [("crab_body", body), ("crab_forward", fwd), ("crab_dvl", dvl)]:
         with open(os.path.join(out, name + ".toml"), "w") as f:
             f.write(f'name = "{name}"\ndescription = "plaza1 crabbing in a 0.1 m/s current toward north"\n' + text + estimators)
 

@@ -21,6 +21,7 @@ mod output;
 mod plot;
 mod replay;
 mod report;
+mod tune;
 
 use clap::{Parser, Subcommand};
 
@@ -111,6 +112,38 @@ enum Command {
         /// and stop.
         #[arg(long, conflicts_with_all = ["json", "out", "beacons"])]
         print_stream: bool,
+        /// Run the `[[estimators]]` of this TOML file instead of the log's (what `tune`
+        /// writes).
+        #[arg(long, value_name = "FILE")]
+        estimators: Option<PathBuf>,
+    },
+    /// Fit estimators' noise keys to a log: the values that maximise the likelihood of
+    /// their innovations (no ground truth needed). Writes estimators.toml (the log's
+    /// estimators, tuned, for `replay --estimators` on another log) and tune.json.
+    Tune {
+        /// The log description (TOML).
+        log: PathBuf,
+        /// The estimators to tune (names, comma-separated; default: every one that uses
+        /// ranges or Doppler).
+        #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+        estimators: Option<Vec<String>>,
+        /// The keys to fit (default: range_sigma_m, distance_sigma_frac,
+        /// heading_change_sigma_frac, heading_walk_deg_per_sqrt_m).
+        #[arg(long, value_delimiter = ',', value_name = "KEYS")]
+        keys: Option<Vec<String>>,
+        /// Use only these beacons (ids, comma-separated).
+        #[arg(long, value_delimiter = ',', value_name = "IDS")]
+        beacons: Option<Vec<u32>>,
+        /// Fit to the log with its beacons together and with each beacon alone (the
+        /// likelihoods multiplied): noise that also serves single-beacon navigation.
+        #[arg(long)]
+        each_beacon: bool,
+        /// Output directory (default: out/<log>-tune).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Print one JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
     },
     /// Run the estimators of CONFIG on JSON Lines measurements from stdin, writing one
     /// JSON line of estimates per input line to stdout, flushed after each.
@@ -247,8 +280,11 @@ fn main() -> ExitCode {
         Command::Dsp { command: DspCommand::Process { wav, config, out, json } } => {
             dsp::process(&wav, config.as_deref(), out, json)
         }
-        Command::Replay { log, out, beacons, json, print_stream } => {
-            replay::replay(&log, out, beacons, json, print_stream)
+        Command::Replay { log, out, beacons, json, print_stream, estimators } => {
+            replay::replay(&log, out, beacons, json, print_stream, estimators.as_deref())
+        }
+        Command::Tune { log, estimators, keys, beacons, each_beacon, out, json } => {
+            tune::tune(&log, tune::TuneArgs { estimators, keys, beacons, each_beacon, out, json })
         }
         Command::Stream { config } => replay::stream(&config),
         Command::Guidance { command: GuidanceCommand::Standoff { speed_m_s, depths_m, period_s, json } } => {

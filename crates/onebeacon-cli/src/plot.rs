@@ -1,4 +1,5 @@
-//! PNG plots with plotters and an embedded font (no system font libraries needed).
+//! Plots with plotters and an embedded font (no system font libraries needed): each
+//! one as a PNG and, beside it, an SVG for print ([`both`]).
 
 use anyhow::Result;
 use nalgebra::Vector3;
@@ -29,7 +30,22 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
-type Chart<'a> = ChartContext<'a, BitMapBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+type Area<DB> = DrawingArea<DB, plotters::coord::Shift>;
+
+/// Draws a plot twice: as the PNG `path` and as an SVG of the same name beside it.
+macro_rules! both {
+    ($path:expr, $size:expr, |$root:ident| $draw:expr) => {{
+        let (path, size): (&Path, (u32, u32)) = ($path, $size);
+        {
+            let $root = BitMapBackend::new(path, size).into_drawing_area();
+            $draw?;
+        }
+        let svg = path.with_extension("svg");
+        let $root = SVGBackend::new(&svg, size).into_drawing_area();
+        $draw
+    }};
+}
 
 fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
@@ -55,13 +71,16 @@ fn span(values: impl Iterator<Item = f64>, margin: f64) -> (f64, f64) {
 }
 
 /// A white canvas with a titled, labelled chart of the given ranges.
-fn chart<'a>(
-    root: &DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>,
+fn chart<'a, DB: DrawingBackend + 'a>(
+    root: &Area<DB>,
     caption: &str,
     x: Range<f64>,
     y: Range<f64>,
     labels: (&str, &str),
-) -> Result<Chart<'a>> {
+) -> Result<Chart<'a, DB>>
+where
+    DB::ErrorType: 'static,
+{
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(root)
         .caption(caption, (FONT, 22))
@@ -73,7 +92,10 @@ fn chart<'a>(
     Ok(chart)
 }
 
-fn legend(chart: &mut Chart<'_>, position: SeriesLabelPosition) -> Result<()> {
+fn legend<'a, DB: DrawingBackend + 'a>(chart: &mut Chart<'a, DB>, position: SeriesLabelPosition) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
@@ -85,16 +107,104 @@ fn legend(chart: &mut Chart<'_>, position: SeriesLabelPosition) -> Result<()> {
 }
 
 /// A line series with a legend entry.
-fn line(
-    chart: &mut Chart<'_>,
+fn line<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
     points: impl IntoIterator<Item = (f64, f64)>,
     style: ShapeStyle,
     label: Option<&str>,
-) -> Result<()> {
-    let series = chart.draw_series(LineSeries::new(points, style))?;
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let series = chart.draw_series(LineSeries::new(decimated(points), style))?;
     if let Some(label) = label {
         series.label(label).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
+    Ok(())
+}
+
+/// Most points of one drawn line: a 1200-pixel plot shows no more, and a thick line of
+/// many sub-pixel segments renders broken.
+const MAX_LINE_POINTS: usize = 3000;
+
+/// The finite points of a line, evenly thinned to at most [`MAX_LINE_POINTS`] (the last
+/// one kept).
+fn decimated(points: impl IntoIterator<Item = (f64, f64)>) -> Vec<(f64, f64)> {
+    let all: Vec<(f64, f64)> = points.into_iter().filter(|(x, y)| x.is_finite() && y.is_finite()).collect();
+    let stride = all.len().div_ceil(MAX_LINE_POINTS).max(1);
+    let mut kept: Vec<(f64, f64)> = all.iter().step_by(stride).copied().collect();
+    if let Some(&last) = all.last()
+        && kept.last() != Some(&last)
+    {
+        kept.push(last);
+    }
+    kept
+}
+
+/// A dashed line series with a legend entry drawn dashed.
+fn dashed<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    points: impl IntoIterator<Item = (f64, f64)>,
+    style: ShapeStyle,
+    label: Option<&str>,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let series = chart.draw_series(DashedLineSeries::new(decimated(points), 8, 5, style))?;
+    if let Some(label) = label {
+        series.label(label).legend(move |(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (7, 0)], style)
+                + PathElement::new(vec![(12, 0), (19, 0)], style)
+        });
+    }
+    Ok(())
+}
+
+/// Estimator `i`'s line: its own colour, solid for even `i` and dashed for odd, so that
+/// estimators whose tracks coincide stay visible on top of each other.
+fn estimator_line<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    i: usize,
+    points: impl IntoIterator<Item = (f64, f64)>,
+    width: u32,
+    label: Option<&str>,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let style = colour(i).stroke_width(width);
+    if i.is_multiple_of(2) { line(chart, points, style, label) } else { dashed(chart, points, style, label) }
+}
+
+/// A vertical colour bar for a heatmap from `lo` to `hi` (viridis), with its label, in
+/// `area`.
+fn colour_bar<DB: DrawingBackend>(area: &Area<DB>, lo: f64, hi: f64, label: &str) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let (lo, hi) = if hi > lo { (lo, hi) } else { (lo, lo + 1.0) };
+    let mut bar = ChartBuilder::on(area)
+        .margin_top(60)
+        .margin_bottom(60)
+        .margin_right(10)
+        .y_label_area_size(85)
+        .build_cartesian_2d(0.0..1.0, lo..hi)?;
+    bar.configure_mesh()
+        .disable_x_mesh()
+        .disable_x_axis()
+        .y_desc(label)
+        .y_label_formatter(&|v| {
+            if *v == 0.0 || (0.01..1000.0).contains(&v.abs()) { format!("{v:.3}") } else { format!("{v:.2e}") }
+        })
+        .label_style((FONT, 14))
+        .draw()?;
+    let n = 100;
+    bar.draw_series((0..n).map(|k| {
+        let (a, b) = (lo + (hi - lo) * k as f64 / n as f64, lo + (hi - lo) * (k + 1) as f64 / n as f64);
+        Rectangle::new([(0.0, a), (1.0, b)], viridis((k as f64 + 0.5) / n as f64).filled())
+    }))?;
     Ok(())
 }
 
@@ -142,10 +252,10 @@ pub fn top_view(
     names: &[String],
     title: &str,
     traj: &[StepRecord],
-    fixed_beacons: Option<&[Vector3<f64>]>,
+    fixed_beacons: Option<&[(u32, Vector3<f64>)]>,
 ) -> Result<()> {
     register_fonts();
-    let fixed = fixed_beacons.unwrap_or(&[]);
+    let fixed: Vec<Vector3<f64>> = fixed_beacons.unwrap_or(&[]).iter().map(|b| b.1).collect();
     let all = || {
         traj.iter()
             .flat_map(|r| {
@@ -161,49 +271,54 @@ pub fn top_view(
     let (ec, nc) = ((e0 + e1) / 2.0, (n0 + n1) / 2.0);
     let (he, hn) = (scale * (w - 120) as f64 / 2.0, scale * (h - 120) as f64 / 2.0);
 
-    let root = BitMapBackend::new(path, (w, h)).into_drawing_area();
-    let mut chart =
-        chart(&root, &format!("{title}: top view"), ec - he..ec + he, nc - hn..nc + hn, ("east (m)", "north (m)"))?;
-    let moving = fixed_beacons.is_none() && traj.windows(2).any(|w| (w[1].beacon - w[0].beacon).norm() > 1e-9);
-    if moving {
-        line(
-            &mut chart,
-            traj.iter().map(|r| (r.beacon.y, r.beacon.x)),
-            BLUE.mix(0.5).stroke_width(1),
-            Some("beacon (ASV)"),
-        )?;
-    }
-    for (v, name) in vehicles.iter().enumerate() {
-        let truth = traj.iter().map(|r| r.truth[v].pos).filter(|p| p.x.is_finite());
-        let label = if vehicles.len() > 1 { format!("truth {name}") } else { "truth".into() };
-        let style = BLACK.mix(1.0 - 0.35 * v.min(2) as f64).stroke_width(2);
-        line(&mut chart, truth.map(|p| (p.y, p.x)), style, Some(&label))?;
-    }
-    for (i, name) in names.iter().enumerate() {
-        let points = traj.iter().map(|r| (r.estimates[i].pos.y, r.estimates[i].pos.x));
-        line(&mut chart, points, colour(i).stroke_width(1), Some(name))?;
-    }
-    let beacons: Vec<Vector3<f64>> = match fixed_beacons {
-        Some(b) => b.to_vec(),
-        None => traj.first().map(|r| r.beacon).into_iter().collect(),
-    };
-    if !beacons.is_empty() {
-        chart
-            .draw_series(beacons.iter().map(|b| TriangleMarker::new((b.y, b.x), 9, BLUE.filled())))?
-            .label(if moving { "beacon start" } else { "beacon" })
-            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLUE.filled()));
-    }
-    let starts: Vec<Vector3<f64>> =
-        (0..vehicles.len()).filter_map(|v| traj.iter().map(|r| r.truth[v].pos).find(|p| p.x.is_finite())).collect();
-    if !starts.is_empty() {
-        chart
-            .draw_series(starts.iter().map(|p| Circle::new((p.y, p.x), 5, BLACK.filled())))?
-            .label("start")
-            .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
-    }
-    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
-    root.present()?;
-    Ok(())
+    both!(path, (w, h), |root| (|| -> Result<()> {
+        let mut chart =
+            chart(&root, &format!("{title}: top view"), ec - he..ec + he, nc - hn..nc + hn, ("east (m)", "north (m)"))?;
+        let moving = fixed_beacons.is_none() && traj.windows(2).any(|w| (w[1].beacon - w[0].beacon).norm() > 1e-9);
+        if moving {
+            line(
+                &mut chart,
+                traj.iter().map(|r| (r.beacon.y, r.beacon.x)),
+                BLUE.mix(0.25).stroke_width(1),
+                Some("beacon (ASV)"),
+            )?;
+        }
+        for (v, name) in vehicles.iter().enumerate() {
+            let truth = traj.iter().map(|r| r.truth[v].pos).filter(|p| p.x.is_finite());
+            let label = if vehicles.len() > 1 { format!("truth {name}") } else { "truth".into() };
+            let style = BLACK.mix(1.0 - 0.35 * v.min(2) as f64).stroke_width(3);
+            line(&mut chart, truth.map(|p| (p.y, p.x)), style, Some(&label))?;
+        }
+        for (i, name) in names.iter().enumerate() {
+            let points = traj.iter().map(|r| (r.estimates[i].pos.y, r.estimates[i].pos.x));
+            estimator_line(&mut chart, i, points, 2, Some(name))?;
+        }
+        let beacons: Vec<Vector3<f64>> = match fixed_beacons {
+            Some(_) => fixed.clone(),
+            None => traj.first().map(|r| r.beacon).into_iter().collect(),
+        };
+        for (id, b) in fixed_beacons.unwrap_or(&[]) {
+            let label = EmptyElement::at((b.y, b.x)) + Text::new(format!("{id}"), (9, -22), (FONT, 18).into_font());
+            chart.draw_series(std::iter::once(label))?;
+        }
+        if !beacons.is_empty() {
+            chart
+                .draw_series(beacons.iter().map(|b| TriangleMarker::new((b.y, b.x), 9, BLUE.filled())))?
+                .label(if moving { "beacon start" } else { "beacon" })
+                .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLUE.filled()));
+        }
+        let starts: Vec<Vector3<f64>> =
+            (0..vehicles.len()).filter_map(|v| traj.iter().map(|r| r.truth[v].pos).find(|p| p.x.is_finite())).collect();
+        if !starts.is_empty() {
+            chart
+                .draw_series(starts.iter().map(|p| Circle::new((p.y, p.x), 5, BLACK.filled())))?
+                .label("start")
+                .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        root.present()?;
+        Ok(())
+    })())
 }
 
 /// Horizontal position error versus time, one line per estimator, with its 2-sigma
@@ -214,18 +329,25 @@ pub fn error_vs_time(path: &Path, names: &[String], title: &str, traj: &[StepRec
     let t1 = traj.last().map(|r| r.t_s - t0).unwrap_or(1.0).max(1e-3);
     let sigma2 = |e: &Estimate| 2.0 * e.sigma_pos.norm();
     let (_, ymax) = span(traj.iter().flat_map(|r| r.estimates.iter().flat_map(|e| [e.error_m, sigma2(e)])), 0.05);
-    let root = BitMapBackend::new(path, (1200, 600)).into_drawing_area();
-    let caption = format!("{title}: position error (thick), 2-sigma bound (thin)");
-    let x_desc = if t0 == 0.0 { "time (s)".to_string() } else { format!("time since {t0:.1} s (s)") };
-    let mut chart = chart(&root, &caption, 0.0..t1, 0.0..ymax.max(0.01), (&x_desc, "horizontal error (m)"))?;
-    for (i, name) in names.iter().enumerate() {
-        let c = colour(i);
-        line(&mut chart, traj.iter().map(|r| (r.t_s - t0, r.estimates[i].error_m)), c.stroke_width(2), Some(name))?;
-        line(&mut chart, traj.iter().map(|r| (r.t_s - t0, sigma2(&r.estimates[i]))), c.mix(0.5).stroke_width(1), None)?;
-    }
-    legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
-    root.present()?;
-    Ok(())
+    both!(path, (1200, 600), |root| (|| -> Result<()> {
+        let start = if t0 == 0.0 { String::new() } else { format!(" from t = {t0:.1} s") };
+        let caption = format!("{title}: position error (thick), 2-sigma bound (thin){start}");
+        let x_desc = "elapsed time (s)";
+        let mut chart = chart(&root, &caption, 0.0..t1, 0.0..ymax.max(0.01), (x_desc, "horizontal error (m)"))?;
+        for (i, name) in names.iter().enumerate() {
+            let c = colour(i);
+            estimator_line(&mut chart, i, traj.iter().map(|r| (r.t_s - t0, r.estimates[i].error_m)), 2, Some(name))?;
+            line(
+                &mut chart,
+                traj.iter().map(|r| (r.t_s - t0, sigma2(&r.estimates[i]))),
+                c.mix(0.5).stroke_width(1),
+                None,
+            )?;
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+        root.present()?;
+        Ok(())
+    })())
 }
 
 /// Monte Carlo: mean error (inliers) and RMSE versus the first numeric swept key. With
@@ -259,53 +381,59 @@ pub fn mc_errors(path: &Path, s: &Scenario, r: &McResult) -> Result<()> {
     let (_, ymax) = span(stats.chain(r.cells.iter().flat_map(|c| c.pcrb_rmse_m.iter().copied())), 0.1);
     let cols = if panels.len() > 1 { 2 } else { 1 };
     let rows = panels.len().div_ceil(cols);
-    let root = BitMapBackend::new(path, (1000 * cols as u32, 600 * rows as u32)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((rows, cols));
-    let tracks = s.tracks();
-    let names: Vec<String> = tracks.iter().map(|t| t.label.clone()).collect();
-    for (panel, area) in panels.iter().zip(areas.iter()) {
-        let cells: Vec<&CellResult> =
-            r.cells.iter().filter(|c| text_of(c, &text_keys[..text_keys.len().min(1)]) == *panel).collect();
-        let caption = if panel.is_empty() {
-            format!("{}: {} runs per cell, mean error (thick), RMSE (thin)", s.name(), r.runs)
-        } else {
-            format!("{} {panel}: {} mean error (thick), RMSE (thin), PCRB (dashed)", s.name(), names[0])
-        };
-        let mut chart = chart(area, &caption, x0..x1, 0.0..ymax.max(0.01), (values[x_key].0, "horizontal error (m)"))?;
-        // series: the remaining text keys, or the estimators
-        let series: Vec<(String, usize)> = if text_keys.len() > 1 {
-            let mut v: Vec<String> = Vec::new();
-            for c in &cells {
-                let t = text_of(c, &text_keys[1..]);
-                if !v.contains(&t) {
-                    v.push(t);
+    both!(path, (1000 * cols as u32, 600 * rows as u32), |root| (|| -> Result<()> {
+        root.fill(&WHITE)?;
+        let areas = root.split_evenly((rows, cols));
+        let tracks = s.tracks();
+        let names: Vec<String> = tracks.iter().map(|t| t.label.clone()).collect();
+        for (panel, area) in panels.iter().zip(areas.iter()) {
+            let cells: Vec<&CellResult> =
+                r.cells.iter().filter(|c| text_of(c, &text_keys[..text_keys.len().min(1)]) == *panel).collect();
+            let caption = if panel.is_empty() {
+                format!("{}: {} runs per cell, mean error (thick), RMSE (thin)", s.name(), r.runs)
+            } else {
+                format!("{} {panel}: {} mean error (thick), RMSE (thin), PCRB (dashed)", s.name(), names[0])
+            };
+            let mut chart =
+                chart(area, &caption, x0..x1, 0.0..ymax.max(0.01), (values[x_key].0, "horizontal error (m)"))?;
+            // series: the remaining text keys, or the estimators
+            let series: Vec<(String, usize)> = if text_keys.len() > 1 {
+                let mut v: Vec<String> = Vec::new();
+                for c in &cells {
+                    let t = text_of(c, &text_keys[1..]);
+                    if !v.contains(&t) {
+                        v.push(t);
+                    }
+                }
+                v.into_iter().map(|t| (t, 0)).collect()
+            } else {
+                names.iter().enumerate().map(|(i, n)| (n.clone(), i)).collect()
+            };
+            for (i, (label, est)) in series.iter().enumerate() {
+                let c = colour(i);
+                let mine: Vec<&&CellResult> = cells
+                    .iter()
+                    .filter(|cell| text_keys.len() <= 1 || text_of(cell, &text_keys[1..]) == *label)
+                    .collect();
+                let mean: Vec<(f64, f64)> =
+                    mine.iter().map(|cell| (x_of(cell), cell.estimators[*est].1.mean_error_m)).collect();
+                let rmse = mine.iter().map(|cell| (x_of(cell), cell.estimators[*est].1.rmse_m));
+                estimator_line(&mut chart, i, mean.iter().copied(), 2, Some(label))?;
+                chart.draw_series(mean.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
+                line(&mut chart, rmse, c.mix(0.6).stroke_width(1), None)?;
+                let pcrb: Vec<(f64, f64)> = mine
+                    .iter()
+                    .filter_map(|cell| cell.pcrb(tracks[*est].vehicle_index).map(|p| (x_of(cell), p)))
+                    .collect();
+                if pcrb.len() > 1 {
+                    chart.draw_series(DashedLineSeries::new(pcrb, 6, 4, c.mix(0.8).stroke_width(1)))?;
                 }
             }
-            v.into_iter().map(|t| (t, 0)).collect()
-        } else {
-            names.iter().enumerate().map(|(i, n)| (n.clone(), i)).collect()
-        };
-        for (i, (label, est)) in series.iter().enumerate() {
-            let c = colour(i);
-            let mine: Vec<&&CellResult> =
-                cells.iter().filter(|cell| text_keys.len() <= 1 || text_of(cell, &text_keys[1..]) == *label).collect();
-            let mean: Vec<(f64, f64)> =
-                mine.iter().map(|cell| (x_of(cell), cell.estimators[*est].1.mean_error_m)).collect();
-            let rmse = mine.iter().map(|cell| (x_of(cell), cell.estimators[*est].1.rmse_m));
-            line(&mut chart, mean.iter().copied(), c.stroke_width(2), Some(label))?;
-            chart.draw_series(mean.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
-            line(&mut chart, rmse, c.mix(0.6).stroke_width(1), None)?;
-            let pcrb: Vec<(f64, f64)> =
-                mine.iter().filter_map(|cell| cell.pcrb(tracks[*est].vehicle_index).map(|p| (x_of(cell), p))).collect();
-            if pcrb.len() > 1 {
-                chart.draw_series(DashedLineSeries::new(pcrb, 6, 4, c.mix(0.8).stroke_width(1)))?;
-            }
+            legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         }
-        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
-    }
-    root.present()?;
-    Ok(())
+        root.present()?;
+        Ok(())
+    })())
 }
 
 /// A viridis-like colour for `v` in [0, 1].
@@ -339,42 +467,51 @@ pub fn guidance_map(path: &Path, g: &GuidanceSnapshot) -> Result<()> {
         }
     }
     let vmax = values.iter().cloned().fold(f64::MIN_POSITIVE, f64::max);
-    let root = BitMapBackend::new(path, (900, 860)).into_drawing_area();
-    let caption = format!("{:?} metric at the ping of t = {:.0} s (max {:.3e})", g.planner.metric, g.t_s, vmax);
-    let mut chart = chart(&root, &caption, e0..e0 + 2.0 * half, n0..n0 + 2.0 * half, ("east (m)", "north (m)"))?;
-    chart.draw_series((0..cells).flat_map(|i| {
-        let values = &values;
-        (0..cells).map(move |j| {
-            let (n, e) = (n0 + i as f64 * size, e0 + j as f64 * size);
-            Rectangle::new([(e, n), (e + size, n + size)], viridis(values[i * cells + j] / vmax).filled())
-        })
-    }))?;
-    let circle = (0..=180).map(|k| {
-        let a = std::f64::consts::TAU * k as f64 / 180.0;
-        (g.previous.y + g.reach_m * a.sin(), g.previous.x + g.reach_m * a.cos())
-    });
-    line(&mut chart, circle, WHITE.stroke_width(2), Some("reaching set"))?;
-    chart
-        .draw_series(std::iter::once(TriangleMarker::new((g.previous.y, g.previous.x), 9, WHITE.filled())))?
-        .label("beacon now")
-        .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.filled()));
-    chart
-        .draw_series(std::iter::once(Circle::new((g.target.y, g.target.x), 6, RED.filled())))?
-        .label("vehicle estimate")
-        .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.filled()));
-    if g.planner.metric == Metric::ApproachB {
+    both!(path, (950, 780), |root| (|| -> Result<()> {
+        let metric = match g.planner.metric {
+            Metric::ApproachA => "approach A (det FIM)",
+            Metric::ApproachB => "approach B (det FIM now + next)",
+        };
+        let caption = format!("guidance metric, {metric}, ping at t = {:.0} s", g.t_s);
+        root.fill(&WHITE)?;
+        let (main, side) = root.split_horizontally(800);
+        colour_bar(&side, 0.0, vmax, "metric")?;
+        let root = main;
+        let mut chart = chart(&root, &caption, e0..e0 + 2.0 * half, n0..n0 + 2.0 * half, ("east (m)", "north (m)"))?;
+        chart.draw_series((0..cells).flat_map(|i| {
+            let values = &values;
+            (0..cells).map(move |j| {
+                let (n, e) = (n0 + i as f64 * size, e0 + j as f64 * size);
+                Rectangle::new([(e, n), (e + size, n + size)], viridis(values[i * cells + j] / vmax).filled())
+            })
+        }))?;
+        let circle = (0..=180).map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / 180.0;
+            (g.previous.y + g.reach_m * a.sin(), g.previous.x + g.reach_m * a.cos())
+        });
+        line(&mut chart, circle, WHITE.stroke_width(2), Some("reaching set"))?;
         chart
-            .draw_series(std::iter::once(Circle::new((g.target_next.y, g.target_next.x), 6, RED.stroke_width(2))))?
-            .label("vehicle predicted")
-            .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.stroke_width(2)));
-    }
-    chart
-        .draw_series(std::iter::once(Cross::new((g.waypoint.y, g.waypoint.x), 8, WHITE.stroke_width(3))))?
-        .label("chosen waypoint")
-        .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
-    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
-    root.present()?;
-    Ok(())
+            .draw_series(std::iter::once(TriangleMarker::new((g.previous.y, g.previous.x), 9, WHITE.filled())))?
+            .label("beacon now")
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.filled()));
+        chart
+            .draw_series(std::iter::once(Circle::new((g.target.y, g.target.x), 6, RED.filled())))?
+            .label("vehicle estimate")
+            .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.filled()));
+        if g.planner.metric == Metric::ApproachB {
+            chart
+                .draw_series(std::iter::once(Circle::new((g.target_next.y, g.target_next.x), 6, RED.stroke_width(2))))?
+                .label("vehicle predicted")
+                .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.stroke_width(2)));
+        }
+        chart
+            .draw_series(std::iter::once(Cross::new((g.waypoint.y, g.waypoint.x), 8, WHITE.stroke_width(3))))?
+            .label("chosen waypoint")
+            .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        root.present()?;
+        Ok(())
+    })())
 }
 
 /// The range pseudo-distribution of one ping (rypkema eq. 5, Fig. 3 top), with the
@@ -390,15 +527,16 @@ pub fn range_distribution(
     let r0 = -offset_m;
     let r1 = distribution.len() as f64 * metres_per_sample - offset_m;
     let (_, ymax) = span(distribution.iter().copied(), 0.05);
-    let root = BitMapBackend::new(path, (1000, 500)).into_drawing_area();
-    let caption = format!("range pseudo-distribution, estimate {estimate_m:.2} m");
-    let mut chart = chart(&root, &caption, r0..r1, 0.0..ymax.max(1e-9), ("range (m)", "pseudo-probability"))?;
-    let points = distribution.iter().enumerate().map(|(i, v)| (i as f64 * metres_per_sample - offset_m, *v));
-    line(&mut chart, points, BLUE.stroke_width(1), None)?;
-    line(&mut chart, [(estimate_m, 0.0), (estimate_m, ymax)], RED.stroke_width(1), Some("estimate"))?;
-    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
-    root.present()?;
-    Ok(())
+    both!(path, (1000, 500), |root| (|| -> Result<()> {
+        let caption = format!("range pseudo-distribution, estimate {estimate_m:.2} m");
+        let mut chart = chart(&root, &caption, r0..r1, 0.0..ymax.max(1e-9), ("range (m)", "pseudo-probability"))?;
+        let points = distribution.iter().enumerate().map(|(i, v)| (i as f64 * metres_per_sample - offset_m, *v));
+        line(&mut chart, points, BLUE.stroke_width(1), None)?;
+        line(&mut chart, [(estimate_m, 0.0), (estimate_m, ymax)], RED.stroke_width(1), Some("estimate"))?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        root.present()?;
+        Ok(())
+    })())
 }
 
 /// The beamformer's power over azimuth x inclination (rypkema Fig. 3 bottom), with the
@@ -410,39 +548,50 @@ pub fn beam_map(
     inclination: f64,
 ) -> Result<()> {
     register_fonts();
-    let (na, ni) = (360usize, 180usize);
+    // 2-degree cells: fine for the eye, and an SVG of 16 200 cells
+    const CELL_DEG: f64 = 2.0;
+    let (na, ni) = (180usize, 90usize);
     let mut values = vec![0.0; na * ni];
     for a in 0..na {
         for i in 0..ni {
-            let u =
-                onebeacon::dsp::beamform::direction(((a as f64) + 0.5).to_radians(), ((i as f64) + 0.5).to_radians());
+            let u = onebeacon::dsp::beamform::direction(
+                ((a as f64 + 0.5) * CELL_DEG).to_radians(),
+                ((i as f64 + 0.5) * CELL_DEG).to_radians(),
+            );
             values[a * ni + i] = power(&u);
         }
     }
     let (lo, hi) = values.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
-    let root = BitMapBackend::new(path, (1000, 560)).into_drawing_area();
-    let caption = format!(
-        "beam map (SPD-BF): azimuth {:.1} deg, inclination {:.1} deg",
-        azimuth.to_degrees(),
-        inclination.to_degrees()
-    );
-    let mut chart = chart(&root, &caption, 0.0..360.0, 0.0..180.0, ("azimuth (deg)", "inclination (deg from down)"))?;
-    chart.draw_series((0..na).flat_map(|a| {
-        let values = &values;
-        (0..ni).map(move |i| {
-            let v = (values[a * ni + i] - lo) / (hi - lo).max(f64::MIN_POSITIVE);
-            Rectangle::new([(a as f64, i as f64), (a as f64 + 1.0, i as f64 + 1.0)], viridis(v).filled())
-        })
-    }))?;
-    chart
-        .draw_series(std::iter::once(Cross::new(
-            (azimuth.to_degrees(), inclination.to_degrees()),
-            8,
-            WHITE.stroke_width(3),
-        )))?
-        .label("estimate")
-        .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
-    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
-    root.present()?;
-    Ok(())
+    both!(path, (1150, 560), |root| (|| -> Result<()> {
+        let caption = format!(
+            "beam map (SPD-BF): azimuth {:.1} deg, inclination {:.1} deg",
+            azimuth.to_degrees(),
+            inclination.to_degrees()
+        );
+        root.fill(&WHITE)?;
+        let (main, side) = root.split_horizontally(1000);
+        colour_bar(&side, lo, hi, "power")?;
+        let root = main;
+        let mut chart =
+            chart(&root, &caption, 0.0..360.0, 0.0..180.0, ("azimuth (deg)", "inclination (deg from down)"))?;
+        chart.draw_series((0..na).flat_map(|a| {
+            let values = &values;
+            (0..ni).map(move |i| {
+                let v = (values[a * ni + i] - lo) / (hi - lo).max(f64::MIN_POSITIVE);
+                let (x, y) = (a as f64 * CELL_DEG, i as f64 * CELL_DEG);
+                Rectangle::new([(x, y), (x + CELL_DEG, y + CELL_DEG)], viridis(v).filled())
+            })
+        }))?;
+        chart
+            .draw_series(std::iter::once(Cross::new(
+                (azimuth.to_degrees(), inclination.to_degrees()),
+                8,
+                WHITE.stroke_width(3),
+            )))?
+            .label("estimate")
+            .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        root.present()?;
+        Ok(())
+    })())
 }

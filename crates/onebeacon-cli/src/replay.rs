@@ -7,7 +7,7 @@ use crate::{plot, report};
 use anyhow::{Context, Result};
 use onebeacon::io::jsonl;
 use onebeacon::nav::session::{Limits, Session, Start};
-use onebeacon_sim::replay::log::HeadingFrom;
+use onebeacon_sim::replay::log::{HeadingFrom, InitialFrom};
 use onebeacon_sim::replay::{Log, LogDescription, Replay, new_session, replay as run_replay};
 use serde_json::{Value, json};
 use std::collections::BTreeSet;
@@ -15,7 +15,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// `--beacons` checked against the log's beacons.
-fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Option<BTreeSet<u32>>> {
+pub(crate) fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Option<BTreeSet<u32>>> {
     let Some(ids) = ids else { return Ok(None) };
     for id in &ids {
         if !known.contains(id) {
@@ -35,8 +35,12 @@ pub fn replay(
     beacons: Option<Vec<u32>>,
     as_json: bool,
     print_stream: bool,
+    estimators: Option<&Path>,
 ) -> Result<()> {
-    let log = Log::load(path)?;
+    let mut log = Log::load(path)?;
+    if let Some(file) = estimators {
+        log.description.estimators = onebeacon_sim::replay::log::load_estimators(file)?;
+    }
     if print_stream {
         let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
         for item in log.items()? {
@@ -74,7 +78,7 @@ pub fn replay(
     staging.write("summary.json", serde_json::to_string_pretty(&summary)?.as_bytes())?;
     staging.write("rejected.csv", &rejected_csv(s)?)?;
     let fixed: Vec<_> =
-        used.iter().filter_map(|b| log.beacons.get(b)).map(|p| log.frame.to_ned(p.x, p.y, p.z)).collect();
+        used.iter().filter_map(|b| log.beacons.get(b).map(|p| (*b, log.frame.to_ned(p.x, p.y, p.z)))).collect();
     let title = format!("{name}, beacons {}", used.iter().map(u32::to_string).collect::<Vec<_>>().join(", "));
     plot::top_view(&staging.file("top_view.png"), &vehicles, &s.names, &title, plotted.records(), Some(&fixed))
         .context("cannot draw top_view.png")?;
@@ -200,6 +204,13 @@ pub fn stream(config: &Path) -> Result<()> {
     let init = &d.initial;
     let start = match init.given_pose(frame) {
         Some(pose) => Start::At { t0_s: None, pose },
+        None if init.from == InitialFrom::Ranges => {
+            return Err(BadInput(format!(
+                "{}: key `initial.from` = \"ranges\": needs a window of the log; a stream starts from the first ground_truth line or a given pose",
+                config.display()
+            ))
+            .into());
+        }
         None if init.heading_from == HeadingFrom::Track => {
             return Err(BadInput(format!(
                 "{}: key `initial.heading_from` = \"track\": needs the whole log; a stream starts from the first ground_truth line's heading (\"column\") or a given pose",

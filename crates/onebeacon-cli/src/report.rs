@@ -316,7 +316,7 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
                 m.etd_max_pct,
                 m.etd_mean_pct,
                 m.nees_mean,
-                format!("[{:.2}, {:.2}]", m.nees_band[0], m.nees_band[1]),
+                format!("{:.2}-{:.2}", m.nees_band[0], m.nees_band[1]),
                 m.nees_mean_all_runs,
                 c.pcrb(track.vehicle_index).map(|p| format!("{p:.3}")).unwrap_or_else(|| "-".into()),
             );

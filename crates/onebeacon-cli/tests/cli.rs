@@ -90,6 +90,11 @@ fn run_writes_trajectory_summary_and_plots() {
         let bytes = std::fs::read(out_dir.join(png)).unwrap();
         assert!(bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000, "{png}");
     }
+    // and each as an SVG beside it
+    for svg in ["top_view.svg", "error.svg"] {
+        let text = std::fs::read_to_string(out_dir.join(svg)).unwrap();
+        assert!(text.contains("<svg") && text.contains("<polyline") && text.trim_end().ends_with("</svg>"), "{svg}");
+    }
     // no staging directory left behind
     let leftovers: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
@@ -502,7 +507,7 @@ fn out_replaces_an_existing_directory_whole() {
     let mut names: Vec<String> =
         std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    assert_eq!(names, ["error.png", "summary.json", "top_view.png", "trajectory.csv"]);
+    assert_eq!(names, ["error.png", "error.svg", "summary.json", "top_view.png", "top_view.svg", "trajectory.csv"]);
     let beside: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(beside.iter().all(|n| !n.contains("partial")), "{beside:?}");

@@ -47,6 +47,9 @@ impl From<FrameKey> for Frame {
 pub enum SourceKind {
     Odometry,
     BodyOdometry,
+    /// Body-frame speeds (a DVL): forward, lateral, optional yaw rate, held until the
+    /// next.
+    BodyVelocity,
     Speed,
     Heading,
     SpeedHeading,
@@ -63,6 +66,7 @@ impl SourceKind {
         match self {
             SourceKind::Odometry => (&["distance", "heading_change"], &[]),
             SourceKind::BodyOdometry => (&["forward", "lateral", "heading_change"], &[]),
+            SourceKind::BodyVelocity => (&["forward_speed", "lateral_speed"], &["yaw_rate"]),
             SourceKind::Speed => (&["speed"], &[]),
             SourceKind::Heading => (&["heading"], &[]),
             SourceKind::SpeedHeading => (&["speed", "heading"], &[]),
@@ -246,6 +250,9 @@ pub struct Source {
     pub heading_change: Option<String>,
     pub forward: Option<String>,
     pub lateral: Option<String>,
+    pub forward_speed: Option<String>,
+    pub lateral_speed: Option<String>,
+    pub yaw_rate: Option<String>,
     pub speed: Option<String>,
     pub heading: Option<String>,
     pub depth: Option<String>,
@@ -271,6 +278,9 @@ impl Source {
             "heading_change" => self.heading_change.as_ref(),
             "forward" => self.forward.as_ref(),
             "lateral" => self.lateral.as_ref(),
+            "forward_speed" => self.forward_speed.as_ref(),
+            "lateral_speed" => self.lateral_speed.as_ref(),
+            "yaw_rate" => self.yaw_rate.as_ref(),
             "speed" => self.speed.as_ref(),
             "heading" => self.heading.as_ref(),
             "depth" => self.depth.as_ref(),
@@ -287,11 +297,14 @@ impl Source {
     }
 }
 
-pub(crate) const COLUMN_KEYS: [&str; 15] = [
+pub(crate) const COLUMN_KEYS: [&str; 18] = [
     "distance",
     "heading_change",
     "forward",
     "lateral",
+    "forward_speed",
+    "lateral_speed",
+    "yaw_rate",
     "speed",
     "heading",
     "depth",
@@ -345,6 +358,10 @@ pub enum InitialFrom {
     GroundTruth,
     /// `x_m`, `y_m`, `heading_deg`.
     Given,
+    /// A robust multilateration of the ranges of the first `ranges_window_s` seconds
+    /// (three beacons at least), heading from `heading_deg` or the window's first heading
+    /// measurement: for a log whose start is unknown or doubtful.
+    Ranges,
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
@@ -368,6 +385,9 @@ pub struct Initial {
     pub heading_from: HeadingFrom,
     #[serde(default = "default_track_m")]
     pub track_m: f64,
+    /// `from = "ranges"`: how long ranges are gathered from the first one, s.
+    #[serde(default = "default_ranges_window_s")]
+    pub ranges_window_s: f64,
     pub x_m: Option<f64>,
     pub y_m: Option<f64>,
     pub heading_deg: Option<f64>,
@@ -386,6 +406,7 @@ impl Default for Initial {
             from: InitialFrom::default(),
             heading_from: HeadingFrom::default(),
             track_m: default_track_m(),
+            ranges_window_s: default_ranges_window_s(),
             x_m: None,
             y_m: None,
             heading_deg: None,
@@ -409,11 +430,65 @@ impl Initial {
 fn default_track_m() -> f64 {
     2.0
 }
+fn default_ranges_window_s() -> f64 {
+    30.0
+}
 fn default_position_sigma_m() -> f64 {
     1.0
 }
 fn default_heading_sigma_deg() -> f64 {
     5.0
+}
+
+/// Noise every estimator of the log takes unless its own table gives the key (`[noise]`):
+/// one place for what the sensors are, the estimators differing in what they estimate.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseDefaults {
+    pub range_sigma_m: Option<f64>,
+    pub doppler_sigma_m_s: Option<f64>,
+    pub heading_sigma_deg: Option<f64>,
+    pub distance_sigma_frac: Option<f64>,
+    pub heading_change_sigma_frac: Option<f64>,
+    pub heading_walk_deg_per_sqrt_m: Option<f64>,
+    pub speed_sigma_m_s: Option<f64>,
+    pub bias_walk_m_per_sqrt_s: Option<f64>,
+    pub position_walk_m_per_sqrt_s: Option<f64>,
+}
+
+impl NoiseDefaults {
+    /// Each key with its value and whether it must be > 0 (else >= 0).
+    pub(crate) fn keys(&self) -> [(&'static str, Option<f64>, bool); 9] {
+        [
+            ("range_sigma_m", self.range_sigma_m, true),
+            ("doppler_sigma_m_s", self.doppler_sigma_m_s, true),
+            ("heading_sigma_deg", self.heading_sigma_deg, true),
+            ("distance_sigma_frac", self.distance_sigma_frac, false),
+            ("heading_change_sigma_frac", self.heading_change_sigma_frac, false),
+            ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, false),
+            ("speed_sigma_m_s", self.speed_sigma_m_s, false),
+            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, false),
+            ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, false),
+        ]
+    }
+
+    /// `e` with every key it leaves out taken from here.
+    fn fill(&self, e: &mut EstimatorSpec) {
+        let pairs = [
+            (&mut e.range_sigma_m, self.range_sigma_m),
+            (&mut e.doppler_sigma_m_s, self.doppler_sigma_m_s),
+            (&mut e.heading_sigma_deg, self.heading_sigma_deg),
+            (&mut e.distance_sigma_frac, self.distance_sigma_frac),
+            (&mut e.heading_change_sigma_frac, self.heading_change_sigma_frac),
+            (&mut e.heading_walk_deg_per_sqrt_m, self.heading_walk_deg_per_sqrt_m),
+            (&mut e.speed_sigma_m_s, self.speed_sigma_m_s),
+            (&mut e.bias_walk_m_per_sqrt_s, self.bias_walk_m_per_sqrt_s),
+            (&mut e.position_walk_m_per_sqrt_s, self.position_walk_m_per_sqrt_s),
+        ];
+        for (own, shared) in pairs {
+            *own = own.or(shared);
+        }
+    }
 }
 
 /// The log description file.
@@ -437,9 +512,22 @@ pub struct LogDescription {
     /// `[[estimators]]` as in scenarios (`[[estimator]]`, the old name, is read too).
     #[serde(alias = "estimator")]
     pub estimators: Vec<EstimatorSpec>,
+    /// Noise keys every estimator takes unless it gives its own.
+    #[serde(default)]
+    pub noise: NoiseDefaults,
     /// What an item must respect before any estimator sees it.
     #[serde(default)]
     pub limits: Limits,
+}
+
+/// Where and when a log's estimators start.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InitialStart {
+    pub t0_s: f64,
+    /// North, east (m) and heading (rad), NED.
+    pub pose: (f64, f64, f64),
+    /// The initial position sigma of each axis, m.
+    pub position_sigma_m: f64,
 }
 
 /// A loaded log: the description and its fixed beacons (SI units, the log's frame). Its
@@ -468,9 +556,12 @@ impl LogDescription {
 
     /// Parses and checks the text of a log description; `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, LogError> {
-        let d: LogDescription = deserialize(text, name)?;
+        let mut d: LogDescription = deserialize(text, name)?;
         crate::scenario::validate::validate_log(&d)
             .map_err(|v| LogError::Description(crate::scenario::load::invalid(name, v)))?;
+        for e in &mut d.estimators {
+            d.noise.fill(e);
+        }
         Ok(d)
     }
 
@@ -558,6 +649,29 @@ impl LogDescription {
     }
 }
 
+/// A file of `[[estimators]]` tables alone (what `onebeacon tune` writes).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EstimatorFile {
+    #[serde(alias = "estimator")]
+    estimators: Vec<EstimatorSpec>,
+}
+
+/// Reads and checks a file of `[[estimators]]` tables, to run on a log instead of its
+/// own (`replay --estimators`).
+pub fn load_estimators(path: &Path) -> Result<Vec<EstimatorSpec>, LogError> {
+    let name = path.display().to_string();
+    let text =
+        std::fs::read_to_string(path).map_err(|e| LogError::File { file: name.clone(), message: e.to_string() })?;
+    let f: EstimatorFile = deserialize(&text, &name)?;
+    if f.estimators.is_empty() {
+        return Err(LogError::File { file: name, message: "no [[estimators]] table".into() });
+    }
+    crate::scenario::validate::check_estimators(&f.estimators, crate::scenario::Host::Log)
+        .map_err(|v| LogError::Description(crate::scenario::load::invalid(&name, v)))?;
+    Ok(f.estimators)
+}
+
 impl Log {
     /// Loads a log description, its fixed beacons and the beacon ids of its tracks,
     /// and opens every file it names (relative to its directory): headers, columns and
@@ -624,6 +738,67 @@ impl Log {
     /// Whether the log has a ground truth.
     pub fn has_truth(&self) -> bool {
         self.description.sources.iter().any(|s| s.kind == SourceKind::GroundTruth)
+    }
+
+    /// The initial time, pose (NED) and position sigma, from the description: given,
+    /// the first ground-truth pose (heading from its column or its track), or a fix from
+    /// the first ranges (its sigma: the larger of `position_sigma_m` and three times
+    /// the fix's). Reads the log only as far as it needs.
+    pub fn initial_start(&self) -> Result<InitialStart, LogError> {
+        let position_sigma_m = self.description.initial.position_sigma_m;
+        if self.description.initial.from == InitialFrom::Ranges {
+            return self.start_from_ranges();
+        }
+        self.initial_pose().map(|(t0_s, pose)| InitialStart { t0_s, pose, position_sigma_m })
+    }
+
+    /// `from = "ranges"`: the fix of the first window's ranges to fixed beacons.
+    fn start_from_ranges(&self) -> Result<InitialStart, LogError> {
+        let init = &self.description.initial;
+        let fail = |message: String| LogError::File { file: self.description.name.clone(), message };
+        let (mut ranges, mut heading, mut depth, mut window) = (Vec::new(), None, 0.0, None::<(f64, f64)>);
+        for item in self.items()? {
+            let item = item?;
+            let t = item.t_s;
+            if window.is_some_and(|(_, end)| t > end) {
+                break;
+            }
+            match item.input.to_ned(self.frame) {
+                Input::Measurement(Kind::Range { beacon, range_m })
+                    if beacon.position_ned_m.iter().all(|v| v.is_finite()) =>
+                {
+                    window.get_or_insert((t, t + init.ranges_window_s));
+                    ranges.push((beacon.position_ned_m, range_m));
+                }
+                Input::Measurement(Kind::Heading { heading_rad }) if window.is_some() => {
+                    heading.get_or_insert(heading_rad);
+                }
+                Input::Measurement(Kind::Depth { depth_m }) => depth = depth_m,
+                _ => {}
+            }
+        }
+        let Some((_, end)) = window else {
+            return Err(fail("initial.from = \"ranges\" but the log has no range to a fixed beacon".into()));
+        };
+        let fix = onebeacon::nav::fix::multilaterate(&ranges, depth).ok_or_else(|| {
+            fail(format!(
+                "initial.from = \"ranges\": the {} ranges of the first {} s (initial.ranges_window_s) do not fix a position (three beacons not in a line are needed)",
+                ranges.len(),
+                init.ranges_window_s
+            ))
+        })?;
+        let psi = match (init.heading_deg, heading) {
+            (Some(h), _) => self.frame.heading_to_ned(h.to_radians()),
+            (None, Some(h)) => h,
+            (None, None) => {
+                return Err(fail(
+                    "initial.from = \"ranges\" needs initial.heading_deg or a heading measurement in the window".into(),
+                ));
+            }
+        };
+        let fix_sigma = fix.covariance.symmetric_eigenvalues().max().max(0.0).sqrt();
+        let position_sigma_m = init.position_sigma_m.max(3.0 * fix_sigma);
+        Ok(InitialStart { t0_s: end, pose: (fix.position.x, fix.position.y, psi), position_sigma_m })
     }
 
     /// The initial pose (NED) and time, from the description: given, or the first
@@ -1055,6 +1230,11 @@ impl<'a> SourceRows<'a> {
                 lateral_m: sense * num("lateral")? * len,
                 heading_change_rad: turn("heading_change")?,
             }),
+            SourceKind::BodyVelocity => {
+                let r = cols.contains_key("yaw_rate").then(|| turn("yaw_rate")).transpose()?.unwrap_or(0.0);
+                let (u, v) = (num("forward_speed")? * len, sense * num("lateral_speed")? * len);
+                measurement(Kind::BodyVelocity { nu: [u, v, 0.0, 0.0, 0.0, r] })
+            }
             SourceKind::Speed => measurement(Kind::Speed { speed_m_s: num("speed")? * len }),
             SourceKind::Heading => measurement(Kind::Heading { heading_rad: heading("heading")? }),
             SourceKind::SpeedHeading => {
@@ -1537,5 +1717,77 @@ heading_clockwise = true
         assert!(e.contains("beacon[0].x_m"), "{e}");
         let e = parse("[origin]\nlat_deg = 95.0\nlon_deg = 0.0\n");
         assert!(e.contains("origin"), "{e}");
+    }
+
+    /// `[noise]`: every estimator takes its keys unless it gives its own; a bad value is
+    /// refused by its key.
+    #[test]
+    fn noise_table_is_inherited_and_overridden() {
+        let toml = "name = \"n\"\n[noise]\nrange_sigma_m = 0.7\nheading_walk_deg_per_sqrt_m = 0.2\n\
+                    [[estimators]]\nname = \"a\"\nkind = \"range-ekf\"\n\
+                    [[estimators]]\nname = \"b\"\nkind = \"range-ekf\"\nrange_sigma_m = 2.0\n";
+        let d = LogDescription::parse(toml, "n.toml").unwrap();
+        let (a, b) = (d.estimators[0].planar_config().noise, d.estimators[1].planar_config().noise);
+        assert_eq!((a.range_sigma_m, b.range_sigma_m), (0.7, 2.0));
+        assert_abs_diff_eq!(a.heading_walk_rad_per_sqrt_m, 0.2f64.to_radians(), epsilon = 1e-15);
+        assert_abs_diff_eq!(b.heading_walk_rad_per_sqrt_m, 0.2f64.to_radians(), epsilon = 1e-15);
+        let e = LogDescription::parse(&toml.replace("0.7", "-1.0"), "n.toml").unwrap_err().to_string();
+        assert!(e.contains("noise.range_sigma_m"), "{e}");
+    }
+
+    /// `initial.from = "ranges"`: a vehicle resting at (3, 4) ranged from three beacons
+    /// (exact ranges, and one 150 m off): the start is the fix, at the end of the window,
+    /// with the heading given; with two beacons it is refused, naming the key.
+    #[test]
+    fn a_start_from_the_first_ranges() {
+        let body = "[[source]]\nkind = \"range\"\nfile = \"r.csv\"\ntime = \"t\"\nbeacon = \"id\"\nrange = \"r\"\n\
+                    [[beacon]]\nid = 0\nx_m = 40.0\ny_m = 0.0\n[[beacon]]\nid = 1\nx_m = -20.0\ny_m = 30.0\n\
+                    [[beacon]]\nid = 2\nx_m = -20.0\ny_m = -30.0\n";
+        let p = (3.0f64, 4.0f64);
+        let d = |bx: f64, by: f64| (p.0 - bx).hypot(p.1 - by);
+        let mut csv = String::from("t,id,r\n");
+        for k in 0..12 {
+            let (id, (bx, by)) = [(0, (40.0, 0.0)), (1, (-20.0, 30.0)), (2, (-20.0, -30.0))][k % 3];
+            let outlier = if k == 4 { 150.0 } else { 0.0 };
+            csv += &format!("{},{id},{}\n", 1.0 + k as f64, d(bx, by) + outlier);
+        }
+        let log = load("ranges-start", body, &[("r.csv", &csv)]).unwrap();
+        let mut log = log;
+        log.description.initial.from = InitialFrom::Ranges;
+        log.description.initial.ranges_window_s = 10.0;
+        log.description.initial.heading_deg = Some(90.0);
+        let InitialStart { t0_s: t0, pose: (n, e, psi), position_sigma_m: sigma } = log.initial_start().unwrap();
+        assert_eq!(t0, 11.0);
+        // the 150 m outlier keeps a Huber weight of about 1e-4: 1 mm of pull
+        assert_abs_diff_eq!(n, p.0, epsilon = 0.01);
+        assert_abs_diff_eq!(e, p.1, epsilon = 0.01);
+        assert_abs_diff_eq!(psi, FRAC_PI_2, epsilon = 1e-12);
+        assert_eq!(sigma, 1.0); // the fix is exact: position_sigma_m's default
+        let two = csv.lines().filter(|l| !l.contains(",2,")).collect::<Vec<_>>().join("\n");
+        let mut log = load("ranges-two", body, &[("r.csv", &two)]).unwrap();
+        log.description.initial.from = InitialFrom::Ranges;
+        log.description.initial.heading_deg = Some(0.0);
+        let e = log.initial_start().unwrap_err().to_string();
+        assert!(e.contains("initial.ranges_window_s") && e.contains("three beacons"), "{e}");
+    }
+
+    /// A DVL: forward and lateral speeds and a yaw rate in the source's units, read to
+    /// SI; in an ENU log the lateral speed and yaw rate flip at the session (left-handed
+    /// turns become NED's).
+    #[test]
+    fn body_velocity_is_read_to_si() {
+        let body = "frame = \"enu\"\n[[source]]\nkind = \"body_velocity\"\nfile = \"dvl.csv\"\ntime = \"t\"\n\
+                    forward_speed = \"u\"\nlateral_speed = \"v\"\nyaw_rate = \"r\"\nlength_unit = \"cm\"\nangle_unit = \"deg\"\n";
+        let log = load("dvl", body, &[("dvl.csv", "t,u,v,r\n1.0,120,-15,-30\n")]).unwrap();
+        let item = &items(&log)[0];
+        let Kind::BodyVelocity { nu } = measurement(item) else { panic!() };
+        assert_abs_diff_eq!(nu[0], 1.2, epsilon = 1e-12);
+        assert_abs_diff_eq!(nu[1], -0.15, epsilon = 1e-12);
+        assert_abs_diff_eq!(nu[5], -PI / 6.0, epsilon = 1e-12);
+        let Kind::BodyVelocity { nu } = measurement(&Item { t_s: 1.0, input: item.input.to_ned(log.frame) }) else {
+            panic!()
+        };
+        assert_abs_diff_eq!(nu[1], 0.15, epsilon = 1e-12);
+        assert_abs_diff_eq!(nu[5], PI / 6.0, epsilon = 1e-12);
     }
 }

@@ -4,6 +4,7 @@
 //! and keeps what the outputs need.
 
 pub mod log;
+pub mod tune;
 
 pub use log::{Log, LogDescription, LogError};
 
@@ -33,8 +34,9 @@ pub fn new_session(d: &LogDescription, start: Start, beacons: Option<BTreeSet<u3
 
 /// The session a log describes, started at its initial pose.
 pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
-    let (t0, pose) = log.initial_pose()?;
-    Ok(new_session(&log.description, Start::At { t0_s: Some(t0), pose }, beacons))
+    let start = log.initial_start()?;
+    let session = new_session(&log.description, Start::At { t0_s: Some(start.t0_s), pose: start.pose }, beacons);
+    Ok(session.with_position_sigma(start.position_sigma_m))
 }
 
 /// Runs every estimator of `log` over its stream, giving `record` one trajectory row
@@ -55,7 +57,7 @@ pub fn replay<E: From<LogError>>(
         items += 1;
         // a screened item is counted and logged by the session; the replay goes on
         let Ok(Some(step)) = session.push(&item) else { continue };
-        heard |= step.outcomes.iter().any(|o| matches!(o, Some(onebeacon::nav::Outcome::Accepted(_))));
+        heard |= step.outcomes.iter().any(|o| matches!(o, Some(onebeacon::nav::Outcome::Accepted(..))));
         if has_truth && step.truth.is_none() || !has_truth && !matches!(item.input, Input::Measurement(_)) {
             continue;
         }

@@ -477,6 +477,7 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
             s.kind,
             SourceKind::Odometry
                 | SourceKind::BodyOdometry
+                | SourceKind::BodyVelocity
                 | SourceKind::Heading
                 | SourceKind::SpeedHeading
                 | SourceKind::GroundTruth
@@ -508,6 +509,11 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
             check(&format!("beacon[{i}]"), v, Rule::Finite)?;
         }
     }
+    for (key, v, positive) in d.noise.keys() {
+        if let Some(v) = v {
+            check(&format!("noise.{key}"), v, if positive { Rule::Positive } else { Rule::NonNegative })?;
+        }
+    }
     check_estimators(&d.estimators, Host::Log)?;
     let init = &d.initial;
     if init.from == InitialFrom::Given && (init.x_m.is_none() || init.y_m.is_none() || init.heading_deg.is_none()) {
@@ -521,6 +527,7 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
         position_sigma_m: Positive,
         heading_sigma_deg: Positive,
         track_m: Positive,
+        ranges_window_s: Positive,
     });
     let l = &d.limits;
     check_fields!("limits", l, {

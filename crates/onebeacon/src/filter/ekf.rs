@@ -141,11 +141,11 @@ impl<const N: usize> GaussianFilter<N> for Ekf<N> {
         let s = h * pht + r;
         // Cholesky proves S positive definite; the closed-form inverse of small
         // matrices is several times faster than inverting through the factor.
-        s.cholesky().ok_or(FilterError::InnovationNotPositiveDefinite)?;
+        let det_s = det_from_cholesky(&s.cholesky().ok_or(FilterError::InnovationNotPositiveDefinite)?);
         let s_inv = s.try_inverse().ok_or(FilterError::InnovationNotPositiveDefinite)?;
         let nis = nu.dot(&(s_inv * nu));
         if nis > max_nis {
-            return Ok(Gated::Rejected(nis));
+            return Ok(Gated::Rejected(nis, det_s));
         }
         let k = pht * s_inv;
         self.x += k * nu;
@@ -154,23 +154,37 @@ impl<const N: usize> GaussianFilter<N> for Ekf<N> {
         let a = self.p - k * pht.transpose();
         let p = a - (a * h.transpose()) * k.transpose() + k * r * k.transpose();
         self.p = (p + p.transpose()) * 0.5;
-        Ok(Gated::Accepted(nis))
+        Ok(Gated::Accepted(nis, det_s))
     }
 }
 
-/// What a gated update did, with the measurement's NIS.
+/// What a gated update did, with the measurement's NIS and the determinant of its
+/// innovation covariance S (with the NIS, the measurement's likelihood).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Gated {
-    Accepted(f64),
-    Rejected(f64),
+    Accepted(f64, f64),
+    Rejected(f64, f64),
 }
 
 impl Gated {
     pub fn nis(self) -> f64 {
         match self {
-            Gated::Accepted(n) | Gated::Rejected(n) => n,
+            Gated::Accepted(n, _) | Gated::Rejected(n, _) => n,
         }
     }
+
+    /// det S.
+    pub fn det_s(self) -> f64 {
+        match self {
+            Gated::Accepted(_, d) | Gated::Rejected(_, d) => d,
+        }
+    }
+}
+
+/// det S from its Cholesky factor: the squared product of the factor's diagonal.
+pub(crate) fn det_from_cholesky<const M: usize>(l: &nalgebra::Cholesky<f64, nalgebra::Const<M>>) -> f64 {
+    let p: f64 = l.l_dirty().diagonal().iter().product();
+    p * p
 }
 
 #[cfg(test)]
@@ -299,9 +313,14 @@ pub(crate) mod tests {
         let r = nalgebra::Matrix1::new(1.0);
         let before = ekf.clone();
         // innovation 3, S = 1 + 1: NIS 4.5
-        assert_eq!(ekf.update_gated(&PositionFix, &Vector1::new(3.0), &r, 4.4), Ok(Gated::Rejected(4.5)));
+        let rejected = ekf.update_gated(&PositionFix, &Vector1::new(3.0), &r, 4.4).unwrap();
+        assert!(matches!(rejected, Gated::Rejected(..)));
+        assert_relative_eq!(rejected.nis(), 4.5, epsilon = 1e-12);
+        assert_relative_eq!(rejected.det_s(), 2.0, epsilon = 1e-12);
         assert_eq!(ekf, before);
-        assert_eq!(ekf.update_gated(&PositionFix, &Vector1::new(3.0), &r, 4.6), Ok(Gated::Accepted(4.5)));
+        let accepted = ekf.update_gated(&PositionFix, &Vector1::new(3.0), &r, 4.6).unwrap();
+        assert!(matches!(accepted, Gated::Accepted(..)));
+        assert_relative_eq!(accepted.nis(), 4.5, epsilon = 1e-12);
         assert_relative_eq!(ekf.x[0], 1.5, epsilon = 1e-12);
     }
 }

@@ -205,8 +205,9 @@ impl<const N: usize> GaussianFilter<N> for Ukf<N> {
         }
         let s_chol = s.cholesky().ok_or(FilterError::InnovationNotPositiveDefinite)?;
         let nis = nu.dot(&s_chol.solve(&nu));
+        let det_s = super::ekf::det_from_cholesky(&s_chol);
         if nis > max_nis {
-            return Ok(Gated::Rejected(nis));
+            return Ok(Gated::Rejected(nis, det_s));
         }
         let k = s_chol.solve(&pxz.transpose()).transpose(); // K = Pxz S^-1
         // Joseph form with the statistically linearised H = Pxz' P^-1 and the effective
@@ -218,7 +219,7 @@ impl<const N: usize> GaussianFilter<N> for Ukf<N> {
         let p = self.p - kpxz - kpxz.transpose() + k * s * k.transpose();
         self.x += k * nu;
         self.p = (p + p.transpose()) * 0.5;
-        Ok(Gated::Accepted(nis))
+        Ok(Gated::Accepted(nis, det_s))
     }
 }
 

@@ -181,8 +181,8 @@ pub fn step_json(line: usize, step: &Step, names: &[String], frame: Frame) -> Va
             if let Some(o) = step.outcomes[i] {
                 let (outcome, nis) = match o {
                     Outcome::Applied => ("applied", None),
-                    Outcome::Accepted(n) => ("accepted", Some(n)),
-                    Outcome::Rejected(n) => ("rejected", Some(n)),
+                    Outcome::Accepted(n, _) => ("accepted", Some(n)),
+                    Outcome::Rejected(n, _) => ("rejected", Some(n)),
                     Outcome::Skipped => ("skipped", None),
                     Outcome::Failed(_) => ("failed", None),
                 };

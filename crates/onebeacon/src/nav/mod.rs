@@ -7,6 +7,7 @@
 //! replay and the live stream drive them through this interface alone.
 
 pub mod event;
+pub mod fix;
 pub mod planar;
 pub mod range_6dof;
 pub mod session;
@@ -63,21 +64,21 @@ pub(crate) fn gated_update<const N: usize, const M: usize, H: MeasurementModel<N
     let r = models.covariance(filter.mean());
     let Some(robust) = robust else {
         return match filter.update_gated(models, &z, &r, gate) {
-            Ok(Gated::Accepted(nis)) => Outcome::Accepted(nis),
-            Ok(Gated::Rejected(nis)) => Outcome::Rejected(nis),
+            Ok(Gated::Accepted(nis, det_s)) => Outcome::Accepted(nis, det_s),
+            Ok(Gated::Rejected(nis, det_s)) => Outcome::Rejected(nis, det_s),
             Err(e) => Outcome::Failed(e),
         };
     };
     // the nominal NIS first: a gate of -1 rejects, leaving the state as it was
-    let nis = match filter.update_gated(models, &z, &r, -1.0) {
-        Ok(g) => g.nis(),
+    let (nis, det_s) = match filter.update_gated(models, &z, &r, -1.0) {
+        Ok(g) => (g.nis(), g.det_s()),
         Err(e) => return Outcome::Failed(e),
     };
     if nis > gate {
-        return Outcome::Rejected(nis);
+        return Outcome::Rejected(nis, det_s);
     }
     match filter.update_gated(models, &z, &(r * robust.inflation(nis, M)), f64::INFINITY) {
-        Ok(_) => Outcome::Accepted(nis),
+        Ok(_) => Outcome::Accepted(nis, det_s),
         Err(e) => Outcome::Failed(e),
     }
 }
@@ -112,9 +113,10 @@ pub enum Outcome {
     /// An input was applied (odometry, speed, body velocity), or a measurement held for
     /// the filter's next tick (a frame fused with the next inertial sample).
     Applied,
-    /// A correction was accepted or rejected by the gate, with its NIS.
-    Accepted(f64),
-    Rejected(f64),
+    /// A correction was accepted or rejected by the gate, with its NIS and the
+    /// determinant of its innovation covariance (nominal noise).
+    Accepted(f64, f64),
+    Rejected(f64, f64),
     /// Not used by this navigator (dead reckoning and beacons, say).
     Skipped,
     /// The update could not be computed; the state is unchanged.
@@ -222,11 +224,15 @@ mod tests {
         let (x, outcome) = posterior(100.0, Some(huber), f64::INFINITY);
         assert_abs_diff_eq!(x, gauss(100.0, r / w_huber), epsilon = 1e-9);
         assert_abs_diff_eq!(x, 10.74, epsilon = 0.01);
-        assert_eq!(outcome, Outcome::Accepted(nis));
+        let Outcome::Accepted(n, det_s) = outcome else { panic!("{outcome:?}") };
+        assert_abs_diff_eq!(n, nis, epsilon = 1e-9);
+        assert_abs_diff_eq!(det_s, p + r, epsilon = 1e-12);
         let w_t = 5.0 / (4.0 + nis);
         assert_abs_diff_eq!(posterior(100.0, Some(student), f64::INFINITY).0, gauss(100.0, r / w_t), epsilon = 1e-9);
         assert_abs_diff_eq!(posterior(100.0, Some(student), f64::INFINITY).0, 0.988, epsilon = 0.001);
         // gated on the nominal NIS: rejected, the state untouched
-        assert_eq!(posterior(100.0, Some(student), 10.83), (0.0, Outcome::Rejected(nis)));
+        let (x, outcome) = posterior(100.0, Some(student), 10.83);
+        assert_eq!(x, 0.0);
+        assert!(matches!(outcome, Outcome::Rejected(n, _) if (n - nis).abs() < 1e-9), "{outcome:?}");
     }
 }

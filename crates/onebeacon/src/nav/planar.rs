@@ -248,6 +248,10 @@ pub struct PlanarNavigator<const N: usize = STATES> {
     /// Latest forward-speed input, and whether it drives the motion between events.
     speed_m_s: f64,
     coasting: bool,
+    /// With a body velocity (a DVL): its starboard speed and yaw rate, held with the
+    /// forward speed.
+    lateral_m_s: f64,
+    yaw_rate_rad_s: f64,
     last_odometry_s: Option<f64>,
     depth_m: f64,
 }
@@ -328,6 +332,8 @@ impl<const N: usize> PlanarNavigator<N> {
             t_s,
             speed_m_s: 0.0,
             coasting: false,
+            lateral_m_s: 0.0,
+            yaw_rate_rad_s: 0.0,
             last_odometry_s: None,
             depth_m: 0.0,
         }
@@ -350,8 +356,15 @@ impl<const N: usize> PlanarNavigator<N> {
             return;
         }
         if self.coasting {
-            let n = self.config.noise;
-            self.motion(self.speed_m_s * dt, 0.0, 0.0, n.speed_sigma_m_s * dt, 0.0);
+            // the held body velocity over dt: an SE(2) step at the mid heading (exact on
+            // a circle), the speed error on each axis
+            // a constant body velocity turning at r traces a circle: its chord is the arc
+            // (u, v) dt times sinc(r dt / 2), along the mid heading
+            let half = self.yaw_rate_rad_s * dt / 2.0;
+            let chord = if half.abs() < 1e-9 { 1.0 } else { half.sin() / half };
+            let sigma = self.config.noise.speed_sigma_m_s * dt;
+            let (d, lat) = (self.speed_m_s * dt * chord, self.lateral_m_s * dt * chord);
+            self.motion(d, lat, 2.0 * half, sigma, sigma);
         }
         let n = self.config.noise;
         let q_bias = n.bias_walk_m_per_sqrt_s.powi(2) * dt;
@@ -433,7 +446,12 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
                 self.odometry(t_s, forward_m, lateral_m, heading_change_rad)
             }
             Kind::Speed { speed_m_s } => {
-                self.speed_m_s = speed_m_s;
+                (self.speed_m_s, self.lateral_m_s, self.yaw_rate_rad_s) = (speed_m_s, 0.0, 0.0);
+                self.coasting = true;
+                Outcome::Applied
+            }
+            Kind::BodyVelocity { nu } => {
+                (self.speed_m_s, self.lateral_m_s, self.yaw_rate_rad_s) = (nu[0], nu[1], nu[5]);
                 self.coasting = true;
                 Outcome::Applied
             }
@@ -468,7 +486,7 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
                 // the worse of the two outcomes
                 match (range, doppler) {
                     (Outcome::Failed(e), _) | (_, Outcome::Failed(e)) => Outcome::Failed(e),
-                    (Outcome::Rejected(n), _) | (_, Outcome::Rejected(n)) => Outcome::Rejected(n),
+                    (Outcome::Rejected(n, d), _) | (_, Outcome::Rejected(n, d)) => Outcome::Rejected(n, d),
                     (Outcome::Skipped, b) => b,
                     (a, _) => a,
                 }
@@ -659,7 +677,7 @@ mod tests {
             let range_m = (truth - b).norm() + bias;
             let out =
                 nav.process(&Measurement::new(t, Kind::Range { beacon: BeaconFix::fixed((k % 3) as u32, b), range_m }));
-            assert!(matches!(out, Outcome::Accepted(_)), "{out:?}");
+            assert!(matches!(out, Outcome::Accepted(..)), "{out:?}");
         }
         let e = nav.estimate();
         assert_abs_diff_eq!(e.north_m(), truth.x, epsilon = 0.1);
@@ -667,7 +685,7 @@ mod tests {
         assert_abs_diff_eq!(e.range_bias_m, bias, epsilon = 0.1);
         let outlier = Kind::Range { beacon: BeaconFix::fixed(0, beacons[0]), range_m: truth.norm() + bias + 20.0 };
         let before = nav.estimate();
-        assert!(matches!(nav.process(&Measurement::new(t, outlier)), Outcome::Rejected(nis) if nis > 10.83));
+        assert!(matches!(nav.process(&Measurement::new(t, outlier)), Outcome::Rejected(nis, _) if nis > 10.83));
         assert_eq!(nav.estimate(), before);
         let mut dr = start(PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() });
         assert_eq!(dr.process(&Measurement::new(1.0, outlier)), Outcome::Skipped);
@@ -797,6 +815,38 @@ mod tests {
         assert_eq!(full.filter.covariance()[(idx::BIAS, idx::BIAS)], 0.0);
     }
 
+    /// A DVL's body velocity held between events: heading east at 1 m/s forward and
+    /// 0.2 m/s to starboard for 10 s ends at (-2, 10) (NED: starboard of east is south);
+    /// with a yaw rate of 0.1 rad/s from heading north, the track is the circle of radius
+    /// 10 m: after 10 s at (10 sin 1, 10 (1 - cos 1)), heading 1 rad (closed forms). The
+    /// position variance grows by the speed error on each axis.
+    #[test]
+    fn body_velocity_is_integrated_on_se2() {
+        let events = |nav: &mut PlanarNavigator, nu: [f64; 6]| {
+            nav.process(&Measurement::new(0.0, Kind::BodyVelocity { nu }));
+            for k in 1..=10 {
+                nav.process(&Measurement::new(k as f64, Kind::Depth { depth_m: 0.0 }));
+            }
+            nav.estimate()
+        };
+        // without heading noise the heading stays exact and the position variance is the
+        // speed error's alone
+        let mut still_heading = PlanarConfig::default();
+        (still_heading.noise.heading_walk_rad_per_sqrt_m, still_heading.noise.heading_change_sigma_frac) = (0.0, 0.0);
+        let mut crab = PlanarNavigator::new(still_heading, FilterKind::Ekf, 0.0, (0.0, 0.0, FRAC_PI_2), 0.0, 0.0);
+        let e = events(&mut crab, [1.0, 0.2, 0.0, 0.0, 0.0, 0.0]);
+        assert_abs_diff_eq!(e.north_m(), -2.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(e.east_m(), 10.0, epsilon = 1e-9);
+        let sigma = PlanarNoise::default().speed_sigma_m_s;
+        // ten steps of 1 s, each adding sigma^2 on both axes (heading exact, rotation-invariant)
+        assert_abs_diff_eq!(e.horizontal_cov_m2.trace(), 2.0 * 10.0 * sigma * sigma, epsilon = 1e-9);
+        let mut turn = start(PlanarConfig::default());
+        let e = events(&mut turn, [1.0, 0.0, 0.0, 0.0, 0.0, 0.1]);
+        assert_abs_diff_eq!(e.north_m(), 10.0 * 1f64.sin(), epsilon = 1e-9);
+        assert_abs_diff_eq!(e.east_m(), 10.0 * (1.0 - 1f64.cos()), epsilon = 1e-9);
+        assert_abs_diff_eq!(e.heading_rad(), 1.0, epsilon = 1e-12);
+    }
+
     #[test]
     fn doppler_and_heading_corrections() {
         // heading fix pulls the heading; a Doppler speed with the known odometry speed
@@ -804,7 +854,7 @@ mod tests {
         let mut nav = PlanarNavigator::new(PlanarConfig::default(), FilterKind::Ekf, 0.0, (10.0, 0.0, 0.2), 1.0, 0.3);
         assert!(matches!(
             nav.process(&Measurement::new(0.0, Kind::Heading { heading_rad: 0.0 })),
-            Outcome::Accepted(_)
+            Outcome::Accepted(..)
         ));
         assert!(nav.estimate().heading_rad().abs() < 0.2);
         nav.process(&Measurement::new(1.0, Kind::Odometry { distance_m: 0.0, heading_change_rad: 0.0 }));
@@ -815,6 +865,6 @@ mod tests {
             2.0,
             Kind::Doppler { beacon: BeaconFix::fixed(0, beacon), radial_speed_m_s: -1.5 },
         ));
-        assert!(matches!(out, Outcome::Accepted(nis) if nis < 1.0), "{out:?}");
+        assert!(matches!(out, Outcome::Accepted(nis, _) if nis < 1.0), "{out:?}");
     }
 }

@@ -60,6 +60,17 @@ impl Input {
                         lateral_m: frame.turn_to_ned(lateral_m),
                         heading_change_rad: frame.turn_to_ned(heading_change_rad),
                     },
+                    // body axes FLU in ENU, FRD in NED: v, w, q and r flip with the sense of turns
+                    Kind::BodyVelocity { nu: [u, v, w, p, q, r] } => Kind::BodyVelocity {
+                        nu: [
+                            u,
+                            frame.turn_to_ned(v),
+                            frame.turn_to_ned(w),
+                            p,
+                            frame.turn_to_ned(q),
+                            frame.turn_to_ned(r),
+                        ],
+                    },
                     Kind::Heading { heading_rad } => Kind::Heading { heading_rad: frame.heading_to_ned(heading_rad) },
                     Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
                         Kind::Attitude { roll_rad, pitch_rad, heading_rad: frame.heading_to_ned(heading_rad) }
@@ -290,6 +301,8 @@ pub struct ErrorStats {
     pub nis_sum: f64,
     pub nis_count: usize,
     pub nis_within_95: usize,
+    /// Sum of ln det S of the same corrections: with the NIS, their Gaussian likelihood.
+    pub ln_det_s_sum: f64,
 }
 
 /// The 95 % quantile of chi-square with 2 degrees of freedom, -2 ln 0.05.
@@ -323,11 +336,18 @@ impl ErrorStats {
         self.nis_within_95 as f64 / self.nis_count as f64
     }
 
-    fn push_nis(&mut self, nis: f64) {
-        if nis.is_finite() {
+    /// The negative log-likelihood of the corrections weighed, sum of (ln det(2 pi S) +
+    /// NIS) / 2 over them (the innovations' Gaussian density, what `tune` minimises).
+    pub fn neg_log_likelihood(&self) -> f64 {
+        0.5 * (self.ln_det_s_sum + self.nis_count as f64 * std::f64::consts::TAU.ln() + self.nis_sum)
+    }
+
+    fn push_nis(&mut self, nis: f64, det_s: f64) {
+        if nis.is_finite() && det_s > 0.0 && det_s.is_finite() {
             self.nis_sum += nis;
             self.nis_count += 1;
             self.nis_within_95 += usize::from(nis <= NIS_95_1DOF);
+            self.ln_det_s_sum += det_s.ln();
         }
     }
 
@@ -480,6 +500,12 @@ impl Session {
         }
     }
 
+    /// The session with its estimators' initial position sigma set to `sigma_m`.
+    pub fn with_position_sigma(mut self, sigma_m: f64) -> Self {
+        self.sigma_position_m = sigma_m;
+        self
+    }
+
     /// The session with `limits` instead of [`Limits::default`].
     pub fn with_limits(mut self, limits: Limits) -> Self {
         self.limits = limits;
@@ -625,13 +651,13 @@ impl Session {
                     for (i, nav) in self.navs.iter_mut().enumerate() {
                         let out = nav.navigator().process(&m);
                         self.stats[i].failed += usize::from(matches!(out, Outcome::Failed(_)));
-                        if let Outcome::Accepted(nis) | Outcome::Rejected(nis) = out {
-                            self.stats[i].push_nis(nis);
+                        if let Outcome::Accepted(nis, det_s) | Outcome::Rejected(nis, det_s) = out {
+                            self.stats[i].push_nis(nis, det_s);
                         }
                         outcomes[i] = Some(out);
                     }
                     for (i, out) in outcomes.iter().enumerate() {
-                        if let Some(Outcome::Rejected(nis)) = *out {
+                        if let Some(Outcome::Rejected(nis, _)) = *out {
                             self.stats[i].rejected += 1;
                             self.log_rejection(Rejection {
                                 estimator: Some(i),

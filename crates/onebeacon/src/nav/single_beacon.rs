@@ -189,7 +189,7 @@ impl SingleBeaconNavigator {
 
     /// Predicts to `t_s`, then one stacked update of the inertial sample and the
     /// pending frame. Returns the NIS.
-    fn tick(&mut self, t_s: f64, heading: f64, yaw_rate: f64, accel: f64) -> Result<f64, FilterError> {
+    fn tick(&mut self, t_s: f64, heading: f64, yaw_rate: f64, accel: f64) -> Result<Gated, FilterError> {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
             self.filter.predict(&self.model, dt, &self.q);
@@ -219,14 +219,14 @@ impl SingleBeaconNavigator {
     }
 }
 
-/// One update of `filter` with the stacked `models` and their values `z`; the NIS.
+/// One update of `filter` with the stacked `models` and their values `z`.
 fn update<const M: usize, H: MeasurementModel<DIM, M>>(
     filter: &mut AnyFilter<DIM>,
     models: &H,
     z: [f64; M],
-) -> Result<f64, FilterError> {
+) -> Result<Gated, FilterError> {
     let r = models.covariance(filter.mean());
-    filter.update_gated(models, &SVector::from(z), &r, f64::INFINITY).map(Gated::nis)
+    filter.update_gated(models, &SVector::from(z), &r, f64::INFINITY)
 }
 
 impl Navigator for SingleBeaconNavigator {
@@ -237,7 +237,7 @@ impl Navigator for SingleBeaconNavigator {
                 self.unmirror();
                 self.floor_speed();
                 match nis {
-                    Ok(nis) => Outcome::Accepted(nis),
+                    Ok(g) => Outcome::Accepted(g.nis(), g.det_s()),
                     Err(e) => Outcome::Failed(e),
                 }
             }
@@ -322,7 +322,7 @@ mod tests {
                     if let Some(frame) = frame {
                         assert_eq!(f.process(&Measurement::new(t, frame)), Outcome::Applied);
                     }
-                    assert!(matches!(f.process(&Measurement::new(t, inertial)), Outcome::Accepted(_)));
+                    assert!(matches!(f.process(&Measurement::new(t, inertial)), Outcome::Accepted(..)));
                     *e = (f.state()[idx::V] - 1.0).abs();
                 }
                 for (sum, e) in speed_err_sum.iter_mut().zip(speed_err) {

@@ -1,0 +1,248 @@
+//! Fitting an estimator's noise keys to a log: the values that maximise the likelihood
+//! of its innovations (every range, Doppler speed and heading fix it weighs, Gaussian
+//! with the covariance S the filter predicts), found by a pattern search on their
+//! logarithms. No ground truth is used, so a log without one can be tuned; the fit is
+//! in-sample on that log, to be applied to another (`replay --estimators`).
+
+use super::{Log, LogError, replay};
+use crate::scenario::EstimatorSpec;
+use onebeacon::nav::session::ErrorStats;
+use rayon::prelude::*;
+use std::collections::BTreeSet;
+
+/// The keys `tune` can fit, with the value a search starts from when the key is 0 (a
+/// process noise that is off).
+pub const TUNABLE: [(&str, f64); 10] = [
+    ("range_sigma_m", 1.0),
+    ("doppler_sigma_m_s", 0.1),
+    ("heading_sigma_deg", 2.0),
+    ("distance_sigma_frac", 0.02),
+    ("heading_change_sigma_frac", 0.02),
+    ("heading_walk_deg_per_sqrt_m", 0.1),
+    ("speed_sigma_m_s", 0.05),
+    ("bias_walk_m_per_sqrt_s", 0.005),
+    ("position_walk_m_per_sqrt_s", 0.1),
+    ("track_accel_sigma_m_s2", 0.1),
+];
+
+/// The keys tuned when none are named: the range noise and the odometry's.
+pub const DEFAULT_KEYS: [&str; 4] =
+    ["range_sigma_m", "distance_sigma_frac", "heading_change_sigma_frac", "heading_walk_deg_per_sqrt_m"];
+
+/// The value of a tunable key in `spec`: given, or the default the estimator runs with;
+/// None for a key `tune` does not know.
+pub fn key_value(spec: &EstimatorSpec, key: &str) -> Option<f64> {
+    let c = spec.planar_config();
+    let n = c.noise;
+    Some(match key {
+        "range_sigma_m" => n.range_sigma_m,
+        "doppler_sigma_m_s" => n.doppler_sigma_m_s,
+        "heading_sigma_deg" => n.heading_sigma_rad.to_degrees(),
+        "distance_sigma_frac" => n.distance_sigma_frac,
+        "heading_change_sigma_frac" => n.heading_change_sigma_frac,
+        "heading_walk_deg_per_sqrt_m" => n.heading_walk_rad_per_sqrt_m.to_degrees(),
+        "speed_sigma_m_s" => n.speed_sigma_m_s,
+        "bias_walk_m_per_sqrt_s" => n.bias_walk_m_per_sqrt_s,
+        "position_walk_m_per_sqrt_s" => n.position_walk_m_per_sqrt_s,
+        "track_accel_sigma_m_s2" => c.track_accel_sigma_m_s2.unwrap_or(0.0),
+        _ => return None,
+    })
+}
+
+/// Sets a tunable key of `spec`.
+fn set_key(spec: &mut EstimatorSpec, key: &str, v: f64) {
+    let slot = match key {
+        "range_sigma_m" => &mut spec.range_sigma_m,
+        "doppler_sigma_m_s" => &mut spec.doppler_sigma_m_s,
+        "heading_sigma_deg" => &mut spec.heading_sigma_deg,
+        "distance_sigma_frac" => &mut spec.distance_sigma_frac,
+        "heading_change_sigma_frac" => &mut spec.heading_change_sigma_frac,
+        "heading_walk_deg_per_sqrt_m" => &mut spec.heading_walk_deg_per_sqrt_m,
+        "speed_sigma_m_s" => &mut spec.speed_sigma_m_s,
+        "bias_walk_m_per_sqrt_s" => &mut spec.bias_walk_m_per_sqrt_s,
+        "position_walk_m_per_sqrt_s" => &mut spec.position_walk_m_per_sqrt_s,
+        "track_accel_sigma_m_s2" => &mut spec.track_accel_sigma_m_s2,
+        _ => unreachable!("checked against TUNABLE"),
+    };
+    *slot = Some(v);
+}
+
+/// An estimator tuned on a log.
+#[derive(Debug, Clone)]
+pub struct Tuned {
+    /// The estimator with its tuned keys set.
+    pub spec: EstimatorSpec,
+    /// Each key: its value before and after.
+    pub keys: Vec<(String, f64, f64)>,
+    /// The innovations' negative log-likelihood before and after.
+    pub nll_before: f64,
+    pub nll_after: f64,
+    /// The estimator's statistics on the log before and after (errors and NEES need
+    /// the log's ground truth; in-sample).
+    pub before: ErrorStats,
+    pub after: ErrorStats,
+    /// Replays of the log the search took.
+    pub evaluations: usize,
+}
+
+/// The smallest step of the search, as a factor on a value: it stops at 2 %.
+const FINEST_STEP: f64 = 1.02;
+
+/// How far a value may go from where it started, as a factor either way: a noise the
+/// likelihood would drive to zero stops at 1e-4 of its start.
+const RANGE_FACTOR: f64 = 1e4;
+
+/// A value rounded to 4 significant digits (what the tuned file holds).
+fn round4(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(3 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
+}
+
+/// Tunes `keys` of `spec` on `log` replayed with each of `beacon_sets` (all beacons for
+/// `None`; the likelihoods of the sets multiplied, so that one choice serves a filter
+/// with many beacons and with one): a compass search on
+/// the logarithms of the values, steps from a factor of 2 down to 2 % (doubled after a
+/// round that helped, halved after one that did not), each round trying every key up
+/// and down (in parallel; the result does not depend on the thread count).
+/// `progress` is called after each round.
+pub fn tune(
+    log: &Log,
+    spec: &EstimatorSpec,
+    keys: &[String],
+    beacon_sets: &[Option<BTreeSet<u32>>],
+    progress: impl Fn(),
+) -> Result<Tuned, LogError> {
+    assert!(!beacon_sets.is_empty(), "at least one beacon set");
+    let start: Vec<f64> = keys
+        .iter()
+        .map(|k| {
+            let nominal = TUNABLE.iter().find(|(t, _)| t == k).map(|t| t.1).expect("checked against TUNABLE");
+            key_value(spec, k).filter(|v| *v > 0.0).unwrap_or(nominal).ln()
+        })
+        .collect();
+    let with = |x: &[f64]| {
+        let mut s = spec.clone();
+        for (k, v) in keys.iter().zip(x) {
+            set_key(&mut s, k, round4(v.exp()));
+        }
+        s
+    };
+    // one replay: the negative log-likelihood and the statistics of the first set
+    let replay_one = |x: &[f64], set: &Option<BTreeSet<u32>>| -> Result<(f64, ErrorStats), LogError> {
+        let mut one = log.clone();
+        one.description.estimators = vec![with(x)];
+        let r = replay(&one, set.clone(), |_| Ok::<(), LogError>(()))?;
+        let st = r.session.stats[0];
+        // a filter that weighs nothing, or diverges to non-finite, is the worst there is
+        let nll = st.neg_log_likelihood();
+        Ok((if st.nis_count > 0 && nll.is_finite() { nll } else { f64::INFINITY }, st))
+    };
+    let evaluate = |x: &[f64]| -> Result<(f64, ErrorStats), LogError> {
+        let each = beacon_sets.par_iter().map(|set| replay_one(x, set)).collect::<Result<Vec<_>, _>>()?;
+        Ok((each.iter().map(|e| e.0).sum(), each[0].1))
+    };
+    let (nll_before, before) = evaluate(&start)?;
+    let (mut x, mut best, mut evaluations) = (start.clone(), nll_before, beacon_sets.len());
+    let mut step = 2f64.ln();
+    while step >= FINEST_STEP.ln() {
+        let candidates: Vec<Vec<f64>> = (0..2 * keys.len())
+            .map(|c| {
+                let mut y = x.clone();
+                let (i, bound) = (c / 2, RANGE_FACTOR.ln());
+                y[i] = (y[i] + if c % 2 == 0 { step } else { -step }).clamp(start[i] - bound, start[i] + bound);
+                y
+            })
+            .filter(|y| *y != x)
+            .collect();
+        let scores = candidates.par_iter().map(|y| evaluate(y).map(|(nll, _)| nll)).collect::<Result<Vec<_>, _>>()?;
+        evaluations += candidates.len() * beacon_sets.len();
+        // the best candidate, the first of equals
+        let (i, nll) =
+            scores.iter().enumerate().fold((usize::MAX, best), |a, (i, &s)| if s < a.1 { (i, s) } else { a });
+        // a move that helped doubles the step (to a factor of 2), one that did not halves it
+        if i == usize::MAX {
+            step /= 2.0;
+        } else {
+            x = candidates[i].clone();
+            best = nll;
+            step = (step * 2.0).min(2f64.ln());
+        }
+        progress();
+    }
+    let keys = keys
+        .iter()
+        .zip(start.iter().zip(&x))
+        .map(|(k, (a, b))| (k.clone(), round4(a.exp()), round4(b.exp())))
+        .collect();
+    let (nll_after, after) = evaluate(&x)?;
+    evaluations += beacon_sets.len();
+    Ok(Tuned { spec: with(&x), keys, nll_before, nll_after, before, after, evaluations })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+
+    /// A vehicle on a 40 m circle with exact odometry, ranged from three beacons with
+    /// Gaussian noise of 0.8 m: tuning `range_sigma_m` from 2 m recovers the noise drawn
+    /// (its sample standard deviation) to 10 %, and lowers the likelihood's cost.
+    #[test]
+    fn tune_recovers_the_range_noise_of_a_synthetic_log() {
+        let dir = std::env::temp_dir().join(format!("onebeacon-tune-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let beacons = [(0, 60.0, 0.0), (1, -30.0, 50.0), (2, -30.0, -50.0)];
+        let noise = Normal::new(0.0, 0.8).unwrap();
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        let (r, step) = (40.0f64, 0.5f64);
+        let dpsi = step / r;
+        let (mut odo, mut ranges, mut truth) =
+            (String::from("t,d,dh\n"), String::from("t,id,r\n"), String::from("t,x,y,h\n"));
+        let (mut drawn_sq, mut drawn_n) = (0.0, 0);
+        let (mut n, mut e, mut psi) = (0.0f64, 0.0f64, 0.0f64);
+        truth += "0,0,0,0\n";
+        for k in 1..=2000 {
+            let t = k as f64 * 0.5;
+            n += 2.0 * r * (dpsi / 2.0).sin() * (psi + dpsi / 2.0).cos();
+            e += 2.0 * r * (dpsi / 2.0).sin() * (psi + dpsi / 2.0).sin();
+            psi += dpsi;
+            odo += &format!("{t},{},{dpsi}\n", 2.0 * r * (dpsi / 2.0).sin());
+            truth += &format!("{t},{n},{e},{psi}\n");
+            if k % 2 == 0 {
+                let (id, bn, be) = beacons[(k / 2) % 3];
+                let w: f64 = noise.sample(&mut rng);
+                drawn_sq += w * w;
+                drawn_n += 1;
+                ranges += &format!("{t},{id},{}\n", (n - bn).hypot(e - be) + w);
+            }
+        }
+        let beacon_rows: String = beacons.iter().map(|(id, n, e)| format!("{id},{n},{e}\n")).collect();
+        for (f, text) in [
+            ("odo.csv", odo),
+            ("ranges.csv", ranges),
+            ("truth.csv", truth),
+            ("b.csv", format!("id,x,y\n{beacon_rows}")),
+        ] {
+            std::fs::write(dir.join(f), text).unwrap();
+        }
+        let toml = "name = \"circle\"\n\
+            [[source]]\nkind = \"odometry\"\nfile = \"odo.csv\"\ntime = \"t\"\ndistance = \"d\"\nheading_change = \"dh\"\n\
+            [[source]]\nkind = \"range\"\nfile = \"ranges.csv\"\ntime = \"t\"\nbeacon = \"id\"\nrange = \"r\"\n\
+            [[source]]\nkind = \"ground_truth\"\nfile = \"truth.csv\"\ntime = \"t\"\nx = \"x\"\ny = \"y\"\nheading = \"h\"\n\
+            [beacons]\nfile = \"b.csv\"\nid = \"id\"\nx = \"x\"\ny = \"y\"\n\
+            [[estimators]]\nname = \"ekf\"\nkind = \"range-ekf\"\nrange_sigma_m = 2.0\ndistance_sigma_frac = 0.001\n\
+            heading_change_sigma_frac = 0.001\nheading_walk_deg_per_sqrt_m = 0.001\n";
+        std::fs::write(dir.join("log.toml"), toml).unwrap();
+        let log = Log::load(&dir.join("log.toml")).unwrap();
+        let t = tune(&log, &log.description.estimators[0], &["range_sigma_m".to_string()], &[None], || {}).unwrap();
+        let drawn = (drawn_sq / drawn_n as f64).sqrt();
+        let fitted = t.keys[0].2;
+        assert!((fitted / drawn - 1.0).abs() < 0.1, "fitted {fitted} m, drawn {drawn} m");
+        assert!(t.nll_after < t.nll_before);
+        assert_eq!(t.spec.range_sigma_m, Some(fitted));
+    }
+}
