@@ -12,18 +12,18 @@ scale of the distance, so that error model is kept).
                                              # speeds and yaw rate held until the next row
 
 Only the standard library is used."""
-import bisect, csv, math, os, shutil, sys
+import math, os, shutil, sys
+
+import plaza_common
+from plaza_common import rows
 
 CURRENT_NORTH_M_S = 0.1
 
-def rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
 
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: plaza_crab.py DIR")
-    src = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "plaza")
+    src = plaza_common.DATA
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
     truth = rows(os.path.join(src, "plaza1_ground_truth.csv"))
@@ -32,15 +32,7 @@ def main():
     beacons = {int(b["beacon_id"]): (float(b["x_m"]), float(b["y_m"])) for b in rows(os.path.join(src, "plaza1_beacons.csv"))}
     shutil.copy(os.path.join(src, "plaza1_beacons.csv"), os.path.join(out, "crab_beacons.csv"))
     t0 = float(truth[0]["t_s"])
-    tt = [float(r["t_s"]) for r in truth]
-
-    def truth_at(t):  # linear interpolation of the original track
-        i = min(max(bisect.bisect_left(tt, t), 1), len(tt) - 1)
-        a, b = truth[i - 1], truth[i]
-        w = (t - tt[i - 1]) / (tt[i] - tt[i - 1]) if tt[i] > tt[i - 1] else 0.0
-        w = min(max(w, 0.0), 1.0)
-        return (float(a["x_m"]) + w * (float(b["x_m"]) - float(a["x_m"])),
-                float(a["y_m"]) + w * (float(b["y_m"]) - float(a["y_m"])))
+    truth_at = plaza_common.truth_at(truth)
 
     drift = lambda t: CURRENT_NORTH_M_S * (t - t0)
     with open(os.path.join(out, "crab_truth.csv"), "w") as f:

@@ -9,33 +9,27 @@ start, to the beacons in turn. Everything else is plaza1's own files and estimat
 An error that makes the range negative is screened by the session's limits (a range
 must be in (0, limits.max_range_m]); the others reach the estimators.
 Only the standard library is used."""
-import bisect, csv, math, os, shutil, sys
+import math, os, shutil, sys
+
+import plaza_common
+from plaza_common import rows
 
 ERRORS_M = [-200.0, -75.0, 50.0, 175.0, 300.0]
 
-def rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
 
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: plaza_outliers.py DIR")
-    src = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "plaza")
+    src = plaza_common.DATA
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
     for f in ["plaza1_beacons.csv", "plaza1_ground_truth.csv", "plaza1_odometry.csv"]:
         shutil.copy(os.path.join(src, f), os.path.join(out, f))
     truth = rows(os.path.join(src, "plaza1_ground_truth.csv"))
     beacons = {int(b["beacon_id"]): (float(b["x_m"]), float(b["y_m"])) for b in rows(os.path.join(src, "plaza1_beacons.csv"))}
-    tt = [float(r["t_s"]) for r in truth]
-    t0 = tt[0]
+    t0 = float(truth[0]["t_s"])
 
-    def truth_at(t):
-        i = min(max(bisect.bisect_left(tt, t), 1), len(tt) - 1)
-        a, b = truth[i - 1], truth[i]
-        w = min(max((t - tt[i - 1]) / (tt[i] - tt[i - 1]), 0.0), 1.0) if tt[i] > tt[i - 1] else 0.0
-        return (float(a["x_m"]) + w * (float(b["x_m"]) - float(a["x_m"])),
-                float(a["y_m"]) + w * (float(b["y_m"]) - float(a["y_m"])))
+    truth_at = plaza_common.truth_at(truth)
 
     ranges = rows(os.path.join(src, "plaza1_ranges.csv"))
     ids = sorted(beacons)

@@ -116,9 +116,34 @@ fn line<'a, DB: DrawingBackend + 'a>(
 where
     DB::ErrorType: 'static,
 {
-    let series = chart.draw_series(LineSeries::new(decimated(points), style))?;
+    styled_line(chart, points, style, false, label)
+}
+
+/// A solid or dashed line series, thinned ([`decimated`]), with a legend entry drawn
+/// the same way.
+fn styled_line<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    points: impl IntoIterator<Item = (f64, f64)>,
+    style: ShapeStyle,
+    dashed: bool,
+    label: Option<&str>,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let points = decimated(points);
+    let series = if dashed {
+        chart.draw_series(DashedLineSeries::new(points, 8, 5, style))?
+    } else {
+        chart.draw_series(LineSeries::new(points, style))?
+    };
     if let Some(label) = label {
-        series.label(label).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        let gap = if dashed { 5 } else { 0 };
+        series.label(label).legend(move |(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (8, 0)], style)
+                + PathElement::new(vec![(8 + gap, 0), (20, 0)], style)
+        });
     }
     Ok(())
 }
@@ -141,27 +166,6 @@ fn decimated(points: impl IntoIterator<Item = (f64, f64)>) -> Vec<(f64, f64)> {
     kept
 }
 
-/// A dashed line series with a legend entry drawn dashed.
-fn dashed<'a, DB: DrawingBackend + 'a>(
-    chart: &mut Chart<'a, DB>,
-    points: impl IntoIterator<Item = (f64, f64)>,
-    style: ShapeStyle,
-    label: Option<&str>,
-) -> Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    let series = chart.draw_series(DashedLineSeries::new(decimated(points), 8, 5, style))?;
-    if let Some(label) = label {
-        series.label(label).legend(move |(x, y)| {
-            EmptyElement::at((x, y))
-                + PathElement::new(vec![(0, 0), (7, 0)], style)
-                + PathElement::new(vec![(12, 0), (19, 0)], style)
-        });
-    }
-    Ok(())
-}
-
 /// Estimator `i`'s line: its own colour, solid for even `i` and dashed for odd, so that
 /// estimators whose tracks coincide stay visible on top of each other.
 fn estimator_line<'a, DB: DrawingBackend + 'a>(
@@ -175,7 +179,7 @@ where
     DB::ErrorType: 'static,
 {
     let style = colour(i).stroke_width(width);
-    if i.is_multiple_of(2) { line(chart, points, style, label) } else { dashed(chart, points, style, label) }
+    styled_line(chart, points, style, !i.is_multiple_of(2), label)
 }
 
 /// A vertical colour bar for a heatmap from `lo` to `hi` (viridis), with its label, in
@@ -426,7 +430,7 @@ pub fn mc_errors(path: &Path, s: &Scenario, r: &McResult) -> Result<()> {
                     .filter_map(|cell| cell.pcrb(tracks[*est].vehicle_index).map(|p| (x_of(cell), p)))
                     .collect();
                 if pcrb.len() > 1 {
-                    chart.draw_series(DashedLineSeries::new(pcrb, 6, 4, c.mix(0.8).stroke_width(1)))?;
+                    styled_line(&mut chart, pcrb, c.mix(0.8).stroke_width(1), true, None)?;
                 }
             }
             legend(&mut chart, SeriesLabelPosition::UpperLeft)?;

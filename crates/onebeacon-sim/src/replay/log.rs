@@ -440,57 +440,6 @@ fn default_heading_sigma_deg() -> f64 {
     5.0
 }
 
-/// Noise every estimator of the log takes unless its own table gives the key (`[noise]`):
-/// one place for what the sensors are, the estimators differing in what they estimate.
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct NoiseDefaults {
-    pub range_sigma_m: Option<f64>,
-    pub doppler_sigma_m_s: Option<f64>,
-    pub heading_sigma_deg: Option<f64>,
-    pub distance_sigma_frac: Option<f64>,
-    pub heading_change_sigma_frac: Option<f64>,
-    pub heading_walk_deg_per_sqrt_m: Option<f64>,
-    pub speed_sigma_m_s: Option<f64>,
-    pub bias_walk_m_per_sqrt_s: Option<f64>,
-    pub position_walk_m_per_sqrt_s: Option<f64>,
-}
-
-impl NoiseDefaults {
-    /// Each key with its value and whether it must be > 0 (else >= 0).
-    pub(crate) fn keys(&self) -> [(&'static str, Option<f64>, bool); 9] {
-        [
-            ("range_sigma_m", self.range_sigma_m, true),
-            ("doppler_sigma_m_s", self.doppler_sigma_m_s, true),
-            ("heading_sigma_deg", self.heading_sigma_deg, true),
-            ("distance_sigma_frac", self.distance_sigma_frac, false),
-            ("heading_change_sigma_frac", self.heading_change_sigma_frac, false),
-            ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, false),
-            ("speed_sigma_m_s", self.speed_sigma_m_s, false),
-            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, false),
-            ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, false),
-        ]
-    }
-
-    /// `e` with every key it leaves out taken from here.
-    fn fill(&self, e: &mut EstimatorSpec) {
-        let pairs = [
-            (&mut e.range_sigma_m, self.range_sigma_m),
-            (&mut e.doppler_sigma_m_s, self.doppler_sigma_m_s),
-            (&mut e.heading_sigma_deg, self.heading_sigma_deg),
-            (&mut e.distance_sigma_frac, self.distance_sigma_frac),
-            (&mut e.heading_change_sigma_frac, self.heading_change_sigma_frac),
-            (&mut e.heading_walk_deg_per_sqrt_m, self.heading_walk_deg_per_sqrt_m),
-            (&mut e.speed_sigma_m_s, self.speed_sigma_m_s),
-            (&mut e.bias_walk_m_per_sqrt_s, self.bias_walk_m_per_sqrt_s),
-            (&mut e.position_walk_m_per_sqrt_s, self.position_walk_m_per_sqrt_s),
-        ];
-        for (own, shared) in pairs {
-            *own = own.or(shared);
-        }
-    }
-}
-
 /// The log description file.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -512,9 +461,11 @@ pub struct LogDescription {
     /// `[[estimators]]` as in scenarios (`[[estimator]]`, the old name, is read too).
     #[serde(alias = "estimator")]
     pub estimators: Vec<EstimatorSpec>,
-    /// Noise keys every estimator takes unless it gives its own.
+    /// Noise keys every estimator takes unless it gives its own (`[noise]`): one place
+    /// for what the sensors are, the estimators differing in what they estimate. Its
+    /// keys are [`crate::scenario::estimator::NOISE_KEYS`].
     #[serde(default)]
-    pub noise: NoiseDefaults,
+    pub noise: BTreeMap<String, f64>,
     /// What an item must respect before any estimator sees it.
     #[serde(default)]
     pub limits: Limits,
@@ -560,7 +511,9 @@ impl LogDescription {
         crate::scenario::validate::validate_log(&d)
             .map_err(|v| LogError::Description(crate::scenario::load::invalid(name, v)))?;
         for e in &mut d.estimators {
-            d.noise.fill(e);
+            for (key, v) in &d.noise {
+                e.key_mut(key).expect("validated: a noise key").get_or_insert(*v);
+            }
         }
         Ok(d)
     }

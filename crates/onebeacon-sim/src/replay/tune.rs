@@ -49,24 +49,6 @@ pub fn key_value(spec: &EstimatorSpec, key: &str) -> Option<f64> {
     })
 }
 
-/// Sets a tunable key of `spec`.
-fn set_key(spec: &mut EstimatorSpec, key: &str, v: f64) {
-    let slot = match key {
-        "range_sigma_m" => &mut spec.range_sigma_m,
-        "doppler_sigma_m_s" => &mut spec.doppler_sigma_m_s,
-        "heading_sigma_deg" => &mut spec.heading_sigma_deg,
-        "distance_sigma_frac" => &mut spec.distance_sigma_frac,
-        "heading_change_sigma_frac" => &mut spec.heading_change_sigma_frac,
-        "heading_walk_deg_per_sqrt_m" => &mut spec.heading_walk_deg_per_sqrt_m,
-        "speed_sigma_m_s" => &mut spec.speed_sigma_m_s,
-        "bias_walk_m_per_sqrt_s" => &mut spec.bias_walk_m_per_sqrt_s,
-        "position_walk_m_per_sqrt_s" => &mut spec.position_walk_m_per_sqrt_s,
-        "track_accel_sigma_m_s2" => &mut spec.track_accel_sigma_m_s2,
-        _ => unreachable!("checked against TUNABLE"),
-    };
-    *slot = Some(v);
-}
-
 /// An estimator tuned on a log.
 #[derive(Debug, Clone)]
 pub struct Tuned {
@@ -126,7 +108,7 @@ pub fn tune(
     let with = |x: &[f64]| {
         let mut s = spec.clone();
         for (k, v) in keys.iter().zip(x) {
-            set_key(&mut s, k, round4(v.exp()));
+            *s.key_mut(k).expect("checked against TUNABLE") = Some(round4(v.exp()));
         }
         s
     };

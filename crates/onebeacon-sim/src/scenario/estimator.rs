@@ -161,6 +161,20 @@ pub struct EstimatorSpec {
     pub turn_scale_sigma: Option<f64>,
 }
 
+/// The noise keys a log's `[noise]` table may give its estimators, and whether each
+/// must be > 0 (else >= 0).
+pub const NOISE_KEYS: [(&str, bool); 9] = [
+    ("range_sigma_m", true),
+    ("doppler_sigma_m_s", true),
+    ("heading_sigma_deg", true),
+    ("distance_sigma_frac", false),
+    ("heading_change_sigma_frac", false),
+    ("heading_walk_deg_per_sqrt_m", false),
+    ("speed_sigma_m_s", false),
+    ("bias_walk_m_per_sqrt_s", false),
+    ("position_walk_m_per_sqrt_s", false),
+];
+
 /// What a numeric key must be.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Sign {
@@ -210,6 +224,24 @@ impl EstimatorSpec {
             estimate_turn_scale: None,
             turn_scale_sigma: None,
         }
+    }
+
+    /// The value of a noise key (those of [`NOISE_KEYS`] and `track_accel_sigma_m_s2`),
+    /// to read or set; None for another key.
+    pub fn key_mut(&mut self, key: &str) -> Option<&mut Option<f64>> {
+        Some(match key {
+            "range_sigma_m" => &mut self.range_sigma_m,
+            "doppler_sigma_m_s" => &mut self.doppler_sigma_m_s,
+            "heading_sigma_deg" => &mut self.heading_sigma_deg,
+            "distance_sigma_frac" => &mut self.distance_sigma_frac,
+            "heading_change_sigma_frac" => &mut self.heading_change_sigma_frac,
+            "heading_walk_deg_per_sqrt_m" => &mut self.heading_walk_deg_per_sqrt_m,
+            "speed_sigma_m_s" => &mut self.speed_sigma_m_s,
+            "bias_walk_m_per_sqrt_s" => &mut self.bias_walk_m_per_sqrt_s,
+            "position_walk_m_per_sqrt_s" => &mut self.position_walk_m_per_sqrt_s,
+            "track_accel_sigma_m_s2" => &mut self.track_accel_sigma_m_s2,
+            _ => return None,
+        })
     }
 
     /// Name in outputs: `name`, or the kind with "-ukf" for the UKF.

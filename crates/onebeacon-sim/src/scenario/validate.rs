@@ -1,6 +1,6 @@
 //! Range checks on a parsed scenario. The first violation is reported with its key.
 
-use super::estimator::{EstimatorSpec, Host, Sign};
+use super::estimator::{EstimatorSpec, Host, NOISE_KEYS, Sign};
 use super::moving_beacon::Vehicle;
 use super::{FixedBeacon, MovingBeacon, Scenario};
 use crate::replay::log::{COLUMN_KEYS, InitialFrom, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
@@ -509,10 +509,16 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
             check(&format!("beacon[{i}]"), v, Rule::Finite)?;
         }
     }
-    for (key, v, positive) in d.noise.keys() {
-        if let Some(v) = v {
-            check(&format!("noise.{key}"), v, if positive { Rule::Positive } else { Rule::NonNegative })?;
-        }
+    for (key, v) in &d.noise {
+        let Some((_, positive)) = NOISE_KEYS.iter().find(|(k, _)| k == key) else {
+            let keys: Vec<&str> = NOISE_KEYS.iter().map(|k| k.0).collect();
+            return Err(Violation {
+                key: format!("noise.{key}"),
+                value: format!("{v:?}"),
+                allowed: format!("is not a noise key (keys: {})", keys.join(", ")),
+            });
+        };
+        check(&format!("noise.{key}"), *v, if *positive { Rule::Positive } else { Rule::NonNegative })?;
     }
     check_estimators(&d.estimators, Host::Log)?;
     let init = &d.initial;
