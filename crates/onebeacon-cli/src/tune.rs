@@ -111,10 +111,8 @@ pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
         outln!("{summary}");
         return Ok(());
     }
-    outln!(
-        "{name}: {} estimators tuned in {wall_s:.1} s (in-sample: these figures are on the log tuned on)",
-        tuned.len()
-    );
+    let (n, plural) = (tuned.len(), if tuned.len() == 1 { "" } else { "s" });
+    outln!("{name}: {n} estimator{plural} tuned in {wall_s:.1} s (in-sample: these figures are on the log tuned on)");
     for (i, t) in &tuned {
         let (b, a) = (&t.before, &t.after);
         outln!(

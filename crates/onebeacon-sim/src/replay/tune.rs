@@ -31,7 +31,7 @@ pub const DEFAULT_KEYS: [&str; 4] =
 
 /// The value of a tunable key in `spec`: given, or the default the estimator runs with;
 /// None for a key `tune` does not know.
-pub fn key_value(spec: &EstimatorSpec, key: &str) -> Option<f64> {
+fn key_value(spec: &EstimatorSpec, key: &str) -> Option<f64> {
     let c = spec.planar_config();
     let n = c.noise;
     Some(match key {
