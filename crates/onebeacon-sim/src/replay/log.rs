@@ -1020,7 +1020,10 @@ impl Clock {
     fn new(s: &Source) -> Self {
         match (&s.time_format, &s.date) {
             (None, _) => Clock::Number(s.time_unit.seconds()),
-            (Some(format), None) => Clock::DateTime { format: format.clone(), zoned: format.contains('z') },
+            (Some(format), None) => {
+                let zoned = ["%z", "%:z", "%::z", "%:::z", "%#z"].iter().any(|z| format.contains(z));
+                Clock::DateTime { format: format.clone(), zoned }
+            }
             (Some(format), Some(date)) => {
                 let day = chrono::NaiveDate::parse_from_str(date, "%Y-%m-%d").expect("validated: date is YYYY-MM-DD");
                 let day_s = day.and_time(chrono::NaiveTime::MIN).and_utc().timestamp() as f64;
