@@ -8,6 +8,8 @@
 
 pub mod consistency;
 pub mod ekf;
+pub mod particle;
+pub mod truncated;
 pub mod ukf;
 
 pub use ekf::{Ekf, FilterError, Gated, MeasurementModel, ProcessModel};

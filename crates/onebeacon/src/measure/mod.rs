@@ -13,10 +13,12 @@
 pub mod doppler;
 pub mod range;
 pub mod state;
+pub mod usbl;
 
 pub use doppler::RadialSpeed2d;
 pub use range::{Range2d, Range3d, SlantRange};
 pub use state::StateComponent;
+pub use usbl::{Usbl, UsblAngle, UsblModel};
 
 use crate::filter::MeasurementModel;
 use nalgebra::{SMatrix, SVector};

@@ -1,5 +1,6 @@
 //! Process models used by the estimators.
 
+pub mod hoff;
 pub mod kinematic6dof;
 pub mod unicycle;
 

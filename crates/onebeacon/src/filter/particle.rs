@@ -1,0 +1,481 @@
+//! A particle filter (hoff2024 sec. 2.2), generic over its process and likelihood
+//! models: particles stored one array per state component (structure of arrays),
+//! log-domain weights (eq. 5 as a sum of log-likelihoods), the weighted mean and
+//! covariance as the estimate, resampling (multinomial as in eq. 9, systematic,
+//! stratified, residual) when the effective sample size falls below a threshold, and
+//! optional roughening.
+//!
+//! Work is split into chunks of [`CHUNK`] particles run in parallel (rayon); each chunk
+//! draws from its own random stream, derived from (seed, step, chunk), and sums are
+//! reduced in chunk order, so a result does not depend on the thread count.
+
+use nalgebra::{SMatrix, SVector};
+use rand::RngExt;
+use rand_pcg::Pcg64;
+use rayon::prelude::*;
+
+/// Particles per chunk: the unit of parallel work and of random streams.
+pub const CHUNK: usize = 8192;
+
+/// How particles are drawn again in proportion to their weights.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Resampler {
+    /// N independent draws (hoff2024 eq. 9).
+    Multinomial,
+    /// One uniform offset, N evenly spaced points.
+    #[default]
+    Systematic,
+    /// One uniform draw in each of N strata.
+    Stratified,
+    /// floor(N w_i) copies of each, the rest multinomially on the residual weights.
+    Residual,
+}
+
+/// The motion of the particles over a step.
+pub trait ParticleProcess: Sync {
+    /// Moves the particles of one chunk over `dt` seconds: `x[k][i]` is component `k` of
+    /// particle `i`; `rng` is the chunk's own stream.
+    fn propagate(&self, x: &mut [&mut [f64]], dt: f64, rng: &mut Pcg64);
+}
+
+/// What a measurement says of each particle.
+pub trait ParticleLikelihood: Sync {
+    /// Adds ln l(y | x_i), up to a constant common to all particles, to `log_w[i]` for
+    /// the particles of one chunk (`x[k][i]` as in [`ParticleProcess`]).
+    fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]);
+}
+
+/// Two measurements of the same time weigh the particles together.
+impl<A: ParticleLikelihood, B: ParticleLikelihood> ParticleLikelihood for (A, B) {
+    fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+        self.0.add_log_likelihood(x, log_w);
+        self.1.add_log_likelihood(x, log_w);
+    }
+}
+
+/// The filter's settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParticleSettings {
+    pub resampler: Resampler,
+    /// Resample when the effective sample size falls below this fraction of the
+    /// particles (1: after every update).
+    pub ess_fraction: f64,
+    /// Roughening after resampling (Gordon, Salmond and Smith 1993): each component
+    /// jittered by K E_k N^(-1/d), E_k its spread over the particles; None: off.
+    pub roughening_k: Option<f64>,
+}
+
+impl Default for ParticleSettings {
+    fn default() -> Self {
+        Self { resampler: Resampler::Systematic, ess_fraction: 0.5, roughening_k: None }
+    }
+}
+
+/// N particles of a D-dimensional state.
+#[derive(Debug, Clone)]
+pub struct ParticleFilter<const D: usize> {
+    /// Component k of every particle.
+    x: Vec<Vec<f64>>,
+    /// Resampling's target buffers, kept to avoid an allocation per step.
+    spare: Vec<Vec<f64>>,
+    log_w: Vec<f64>,
+    pub settings: ParticleSettings,
+    seed: u64,
+    /// Steps so far (predictions, updates and resamplings each take one): the random
+    /// streams' second coordinate.
+    step: u64,
+}
+
+/// The random stream of (seed, step, chunk): a PCG with the chunk as its stream
+/// selector and the seed and step mixed into its state (SplitMix64 finaliser).
+fn stream(seed: u64, step: u64, chunk: u64) -> Pcg64 {
+    let mut z = seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    Pcg64::new(u128::from(z) << 64 | u128::from(step), u128::from(chunk))
+}
+
+impl<const D: usize> ParticleFilter<D> {
+    /// `n` particles drawn from N(mean, diag(sigma^2)), equal weights.
+    pub fn gaussian(
+        n: usize,
+        mean: &SVector<f64, D>,
+        sigma: &SVector<f64, D>,
+        settings: ParticleSettings,
+        seed: u64,
+    ) -> Self {
+        let mut f = Self {
+            x: vec![vec![0.0; n]; D],
+            spare: vec![vec![0.0; n]; D],
+            log_w: vec![0.0; n],
+            settings,
+            seed,
+            step: 0,
+        };
+        let (mean, sigma) = (*mean, *sigma);
+        f.for_chunks(|x, rng| {
+            for (k, comp) in x.iter_mut().enumerate() {
+                for v in comp.iter_mut() {
+                    *v = mean[k] + sigma[k] * rng.sample::<f64, _>(rand_distr::StandardNormal);
+                }
+            }
+        });
+        f
+    }
+
+    pub fn len(&self) -> usize {
+        self.log_w.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.log_w.is_empty()
+    }
+
+    /// Component `k` of every particle.
+    pub fn component(&self, k: usize) -> &[f64] {
+        &self.x[k]
+    }
+
+    /// The log-weights (not normalised).
+    pub fn log_weights(&self) -> &[f64] {
+        &self.log_w
+    }
+
+    /// Runs `f` on every chunk in parallel with the chunk's random stream, and counts a
+    /// step.
+    fn for_chunks(&mut self, f: impl Fn(&mut [&mut [f64]], &mut Pcg64) + Sync) {
+        let (seed, step) = (self.seed, self.step);
+        self.step += 1;
+        let mut views = chunk_views(&mut self.x);
+        views.par_iter_mut().enumerate().for_each(|(c, view)| {
+            let mut rng = stream(seed, step, c as u64);
+            f(view, &mut rng);
+        });
+    }
+
+    /// Propagates every particle through `model` over `dt` seconds.
+    pub fn predict(&mut self, model: &impl ParticleProcess, dt: f64) {
+        self.for_chunks(|x, rng| model.propagate(x, dt, rng));
+    }
+
+    /// Weighs every particle by `likelihood` (eq. 5, in logs), then resamples when the
+    /// effective sample size falls below the threshold; whether it did.
+    pub fn update(&mut self, likelihood: &impl ParticleLikelihood) -> bool {
+        let n = self.len();
+        let x = &self.x;
+        self.log_w.par_chunks_mut(CHUNK).enumerate().for_each(|(c, lw)| {
+            let start = c * CHUNK;
+            let view: Vec<&[f64]> = x.iter().map(|comp| &comp[start..start + lw.len()]).collect();
+            likelihood.add_log_likelihood(&view, lw);
+        });
+        self.step += 1;
+        let w = self.weights();
+        if ess_of(&w) < self.settings.ess_fraction * n as f64 {
+            self.resample_with(&w);
+            return true;
+        }
+        false
+    }
+
+    /// The normalised weights.
+    pub fn weights(&self) -> Vec<f64> {
+        let max = self.log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let w: Vec<f64> = self.log_w.iter().map(|l| (l - max).exp()).collect();
+        let total = sum_in_order(&w);
+        w.into_iter().map(|v| v / total).collect()
+    }
+
+    /// The effective sample size, 1 / sum w_i^2.
+    pub fn ess(&self) -> f64 {
+        ess_of(&self.weights())
+    }
+
+    /// The weighted mean and covariance of the particles.
+    pub fn mean_covariance(&self) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
+        let w = self.weights();
+        let x = &self.x;
+        // per chunk: sum w x and sum w x x', reduced in chunk order
+        let partial: Vec<(SVector<f64, D>, SMatrix<f64, D, D>)> = (0..w.len().div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (start, end) = (c * CHUNK, ((c + 1) * CHUNK).min(w.len()));
+                let (mut s, mut ss) = (SVector::<f64, D>::zeros(), SMatrix::<f64, D, D>::zeros());
+                for i in start..end {
+                    let p = SVector::<f64, D>::from_fn(|k, _| x[k][i]);
+                    s += w[i] * p;
+                    ss += w[i] * p * p.transpose();
+                }
+                (s, ss)
+            })
+            .collect();
+        let (mut mean, mut second) = (SVector::zeros(), SMatrix::zeros());
+        for (s, ss) in partial {
+            mean += s;
+            second += ss;
+        }
+        (mean, second - mean * mean.transpose())
+    }
+
+    /// Draws the particles again in proportion to their weights, resets the weights,
+    /// and roughens when asked.
+    pub fn resample(&mut self) {
+        self.resample_with(&self.weights());
+    }
+
+    /// [`ParticleFilter::resample`] with the normalised weights `w` in hand.
+    fn resample_with(&mut self, w: &[f64]) {
+        let mut rng = stream(self.seed, self.step, u64::MAX);
+        self.step += 1;
+        let ancestors = ancestors(self.settings.resampler, w, &mut rng);
+        for (from, to) in self.x.iter().zip(self.spare.iter_mut()) {
+            to.par_chunks_mut(CHUNK).zip(ancestors.par_chunks(CHUNK)).for_each(|(t, a)| {
+                for (v, &i) in t.iter_mut().zip(a) {
+                    *v = from[i];
+                }
+            });
+        }
+        std::mem::swap(&mut self.x, &mut self.spare);
+        self.log_w.iter_mut().for_each(|l| *l = 0.0);
+        if let Some(k) = self.settings.roughening_k {
+            let n = self.len() as f64;
+            let sigma: Vec<f64> = self
+                .x
+                .iter()
+                .map(|c| {
+                    let (lo, hi) = c.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+                    k * (hi - lo).max(0.0) * n.powf(-1.0 / D as f64)
+                })
+                .collect();
+            self.for_chunks(|x, rng| {
+                for (comp, s) in x.iter_mut().zip(&sigma) {
+                    for v in comp.iter_mut() {
+                        *v += s * rng.sample::<f64, _>(rand_distr::StandardNormal);
+                    }
+                }
+            });
+        }
+    }
+}
+
+/// The chunks of every component: `views[c][k]` is component `k` of chunk `c`.
+fn chunk_views(x: &mut [Vec<f64>]) -> Vec<Vec<&mut [f64]>> {
+    let n = x.first().map_or(0, Vec::len);
+    let mut views: Vec<Vec<&mut [f64]>> = (0..n.div_ceil(CHUNK)).map(|_| Vec::with_capacity(x.len())).collect();
+    for comp in x.iter_mut() {
+        for (c, part) in comp.chunks_mut(CHUNK).enumerate() {
+            views[c].push(part);
+        }
+    }
+    views
+}
+
+/// The effective sample size of normalised weights, 1 / sum w_i^2.
+fn ess_of(w: &[f64]) -> f64 {
+    let partial: Vec<f64> = w.par_chunks(CHUNK).map(|c| c.iter().map(|v| v * v).sum::<f64>()).collect();
+    1.0 / partial.iter().sum::<f64>()
+}
+
+/// A sum in index order by chunks (the same whatever the thread count).
+fn sum_in_order(v: &[f64]) -> f64 {
+    let partial: Vec<f64> = v.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect();
+    partial.iter().sum()
+}
+
+/// The index of the particle each new particle copies, for normalised weights `w`.
+pub(crate) fn ancestors(resampler: Resampler, w: &[f64], rng: &mut Pcg64) -> Vec<usize> {
+    let n = w.len();
+    // the points in [0, 1) whose cumulative-weight cell names the ancestor, in order
+    let walk = |points: &mut dyn Iterator<Item = f64>| -> Vec<usize> {
+        let mut out = Vec::with_capacity(n);
+        let (mut i, mut cum) = (0, w[0]);
+        for u in points {
+            while u >= cum && i + 1 < n {
+                i += 1;
+                cum += w[i];
+            }
+            out.push(i);
+        }
+        out
+    };
+    match resampler {
+        Resampler::Systematic => {
+            let u0: f64 = rng.random();
+            walk(&mut (0..n).map(|k| (k as f64 + u0) / n as f64))
+        }
+        Resampler::Stratified => {
+            let points: Vec<f64> = (0..n).map(|k| (k as f64 + rng.random::<f64>()) / n as f64).collect();
+            walk(&mut points.into_iter())
+        }
+        Resampler::Multinomial => multinomial(w, n, rng),
+        Resampler::Residual => {
+            let mut out = Vec::with_capacity(n);
+            let mut residual: Vec<f64> = Vec::with_capacity(n);
+            for (i, wi) in w.iter().enumerate() {
+                let copies = (n as f64 * wi).floor() as usize;
+                out.extend(std::iter::repeat_n(i, copies));
+                residual.push(n as f64 * wi - copies as f64);
+            }
+            let rest = n - out.len();
+            if rest > 0 {
+                let total: f64 = residual.iter().sum();
+                residual.iter_mut().for_each(|r| *r /= total);
+                out.extend(multinomial(&residual, rest, rng));
+            }
+            out
+        }
+    }
+}
+
+/// `m` independent draws of an index with probabilities `w`: sorted uniforms (from
+/// exponential spacings) walked along the cumulative weights.
+fn multinomial(w: &[f64], m: usize, rng: &mut Pcg64) -> Vec<usize> {
+    let mut e: Vec<f64> = (0..=m).map(|_| -(1.0 - rng.random::<f64>()).ln()).collect();
+    let total: f64 = e.iter().sum();
+    let mut acc = 0.0;
+    for v in e.iter_mut() {
+        acc += *v;
+        *v = acc / total;
+    }
+    let mut out = Vec::with_capacity(m);
+    let (mut i, mut cum) = (0, w[0]);
+    for &u in &e[..m] {
+        while u >= cum && i + 1 < w.len() {
+            i += 1;
+            cum += w[i];
+        }
+        out.push(i);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+    use nalgebra::{Matrix2, Vector2};
+
+    /// Each resampler copies particle i N w_i times on average (2000 resamplings of 7
+    /// particles, within 4 standard errors); systematic and residual copy it at least
+    /// floor(N w_i) times every time, systematic at most ceil(N w_i).
+    #[test]
+    fn resamplers_copy_in_proportion_to_weight() {
+        let w = [0.05, 0.3, 0.01, 0.24, 0.1, 0.2, 0.1];
+        let n = w.len();
+        for r in [Resampler::Multinomial, Resampler::Systematic, Resampler::Stratified, Resampler::Residual] {
+            let mut rng = stream(1, 2, 3);
+            let reps = 2000;
+            let mut counts = [0.0; 7];
+            for _ in 0..reps {
+                let a = ancestors(r, &w, &mut rng);
+                assert_eq!(a.len(), n);
+                let mut c = [0usize; 7];
+                a.iter().for_each(|&i| c[i] += 1);
+                for i in 0..n {
+                    let expected = n as f64 * w[i];
+                    if matches!(r, Resampler::Systematic | Resampler::Residual) {
+                        assert!(c[i] as f64 >= expected.floor() - 1e-9, "{r:?}: {c:?}");
+                    }
+                    if r == Resampler::Systematic {
+                        assert!(c[i] as f64 <= expected.ceil() + 1e-9, "{r:?}: {c:?}");
+                    }
+                    counts[i] += c[i] as f64;
+                }
+            }
+            for i in 0..n {
+                let (mean, expected) = (counts[i] / reps as f64, n as f64 * w[i]);
+                // a multinomial count's variance n w (1 - w) bounds the others'
+                let se = (n as f64 * w[i] * (1.0 - w[i]) / reps as f64).sqrt();
+                assert!((mean - expected).abs() < 4.0 * se + 1e-9, "{r:?} particle {i}: {mean} against {expected}");
+            }
+        }
+    }
+
+    /// A random walk in position and velocity (x' = x + v dt, both with Gaussian process
+    /// noise) measured directly in position: the particle filter's mean and covariance
+    /// after 30 steps match the Kalman filter's closed form within Monte Carlo tolerance.
+    #[test]
+    fn matches_the_kalman_filter_on_a_linear_gaussian_problem() {
+        struct Walk;
+        impl ParticleProcess for Walk {
+            fn propagate(&self, x: &mut [&mut [f64]], dt: f64, rng: &mut Pcg64) {
+                let (p, v) = x.split_at_mut(1);
+                for (p, v) in p[0].iter_mut().zip(v[0].iter_mut()) {
+                    *p += *v * dt + 0.3 * rng.sample::<f64, _>(rand_distr::StandardNormal);
+                    *v += 0.1 * rng.sample::<f64, _>(rand_distr::StandardNormal);
+                }
+            }
+        }
+        struct Fix(f64);
+        impl ParticleLikelihood for Fix {
+            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+                for (p, lw) in x[0].iter().zip(log_w.iter_mut()) {
+                    *lw -= (p - self.0) * (p - self.0) / (2.0 * 0.5 * 0.5);
+                }
+            }
+        }
+        let settings = ParticleSettings { resampler: Resampler::Systematic, ess_fraction: 0.5, roughening_k: None };
+        let n = 200_000;
+        let mut pf = ParticleFilter::<2>::gaussian(n, &Vector2::new(0.0, 1.0), &Vector2::new(1.0, 0.5), settings, 7);
+        // the Kalman filter
+        let (f, q, h, r) =
+            (Matrix2::new(1.0, 1.0, 0.0, 1.0), Matrix2::new(0.09, 0.0, 0.0, 0.01), Vector2::new(1.0, 0.0), 0.25);
+        let (mut m, mut p) = (Vector2::new(0.0, 1.0), Matrix2::new(1.0, 0.0, 0.0, 0.25));
+        for k in 1..=30 {
+            let z = 1.1 * k as f64 + 0.4 * (k as f64).sin(); // any measurements will do
+            pf.predict(&Walk, 1.0);
+            pf.update(&Fix(z));
+            m = f * m;
+            p = f * p * f.transpose() + q;
+            let s = (h.transpose() * p * h)[0] + r;
+            let gain = p * h / s;
+            m += gain * (z - m.x);
+            p -= gain * h.transpose() * p;
+        }
+        let (pm, pc) = pf.mean_covariance();
+        let ess = pf.ess();
+        for k in 0..2 {
+            let se = (p[(k, k)] / ess).sqrt();
+            assert!((pm[k] - m[k]).abs() < 5.0 * se, "component {k}: {} against {}", pm[k], m[k]);
+            assert_abs_diff_eq!(pc[(k, k)] / p[(k, k)], 1.0, epsilon = 0.05);
+        }
+    }
+
+    /// The same seed gives the same particles whatever the thread count.
+    #[test]
+    fn results_do_not_depend_on_the_thread_count() {
+        struct Jitter;
+        impl ParticleProcess for Jitter {
+            fn propagate(&self, x: &mut [&mut [f64]], _dt: f64, rng: &mut Pcg64) {
+                for c in x.iter_mut() {
+                    for v in c.iter_mut() {
+                        *v += rng.sample::<f64, _>(rand_distr::StandardNormal);
+                    }
+                }
+            }
+        }
+        struct Near;
+        impl ParticleLikelihood for Near {
+            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+                for (i, lw) in log_w.iter_mut().enumerate() {
+                    *lw -= x[0][i] * x[0][i] + x[1][i] * x[1][i];
+                }
+            }
+        }
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let settings =
+                    ParticleSettings { resampler: Resampler::Residual, ess_fraction: 1.0, roughening_k: Some(0.2) };
+                let mut pf =
+                    ParticleFilter::<2>::gaussian(50_000, &Vector2::zeros(), &Vector2::repeat(3.0), settings, 5);
+                for _ in 0..3 {
+                    pf.predict(&Jitter, 1.0);
+                    pf.update(&Near);
+                }
+                (pf.component(0).to_vec(), pf.mean_covariance())
+            })
+        };
+        assert_eq!(run(1), run(3));
+    }
+}
