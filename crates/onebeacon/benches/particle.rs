@@ -41,5 +41,37 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// One planner decision (3 radii x 13 angles) on a belief of n particles: every one of
+/// 5e5, or a subsample. Issue 13's target: <= 50 ms at N = 5e5.
+fn planner(c: &mut Criterion) {
+    use nalgebra::Vector2;
+    use onebeacon::guidance::bearing::{BearingPlanner, Belief, SpreadMetric};
+    let p = BearingPlanner {
+        metric: SpreadMetric::Determinant,
+        r1_m: 16.0,
+        r2_m: 26.0,
+        radii: 3,
+        angles: 13,
+        sigma_usbl_rad_per_m: 0.022f64.to_radians(),
+    };
+    let mut group = c.benchmark_group("hoff2024 planner decision, 39 candidates");
+    group.sample_size(10);
+    for n in [20_000usize, 100_000, 500_000] {
+        let positions: Vec<Vector3<f64>> = (0..n)
+            .map(|i| {
+                let t = i as f64;
+                Vector3::new(100.0 + 5.0 * (t * 0.7).sin(), 50.0 + 5.0 * (t * 1.3).cos(), 30.0 + (t * 0.4).sin())
+            })
+            .collect();
+        let weights = vec![1.0 / n as f64; n];
+        let belief =
+            Belief { positions: &positions, weights: &weights, velocity_m_s: Vector2::new(1.0, 0.5), lead_s: 8.0 };
+        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| black_box(p.decide(&belief, Vector2::new(60.0, 40.0), Vector2::new(0.0, 2.0))))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, planner);
 criterion_main!(benches);

@@ -1,6 +1,9 @@
 //! Guidance of the beacon vehicle: where an ASV carrying the beacon should be at the
 //! next ping so that the ranges tell the underwater vehicle the most.
 //!
+//! - [`bearing`]: hoff2024's planner for a surface vehicle listening with a USBL: the
+//!   point of a half-annulus around the particle belief whose bearing spreads the
+//!   predicted measurements most (eq. 10-12), and its straight legs (eq. 13-16);
 //! - [`fim`]: Fisher information of range measurements about the target's horizontal
 //!   position (sousa eq. 3.11-3.15);
 //! - [`planner`]: the next waypoint inside the ASV's reaching set, by approach A (one
@@ -9,6 +12,7 @@
 //! - [`standoff`]: the best initial horizontal distance for a target depth and ASV reach
 //!   (sousa Fig. 4.7-4.8), answered with the same planner.
 
+pub mod bearing;
 pub mod fim;
 pub mod planner;
 pub mod standoff;

@@ -1,0 +1,275 @@
+//! Where a surface vehicle listening with a USBL should go next (hoff2024 sec. 3): the
+//! candidate point on a half-annulus around the belief whose bearing to the vehicle
+//! would spread the particles' predicted measurements most (eq. 10-12), and the
+//! straight-line waypoint following of eq. 13-16.
+
+use crate::measure::Usbl;
+use nalgebra::{Matrix2, Vector2, Vector3};
+use rayon::prelude::*;
+
+/// How a candidate's spread of predicted measurements is scored (eq. 10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpreadMetric {
+    /// The generalised variance, det C.
+    Determinant,
+    /// The first principal component, the largest eigenvalue of C.
+    MaxEigenvalue,
+}
+
+/// The planner's settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BearingPlanner {
+    pub metric: SpreadMetric,
+    /// The half-annulus: radii r1..r2 (m) about the belief, sampled at `radii` radii and
+    /// `angles` rotations beta in [0, pi].
+    pub r1_m: f64,
+    pub r2_m: f64,
+    pub radii: usize,
+    pub angles: usize,
+    /// The USBL's baseline noise, rad per metre of range (eq. 3).
+    pub sigma_usbl_rad_per_m: f64,
+}
+
+/// The belief the planner scores candidates against.
+#[derive(Debug, Clone, Copy)]
+pub struct Belief<'a> {
+    /// Particle positions (NED) and their normalised weights; a subsample will do.
+    pub positions: &'a [Vector3<f64>],
+    pub weights: &'a [f64],
+    /// The vehicle's estimated velocity over ground (NED, m/s) and the time the surface
+    /// vehicle is assumed to take to the next point: the belief is shifted by their
+    /// product (the paper's "assumed number of steps").
+    pub velocity_m_s: Vector2<f64>,
+    pub lead_s: f64,
+}
+
+/// One decision: the chosen point, its score, and every candidate with its score.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BearingDecision {
+    pub waypoint: Vector2<f64>,
+    pub score: f64,
+    pub candidates: Vec<(Vector2<f64>, f64)>,
+}
+
+impl BearingPlanner {
+    /// The spread of the belief's predicted USBL measurements from a surface vehicle at
+    /// `p` (eq. 10): C = Cov(S (h(x_i, p) - E_i h)), S = diag(sigma_alpha^-2,
+    /// sigma_phi^-2) as the paper writes it, sigma from the range to the weighted mean
+    /// (eq. 3), scored by the metric. The azimuth is taken relative to its weighted
+    /// circular mean so that a belief across +-pi is not torn apart.
+    pub fn spread(&self, belief: &Belief<'_>, p: Vector2<f64>) -> f64 {
+        let shift = belief.velocity_m_s * belief.lead_s;
+        let at = |x: &Vector3<f64>| Vector3::new(x.x + shift.x, x.y + shift.y, x.z);
+        let usbl = Usbl {
+            position_ned_m: Vector3::new(p.x, p.y, 0.0),
+            heading_rad: 0.0,
+            sigma_rad_per_m: self.sigma_usbl_rad_per_m,
+        };
+        let mean = belief.positions.iter().zip(belief.weights).map(|(x, w)| at(x) * *w).sum::<Vector3<f64>>();
+        let (_, _, sigma) = usbl.angles(&mean);
+        let s = 1.0 / (sigma * sigma).max(f64::MIN_POSITIVE);
+        let (mut sin, mut cos) = (0.0, 0.0);
+        let h: Vec<(f64, f64)> = belief
+            .positions
+            .iter()
+            .zip(belief.weights)
+            .map(|(x, w)| {
+                let (a, phi, _) = usbl.angles(&at(x));
+                sin += w * a.sin();
+                cos += w * a.cos();
+                (a, phi)
+            })
+            .collect();
+        let centre = sin.atan2(cos);
+        let rel: Vec<Vector2<f64>> =
+            h.iter().map(|(a, phi)| Vector2::new(crate::geo::wrap_angle(a - centre), *phi)).collect();
+        let m: Vector2<f64> = rel.iter().zip(belief.weights).map(|(r, w)| r * *w).sum();
+        let c: Matrix2<f64> = rel.iter().zip(belief.weights).map(|(r, w)| (r - m) * (r - m).transpose() * *w).sum();
+        let c = c * (s * s); // S C S with S = s I
+        match self.metric {
+            SpreadMetric::Determinant => c.determinant(),
+            SpreadMetric::MaxEigenvalue => c.symmetric_eigenvalues().max(),
+        }
+    }
+
+    /// The candidates of eq. 11-12: the belief's (shifted) mean plus v = r (p_ASV -
+    /// p_AUV) / |...| rotated by beta in [0, pi] about k = v_ASV x (p_AUV - p_ASV) /
+    /// |...|, the vertical on the side the surface vehicle is heading to.
+    pub fn candidates(
+        &self,
+        belief_mean: Vector2<f64>,
+        asv: Vector2<f64>,
+        asv_velocity: Vector2<f64>,
+    ) -> Vec<Vector2<f64>> {
+        let away = asv - belief_mean;
+        let dir = if away.norm() > 1e-9 { away / away.norm() } else { Vector2::new(1.0, 0.0) };
+        let to_auv = belief_mean - asv;
+        // k is +-z: the sign of the vertical component of v_ASV x (p_AUV - p_ASV)
+        let kz = asv_velocity.x * to_auv.y - asv_velocity.y * to_auv.x;
+        let sign = if kz < 0.0 { -1.0 } else { 1.0 };
+        let mut out = Vec::with_capacity(self.radii * self.angles);
+        for ir in 0..self.radii {
+            let r = if self.radii == 1 {
+                self.r1_m
+            } else {
+                self.r1_m + (self.r2_m - self.r1_m) * ir as f64 / (self.radii - 1) as f64
+            };
+            for ib in 0..self.angles {
+                let beta =
+                    if self.angles == 1 { 0.0 } else { std::f64::consts::PI * ib as f64 / (self.angles - 1) as f64 };
+                // Rodrigues about +-z of a horizontal v: v cos b + (k x v) sin b (eq. 11;
+                // k . v = 0)
+                let v = dir * r;
+                let kxv = Vector2::new(-v.y, v.x) * sign;
+                out.push(belief_mean + v * beta.cos() + kxv * beta.sin());
+            }
+        }
+        out
+    }
+
+    /// The best candidate (eq. 10-12) for a surface vehicle at `asv` moving at
+    /// `asv_velocity`.
+    pub fn decide(&self, belief: &Belief<'_>, asv: Vector2<f64>, asv_velocity: Vector2<f64>) -> BearingDecision {
+        let mean3 = belief.positions.iter().zip(belief.weights).map(|(x, w)| x * *w).sum::<Vector3<f64>>();
+        let mean = mean3.xy() + belief.velocity_m_s * belief.lead_s;
+        // candidates scored in parallel, collected in order: the same whatever the threads
+        let candidates: Vec<(Vector2<f64>, f64)> =
+            self.candidates(mean, asv, asv_velocity).into_par_iter().map(|p| (p, self.spread(belief, p))).collect();
+        let (waypoint, score) =
+            candidates.iter().copied().fold((asv, f64::NEG_INFINITY), |best, c| if c.1 > best.1 { c } else { best });
+        BearingDecision { waypoint, score, candidates }
+    }
+}
+
+/// The along-track point of `asv` on the leg from `from` to `to` (eq. 13, with the
+/// projection (a . b) / |a|^2 a: eq. 14 as printed divides by |a| |b|, which is not a
+/// projection), and the target of this cycle `u_nom` x `dt` further along (eq. 15).
+pub fn leg_target(
+    from: Vector2<f64>,
+    to: Vector2<f64>,
+    asv: Vector2<f64>,
+    u_nom_m_s: f64,
+    dt_s: f64,
+) -> (Vector2<f64>, Vector2<f64>) {
+    let a = to - from;
+    let len2 = a.norm_squared();
+    if len2 < 1e-18 {
+        return (to, to);
+    }
+    let along = from + a * (a.dot(&(asv - from)) / len2); // eq. 13-14
+    (along, along + a / len2.sqrt() * u_nom_m_s * dt_s) // eq. 15
+}
+
+/// Whether the surface vehicle will reach waypoint `to` within the next cycle, so that
+/// the next one is to be planned (eq. 16).
+pub fn leg_done(to: Vector2<f64>, asv: Vector2<f64>, u_nom_m_s: f64, dt_s: f64) -> bool {
+    (to - asv).norm() < u_nom_m_s * dt_s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    fn planner(metric: SpreadMetric) -> BearingPlanner {
+        BearingPlanner {
+            metric,
+            r1_m: 16.0,
+            r2_m: 26.0,
+            radii: 3,
+            angles: 13,
+            sigma_usbl_rad_per_m: 0.022f64.to_radians(),
+        }
+    }
+
+    /// The spread of eq. 10 against a brute force written out separately: the angles of
+    /// every particle by acos and atan2, their weighted mean and covariance by sums, the
+    /// Mahalanobis scaling by sigma^-2; det and largest eigenvalue of the 2 x 2 closed
+    /// form.
+    #[test]
+    fn spread_matches_a_brute_force() {
+        let positions: Vec<Vector3<f64>> = (0..40)
+            .map(|i| {
+                let t = i as f64;
+                Vector3::new(100.0 + 3.0 * (t * 0.7).sin(), 50.0 + 2.0 * (t * 1.3).cos(), 30.0 + 0.5 * (t * 0.4).sin())
+            })
+            .collect();
+        let raw: Vec<f64> = (0..40).map(|i| 1.0 + (i % 5) as f64).collect();
+        let total: f64 = raw.iter().sum();
+        let weights: Vec<f64> = raw.iter().map(|w| w / total).collect();
+        let belief =
+            Belief { positions: &positions, weights: &weights, velocity_m_s: Vector2::new(1.0, 0.5), lead_s: 8.0 };
+        let p = Vector2::new(80.0, 70.0);
+        // brute force
+        let shift = Vector2::new(8.0, 4.0);
+        let mut mean = Vector3::zeros();
+        for (x, w) in positions.iter().zip(&weights) {
+            mean += Vector3::new(x.x + shift.x, x.y + shift.y, x.z) * *w;
+        }
+        let range = (mean - Vector3::new(p.x, p.y, 0.0)).norm();
+        let sigma = range * 0.022f64.to_radians();
+        let angles: Vec<(f64, f64)> = positions
+            .iter()
+            .map(|x| {
+                let (dx, dy, dz) = (x.x + shift.x - p.x, x.y + shift.y - p.y, x.z);
+                (dy.atan2(dx), (dz / (dx * dx + dy * dy + dz * dz).sqrt()).acos())
+            })
+            .collect();
+        let ma: f64 = angles.iter().zip(&weights).map(|(a, w)| a.0 * w).sum();
+        let mp: f64 = angles.iter().zip(&weights).map(|(a, w)| a.1 * w).sum();
+        let (mut caa, mut cap, mut cpp) = (0.0, 0.0, 0.0);
+        for (a, w) in angles.iter().zip(&weights) {
+            caa += w * (a.0 - ma) * (a.0 - ma);
+            cap += w * (a.0 - ma) * (a.1 - mp);
+            cpp += w * (a.1 - mp) * (a.1 - mp);
+        }
+        let k = sigma.powi(-4);
+        let (caa, cap, cpp) = (caa * k, cap * k, cpp * k);
+        let det = caa * cpp - cap * cap;
+        let max_eig = (caa + cpp) / 2.0 + (((caa - cpp) / 2.0).powi(2) + cap * cap).sqrt();
+        assert_abs_diff_eq!(planner(SpreadMetric::Determinant).spread(&belief, p) / det, 1.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(planner(SpreadMetric::MaxEigenvalue).spread(&belief, p) / max_eig, 1.0, epsilon = 1e-9);
+    }
+
+    /// Candidates lie on the half-annulus r1..r2 about the belief, from the direction of
+    /// the surface vehicle round the side it is heading to; the decision is the
+    /// candidate of highest score.
+    #[test]
+    fn candidates_sweep_the_half_annulus_on_the_heading_side() {
+        let p = planner(SpreadMetric::Determinant);
+        let (belief, asv) = (Vector2::new(0.0, 0.0), Vector2::new(-40.0, 0.0));
+        // heading east-north... velocity north: v x (p_AUV - p_ASV) = (0,1) x (40,0) < 0
+        let c = p.candidates(belief, asv, Vector2::new(0.0, 1.0));
+        assert_eq!(c.len(), 39);
+        for q in &c {
+            let r = (q - belief).norm();
+            assert!((16.0 - 1e-9..=26.0 + 1e-9).contains(&r), "{r}");
+        }
+        // beta = 0: toward the ASV; beta = pi/2: on the side it heads to (north, y > 0 ...)
+        assert_abs_diff_eq!(c[0], Vector2::new(-16.0, 0.0), epsilon = 1e-9);
+        assert_abs_diff_eq!(c[6], Vector2::new(0.0, 16.0), epsilon = 1e-9);
+        assert_abs_diff_eq!(c[12], Vector2::new(16.0, 0.0), epsilon = 1e-9);
+        let flipped = p.candidates(belief, asv, Vector2::new(0.0, -1.0));
+        assert_abs_diff_eq!(flipped[6], Vector2::new(0.0, -16.0), epsilon = 1e-9);
+
+        let positions = vec![Vector3::new(0.0, 0.0, 30.0), Vector3::new(3.0, 1.0, 31.0), Vector3::new(-2.0, 2.0, 29.0)];
+        let weights = vec![0.5, 0.25, 0.25];
+        let belief = Belief { positions: &positions, weights: &weights, velocity_m_s: Vector2::zeros(), lead_s: 0.0 };
+        let d = p.decide(&belief, asv, Vector2::new(0.0, 1.0));
+        let best = d.candidates.iter().map(|c| c.1).fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(d.score, best);
+        assert!(d.candidates.iter().any(|c| c.0 == d.waypoint && c.1 == best));
+    }
+
+    /// Eq. 13-16: the along-track point is the projection on the leg; the target is
+    /// u_nom dt further along; a waypoint closer than u_nom dt is done.
+    #[test]
+    fn legs_follow_eq_13_to_16() {
+        let (from, to) = (Vector2::new(0.0, 0.0), Vector2::new(100.0, 0.0));
+        let (along, target) = leg_target(from, to, Vector2::new(30.0, 7.0), 2.2, 4.0);
+        assert_abs_diff_eq!(along, Vector2::new(30.0, 0.0), epsilon = 1e-12);
+        assert_abs_diff_eq!(target, Vector2::new(38.8, 0.0), epsilon = 1e-12);
+        assert!(leg_done(to, Vector2::new(92.0, 0.0), 2.2, 4.0));
+        assert!(!leg_done(to, Vector2::new(90.0, 0.0), 2.2, 4.0));
+    }
+}
