@@ -180,10 +180,12 @@ impl<const D: usize> ParticleFilter<D> {
 
     /// The normalised weights.
     pub fn weights(&self) -> Vec<f64> {
-        let max = self.log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let w: Vec<f64> = self.log_w.iter().map(|l| (l - max).exp()).collect();
+        // the maximum is exact in any order; the sum is taken in chunk order
+        let max = self.log_w.par_iter().copied().reduce(|| f64::NEG_INFINITY, f64::max);
+        let mut w: Vec<f64> = self.log_w.par_iter().map(|l| (l - max).exp()).collect();
         let total = sum_in_order(&w);
-        w.into_iter().map(|v| v / total).collect()
+        w.par_iter_mut().for_each(|v| *v /= total);
+        w
     }
 
     /// The effective sample size, 1 / sum w_i^2.
@@ -236,7 +238,7 @@ impl<const D: usize> ParticleFilter<D> {
             });
         }
         std::mem::swap(&mut self.x, &mut self.spare);
-        self.log_w.iter_mut().for_each(|l| *l = 0.0);
+        self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
         if let Some(k) = self.settings.roughening_k {
             let n = self.len() as f64;
             let sigma: Vec<f64> = self
