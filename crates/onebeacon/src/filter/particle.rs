@@ -178,6 +178,23 @@ impl<const D: usize> ParticleFilter<D> {
         false
     }
 
+    /// `m` particles drawn systematically in proportion to their weights (offset one
+    /// half: no random draw), for a planner that scores a belief on a subsample; each
+    /// stands for 1 / m of the weight. Components `k` of each.
+    pub fn subsample(&self, m: usize, k: &[usize]) -> Vec<Vec<f64>> {
+        let w = self.weights();
+        let (mut out, mut i, mut cum) = (Vec::with_capacity(m), 0, w[0]);
+        for j in 0..m {
+            let u = (j as f64 + 0.5) / m as f64;
+            while u >= cum && i + 1 < w.len() {
+                i += 1;
+                cum += w[i];
+            }
+            out.push(k.iter().map(|&c| self.x[c][i]).collect());
+        }
+        out
+    }
+
     /// The normalised weights.
     pub fn weights(&self) -> Vec<f64> {
         // the maximum is exact in any order; the sum is taken in chunk order
