@@ -4,11 +4,12 @@
 //! propagated with truncated Gaussian steps (eq. 4), weighed by the AUV's INS report
 //! (eq. 8) and by the USBL bearing (eq. 6-7).
 
+use crate::filter::ProcessModel;
 use crate::filter::particle::{ParticleLikelihood, ParticleProcess};
 use crate::filter::truncated::truncated_normal;
 use crate::geo::wrap_angle;
 use crate::measure::Usbl;
-use nalgebra::Vector3;
+use nalgebra::{SMatrix, SVector, Vector3};
 use rand::RngExt;
 use rand_pcg::Pcg64;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -94,6 +95,57 @@ impl ParticleProcess for HoffProcess {
     }
 }
 
+/// Eq. 4's mean step and noise as a Gaussian process model, for the EKF and UKF on the
+/// same runs as the particle filter (the truncation left out: the Kalman filters cannot
+/// hold it).
+impl ProcessModel<DIM> for HoffProcess {
+    fn propagate(&self, x: &SVector<f64, DIM>, dt: f64) -> SVector<f64, DIM> {
+        self.transition(x, dt).0
+    }
+
+    fn jacobian(&self, x: &SVector<f64, DIM>, dt: f64) -> SMatrix<f64, DIM, DIM> {
+        self.transition(x, dt).1
+    }
+
+    fn transition(&self, x: &SVector<f64, DIM>, dt: f64) -> (SVector<f64, DIM>, SMatrix<f64, DIM, DIM>) {
+        let (theta, psi, u) = (x[idx::THETA], x[idx::PSI], x[idx::U]);
+        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = psi.sin_cos();
+        let decay = dt / self.t_b_s;
+        let mut n = *x;
+        n[idx::X] += u * ct * cp * dt; // eq. 4, the mean step f(x) dt
+        n[idx::Y] += u * ct * sp * dt;
+        n[idx::Z] -= u * st * dt;
+        n[idx::THETA] += x[idx::B_THETA] * dt;
+        n[idx::PSI] = wrap_angle(psi + x[idx::B_PSI] * dt);
+        n[idx::B_THETA] *= 1.0 - decay;
+        n[idx::B_PSI] *= 1.0 - decay;
+        let mut f = SMatrix::<f64, DIM, DIM>::identity();
+        f[(idx::X, idx::THETA)] = -u * st * cp * dt;
+        f[(idx::X, idx::PSI)] = -u * ct * sp * dt;
+        f[(idx::X, idx::U)] = ct * cp * dt;
+        f[(idx::Y, idx::THETA)] = -u * st * sp * dt;
+        f[(idx::Y, idx::PSI)] = u * ct * cp * dt;
+        f[(idx::Y, idx::U)] = ct * sp * dt;
+        f[(idx::Z, idx::THETA)] = -u * ct * dt;
+        f[(idx::Z, idx::U)] = -st * dt;
+        f[(idx::THETA, idx::B_THETA)] = dt;
+        f[(idx::PSI, idx::B_PSI)] = dt;
+        f[(idx::B_THETA, idx::B_THETA)] = 1.0 - decay;
+        f[(idx::B_PSI, idx::B_PSI)] = 1.0 - decay;
+        (n, f)
+    }
+
+    /// diag(sigma^2) dt^2 (eq. 4).
+    fn noise_covariance(&self, _x: &SVector<f64, DIM>, dt: f64) -> SMatrix<f64, DIM, DIM> {
+        SMatrix::from_diagonal(&SVector::from(self.sigma.map(|s| s * s * dt * dt)))
+    }
+
+    fn is_angle(&self, i: usize) -> bool {
+        i == idx::PSI
+    }
+}
+
 /// The AUV's INS report (eq. 8): heading, speed and depth with the filter's assumed
 /// standard deviations.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -175,5 +227,36 @@ mod tests {
         assert!(z.iter().all(|v| *v >= 1.0));
         assert!(theta.iter().all(|v| v.abs() <= FRAC_PI_2));
         assert!(u.iter().all(|v| *v >= 0.0));
+    }
+
+    /// The Gaussian form's Jacobian against finite differences, and its mean step
+    /// against the particles' noise-free step.
+    #[test]
+    fn gaussian_form_jacobian_and_mean() {
+        let m = HoffProcess::default();
+        for x in [[1.0, 2.0, 30.0, 0.1, 0.5, 2.0, 0.001, 0.01], [-5.0, 7.0, 12.0, -0.4, -2.9, 0.3, -0.002, 0.0]] {
+            let x = SVector::<f64, DIM>::from(x);
+            let f = ProcessModel::jacobian(&m, &x, 4.0);
+            for j in 0..DIM {
+                let eps = 1e-6;
+                let (mut xp, mut xm) = (x, x);
+                xp[j] += eps;
+                xm[j] -= eps;
+                let col = (ProcessModel::propagate(&m, &xp, 4.0) - ProcessModel::propagate(&m, &xm, 4.0)) / (2.0 * eps);
+                for i in 0..DIM {
+                    assert!((f[(i, j)] - col[i]).abs() < 1e-7, "({i}, {j}): {} against {}", f[(i, j)], col[i]);
+                }
+            }
+            let still = HoffProcess { sigma: [0.0; DIM], ..m };
+            let mut pf = ParticleFilter::<DIM>::gaussian(1, &x, &SVector::zeros(), ParticleSettings::default(), 1);
+            pf.predict(&still, 4.0);
+            let (mean, _) = pf.mean_covariance();
+            let n = ProcessModel::propagate(&m, &x, 4.0);
+            for i in 0..DIM {
+                assert!((mean[i] - n[i]).abs() < 1e-12, "{i}");
+            }
+        }
+        let q = ProcessModel::noise_covariance(&m, &SVector::zeros(), 4.0);
+        assert!((q[(0, 0)] - 0.16 * 16.0).abs() < 1e-12);
     }
 }
