@@ -55,7 +55,8 @@ struct Bearing {
 }
 
 fn angles(x: f64, y: f64, z: f64) -> (f64, f64) {
-    (z.atan2(x.hypot(y)), y.atan2(x))
+    use onebeacon::filter::fastmath::atan2;
+    (atan2(z, (x * x + y * y).sqrt()), atan2(y, x))
 }
 
 impl ParticleLikelihood for Bearing {

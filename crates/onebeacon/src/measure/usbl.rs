@@ -28,11 +28,14 @@ impl Usbl {
     /// The azimuth and elevation of a vehicle at `p` (NED), and their common standard
     /// deviation (eq. 1-3).
     pub fn angles(&self, p: &Vector3<f64>) -> (f64, f64, f64) {
+        use crate::filter::fastmath::atan2;
         let d = p - self.position_ned_m;
-        let r = d.norm();
-        let alpha = crate::geo::wrap_angle(d.y.atan2(d.x) - self.heading_rad); // eq. 1
-        let phi = (d.z / r.max(f64::MIN_POSITIVE)).clamp(-1.0, 1.0).acos(); // eq. 2
-        (alpha, phi, r * self.sigma_rad_per_m) // eq. 3
+        // sqrt, not hypot: metres cannot overflow, and hypot's care costs
+        let h2 = d.x * d.x + d.y * d.y;
+        let h = h2.sqrt();
+        let alpha = crate::geo::wrap_angle(atan2(d.y, d.x) - self.heading_rad); // eq. 1
+        let phi = atan2(h, d.z); // eq. 2: acos(dz / r), the angle of (dz, h)
+        (alpha, phi, (h2 + d.z * d.z).sqrt() * self.sigma_rad_per_m) // eq. 3
     }
 
     /// The scalar model of one of the two angles (states with the NED position first).
