@@ -182,17 +182,8 @@ impl<const D: usize> ParticleFilter<D> {
     /// half: no random draw), for a planner that scores a belief on a subsample; each
     /// stands for 1 / m of the weight. Components `k` of each.
     pub fn subsample(&self, m: usize, k: &[usize]) -> Vec<Vec<f64>> {
-        let w = self.weights();
-        let (mut out, mut i, mut cum) = (Vec::with_capacity(m), 0, w[0]);
-        for j in 0..m {
-            let u = (j as f64 + 0.5) / m as f64;
-            while u >= cum && i + 1 < w.len() {
-                i += 1;
-                cum += w[i];
-            }
-            out.push(k.iter().map(|&c| self.x[c][i]).collect());
-        }
-        out
+        let picked = walk(&self.weights(), (0..m).map(|j| (j as f64 + 0.5) / m as f64));
+        picked.into_iter().map(|i| k.iter().map(|&c| self.x[c][i]).collect()).collect()
     }
 
     /// The normalised weights.
@@ -304,28 +295,12 @@ fn sum_in_order(v: &[f64]) -> f64 {
 /// The index of the particle each new particle copies, for normalised weights `w`.
 pub(crate) fn ancestors(resampler: Resampler, w: &[f64], rng: &mut Pcg64) -> Vec<usize> {
     let n = w.len();
-    // the points in [0, 1) whose cumulative-weight cell names the ancestor, in order
-    let walk = |points: &mut dyn Iterator<Item = f64>| -> Vec<usize> {
-        let mut out = Vec::with_capacity(n);
-        let (mut i, mut cum) = (0, w[0]);
-        for u in points {
-            while u >= cum && i + 1 < n {
-                i += 1;
-                cum += w[i];
-            }
-            out.push(i);
-        }
-        out
-    };
     match resampler {
         Resampler::Systematic => {
             let u0: f64 = rng.random();
-            walk(&mut (0..n).map(|k| (k as f64 + u0) / n as f64))
+            walk(w, (0..n).map(|k| (k as f64 + u0) / n as f64))
         }
-        Resampler::Stratified => {
-            let points: Vec<f64> = (0..n).map(|k| (k as f64 + rng.random::<f64>()) / n as f64).collect();
-            walk(&mut points.into_iter())
-        }
+        Resampler::Stratified => walk(w, (0..n).map(|k| (k as f64 + rng.random::<f64>()) / n as f64)),
         Resampler::Multinomial => multinomial(w, n, rng),
         Resampler::Residual => {
             let mut out = Vec::with_capacity(n);
@@ -349,16 +324,24 @@ pub(crate) fn ancestors(resampler: Resampler, w: &[f64], rng: &mut Pcg64) -> Vec
 /// `m` independent draws of an index with probabilities `w`: sorted uniforms (from
 /// exponential spacings) walked along the cumulative weights.
 fn multinomial(w: &[f64], m: usize, rng: &mut Pcg64) -> Vec<usize> {
-    let mut e: Vec<f64> = (0..=m).map(|_| -(1.0 - rng.random::<f64>()).ln()).collect();
+    let e: Vec<f64> = (0..=m).map(|_| -(1.0 - rng.random::<f64>()).ln()).collect();
     let total: f64 = e.iter().sum();
     let mut acc = 0.0;
-    for v in e.iter_mut() {
-        acc += *v;
-        *v = acc / total;
-    }
-    let mut out = Vec::with_capacity(m);
+    walk(
+        w,
+        e[..m].iter().map(|v| {
+            acc += v;
+            acc / total
+        }),
+    )
+}
+
+/// The particle whose cumulative-weight cell holds each of `points` (ascending, in
+/// [0, 1)), walked once along the normalised weights `w`.
+fn walk(w: &[f64], points: impl Iterator<Item = f64>) -> Vec<usize> {
+    let mut out = Vec::with_capacity(points.size_hint().0);
     let (mut i, mut cum) = (0, w[0]);
-    for &u in &e[..m] {
+    for u in points {
         while u >= cum && i + 1 < w.len() {
             i += 1;
             cum += w[i];
