@@ -43,6 +43,15 @@ pub struct Belief<'a> {
     pub lead_s: f64,
 }
 
+impl Belief<'_> {
+    /// The weighted mean of the particles, shifted by the velocity over the lead time.
+    pub fn shifted_mean(&self) -> Vector3<f64> {
+        let shift = self.velocity_m_s * self.lead_s;
+        let mean = self.positions.iter().zip(self.weights).map(|(x, w)| x * *w).sum::<Vector3<f64>>();
+        mean + Vector3::new(shift.x, shift.y, 0.0)
+    }
+}
+
 /// One decision: the chosen point, its score, and every candidate with its score.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BearingDecision {
@@ -58,6 +67,12 @@ impl BearingPlanner {
     /// (eq. 3), scored by the metric. The azimuth is taken relative to its weighted
     /// circular mean so that a belief across +-pi is not torn apart.
     pub fn spread(&self, belief: &Belief<'_>, p: Vector2<f64>) -> f64 {
+        self.spread_about(belief, &belief.shifted_mean(), p)
+    }
+
+    /// [`BearingPlanner::spread`] with the belief's shifted mean in hand (one pass over
+    /// the particles fewer per candidate).
+    fn spread_about(&self, belief: &Belief<'_>, mean: &Vector3<f64>, p: Vector2<f64>) -> f64 {
         let shift = belief.velocity_m_s * belief.lead_s;
         let at = |x: &Vector3<f64>| Vector3::new(x.x + shift.x, x.y + shift.y, x.z);
         let usbl = Usbl {
@@ -65,8 +80,7 @@ impl BearingPlanner {
             heading_rad: 0.0,
             sigma_rad_per_m: self.sigma_usbl_rad_per_m,
         };
-        let mean = belief.positions.iter().zip(belief.weights).map(|(x, w)| at(x) * *w).sum::<Vector3<f64>>();
-        let (_, _, sigma) = usbl.angles(&mean);
+        let (_, _, sigma) = usbl.angles(mean);
         let s = 1.0 / (sigma * sigma).max(f64::MIN_POSITIVE);
         let (mut sin, mut cos) = (0.0, 0.0);
         let h: Vec<(f64, f64)> = belief
@@ -130,11 +144,13 @@ impl BearingPlanner {
     /// The best candidate (eq. 10-12) for a surface vehicle at `asv` moving at
     /// `asv_velocity`.
     pub fn decide(&self, belief: &Belief<'_>, asv: Vector2<f64>, asv_velocity: Vector2<f64>) -> BearingDecision {
-        let mean3 = belief.positions.iter().zip(belief.weights).map(|(x, w)| x * *w).sum::<Vector3<f64>>();
-        let mean = mean3.xy() + belief.velocity_m_s * belief.lead_s;
+        let mean = belief.shifted_mean();
         // candidates scored in parallel, collected in order: the same whatever the threads
-        let candidates: Vec<(Vector2<f64>, f64)> =
-            self.candidates(mean, asv, asv_velocity).into_par_iter().map(|p| (p, self.spread(belief, p))).collect();
+        let candidates: Vec<(Vector2<f64>, f64)> = self
+            .candidates(mean.xy(), asv, asv_velocity)
+            .into_par_iter()
+            .map(|p| (p, self.spread_about(belief, &mean, p)))
+            .collect();
         let (waypoint, score) =
             candidates.iter().copied().fold((asv, f64::NEG_INFINITY), |best, c| if c.1 > best.1 { c } else { best });
         BearingDecision { waypoint, score, candidates }
