@@ -55,8 +55,7 @@ struct Bearing {
 }
 
 fn angles(x: f64, y: f64, z: f64) -> (f64, f64) {
-    use onebeacon::filter::fastmath::atan2;
-    (atan2(z, (x * x + y * y).sqrt()), atan2(y, x))
+    (z.atan2((x * x + y * y).sqrt()), y.atan2(x))
 }
 
 impl ParticleLikelihood for Bearing {

@@ -8,7 +8,6 @@
 
 pub mod consistency;
 pub mod ekf;
-pub mod fastmath;
 pub mod particle;
 pub mod truncated;
 pub mod ukf;

@@ -28,13 +28,12 @@ impl Usbl {
     /// The azimuth and elevation of a vehicle at `p` (NED), and their common standard
     /// deviation (eq. 1-3).
     pub fn angles(&self, p: &Vector3<f64>) -> (f64, f64, f64) {
-        use crate::filter::fastmath::atan2;
         let d = p - self.position_ned_m;
         // sqrt, not hypot: metres cannot overflow, and hypot's care costs
         let h2 = d.x * d.x + d.y * d.y;
         let h = h2.sqrt();
-        let alpha = crate::geo::wrap_angle(atan2(d.y, d.x) - self.heading_rad); // eq. 1
-        let phi = atan2(h, d.z); // eq. 2: acos(dz / r), the angle of (dz, h)
+        let alpha = crate::geo::wrap_angle(d.y.atan2(d.x) - self.heading_rad); // eq. 1
+        let phi = h.atan2(d.z); // eq. 2: acos(dz / r), the angle of (dz, h)
         (alpha, phi, (h2 + d.z * d.z).sqrt() * self.sigma_rad_per_m) // eq. 3
     }
 
