@@ -5,7 +5,7 @@ use crate::{BadInput, plot, report};
 use anyhow::{Context, Result};
 use onebeacon::guidance::{PolarGrid, best_standoff};
 use onebeacon_sim::montecarlo::monte_carlo;
-use onebeacon_sim::run::simulate;
+use onebeacon_sim::run::{GuidanceSnapshot, simulate};
 use onebeacon_sim::scenario::{self, BUILTINS};
 use std::io::Write;
 use std::path::PathBuf;
@@ -68,7 +68,11 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, out: Option<Pat
             .guidance
             .get(ping)
             .ok_or_else(|| BadInput(format!("--ping {ping}: the run has pings 0 to {}", result.guidance.len() - 1)))?;
-        plot::guidance_map(&staging.file("guidance.png"), snapshot).context("cannot draw guidance.png")?;
+        match snapshot {
+            GuidanceSnapshot::Fim(g) => plot::guidance_map(&staging.file("guidance.png"), g),
+            GuidanceSnapshot::Bearing(b) => plot::bearing_map(&staging.file("guidance.png"), b),
+        }
+        .context("cannot draw guidance.png")?;
     }
     let files = staging.commit()?;
 

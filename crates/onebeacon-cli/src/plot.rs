@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use onebeacon::guidance::Metric;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::montecarlo::{CellResult, McResult};
-use onebeacon_sim::run::{Estimate, GuidanceSnapshot, StepRecord};
+use onebeacon_sim::run::{BearingSnapshot, Estimate, FimSnapshot, StepRecord};
 use onebeacon_sim::scenario::SweepValue;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -456,7 +456,7 @@ fn viridis(v: f64) -> RGBColor {
 /// Fig. 3.5 and 3.7): colour from low (dark) to high (yellow), the reaching set as a
 /// circle, the beacon's position, the vehicle's estimate (and its prediction for
 /// approach B) and the chosen waypoint.
-pub fn guidance_map(path: &Path, g: &GuidanceSnapshot) -> Result<()> {
+pub fn guidance_map(path: &Path, g: &FimSnapshot) -> Result<()> {
     register_fonts();
     let centre = g.target.xy();
     let half = ((g.previous - centre).norm() + g.reach_m).max(2.0 * g.reach_m) * 1.2;
@@ -510,6 +510,45 @@ pub fn guidance_map(path: &Path, g: &GuidanceSnapshot) -> Result<()> {
         }
         chart
             .draw_series(std::iter::once(Cross::new((g.waypoint.y, g.waypoint.x), 8, WHITE.stroke_width(3))))?
+            .label("chosen waypoint")
+            .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        root.present()?;
+        Ok(())
+    })())
+}
+
+/// The bearing planner's score over its half-annulus at one decision (hoff2024 eq.
+/// 10-12): each candidate coloured by its score from low (dark) to high (yellow), the
+/// ASV, the belief's shifted mean and the chosen waypoint.
+pub fn bearing_map(path: &Path, g: &BearingSnapshot) -> Result<()> {
+    register_fonts();
+    let m = g.belief_mean.xy();
+    let points = g.candidates.iter().map(|(p, _)| *p).chain([g.asv, m]);
+    let half = points.map(|p| (p - m).abs().max()).fold(1.0f64, f64::max) * 1.15;
+    let (lo, hi) = g.candidates.iter().fold((f64::MAX, f64::MIN), |(l, h), (_, v)| (l.min(*v), h.max(*v)));
+    both!(path, (950, 780), |root| (|| -> Result<()> {
+        let caption = format!("planner score (eq. 10), decision at t = {:.0} s", g.t_s);
+        root.fill(&WHITE)?;
+        let (main, side) = root.split_horizontally(800);
+        colour_bar(&side, lo, hi, "score")?;
+        let root = main;
+        let mut chart =
+            chart(&root, &caption, m.y - half..m.y + half, m.x - half..m.x + half, ("east (m)", "north (m)"))?;
+        chart.draw_series(g.candidates.iter().map(|(p, v)| {
+            let t = (v - lo) / (hi - lo).max(f64::MIN_POSITIVE);
+            Circle::new((p.y, p.x), 6, viridis(t).filled())
+        }))?;
+        chart
+            .draw_series(std::iter::once(TriangleMarker::new((g.asv.y, g.asv.x), 9, BLACK.filled())))?
+            .label("ASV")
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.filled()));
+        chart
+            .draw_series(std::iter::once(Circle::new((m.y, m.x), 6, RED.filled())))?
+            .label("belief (shifted by the lead)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.filled()));
+        chart
+            .draw_series(std::iter::once(Cross::new((g.waypoint.y, g.waypoint.x), 9, BLACK.stroke_width(3))))?
             .label("chosen waypoint")
             .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
         legend(&mut chart, SeriesLabelPosition::UpperRight)?;

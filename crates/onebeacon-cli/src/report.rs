@@ -288,7 +288,7 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
     let _ = writeln!(t);
     let _ = writeln!(
         t,
-        "{:<width$} {:<24} {:>10} {:>5} {:>10} {:>8} {:>9} {:>10} {:>8} {:>15} {:>10} {:>9}",
+        "{:<width$} {:<24} {:>10} {:>5} {:>10} {:>8} {:>9} {:>10} {:>8} {:>15} {:>10} {:>9} {:>6}",
         "sweep",
         "estimator",
         "mean_m",
@@ -300,13 +300,14 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
         "nees",
         "nees_band95",
         "nees_all",
-        "pcrb_m"
+        "pcrb_m",
+        "h2/h1"
     );
     for c in &r.cells {
         for (track, m) in &c.estimators {
             let _ = writeln!(
                 t,
-                "{:<width$} {:<24} {:>10.4} {:>5} {:>10.4} {:>8.3} {:>9.4} {:>10.4} {:>8.2} {:>15} {:>10.1} {:>9}",
+                "{:<width$} {:<24} {:>10.4} {:>5} {:>10.4} {:>8.3} {:>9.4} {:>10.4} {:>8.2} {:>15} {:>10.1} {:>9} {:>6.2}",
                 c.cell.label(),
                 track.label,
                 m.mean_error_m,
@@ -319,6 +320,7 @@ pub fn mc_table(s: &Scenario, r: &McResult, wall_s: f64) -> String {
                 format!("{:.2}-{:.2}", m.nees_band[0], m.nees_band[1]),
                 m.nees_mean_all_runs,
                 c.pcrb(track.vehicle_index).map(|p| format!("{p:.3}")).unwrap_or_else(|| "-".into()),
+                m.mean_error_second_half_m / m.mean_error_first_half_m,
             );
         }
     }

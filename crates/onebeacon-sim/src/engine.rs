@@ -36,12 +36,18 @@ pub(crate) trait World {
     fn truth(&self, v: usize) -> VehicleTruth;
     /// Where the beacon is now.
     fn beacon_ned_m(&self) -> Vector3<f64>;
-    /// Moves from step `k - 1` to `k` and appends to `heard[v]` what vehicle `v`
-    /// measured during the step, in the order its estimators must process it.
-    /// `reports[v]` is what vehicle `v` reports of itself (its first estimator's
-    /// estimate at step `k - 1`), for a beacon that guides itself on it. Returns the
-    /// guidance decision taken in the step, if any.
-    fn advance(&mut self, k: usize, reports: &[Estimate], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot>;
+    /// Moves from step `k - 1` to `k` and appends to `heard[v]` what was measured of
+    /// vehicle `v` during the step, in the order its estimators must process it.
+    /// `beliefs[v]` is vehicle `v`'s first estimator as it stands after step `k - 1`:
+    /// what a beacon vehicle that guides itself on the vehicle knows of it (its
+    /// estimate, and a particle filter's particles). Returns the guidance decision
+    /// taken in the step, if any.
+    fn advance(
+        &mut self,
+        k: usize,
+        beliefs: &[&dyn Navigator],
+        heard: &mut [Vec<Measurement>],
+    ) -> Option<GuidanceSnapshot>;
 }
 
 /// One estimator on one vehicle.
@@ -82,7 +88,6 @@ pub(crate) fn run(world: &mut dyn World, tracks: &mut [Track], observers: &mut [
     let mut heard = vec![Vec::new(); vehicles];
     let mut truth: Vec<VehicleTruth> = (0..vehicles).map(|v| world.truth(v)).collect();
     let mut estimates: Vec<Estimate> = tracks.iter().map(|t| t.navigator.estimate()).collect();
-    let mut reports = Vec::with_capacity(vehicles);
     let mut k = 0;
     loop {
         let step = Step {
@@ -100,9 +105,8 @@ pub(crate) fn run(world: &mut dyn World, tracks: &mut [Track], observers: &mut [
         }
         k += 1;
         heard.iter_mut().for_each(Vec::clear);
-        reports.clear();
-        reports.extend(reporter.iter().map(|&i| estimates[i]));
-        if let Some(g) = world.advance(k, &reports, &mut heard) {
+        let beliefs: Vec<&dyn Navigator> = reporter.iter().map(|&i| &*tracks[i].navigator).collect();
+        if let Some(g) = world.advance(k, &beliefs, &mut heard) {
             observers.iter_mut().for_each(|o| o.guidance(&g));
         }
         for (i, t) in tracks.iter_mut().enumerate() {

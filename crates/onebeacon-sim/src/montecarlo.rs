@@ -5,10 +5,10 @@
 //! data is held at a time.
 
 use crate::metrics::{CellSummary, RunMetrics, summarise};
-use crate::pcrb::horizontal_rmse_bound;
+use crate::pcrb::{bearing_rmse_bound, horizontal_rmse_bound};
 use crate::run::simulate;
 use crate::scenario::{Cell, Scenario, Track};
-use nalgebra::Matrix6;
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
@@ -18,8 +18,8 @@ pub struct CellResult {
     pub cell: Cell,
     /// One summary per (vehicle, estimator) track, in the order of [`Scenario::tracks`].
     pub estimators: Vec<(Track, CellSummary)>,
-    /// Posterior Cramer-Rao bound on each vehicle's horizontal RMSE (moving-beacon
-    /// cells; empty otherwise).
+    /// Posterior Cramer-Rao bound on each vehicle's horizontal RMSE (moving-beacon and
+    /// passive-USBL cells; empty otherwise).
     pub pcrb_rmse_m: Vec<f64>,
 }
 
@@ -68,8 +68,8 @@ pub fn monte_carlo(
     Ok(McResult { runs, seed, cells })
 }
 
-/// What the aggregation keeps of one run: its metrics and its range information.
-type RunSummary = (Vec<RunMetrics>, Vec<(usize, usize, Matrix6<f64>)>);
+/// What the aggregation keeps of one run: its metrics and its acoustic information.
+type RunSummary = (Vec<RunMetrics>, Vec<(usize, usize, DMatrix<f64>)>);
 
 fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: &(dyn Fn() + Sync)) -> CellResult {
     let per_run: Vec<RunSummary> = (0..runs as u64)
@@ -77,7 +77,7 @@ fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: 
         .map(|r| {
             let out = simulate(scenario, cell, seed, r, false);
             progress();
-            (out.metrics, out.range_information)
+            (out.metrics, out.information)
         })
         .collect();
     let estimators = scenario
@@ -89,17 +89,26 @@ fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: 
             (track, summarise(&metrics))
         })
         .collect();
+    // the information summed over the runs, per vehicle and step: one entry per step
+    // with an acoustic measurement, not per step (memory follows the pings)
+    let sum_information = |vehicles: usize| {
+        let mut sum: Vec<BTreeMap<usize, DMatrix<f64>>> = vec![BTreeMap::new(); vehicles];
+        for (_, info) in &per_run {
+            for (v, k, m) in info {
+                sum[*v].entry(*k).and_modify(|s| *s += m).or_insert_with(|| m.clone());
+            }
+        }
+        sum
+    };
     let pcrb_rmse_m = match (scenario, cell) {
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let vehicles = s.vehicles(c);
-            // one entry per step with a range, not per step: memory follows the pings
-            let mut sum = vec![BTreeMap::new(); vehicles.len()];
-            for (_, info) in &per_run {
-                for (v, k, m) in info {
-                    *sum[*v].entry(*k).or_insert_with(Matrix6::zeros) += m;
-                }
-            }
+            let sum = sum_information(vehicles.len());
             vehicles.iter().zip(&sum).map(|(v, sum)| horizontal_rmse_bound(s, v, sum, runs)).collect()
+        }
+        (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(_)) => {
+            let sum = sum_information(s.auvs().len());
+            sum.iter().enumerate().map(|(v, sum)| bearing_rmse_bound(s, v, sum, runs)).collect()
         }
         _ => Vec::new(),
     };

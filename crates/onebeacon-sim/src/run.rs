@@ -6,8 +6,8 @@
 use crate::engine::{self, Observer, Step, Track, VehicleTruth, World};
 use crate::metrics::{ErrorAccumulator, RunMetrics};
 use crate::scenario::{Cell, Scenario};
-use crate::world::{FixedBeaconWorld, MovingBeaconWorld, RangeInformation};
-use nalgebra::{Matrix6, Vector2, Vector3};
+use crate::world::{BearingInformation, FixedBeaconWorld, MovingBeaconWorld, PassiveUsblWorld, RangeInformation};
+use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::filter::consistency::nees;
 use onebeacon::guidance::FimPlanner;
 use onebeacon::nav::Outcome;
@@ -80,10 +80,33 @@ pub struct StepRecord {
     pub estimates: Vec<Estimate>,
 }
 
-/// What the beacon vehicle's guidance knew and chose at one ping (recorded runs), so
-/// that its metric can be mapped over the reaching set (sousa Fig. 3.5, 3.7).
+/// What a beacon vehicle's guidance knew and chose at one decision (recorded runs).
 #[derive(Debug, Clone, PartialEq)]
-pub struct GuidanceSnapshot {
+pub enum GuidanceSnapshot {
+    /// A ranging beacon's Fisher-information guidance (sousa).
+    Fim(FimSnapshot),
+    /// A listening USBL's spread-of-bearings planner (hoff2024).
+    Bearing(BearingSnapshot),
+}
+
+/// The decision of the bearing planner (hoff2024 eq. 10-12) when it chose a waypoint:
+/// every candidate of the half-annulus with its score.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BearingSnapshot {
+    pub t_s: f64,
+    /// The AUV the decision served.
+    pub vehicle: usize,
+    /// The ASV's position, the belief's mean shifted by the lead (NED).
+    pub asv: Vector2<f64>,
+    pub belief_mean: Vector3<f64>,
+    pub candidates: Vec<(Vector2<f64>, f64)>,
+    pub waypoint: Vector2<f64>,
+}
+
+/// What the beacon vehicle's FIM guidance knew and chose at one ping, so that its
+/// metric can be mapped over the reaching set (sousa Fig. 3.5, 3.7).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FimSnapshot {
     pub t_s: f64,
     /// The planner whose metric is mapped (approach A for the baselines).
     pub planner: FimPlanner,
@@ -108,9 +131,10 @@ pub struct RunOutput {
     pub distance_m: Vec<f64>,
     /// Acoustic measurements heard (frames decoded, ranges), all vehicles together.
     pub frames_decoded: u64,
-    /// For bounds: the Fisher information H' R^-1 H of each range received, with the
-    /// vehicle and the step it was received in (moving-beacon runs; empty otherwise).
-    pub range_information: Vec<(usize, usize, Matrix6<f64>)>,
+    /// For bounds: the Fisher information H' R^-1 H of each acoustic measurement at
+    /// the truth (the world's state size), with the vehicle and the step it was received
+    /// in (moving-beacon and passive-USBL runs; empty otherwise).
+    pub information: Vec<(usize, usize, DMatrix<f64>)>,
     /// The guidance decisions of a recorded moving-beacon run, one per ping.
     pub guidance: Vec<GuidanceSnapshot>,
 }
@@ -137,7 +161,15 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
             let mut tracks = world.tracks(s, seed, run);
             let mut info = RangeInformation::new(s.sensor_noise());
             let mut out = drive(&mut world, &mut tracks, Some(&mut info), record);
-            out.range_information = info.into_inner();
+            out.information = info.into_inner();
+            out
+        }
+        (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(c)) => {
+            let mut world = PassiveUsblWorld::new(s, c, seed, run);
+            let mut tracks = world.tracks(s, seed, run);
+            let mut info = BearingInformation::new(s.tracker_noise());
+            let mut out = drive(&mut world, &mut tracks, Some(&mut info), record);
+            out.information = info.into_inner();
             out
         }
         _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),
@@ -160,7 +192,7 @@ fn drive(world: &mut dyn World, tracks: &mut [Track], extra: Option<&mut dyn Obs
         trajectory: recorder.trajectory,
         distance_m: scoring.distance_m,
         frames_decoded: scoring.heard,
-        range_information: Vec::new(),
+        information: Vec::new(),
         guidance: recorder.guidance,
     }
 }

@@ -21,11 +21,7 @@ fn bench(c: &mut Criterion) {
         sigma_speed_m_s: 0.06f64.sqrt(),
         sigma_depth_m: 0.15f64.sqrt(),
     };
-    let usbl = Usbl {
-        position_ned_m: Vector3::new(80.0, 30.0, 0.0),
-        heading_rad: 0.0,
-        sigma_rad_per_m: 0.022f64.to_radians(),
-    };
+    let usbl = Usbl::exact(Vector3::new(80.0, 30.0, 0.0), 0.0, 0.022f64.to_radians());
     let bearing = UsblBearing { usbl, azimuth_rad: 0.78, elevation_rad: 0.8 };
     let mut group = c.benchmark_group("hoff2024 particle filter cycle");
     group.sample_size(10);

@@ -12,6 +12,8 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "garin2024", toml: include_str!("../../../../scenarios/garin2024.toml") },
     Builtin { name: "sousa", toml: include_str!("../../../../scenarios/sousa.toml") },
     Builtin { name: "sousa-pair", toml: include_str!("../../../../scenarios/sousa-pair.toml") },
+    Builtin { name: "hoff2024", toml: include_str!("../../../../scenarios/hoff2024.toml") },
+    Builtin { name: "hoff2024-consistency", toml: include_str!("../../../../scenarios/hoff2024-consistency.toml") },
 ];
 
 /// The built-in scenario called `name`.

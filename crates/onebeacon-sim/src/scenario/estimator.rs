@@ -1,13 +1,16 @@
 //! One estimator description for every world and every log: the `[[estimators]]`
 //! table of scenarios and log descriptions alike. An estimator is its short name
 //! (`kind`), the acoustic measurements it uses, its filter (EKF or UKF with its
-//! sigma-point parameters) and its tuning. The process model is the host's: the
-//! unicycle with acceleration in `fixed_beacon` worlds (garin2024 eq. 3-7), 6-DOF
-//! kinematics in `moving_beacon` worlds (sousa 3.1), planar odometry on logs.
+//! sigma-point parameters, or a particle filter) and its tuning. The process model is
+//! the host's: the unicycle with acceleration in `fixed_beacon` worlds (garin2024 eq.
+//! 3-7), 6-DOF kinematics in `moving_beacon` worlds (sousa 3.1), the stochastic
+//! unicycle of hoff2024 eq. 4 in `passive_usbl` worlds, planar odometry on logs.
 
 use super::FilterName;
 use onebeacon::filter::FilterKind;
-use onebeacon::nav::{Aiding, EkfTuning, PlanarConfig, PlanarNoise, Robust, SensorNoise};
+use onebeacon::filter::particle::{ParticleSettings, Resampler};
+use onebeacon::models::hoff::HoffProcess;
+use onebeacon::nav::{Aiding, EkfTuning, PlanarConfig, PlanarNoise, Robust, SensorNoise, TrackerConfig, TrackerNoise};
 use serde::{Deserialize, Serialize};
 
 /// A heavy-tailed update (`robust` key).
@@ -20,11 +23,22 @@ pub enum RobustName {
     StudentT,
 }
 
+/// How a particle filter resamples (`resampler` key).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ResamplerName {
+    Multinomial,
+    Systematic,
+    Stratified,
+    Residual,
+}
+
 /// Where an estimator runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Host {
     FixedBeacon,
     MovingBeacon,
+    PassiveUsbl,
     Log,
 }
 
@@ -33,6 +47,7 @@ impl Host {
         match self {
             Host::FixedBeacon => "fixed_beacon world",
             Host::MovingBeacon => "moving_beacon world",
+            Host::PassiveUsbl => "passive_usbl world",
             Host::Log => "log",
         }
     }
@@ -42,6 +57,7 @@ impl Host {
         match self {
             Host::FixedBeacon | Host::Log => Aiding::RANGE_DOPPLER,
             Host::MovingBeacon => Aiding::RANGE,
+            Host::PassiveUsbl => Aiding::BEARING,
         }
     }
 }
@@ -61,6 +77,12 @@ pub enum EstimatorKind {
     /// No acoustic measurement.
     #[serde(rename = "dead-reckoning", alias = "dead_reckoning")]
     DeadReckoning,
+    /// hoff2024's particle filter on USBL bearings and the vehicle's reports.
+    #[serde(rename = "pf")]
+    Particle,
+    /// The same models in an EKF or a UKF (`filter`).
+    #[serde(rename = "bearing")]
+    Bearing,
 }
 
 impl EstimatorKind {
@@ -70,6 +92,8 @@ impl EstimatorKind {
             EstimatorKind::Rosb => "rosb",
             EstimatorKind::RangeEkf => "range-ekf",
             EstimatorKind::DeadReckoning => "dead-reckoning",
+            EstimatorKind::Particle => "pf",
+            EstimatorKind::Bearing => "bearing",
         }
     }
 
@@ -80,6 +104,7 @@ impl EstimatorKind {
             EstimatorKind::Rosb => Aiding::RANGE,
             EstimatorKind::RangeEkf => host.acoustic(),
             EstimatorKind::DeadReckoning => Aiding::NONE,
+            EstimatorKind::Particle | EstimatorKind::Bearing => Aiding::BEARING,
         }
     }
 }
@@ -90,6 +115,7 @@ impl EstimatorKind {
 pub enum Acoustic {
     Range,
     Doppler,
+    Bearing,
 }
 
 /// One `[[estimators]]` table. Every key but `kind` is optional; tuning keys apply to
@@ -113,12 +139,34 @@ pub struct EstimatorSpec {
     pub ukf_kappa: Option<f64>,
     // Measurement noise the filter assumes (standard deviations). Default: garin2024
     // eq. 25 (fixed_beacon), the sensors' (moving_beacon), PlanarNoise (logs).
-    /// Range, m (every host).
+    /// Range, m (fixed_beacon, moving_beacon, log).
     pub range_sigma_m: Option<f64>,
     /// Doppler radial speed, m/s (fixed_beacon, log).
     pub doppler_sigma_m_s: Option<f64>,
-    /// Heading, deg (fixed_beacon, log).
+    /// Heading, deg (fixed_beacon, log; passive_usbl: the vehicle's reported heading).
     pub heading_sigma_deg: Option<f64>,
+    /// USBL bearings: sigma_USBL, deg per metre of range (passive_usbl).
+    pub usbl_sigma_deg_per_m: Option<f64>,
+    /// The station's compass error, deg (passive_usbl).
+    pub compass_sigma_deg: Option<f64>,
+    /// The vehicle's reported depth, m (passive_usbl).
+    pub depth_sigma_m: Option<f64>,
+    /// Scales every process noise standard deviation of hoff2024 eq. 4 (passive_usbl).
+    pub process_noise_scale: Option<f64>,
+    /// The process noise standard deviations of eq. 4 per second, state order [x, y, z,
+    /// theta, psi, u, b_theta, b_psi] (m/s, rad/s, m/s^2, rad/s^2; passive_usbl; default:
+    /// hoff2024 sec. 5).
+    pub process_sigma: Option<[f64; 8]>,
+    /// Particles (pf; default 500000, hoff2024 sec. 5).
+    pub particles: Option<usize>,
+    /// `"multinomial"` (hoff2024 eq. 9), `"systematic"` (default), `"stratified"` or
+    /// `"residual"` (pf).
+    pub resampler: Option<ResamplerName>,
+    /// Resample when the effective sample size falls below this fraction (pf; default
+    /// 0.5; 1: every message).
+    pub ess_fraction: Option<f64>,
+    /// Roughening after resampling, K of Gordon et al. (pf; default off).
+    pub roughening_k: Option<f64>,
     /// Yaw rate, rad/s, and forward acceleration, m/s^2 (fixed_beacon).
     pub yaw_rate_sigma_rad_s: Option<f64>,
     pub accel_sigma_m_s2: Option<f64>,
@@ -161,6 +209,9 @@ pub struct EstimatorSpec {
     pub turn_scale_sigma: Option<f64>,
 }
 
+/// Particles of a `pf` estimator without `particles` (hoff2024 sec. 5).
+pub const DEFAULT_PARTICLES: usize = 500_000;
+
 /// The noise keys a log's `[noise]` table may give its estimators, and whether each
 /// must be > 0 (else >= 0).
 pub const NOISE_KEYS: [(&str, bool); 9] = [
@@ -197,6 +248,15 @@ impl EstimatorSpec {
             range_sigma_m: None,
             doppler_sigma_m_s: None,
             heading_sigma_deg: None,
+            usbl_sigma_deg_per_m: None,
+            compass_sigma_deg: None,
+            depth_sigma_m: None,
+            process_noise_scale: None,
+            process_sigma: None,
+            particles: None,
+            resampler: None,
+            ess_fraction: None,
+            roughening_k: None,
             yaw_rate_sigma_rad_s: None,
             accel_sigma_m_s2: None,
             q_diag: None,
@@ -256,7 +316,11 @@ impl EstimatorSpec {
     /// The acoustic measurements used in `host`: `measurements`, or the kind's.
     pub fn aiding(&self, host: Host) -> Aiding {
         match &self.measurements {
-            Some(list) => Aiding { range: list.contains(&Acoustic::Range), doppler: list.contains(&Acoustic::Doppler) },
+            Some(list) => Aiding {
+                range: list.contains(&Acoustic::Range),
+                doppler: list.contains(&Acoustic::Doppler),
+                bearing: list.contains(&Acoustic::Bearing),
+            },
             None => self.kind.aiding(host),
         }
     }
@@ -265,23 +329,31 @@ impl EstimatorSpec {
     pub(crate) fn tuning_keys(&self) -> Vec<(&'static str, f64, Sign, &'static [Host])> {
         use Host::*;
         use Sign::*;
-        const ALL: &[Host] = &[FixedBeacon, MovingBeacon, Log];
+        const RANGING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const FIXED_LOG: &[Host] = &[FixedBeacon, Log];
+        const USBL: &[Host] = &[PassiveUsbl];
         let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
         let mut keys = vec![
-            ("range_sigma_m", self.range_sigma_m, Positive, ALL),
+            ("range_sigma_m", self.range_sigma_m, Positive, RANGING),
             ("doppler_sigma_m_s", self.doppler_sigma_m_s, Positive, FIXED_LOG),
-            ("heading_sigma_deg", self.heading_sigma_deg, Positive, FIXED_LOG),
+            ("heading_sigma_deg", self.heading_sigma_deg, Positive, &[FixedBeacon, PassiveUsbl, Log]),
+            ("usbl_sigma_deg_per_m", self.usbl_sigma_deg_per_m, Positive, USBL),
+            ("compass_sigma_deg", self.compass_sigma_deg, NonNegative, USBL),
+            ("depth_sigma_m", self.depth_sigma_m, Positive, USBL),
+            ("process_noise_scale", self.process_noise_scale, Positive, USBL),
+            ("particles", self.particles.map(|n| n as f64), Positive, USBL),
+            ("ess_fraction", self.ess_fraction, Positive, USBL),
+            ("roughening_k", self.roughening_k, Positive, USBL),
             ("yaw_rate_sigma_rad_s", self.yaw_rate_sigma_rad_s, Positive, &[FixedBeacon]),
             ("accel_sigma_m_s2", self.accel_sigma_m_s2, Positive, &[FixedBeacon]),
             ("distance_sigma_frac", self.distance_sigma_frac, NonNegative, &[Log]),
             ("heading_change_sigma_frac", self.heading_change_sigma_frac, NonNegative, &[Log]),
             ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, NonNegative, &[Log]),
-            ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[Log]),
+            ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[PassiveUsbl, Log]),
             ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
-            ("nis_gate", self.nis_gate, Positive, &[Log]),
+            ("nis_gate", self.nis_gate, Positive, &[PassiveUsbl, Log]),
             ("huber_k", self.huber_k, Positive, &[Log]),
             ("student_t_dof", self.student_t_dof, Positive, &[Log]),
             ("mirror_recovery", flag(self.mirror_recovery), Any, &[FixedBeacon]),
@@ -299,6 +371,9 @@ impl EstimatorSpec {
         ];
         for q in self.q_diag.iter().flatten() {
             keys.push(("q_diag", Some(*q), NonNegative, &[FixedBeacon]));
+        }
+        for q in self.process_sigma.iter().flatten() {
+            keys.push(("process_sigma", Some(*q), NonNegative, USBL));
         }
         keys.into_iter().filter_map(|(k, v, s, h)| v.map(|v| (k, v, s, h))).collect()
     }
@@ -321,6 +396,46 @@ impl EstimatorSpec {
     /// `range_sigma_m` when given.
     pub fn sensor_noise(&self, sensors: SensorNoise) -> SensorNoise {
         SensorNoise { range_m: self.range_sigma_m.unwrap_or(sensors.range_m), ..sensors }
+    }
+
+    /// The trackers' configuration (passive_usbl): the world's noise `n` (a matched
+    /// filter) and [`HoffProcess::default`] where a key is absent.
+    pub fn tracker_config(&self, n: TrackerNoise) -> TrackerConfig {
+        let d = TrackerConfig::default();
+        let scale = self.process_noise_scale.unwrap_or(1.0);
+        TrackerConfig {
+            process: HoffProcess {
+                sigma: self.process_sigma.unwrap_or(d.process.sigma).map(|s| s * scale),
+                ..d.process
+            },
+            noise: TrackerNoise {
+                usbl_sigma_rad_per_m: self.usbl_sigma_deg_per_m.map_or(n.usbl_sigma_rad_per_m, f64::to_radians),
+                station_heading_sigma_rad: self.compass_sigma_deg.map_or(n.station_heading_sigma_rad, f64::to_radians),
+                heading_sigma_rad: self.heading_sigma_deg.map_or(n.heading_sigma_rad, f64::to_radians),
+                speed_sigma_m_s: self.speed_sigma_m_s.unwrap_or(n.speed_sigma_m_s),
+                depth_sigma_m: self.depth_sigma_m.unwrap_or(n.depth_sigma_m),
+            },
+            aiding: self.aiding(Host::PassiveUsbl),
+            nis_gate: self.nis_gate.unwrap_or(d.nis_gate),
+        }
+    }
+
+    /// The particle filter's size and settings (pf).
+    pub fn particle_settings(&self) -> (usize, ParticleSettings) {
+        let d = ParticleSettings::default();
+        let resampler = match self.resampler {
+            None => d.resampler,
+            Some(ResamplerName::Multinomial) => Resampler::Multinomial,
+            Some(ResamplerName::Systematic) => Resampler::Systematic,
+            Some(ResamplerName::Stratified) => Resampler::Stratified,
+            Some(ResamplerName::Residual) => Resampler::Residual,
+        };
+        let settings = ParticleSettings {
+            resampler,
+            ess_fraction: self.ess_fraction.unwrap_or(d.ess_fraction),
+            roughening_k: self.roughening_k.or(d.roughening_k),
+        };
+        (self.particles.unwrap_or(DEFAULT_PARTICLES), settings)
     }
 
     /// The planar navigator's configuration (logs): [`PlanarConfig::default`] where a
@@ -398,7 +513,7 @@ mod tests {
         assert_eq!(spec("kind = \"range_ekf\"").kind, RangeEkf);
         assert_eq!(spec("kind = \"dead_reckoning\"").kind, DeadReckoning);
         let doppler_only = spec("kind = \"range-ekf\"\nmeasurements = [\"doppler\"]");
-        assert_eq!(doppler_only.aiding(Host::Log), Aiding { range: false, doppler: true });
+        assert_eq!(doppler_only.aiding(Host::Log), Aiding { range: false, doppler: true, bearing: false });
     }
 
     /// One table means the same in every host where its keys apply, and is refused by

@@ -1,7 +1,7 @@
 //! Loading a scenario from a built-in name or a file, with one-line errors that name
 //! the source, the key and what is allowed.
 
-use super::{FixedBeacon, MovingBeacon, Scenario, builtin, validate};
+use super::{FixedBeacon, MovingBeacon, PassiveUsbl, Scenario, builtin, validate};
 use std::path::Path;
 
 /// Why a scenario could not be loaded. Each message is one line naming the source (file
@@ -75,6 +75,8 @@ pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
         toml::from_str::<toml::Table>(text).ok().and_then(|t| t.get("kind").and_then(|k| k.as_str().map(String::from)));
     let scenario = if kind.as_deref() == Some("moving_beacon") {
         Scenario::MovingBeacon(deserialize::<MovingBeacon>(text, source_name)?)
+    } else if kind.as_deref() == Some("passive_usbl") {
+        Scenario::PassiveUsbl(deserialize::<PassiveUsbl>(text, source_name)?)
     } else {
         Scenario::FixedBeacon(deserialize::<FixedBeacon>(text, source_name)?)
     };
@@ -139,6 +141,24 @@ mod tests {
 
         let e = err("description = \"no name\"\n");
         assert!(e.contains("name"), "{e}");
+
+        let p = "name = \"x\"\nkind = \"passive_usbl\"\n";
+        let e = err(&format!("{p}[guidance]\nr1_m = 30.0\n"));
+        assert!(e.contains("guidance.r2_m") && e.contains("at least guidance.r1_m"), "{e}");
+        let e = err(&format!("{p}[[estimators]]\nkind = \"bearing\"\nparticles = 100\n"));
+        assert!(e.contains("estimators[0].particles") && e.contains("kind = \"pf\""), "{e}");
+        let e = err(&format!("{p}[[estimators]]\nkind = \"rosb\"\n"));
+        assert!(e.contains("estimators[0].kind") && e.contains("passive_usbl world gives USBL bearings"), "{e}");
+        let e = err("name = \"x\"\n[[estimators]]\nkind = \"pf\"\n");
+        assert!(e.contains("estimators[0].kind") && e.contains("passive_usbl world only"), "{e}");
+        let e = err(&format!("{p}[[estimators]]\nkind = \"pf\"\ness_fraction = 1.5\n"));
+        assert!(e.contains("estimators[0].ess_fraction") && e.contains("probability"), "{e}");
+        let e = err(&format!("{p}[[estimators]]\nkind = \"pf\"\nrange_sigma_m = 1.0\n"));
+        assert!(e.contains("estimators[0].range_sigma_m") && e.contains("passive_usbl"), "{e}");
+        let e = err(&format!("{p}[sweep]\nguidance = [\"det\", \"zigzag\"]\n"));
+        assert!(e.contains("sweep.guidance[1]") && e.contains("max-eig"), "{e}");
+        let e = err(&format!("{p}[usbl]\nnoise_deg_per_m = 0.0\n"));
+        assert!(e.contains("usbl.noise_deg_per_m") && e.contains("> 0"), "{e}");
 
         for e in [err("name = 1\n"), err("name=\"x\"\n[mission]\ndt_s = inf\n")] {
             assert!(!e.contains('\n'), "{e}");

@@ -1,7 +1,8 @@
 //! Scenario files: schema, defaults, loading, validation and the built-in scenarios.
 //!
 //! A scenario is a TOML file whose `kind` names the world it describes:
-//! `fixed_beacon` (the default; garin2024) or `moving_beacon` (sousa). Every key is
+//! `fixed_beacon` (the default; garin2024), `moving_beacon` (sousa) or `passive_usbl`
+//! (hoff2024). Every key is
 //! optional except `name` and has a documented default (the built-in files in
 //! `scenarios/` spell every key out with where its value comes from). Keys carry their
 //! unit in their name; angles in config are degrees (`*_deg`), radians inside.
@@ -11,6 +12,7 @@ pub mod estimator;
 pub mod fixed_beacon;
 pub(crate) mod load;
 pub mod moving_beacon;
+pub mod passive_usbl;
 pub mod ping;
 pub(crate) mod validate;
 
@@ -19,6 +21,7 @@ pub use estimator::{EstimatorKind, EstimatorSpec, Host};
 pub use fixed_beacon::{FixedBeacon, FixedBeaconCell};
 pub use load::{ScenarioError, load, parse};
 pub use moving_beacon::{MovingBeacon, MovingBeaconCell};
+pub use passive_usbl::{PassiveUsbl, PassiveUsblCell};
 
 use onebeacon::filter::{FilterKind, UkfParams};
 use serde::{Deserialize, Serialize};
@@ -32,6 +35,8 @@ pub enum World {
     FixedBeacon,
     /// An underwater vehicle and a beacon on a guided surface vehicle (sousa).
     MovingBeacon,
+    /// AUVs sending messages and a surface vehicle listening with a USBL (hoff2024).
+    PassiveUsbl,
 }
 
 /// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table.
@@ -90,6 +95,7 @@ pub struct Track {
 pub enum Scenario {
     FixedBeacon(FixedBeacon),
     MovingBeacon(MovingBeacon),
+    PassiveUsbl(PassiveUsbl),
 }
 
 /// One value of a swept key.
@@ -113,6 +119,7 @@ impl std::fmt::Display for SweepValue {
 pub enum Cell {
     FixedBeacon(FixedBeaconCell),
     MovingBeacon(MovingBeaconCell),
+    PassiveUsbl(PassiveUsblCell),
 }
 
 impl Cell {
@@ -125,6 +132,7 @@ impl Cell {
                 ("depth_m", SweepValue::Number(c.depth_m)),
                 ("guidance", SweepValue::Text(c.guidance.label())),
             ],
+            Cell::PassiveUsbl(c) => vec![("guidance", SweepValue::Text(c.guidance.label()))],
         }
     }
 
@@ -139,24 +147,28 @@ impl Scenario {
         match self {
             Scenario::FixedBeacon(s) => &s.name,
             Scenario::MovingBeacon(s) => &s.name,
+            Scenario::PassiveUsbl(s) => &s.name,
         }
     }
     pub fn description(&self) -> &str {
         match self {
             Scenario::FixedBeacon(s) => &s.description,
             Scenario::MovingBeacon(s) => &s.description,
+            Scenario::PassiveUsbl(s) => &s.description,
         }
     }
     pub fn seed(&self) -> u64 {
         match self {
             Scenario::FixedBeacon(s) => s.seed,
             Scenario::MovingBeacon(s) => s.seed,
+            Scenario::PassiveUsbl(s) => s.seed,
         }
     }
     pub fn runs(&self) -> usize {
         match self {
             Scenario::FixedBeacon(s) => s.runs,
             Scenario::MovingBeacon(s) => s.runs,
+            Scenario::PassiveUsbl(s) => s.runs,
         }
     }
     /// The (vehicle, estimator) tracks, in the order of every run's metrics and
@@ -166,6 +178,7 @@ impl Scenario {
         let estimators: Vec<String> = match self {
             Scenario::FixedBeacon(s) => s.estimators.iter().map(|e| e.name()).collect(),
             Scenario::MovingBeacon(s) => s.estimators.iter().map(|e| e.name()).collect(),
+            Scenario::PassiveUsbl(s) => s.estimators.iter().map(|e| e.name()).collect(),
         };
         let several = vehicles.len() > 1;
         let mut tracks = Vec::new();
@@ -193,6 +206,7 @@ impl Scenario {
         match self {
             Scenario::FixedBeacon(_) => vec!["auv".into()],
             Scenario::MovingBeacon(s) => s.vehicles(&s.base_cell()).into_iter().filter_map(|v| v.name).collect(),
+            Scenario::PassiveUsbl(s) => s.auvs().into_iter().filter_map(|a| a.name).collect(),
         }
     }
     /// The cell `run` simulates: the scenario's own values, no sweep.
@@ -200,6 +214,7 @@ impl Scenario {
         match self {
             Scenario::FixedBeacon(s) => Cell::FixedBeacon(s.base_cell()),
             Scenario::MovingBeacon(s) => Cell::MovingBeacon(s.base_cell()),
+            Scenario::PassiveUsbl(s) => Cell::PassiveUsbl(s.base_cell()),
         }
     }
     /// The sweep cells of `mc`, in order.
@@ -207,6 +222,7 @@ impl Scenario {
         match self {
             Scenario::FixedBeacon(s) => s.cells().into_iter().map(Cell::FixedBeacon).collect(),
             Scenario::MovingBeacon(s) => s.cells().into_iter().map(Cell::MovingBeacon).collect(),
+            Scenario::PassiveUsbl(s) => s.cells().into_iter().map(Cell::PassiveUsbl).collect(),
         }
     }
     /// Steps of one run after the start.
@@ -214,6 +230,7 @@ impl Scenario {
         match self {
             Scenario::FixedBeacon(s) => s.steps(),
             Scenario::MovingBeacon(s) => s.steps(),
+            Scenario::PassiveUsbl(s) => s.steps(),
         }
     }
     /// Mission duration, s.
@@ -221,6 +238,7 @@ impl Scenario {
         match self {
             Scenario::FixedBeacon(s) => s.duration_s(),
             Scenario::MovingBeacon(s) => s.mission.duration_s,
+            Scenario::PassiveUsbl(s) => s.mission.duration_s,
         }
     }
 }

@@ -1,8 +1,9 @@
 //! Range checks on a parsed scenario. The first violation is reported with its key.
 
-use super::estimator::{EstimatorSpec, Host, NOISE_KEYS, Sign};
+use super::estimator::{EstimatorKind, EstimatorSpec, Host, NOISE_KEYS, Sign};
 use super::moving_beacon::Vehicle;
-use super::{FixedBeacon, MovingBeacon, Scenario};
+use super::passive_usbl::Auv;
+use super::{FixedBeacon, MovingBeacon, PassiveUsbl, Scenario};
 use crate::replay::log::{COLUMN_KEYS, InitialFrom, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
 
 pub(crate) struct Violation {
@@ -59,6 +60,7 @@ pub(super) fn validate(s: &Scenario) -> Result<(), Violation> {
     match s {
         Scenario::FixedBeacon(s) => validate_fixed(s),
         Scenario::MovingBeacon(s) => validate_moving(s),
+        Scenario::PassiveUsbl(s) => validate_passive(s),
     }
 }
 
@@ -123,7 +125,11 @@ fn check_names(section: &str, names: &[String]) -> Result<(), Violation> {
 pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Violation> {
     check_names("estimators", &specs.iter().map(|e| e.name()).collect::<Vec<_>>())?;
     // the planar state has 4 to 8 components; 7 bounds kappa for the common case
-    let states = if host == Host::Log { 7 } else { 6 };
+    let states = match host {
+        Host::Log => 7,
+        Host::PassiveUsbl => 8,
+        Host::FixedBeacon | Host::MovingBeacon => 6,
+    };
     for (k, e) in specs.iter().enumerate() {
         let key = |f: &str| format!("estimators[{k}].{f}");
         check_ukf(&format!("estimators[{k}]"), states, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
@@ -161,17 +167,50 @@ pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<()
                 allowed: format!("does not apply to a {} (it applies to: log)", host.label()),
             });
         }
+        let particle = e.kind == EstimatorKind::Particle;
+        let tracker = particle || e.kind == EstimatorKind::Bearing;
+        if tracker != (host == Host::PassiveUsbl)
+            && (tracker || matches!(e.kind, EstimatorKind::RangeDoppler | EstimatorKind::Rosb))
+        {
+            let allowed = if tracker {
+                format!("tracks a vehicle by USBL bearings: a passive_usbl world only, not a {}", host.label())
+            } else {
+                "uses ranges; a passive_usbl world gives USBL bearings and the vehicle's reports (kinds pf, bearing, range-ekf, dead-reckoning)".to_string()
+            };
+            return Err(Violation { key: key("kind"), value: format!("{:?}", e.kind.label()), allowed });
+        }
+        if !particle
+            && (e.particles.is_some() || e.resampler.is_some() || e.ess_fraction.is_some() || e.roughening_k.is_some())
+        {
+            let name = ["particles", "resampler", "ess_fraction", "roughening_k"]
+                .into_iter()
+                .zip([e.particles.is_some(), e.resampler.is_some(), e.ess_fraction.is_some(), e.roughening_k.is_some()])
+                .find_map(|(n, set)| set.then_some(n))
+                .unwrap_or("particles");
+            return Err(Violation {
+                key: key(name),
+                value: "(set)".into(),
+                allowed: format!("applies to a particle filter (kind = \"pf\") only, not to kind {:?}", e.kind.label()),
+            });
+        }
+        if particle {
+            check_count(&key("particles"), e.particles.unwrap_or(1), 1, 50_000_000)?;
+            if let Some(f) = e.ess_fraction {
+                check(&key("ess_fraction"), f, Rule::Probability)?;
+            }
+        }
         let (asked, has) = (e.aiding(host), host.acoustic());
-        if (asked.doppler && !has.doppler) || (asked.range && !has.range) {
+        if (asked.doppler && !has.doppler) || (asked.range && !has.range) || (asked.bearing && !has.bearing) {
             let (k, value) = match &e.measurements {
                 Some(m) => (key("measurements"), format!("{m:?}").to_lowercase()),
                 None => (key("kind"), format!("{:?}", e.kind.label())),
             };
-            return Err(Violation {
-                key: k,
-                value,
-                allowed: format!("uses Doppler speeds; a {} gives ranges only", host.label()),
-            });
+            let gives = match host {
+                Host::MovingBeacon => "ranges only",
+                Host::PassiveUsbl => "USBL bearings only",
+                Host::FixedBeacon | Host::Log => "ranges and Doppler speeds only",
+            };
+            return Err(Violation { key: k, value, allowed: format!("a {} gives {gives}", host.label()) });
         }
     }
     Ok(())
@@ -296,6 +335,106 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
         check(&format!("sweep.depth_m[{j}]"), d, NonNegative)?;
     }
     check_steps(s.mission.duration_s, s.mission.dt_s)
+}
+
+/// One AUV's table of a passive_usbl scenario (`prefix`: its key).
+fn check_auv(prefix: &str, a: &Auv) -> Result<(), Violation> {
+    use Rule::*;
+    for (field, value, rule) in [
+        ("centre_north_m", a.centre_north_m, Finite),
+        ("centre_east_m", a.centre_east_m, Finite),
+        ("circle_radius_m", a.circle_radius_m, Positive),
+        ("depth_m", a.depth_m, NonNegative),
+        ("speed_m_s", a.speed_m_s, NonNegative),
+        ("start_angle_deg", a.start_angle_deg, Finite),
+    ] {
+        check(&format!("{prefix}.{field}"), value, rule)?;
+    }
+    if let Some(name) = a.name.as_ref().filter(|n| !valid_name(n)) {
+        return Err(Violation { key: format!("{prefix}.name"), value: format!("{name:?}"), allowed: NAME_RULE.into() });
+    }
+    Ok(())
+}
+
+fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
+    check_file_name("name", &s.name)?;
+    check_count("runs", s.runs, 1, 1_000_000)?;
+    check_fields!("mission", s.mission, {
+        duration_s: Positive,
+        message_period_s: Positive,
+        dt_s: Positive,
+    });
+    if s.mission.dt_s > s.mission.message_period_s {
+        return Err(Violation {
+            key: "mission.dt_s".into(),
+            value: format!("{:?}", s.mission.dt_s),
+            allowed: format!("must be at most mission.message_period_s ({})", s.mission.message_period_s),
+        });
+    }
+    check_steps(s.mission.duration_s, s.mission.dt_s)?;
+    check_auv("auv", &s.auv)?;
+    check_count("other_auvs (count)", s.other_auvs.len(), 0, 31)?;
+    for (k, a) in s.other_auvs.iter().enumerate() {
+        check_auv(&format!("other_auvs[{k}]"), a)?;
+    }
+    let names: Vec<String> = s.auvs().into_iter().filter_map(|a| a.name).collect();
+    if let Some(k) = (1..names.len()).find(|&k| names[..k].contains(&names[k])) {
+        return Err(Violation {
+            key: format!("other_auvs[{}].name", k - 1),
+            value: format!("{:?}", names[k]),
+            allowed: "must differ from the other AUVs' names (`auv` for `auv`, `auvN` for the N-th)".into(),
+        });
+    }
+    // the trackers assume these unless told otherwise: a zero would be a likelihood
+    // of zero width
+    check_fields!("reports", s.reports, {
+        heading_noise_deg: Positive,
+        speed_noise_m_s: Positive,
+        depth_noise_m: Positive,
+    });
+    check_fields!("usbl", s.usbl, {
+        noise_deg_per_m: Positive,
+        transducer_depth_m: NonNegative,
+    });
+    check_fields!("asv", s.asv, {
+        max_speed_m_s: Positive,
+        max_turn_rate_deg_s: Positive,
+        nominal_speed_m_s: Positive,
+        along_track_gain: NonNegative,
+        lookahead_m: Positive,
+        gps_noise_m: NonNegative,
+        compass_noise_deg: NonNegative,
+        start_distance_m: NonNegative,
+        start_bearing_deg: Finite,
+    });
+    let g = &s.guidance;
+    check_fields!("guidance", g, {
+        r1_m: Positive,
+        r2_m: Positive,
+        lead_periods: NonNegative,
+        circle_radius_m: Positive,
+        offset_m: NonNegative,
+    });
+    if g.r2_m < g.r1_m {
+        return Err(Violation {
+            key: "guidance.r2_m".into(),
+            value: format!("{:?}", g.r2_m),
+            allowed: format!("must be at least guidance.r1_m ({})", g.r1_m),
+        });
+    }
+    check_count("guidance.radii", g.radii, 1, 1000)?;
+    check_count("guidance.angles", g.angles, 1, 10_000)?;
+    check_count("guidance.planner_particles", g.planner_particles, 1, 10_000_000)?;
+    check_fields!("initial", s.initial, {
+        position_sigma_m: Positive,
+        depth_sigma_m: Positive,
+        pitch_sigma_deg: Positive,
+        heading_sigma_deg: Positive,
+        speed_sigma_m_s: Positive,
+        rate_bias_sigma_deg_s: Positive,
+    });
+    check_estimators(&s.estimators, Host::PassiveUsbl)?;
+    check_list_nonempty("sweep.guidance", &s.sweep.guidance)
 }
 
 fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {

@@ -9,7 +9,7 @@ use crate::sensors::SensorSuite;
 use crate::vehicles::{Path, TruthState, feedback_linearising_control};
 use nalgebra::{SVector, Vector2, Vector3, Vector6};
 use onebeacon::models::unicycle::{Cov, State};
-use onebeacon::nav::{Estimate, Measurement, SingleBeaconNavigator};
+use onebeacon::nav::{Measurement, Navigator, SingleBeaconNavigator};
 
 pub(crate) struct FixedBeaconWorld {
     dt: f64,
@@ -117,7 +117,7 @@ impl World for FixedBeaconWorld {
         Vector3::new(self.beacon.x, self.beacon.y, 0.0)
     }
 
-    fn advance(&mut self, k: usize, _: &[Estimate], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot> {
+    fn advance(&mut self, k: usize, _: &[&dyn Navigator], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot> {
         let t = self.t_s(k);
         // truth moves under the command of the previous step (eq. 3-4), then a new
         // command is computed from the reference (eq. 2)

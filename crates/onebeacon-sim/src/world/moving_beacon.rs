@@ -5,17 +5,17 @@
 
 use crate::acoustics::Ping;
 use crate::engine::{Observer, Step, Track, VehicleTruth, World};
-use crate::run::GuidanceSnapshot;
+use crate::run::{FimSnapshot, GuidanceSnapshot};
 use crate::scenario::moving_beacon::{GuidanceKind, Vehicle};
 use crate::scenario::{Host, MovingBeacon, MovingBeaconCell};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::rov::{body_velocity, rk4_step};
-use nalgebra::{Matrix6, SVector, Vector2, Vector3};
+use nalgebra::{DMatrix, SVector, Vector2, Vector3};
 use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, ReachingSet, best_standoff};
 use onebeacon::measure::ScalarModel;
 use onebeacon::models::kinematic6dof::{BodyVelocity, Cov, State, idx};
-use onebeacon::nav::{BeaconFix, Estimate, Kind, Measurement, Range6DofNavigator, SensorNoise};
+use onebeacon::nav::{BeaconFix, Estimate, Kind, Measurement, Navigator, Range6DofNavigator, SensorNoise};
 use rand_pcg::Pcg64Mcg;
 
 /// The true state of vehicle `v` (path and depth set), step after step: RK4 on its
@@ -176,7 +176,7 @@ impl<'a> MovingBeaconWorld<'a> {
 
     /// The ASV pings, then picks where to be at the next ping (sousa 3.3) from what the
     /// first vehicle reports.
-    fn ping(&mut self, t0: f64, report: &Estimate) -> GuidanceSnapshot {
+    fn ping(&mut self, t0: f64, report: &Estimate) -> FimSnapshot {
         let s = self.s;
         let (period, z_tx) = (s.acoustics.ping_period_s, s.asv.transducer_depth_m);
         let reach = s.asv.max_speed_m_s * period;
@@ -213,15 +213,7 @@ impl<'a> MovingBeaconWorld<'a> {
         };
         self.arrive_at = t0 + period;
         self.next_ping += period;
-        GuidanceSnapshot {
-            t_s: t0,
-            planner,
-            previous: here,
-            reach_m: reach,
-            target,
-            target_next,
-            waypoint: self.waypoint,
-        }
+        FimSnapshot { t_s: t0, planner, previous: here, reach_m: reach, target, target_next, waypoint: self.waypoint }
     }
 }
 
@@ -252,12 +244,18 @@ impl World for MovingBeaconWorld<'_> {
         Vector3::new(self.asv.pos.x, self.asv.pos.y, self.s.asv.transducer_depth_m)
     }
 
-    fn advance(&mut self, k: usize, reports: &[Estimate], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot> {
+    fn advance(
+        &mut self,
+        k: usize,
+        beliefs: &[&dyn Navigator],
+        heard: &mut [Vec<Measurement>],
+    ) -> Option<GuidanceSnapshot> {
         self.k = k;
         let (t0, t1) = (self.t_s(k - 1), self.t_s(k));
         let dt = self.s.mission.dt_s;
         let c = self.s.acoustics.sound_speed_m_s;
-        let snapshot = (t0 + 1e-9 >= self.next_ping).then(|| self.ping(t0, &reports[0]));
+        let snapshot =
+            (t0 + 1e-9 >= self.next_ping).then(|| GuidanceSnapshot::Fim(self.ping(t0, &beliefs[0].estimate())));
         let (u, r) = self.asv.command(self.waypoint, self.arrive_at - t0, &self.lim);
         self.asv = self.asv.step(u, r, dt);
 
@@ -317,7 +315,7 @@ impl World for MovingBeaconWorld<'_> {
 /// from the navigators' own range model, at the truth.
 pub(crate) struct RangeInformation {
     noise: SensorNoise,
-    info: Vec<(usize, usize, Matrix6<f64>)>,
+    info: Vec<(usize, usize, DMatrix<f64>)>,
 }
 
 impl RangeInformation {
@@ -325,7 +323,7 @@ impl RangeInformation {
         Self { noise, info: Vec::new() }
     }
 
-    pub(crate) fn into_inner(self) -> Vec<(usize, usize, Matrix6<f64>)> {
+    pub(crate) fn into_inner(self) -> Vec<(usize, usize, DMatrix<f64>)> {
         self.info
     }
 }
@@ -337,7 +335,8 @@ impl Observer for RangeInformation {
                 if let Kind::Range { beacon, .. } = m.kind {
                     let model = self.noise.range_model(&beacon);
                     let h = ScalarModel::<6>::jacobian(&model, &truth.eta);
-                    self.info.push((v, s.k, h.transpose() * h / model.variance(&truth.eta)));
+                    let info = h.transpose() * h / model.variance(&truth.eta);
+                    self.info.push((v, s.k, DMatrix::from_column_slice(6, 6, info.as_slice())));
                 }
             }
         }

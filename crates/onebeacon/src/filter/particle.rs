@@ -79,6 +79,8 @@ pub struct ParticleFilter<const D: usize> {
     /// Resampling's target buffers, kept to avoid an allocation per step.
     spare: Vec<Vec<f64>>,
     log_w: Vec<f64>,
+    /// The normalised weights, computed once per change of the log-weights.
+    normalised: std::cell::OnceCell<Vec<f64>>,
     pub settings: ParticleSettings,
     seed: u64,
     /// Steps so far (predictions, updates and resamplings each take one): the random
@@ -109,6 +111,7 @@ impl<const D: usize> ParticleFilter<D> {
             x: vec![vec![0.0; n]; D],
             spare: vec![vec![0.0; n]; D],
             log_w: vec![0.0; n],
+            normalised: std::cell::OnceCell::new(),
             settings,
             seed,
             step: 0,
@@ -162,16 +165,42 @@ impl<const D: usize> ParticleFilter<D> {
     /// Weighs every particle by `likelihood` (eq. 5, in logs), then resamples when the
     /// effective sample size falls below the threshold; whether it did.
     pub fn update(&mut self, likelihood: &impl ParticleLikelihood) -> bool {
-        let n = self.len();
+        self.reweight(likelihood);
+        self.resample_if_degenerate()
+    }
+
+    /// Weighs every particle by `likelihood` (eq. 5, in logs), without resampling: for
+    /// several measurements of one time, resampled once after the last. Whether the
+    /// weights are usable: when no particle is left with a finite weight (a measurement
+    /// no particle explains, or a NaN), every weight is reset to equal and false is
+    /// returned, so that one absurd measurement does not end the filter.
+    pub fn reweight(&mut self, likelihood: &impl ParticleLikelihood) -> bool {
         let x = &self.x;
+        self.normalised = std::cell::OnceCell::new();
         self.log_w.par_chunks_mut(CHUNK).enumerate().for_each(|(c, lw)| {
             let start = c * CHUNK;
             let view: Vec<&[f64]> = x.iter().map(|comp| &comp[start..start + lw.len()]).collect();
             likelihood.add_log_likelihood(&view, lw);
         });
         self.step += 1;
-        let w = self.weights();
-        if ess_of(&w) < self.settings.ess_fraction * n as f64 {
+        // NaN compares false both ways: a NaN anywhere makes the maximum NaN
+        let max = self
+            .log_w
+            .par_iter()
+            .copied()
+            .reduce(|| f64::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) });
+        if max.is_finite() {
+            return true;
+        }
+        self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
+        self.normalised = std::cell::OnceCell::new();
+        false
+    }
+
+    /// Resamples when the effective sample size is below the threshold; whether it did.
+    pub fn resample_if_degenerate(&mut self) -> bool {
+        if ess_of(self.normalised()) < self.settings.ess_fraction * self.len() as f64 {
+            let w = self.normalised.take().expect("computed above");
             self.resample_with(&w);
             return true;
         }
@@ -182,29 +211,57 @@ impl<const D: usize> ParticleFilter<D> {
     /// half: no random draw), for a planner that scores a belief on a subsample; each
     /// stands for 1 / m of the weight. Components `k` of each.
     pub fn subsample(&self, m: usize, k: &[usize]) -> Vec<Vec<f64>> {
-        let picked = walk(&self.weights(), (0..m).map(|j| (j as f64 + 0.5) / m as f64));
+        let picked = walk(self.normalised(), (0..m).map(|j| (j as f64 + 0.5) / m as f64));
         picked.into_iter().map(|i| k.iter().map(|&c| self.x[c][i]).collect()).collect()
     }
 
     /// The normalised weights.
     pub fn weights(&self) -> Vec<f64> {
-        // the maximum is exact in any order; the sum is taken in chunk order
-        let max = self.log_w.par_iter().copied().reduce(|| f64::NEG_INFINITY, f64::max);
-        let mut w: Vec<f64> = self.log_w.par_iter().map(|l| (l - max).exp()).collect();
-        let total = sum_in_order(&w);
-        w.par_iter_mut().for_each(|v| *v /= total);
-        w
+        self.normalised().to_vec()
+    }
+
+    /// The normalised weights, computed once per change of the log-weights.
+    fn normalised(&self) -> &[f64] {
+        self.normalised.get_or_init(|| {
+            // the maximum is exact in any order; the sum is taken in chunk order
+            let max = self.log_w.par_iter().copied().reduce(|| f64::NEG_INFINITY, f64::max);
+            let mut w: Vec<f64> = self.log_w.par_iter().map(|l| (l - max).exp()).collect();
+            let total = sum_in_order(&w);
+            w.par_iter_mut().for_each(|v| *v /= total);
+            w
+        })
     }
 
     /// The effective sample size, 1 / sum w_i^2.
     pub fn ess(&self) -> f64 {
-        ess_of(&self.weights())
+        ess_of(self.normalised())
     }
 
-    /// The weighted mean and covariance of the particles.
+    /// The weighted mean and covariance of the particles, in one pass.
     pub fn mean_covariance(&self) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
-        let w = self.weights();
+        self.mean_covariance_with_angle(None)
+    }
+
+    /// [`ParticleFilter::mean_covariance`] with component `angle` (when given) an angle
+    /// in (-pi, pi]: taken as its difference from the heaviest particle's, wrapped, so
+    /// that a cloud across +-pi has its mean and spread where they are (for a spread
+    /// well below pi). The mean angle is wrapped.
+    pub fn mean_covariance_with_angle(&self, angle: Option<usize>) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
+        let w = self.normalised();
         let x = &self.x;
+        let reference = angle.map_or(0.0, |k| {
+            let heaviest = w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b });
+            x[k][heaviest.0]
+        });
+        let wrap = |d: f64| {
+            if d > std::f64::consts::PI {
+                d - std::f64::consts::TAU
+            } else if d <= -std::f64::consts::PI {
+                d + std::f64::consts::TAU
+            } else {
+                d
+            }
+        };
         // per chunk: sum w x and sum w x x', reduced in chunk order
         let partial: Vec<(SVector<f64, D>, SMatrix<f64, D, D>)> = (0..w.len().div_ceil(CHUNK))
             .into_par_iter()
@@ -212,7 +269,10 @@ impl<const D: usize> ParticleFilter<D> {
                 let (start, end) = (c * CHUNK, ((c + 1) * CHUNK).min(w.len()));
                 let (mut s, mut ss) = (SVector::<f64, D>::zeros(), SMatrix::<f64, D, D>::zeros());
                 for i in start..end {
-                    let p = SVector::<f64, D>::from_fn(|k, _| x[k][i]);
+                    let mut p = SVector::<f64, D>::from_fn(|k, _| x[k][i]);
+                    if let Some(k) = angle {
+                        p[k] = wrap(p[k] - reference);
+                    }
                     s += w[i] * p;
                     ss += w[i] * p * p.transpose();
                 }
@@ -224,13 +284,18 @@ impl<const D: usize> ParticleFilter<D> {
             mean += s;
             second += ss;
         }
-        (mean, second - mean * mean.transpose())
+        let cov = second - mean * mean.transpose();
+        if let Some(k) = angle {
+            mean[k] = wrap(mean[k] + reference);
+        }
+        (mean, cov)
     }
 
     /// Draws the particles again in proportion to their weights, resets the weights,
     /// and roughens when asked.
     pub fn resample(&mut self) {
-        self.resample_with(&self.weights());
+        let w = self.normalised.take().unwrap_or_else(|| self.weights());
+        self.resample_with(&w);
     }
 
     /// [`ParticleFilter::resample`] with the normalised weights `w` in hand.
@@ -247,6 +312,7 @@ impl<const D: usize> ParticleFilter<D> {
         }
         std::mem::swap(&mut self.x, &mut self.spare);
         self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
+        self.normalised = std::cell::OnceCell::new();
         if let Some(k) = self.settings.roughening_k {
             let n = self.len() as f64;
             let sigma: Vec<f64> = self
@@ -356,6 +422,7 @@ mod tests {
     use super::*;
     use approx::assert_abs_diff_eq;
     use nalgebra::{Matrix2, Vector2};
+    use std::f64::consts::PI;
 
     /// Each resampler copies particle i N w_i times on average (2000 resamplings of 7
     /// particles, within 4 standard errors); systematic and residual copy it at least
@@ -479,5 +546,23 @@ mod tests {
             })
         };
         assert_eq!(run(1), run(3));
+    }
+
+    /// An angle component across +-pi: the mean where the particles are (pi, not 0) and
+    /// the variance of their wrapped spread, against the values worked out by hand.
+    #[test]
+    fn angle_mean_across_the_wrap() {
+        let mean = SVector::<f64, 2>::from([1.0, 0.0]);
+        let mut pf = ParticleFilter::<2>::gaussian(4, &mean, &SVector::zeros(), ParticleSettings::default(), 1);
+        // four angles 0.1 apart about pi: pi - 0.15, pi - 0.05, -pi + 0.05, -pi + 0.15
+        let angles = [PI - 0.15, PI - 0.05, -PI + 0.05, -PI + 0.15];
+        pf.x[1].copy_from_slice(&angles);
+        let (m, c) = pf.mean_covariance_with_angle(Some(1));
+        assert!((m[1].abs() - PI).abs() < 1e-12, "{}", m[1]);
+        let var = [0.15f64, 0.05, 0.05, 0.15].iter().map(|d| d * d).sum::<f64>() / 4.0;
+        assert!((c[(1, 1)] - var).abs() < 1e-12, "{}", c[(1, 1)]);
+        // linear: the mean is near 0 and the spread near pi^2
+        let (m, c) = pf.mean_covariance();
+        assert!(m[1].abs() < 1e-12 && c[(1, 1)] > 9.0);
     }
 }

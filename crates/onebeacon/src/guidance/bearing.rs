@@ -64,8 +64,8 @@ impl BearingPlanner {
     /// The spread of the belief's predicted USBL measurements from a surface vehicle at
     /// `p` (eq. 10): C = Cov(S (h(x_i, p) - E_i h)), S = diag(sigma_alpha^-2,
     /// sigma_phi^-2) as the paper writes it, sigma from the range to the weighted mean
-    /// (eq. 3), scored by the metric. The azimuth is taken relative to its weighted
-    /// circular mean so that a belief across +-pi is not torn apart.
+    /// (eq. 3), scored by the metric. The azimuth is taken relative to the mean's so
+    /// that a belief across +-pi is not torn apart.
     pub fn spread(&self, belief: &Belief<'_>, p: Vector2<f64>) -> f64 {
         self.spread_about(belief, &belief.shifted_mean(), p)
     }
@@ -75,30 +75,19 @@ impl BearingPlanner {
     fn spread_about(&self, belief: &Belief<'_>, mean: &Vector3<f64>, p: Vector2<f64>) -> f64 {
         let shift = belief.velocity_m_s * belief.lead_s;
         let at = |x: &Vector3<f64>| Vector3::new(x.x + shift.x, x.y + shift.y, x.z);
-        let usbl = Usbl {
-            position_ned_m: Vector3::new(p.x, p.y, 0.0),
-            heading_rad: 0.0,
-            sigma_rad_per_m: self.sigma_usbl_rad_per_m,
-        };
-        let (_, _, sigma) = usbl.angles(mean);
+        let usbl = Usbl::exact(Vector3::new(p.x, p.y, 0.0), 0.0, self.sigma_usbl_rad_per_m);
+        let (centre, _, sigma) = usbl.angles(mean);
         let s = 1.0 / (sigma * sigma).max(f64::MIN_POSITIVE);
-        let (mut sin, mut cos) = (0.0, 0.0);
-        let h: Vec<(f64, f64)> = belief
-            .positions
-            .iter()
-            .zip(belief.weights)
-            .map(|(x, w)| {
-                let (a, phi, _) = usbl.angles(&at(x));
-                sin += w * a.sin();
-                cos += w * a.cos();
-                (a, phi)
-            })
-            .collect();
-        let centre = sin.atan2(cos);
-        let rel: Vec<Vector2<f64>> =
-            h.iter().map(|(a, phi)| Vector2::new(crate::geo::wrap_angle(a - centre), *phi)).collect();
-        let m: Vector2<f64> = rel.iter().zip(belief.weights).map(|(r, w)| r * *w).sum();
-        let c: Matrix2<f64> = rel.iter().zip(belief.weights).map(|(r, w)| (r - m) * (r - m).transpose() * *w).sum();
+        // azimuths about the mean's (the covariance does not depend on the centre), one
+        // pass: sums of w h and w h h'
+        let (mut m, mut second) = (Vector2::zeros(), Matrix2::zeros());
+        for (x, w) in belief.positions.iter().zip(belief.weights) {
+            let (a, phi, _) = usbl.angles(&at(x));
+            let r = Vector2::new(crate::geo::wrap_angle(a - centre), phi);
+            m += r * *w;
+            second += r * r.transpose() * *w;
+        }
+        let c = second - m * m.transpose();
         let c = c * (s * s); // S C S with S = s I
         match self.metric {
             SpreadMetric::Determinant => c.determinant(),

@@ -43,6 +43,12 @@ pub fn item_json(item: &Item) -> Value {
                 Kind::RangeDoppler { range_m, radial_speed_m_s, .. } => {
                     json!({"range_m": range_m, "radial_speed_m_s": radial_speed_m_s})
                 }
+                Kind::Bearing { station_heading_rad, azimuth_rad, elevation_rad, .. } => json!({
+                    "station_heading_rad": station_heading_rad, "azimuth_rad": azimuth_rad,
+                    "elevation_rad": elevation_rad}),
+                Kind::Report { heading_rad, speed_m_s, depth_m } => {
+                    json!({"heading_rad": heading_rad, "speed_m_s": speed_m_s, "depth_m": depth_m})
+                }
             };
             v["t_s"] = json!(t);
             v["kind"] = json!(m.name());
@@ -71,7 +77,7 @@ pub fn item_json(item: &Item) -> Value {
 
 /// The kinds a line may have.
 pub const KINDS: &str = "odometry, body_odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
-    range_doppler, beacon_position, ground_truth";
+    range_doppler, bearing, report, beacon_position, ground_truth";
 
 /// Parses one JSON line into an item; `fixed` beacons resolve `beacon` ids, `tracked`
 /// ones (the ids of the `beacon_position` items the session took so far) are resolved
@@ -143,6 +149,15 @@ fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u
             range_m: num("range_m")?,
             radial_speed_m_s: num("radial_speed_m_s")?,
         }),
+        "bearing" => m(Kind::Bearing {
+            station: beacon(tracked)?,
+            station_heading_rad: num("station_heading_rad")?,
+            azimuth_rad: num("azimuth_rad")?,
+            elevation_rad: num("elevation_rad")?,
+        }),
+        "report" => {
+            m(Kind::Report { heading_rad: num("heading_rad")?, speed_m_s: num("speed_m_s")?, depth_m: num("depth_m")? })
+        }
         "beacon_position" => {
             let beacon_id = beacon_id()?;
             let z = optional("z_m")?.unwrap_or(0.0);
@@ -335,6 +350,8 @@ mod tests {
             Kind::Range { beacon: b, range_m: 42.5 },
             Kind::Doppler { beacon: b, radial_speed_m_s: -0.4 },
             Kind::RangeDoppler { beacon: b, range_m: 42.5, radial_speed_m_s: -0.4 },
+            Kind::Bearing { station: b, station_heading_rad: 0.3, azimuth_rad: -1.2, elevation_rad: 0.6 },
+            Kind::Report { heading_rad: 1.1, speed_m_s: 1.5, depth_m: 30.0 },
         ];
         let mut items: Vec<Item> = kinds.iter().map(|k| Item { t_s: 2.5, input: Input::Measurement(*k) }).collect();
         items.push(Item {

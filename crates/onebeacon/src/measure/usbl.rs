@@ -6,13 +6,16 @@ use super::ScalarModel;
 use nalgebra::{SMatrix, SVector, Vector3};
 
 /// The USBL on the surface vehicle: its NED position and heading when the message
-/// arrives, and the baseline noise sigma_USBL in rad per metre of range (the paper's
-/// deg/m, converted).
+/// arrives, the baseline noise sigma_USBL in rad per metre of range (the paper's deg/m,
+/// converted), and how well the station knows its own position (GPS, m per horizontal
+/// axis) and heading (compass, rad): the paper takes both as exact (zero).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Usbl {
     pub position_ned_m: Vector3<f64>,
     pub heading_rad: f64,
     pub sigma_rad_per_m: f64,
+    pub position_sigma_m: f64,
+    pub heading_sigma_rad: f64,
 }
 
 /// Which angle of a [`Usbl`] a scalar model measures.
@@ -35,6 +38,26 @@ impl Usbl {
         let alpha = crate::geo::wrap_angle(d.y.atan2(d.x) - self.heading_rad); // eq. 1
         let phi = h.atan2(d.z); // eq. 2: acos(dz / r), the angle of (dz, h)
         (alpha, phi, (h2 + d.z * d.z).sqrt() * self.sigma_rad_per_m) // eq. 3
+    }
+
+    /// A USBL whose station knows its own pose exactly.
+    pub fn exact(position_ned_m: Vector3<f64>, heading_rad: f64, sigma_rad_per_m: f64) -> Self {
+        Self { position_ned_m, heading_rad, sigma_rad_per_m, position_sigma_m: 0.0, heading_sigma_rad: 0.0 }
+    }
+
+    /// The variances of the azimuth and the elevation of a vehicle at `p`: eq. 3's
+    /// (sigma_USBL r)^2 on each, plus, to first order, what the station's pose errors add:
+    /// its heading error wholly on the azimuth; its position error, across the line of
+    /// sight, on the azimuth (sigma^2 / h^2) and, along it, on the elevation (d phi / d h
+    /// = dz / r^2).
+    pub fn variances(&self, p: &Vector3<f64>) -> (f64, f64) {
+        let d = p - self.position_ned_m;
+        let h2 = (d.x * d.x + d.y * d.y).max(1e-12);
+        let r2 = h2 + d.z * d.z;
+        let base = self.sigma_rad_per_m * self.sigma_rad_per_m * r2; // eq. 3
+        let g2 = self.position_sigma_m * self.position_sigma_m;
+        let c2 = self.heading_sigma_rad * self.heading_sigma_rad;
+        (base + g2 / h2 + c2, base + g2 * d.z * d.z / (r2 * r2))
     }
 
     /// The scalar model of one of the two angles (states with the NED position first).
@@ -89,8 +112,11 @@ impl<const N: usize> ScalarModel<N> for UsblModel {
     }
 
     fn variance(&self, x: &SVector<f64, N>) -> f64 {
-        let (_, _, sigma) = self.usbl.angles(&x.fixed_rows::<3>(0).into_owned());
-        sigma * sigma
+        let (az, el) = self.usbl.variances(&x.fixed_rows::<3>(0).into_owned());
+        match self.angle {
+            UsblAngle::Azimuth => az,
+            UsblAngle::Elevation => el,
+        }
     }
 }
 
@@ -105,8 +131,7 @@ mod tests {
     /// points around the surface vehicle.
     #[test]
     fn angles_and_jacobians() {
-        let usbl =
-            Usbl { position_ned_m: Vector3::new(10.0, 20.0, 0.0), heading_rad: FRAC_PI_2, sigma_rad_per_m: 1e-3 };
+        let usbl = Usbl::exact(Vector3::new(10.0, 20.0, 0.0), FRAC_PI_2, 1e-3);
         // 30 m north and 30 m down of the ASV heading east: azimuth -90 deg, elevation 45 deg
         let (a, p, s) = usbl.angles(&Vector3::new(40.0, 20.0, 30.0));
         assert_abs_diff_eq!(a, -FRAC_PI_2, epsilon = 1e-12);
@@ -119,5 +144,37 @@ mod tests {
                 assert_abs_diff_eq!(ScalarModel::<4>::jacobian(&m, &x), finite_difference::<4>(&m, &x), epsilon = 1e-7);
             }
         }
+    }
+
+    /// The station's pose errors in the variances against the spread of the angles
+    /// over many stations drawn around the nominal one (Monte Carlo, 2e5 draws; the
+    /// first-order terms hold to a few per cent 40 m away with 1 m and 2 deg errors).
+    #[test]
+    fn station_errors_add_their_spread() {
+        use rand::SeedableRng;
+        let nominal = Usbl {
+            position_sigma_m: 1.0,
+            heading_sigma_rad: 2f64.to_radians(),
+            ..Usbl::exact(Vector3::zeros(), 0.3, 0.0)
+        };
+        let p = Vector3::new(20.0, 15.0, 30.0);
+        let (var_az, var_el) = nominal.variances(&p);
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        let n = 200_000;
+        let (a0, e0, _) = nominal.angles(&p);
+        let (mut sa, mut se) = (0.0, 0.0);
+        for _ in 0..n {
+            let g = |rng: &mut rand_pcg::Pcg64Mcg, s: f64| crate::measure::gauss(rng, s);
+            let station = Usbl::exact(
+                Vector3::new(g(&mut rng, 1.0), g(&mut rng, 1.0), 0.0),
+                0.3 + g(&mut rng, 2f64.to_radians()),
+                0.0,
+            );
+            let (a, e, _) = station.angles(&p);
+            sa += crate::geo::wrap_angle(a - a0).powi(2);
+            se += (e - e0).powi(2);
+        }
+        assert_abs_diff_eq!(sa / n as f64, var_az, epsilon = 0.03 * var_az);
+        assert_abs_diff_eq!(se / n as f64, var_el, epsilon = 0.03 * var_el);
     }
 }

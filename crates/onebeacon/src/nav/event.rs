@@ -54,6 +54,14 @@ pub enum Kind {
     /// A decoded communication frame: range and Doppler radial speed at once
     /// (garin2024 eq. 18, left).
     RangeDoppler { beacon: BeaconFix, range_m: f64, radial_speed_m_s: f64 },
+    /// The bearing of the vehicle measured by a USBL on a station (a surface vehicle)
+    /// that heard one of its messages: azimuth from the station's heading and elevation
+    /// from the vertical (hoff2024 eq. 1-2), with the station's position as its GPS
+    /// gives it (`station`, its `sigma_m` the GPS error) and its compass heading.
+    Bearing { station: BeaconFix, station_heading_rad: f64, azimuth_rad: f64, elevation_rad: f64 },
+    /// What the vehicle reports of itself in an acoustic message: its INS heading,
+    /// speed over ground and depth (hoff2024 eq. 8).
+    Report { heading_rad: f64, speed_m_s: f64, depth_m: f64 },
 }
 
 impl Kind {
@@ -63,6 +71,7 @@ impl Kind {
             Kind::Range { beacon, .. } | Kind::Doppler { beacon, .. } | Kind::RangeDoppler { beacon, .. } => {
                 Some(beacon)
             }
+            Kind::Bearing { station, .. } => Some(station),
             _ => None,
         }
     }
@@ -72,6 +81,7 @@ impl Kind {
             Kind::Range { beacon, .. } | Kind::Doppler { beacon, .. } | Kind::RangeDoppler { beacon, .. } => {
                 Some(beacon)
             }
+            Kind::Bearing { station, .. } => Some(station),
             _ => None,
         }
     }
@@ -90,6 +100,8 @@ impl Kind {
             Kind::Range { .. } => "range",
             Kind::Doppler { .. } => "doppler",
             Kind::RangeDoppler { .. } => "range_doppler",
+            Kind::Bearing { .. } => "bearing",
+            Kind::Report { .. } => "report",
         }
     }
 }

@@ -13,6 +13,7 @@ pub mod range_6dof;
 pub mod session;
 pub mod single_beacon;
 pub mod tracking;
+pub mod usbl_track;
 
 pub use event::{BeaconFix, Kind, Measurement};
 pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
@@ -20,6 +21,7 @@ pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
 pub use range_6dof::{Range6DofNavigator, SensorNoise};
 pub use single_beacon::{EkfTuning, SingleBeaconNavigator};
 pub use tracking::TrackingNavigator;
+pub use usbl_track::{GaussianTracker, ParticleTracker, TrackerConfig, TrackerNoise};
 
 use crate::filter::{AnyFilter, FilterError, Gated, GaussianFilter, MeasurementModel};
 use nalgebra::{Matrix2, Matrix3, SVector, Vector3};
@@ -91,19 +93,23 @@ pub struct Aiding {
     pub range: bool,
     /// Doppler radial speeds.
     pub doppler: bool,
+    /// USBL bearings (azimuth and elevation from a station).
+    pub bearing: bool,
 }
 
 impl Aiding {
     /// No beacon: dead reckoning.
-    pub const NONE: Aiding = Aiding { range: false, doppler: false };
+    pub const NONE: Aiding = Aiding { range: false, doppler: false, bearing: false };
     /// Ranges only (ROSB, range-only navigation).
-    pub const RANGE: Aiding = Aiding { range: true, doppler: false };
+    pub const RANGE: Aiding = Aiding { range: true, doppler: false, bearing: false };
     /// Ranges and Doppler speeds (garin2024's filter).
-    pub const RANGE_DOPPLER: Aiding = Aiding { range: true, doppler: true };
+    pub const RANGE_DOPPLER: Aiding = Aiding { range: true, doppler: true, bearing: false };
+    /// USBL bearings only (hoff2024's passive tracking).
+    pub const BEARING: Aiding = Aiding { range: false, doppler: false, bearing: true };
 
     /// Whether any beacon measurement is used.
     pub fn any(self) -> bool {
-        self.range || self.doppler
+        self.range || self.doppler || self.bearing
     }
 }
 
@@ -190,6 +196,12 @@ pub trait Navigator: Send {
     fn process(&mut self, m: &Measurement) -> Outcome;
     /// The current estimate.
     fn estimate(&self) -> Estimate;
+    /// Up to `m` equally weighted samples of the position belief (NED), for a planner
+    /// that scores a belief by its spread: a particle filter's particles, drawn in
+    /// proportion to their weights; None for a Gaussian belief.
+    fn position_sample(&self, _m: usize) -> Option<Vec<Vector3<f64>>> {
+        None
+    }
 }
 
 #[cfg(test)]

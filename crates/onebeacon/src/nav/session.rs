@@ -75,6 +75,17 @@ impl Input {
                     Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
                         Kind::Attitude { roll_rad, pitch_rad, heading_rad: frame.heading_to_ned(heading_rad) }
                     }
+                    // the azimuth turns from the station's heading like a heading change;
+                    // the elevation is from the vertical in either frame
+                    Kind::Bearing { station, station_heading_rad, azimuth_rad, elevation_rad } => Kind::Bearing {
+                        station,
+                        station_heading_rad: frame.heading_to_ned(station_heading_rad),
+                        azimuth_rad: frame.turn_to_ned(azimuth_rad),
+                        elevation_rad,
+                    },
+                    Kind::Report { heading_rad, speed_m_s, depth_m } => {
+                        Kind::Report { heading_rad: frame.heading_to_ned(heading_rad), speed_m_s, depth_m }
+                    }
                     other => other,
                 })
             }
@@ -252,6 +263,22 @@ impl Limits {
                     Kind::RangeDoppler { range_m, radial_speed_m_s, .. } => {
                         range(range_m)?;
                         speed("radial_speed_m_s", radial_speed_m_s)
+                    }
+                    Kind::Bearing { station_heading_rad, azimuth_rad, elevation_rad, .. } => {
+                        angle("station_heading_rad", station_heading_rad)?;
+                        angle("azimuth_rad", azimuth_rad)?;
+                        within(
+                            "elevation_rad",
+                            elevation_rad,
+                            0.0,
+                            std::f64::consts::PI,
+                            "an angle from the vertical in [0, pi]",
+                        )
+                    }
+                    Kind::Report { heading_rad, speed_m_s, depth_m } => {
+                        angle("heading_rad", heading_rad)?;
+                        speed("speed_m_s", speed_m_s)?;
+                        within("depth_m", depth_m, -100.0, self.max_depth_m, "limits.max_depth_m")
                     }
                 }
             }

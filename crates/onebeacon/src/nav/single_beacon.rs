@@ -304,7 +304,14 @@ mod tests {
             let mut filters = [
                 SingleBeaconNavigator::new(Aiding::RANGE_DOPPLER, tuning, kind, 0.0, start, p0),
                 SingleBeaconNavigator::new(Aiding::RANGE, tuning, kind, 0.0, start, p0),
-                SingleBeaconNavigator::new(Aiding { range: false, doppler: true }, tuning, kind, 0.0, start, p0),
+                SingleBeaconNavigator::new(
+                    Aiding { range: false, doppler: true, bearing: false },
+                    tuning,
+                    kind,
+                    0.0,
+                    start,
+                    p0,
+                ),
             ];
             let mut truth = truth0;
             let (mut speed_err, mut speed_err_sum) = ([0.0; 3], [0.0; 3]);

@@ -1,0 +1,314 @@
+//! Scenarios of kind `passive_usbl` (hoff2024): an AUV on a circle sends an acoustic
+//! message every period with its INS heading, speed and depth; a surface vehicle (ASV)
+//! listens with a USBL, tracks the AUV from the bearings and the reports, and moves to
+//! where the next bearing tells the most. Unknown keys are errors.
+
+use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PassiveUsbl {
+    /// `passive_usbl`.
+    pub kind: World,
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    #[serde(default = "default_runs::<20>")]
+    pub runs: usize,
+    #[serde(default)]
+    pub mission: Mission,
+    #[serde(default)]
+    pub auv: Auv,
+    /// More AUVs sending messages in the same water, tracked by the same estimators;
+    /// the planner serves them all (the worst one first).
+    #[serde(default)]
+    pub other_auvs: Vec<Auv>,
+    #[serde(default)]
+    pub reports: Reports,
+    #[serde(default)]
+    pub usbl: UsblSpec,
+    #[serde(default)]
+    pub asv: Asv,
+    #[serde(default)]
+    pub guidance: Guidance,
+    #[serde(default)]
+    pub initial: Initial,
+    #[serde(default = "default_estimators")]
+    pub estimators: Vec<EstimatorSpec>,
+    #[serde(default)]
+    pub sweep: Sweep,
+}
+
+fn default_estimators() -> Vec<EstimatorSpec> {
+    vec![EstimatorSpec::new(EstimatorKind::Particle), EstimatorSpec::new(EstimatorKind::Bearing)]
+}
+
+/// Durations and periods.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Mission {
+    pub duration_s: f64,
+    /// Time between the AUV's messages (T_comms), s: one filter cycle and one step.
+    pub message_period_s: f64,
+    /// The surface vehicle's integration step, s.
+    pub dt_s: f64,
+}
+
+impl Default for Mission {
+    fn default() -> Self {
+        Self { duration_s: 3600.0, message_period_s: 4.0, dt_s: 0.1 }
+    }
+}
+
+/// An AUV on a circle (eq. 22), at constant depth and speed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Auv {
+    /// Name in outputs (default `auv`, then `auv2`, `auv3`, ... for `other_auvs`).
+    pub name: Option<String>,
+    pub centre_north_m: f64,
+    pub centre_east_m: f64,
+    pub circle_radius_m: f64,
+    pub depth_m: f64,
+    pub speed_m_s: f64,
+    /// Where on the circle it starts, deg from north about the centre.
+    pub start_angle_deg: f64,
+    /// Turning clockwise seen from above (to starboard) or not.
+    pub clockwise: bool,
+}
+
+impl Default for Auv {
+    fn default() -> Self {
+        Self {
+            name: None,
+            centre_north_m: 0.0,
+            centre_east_m: 0.0,
+            circle_radius_m: 500.0,
+            depth_m: 30.0,
+            speed_m_s: 1.5,
+            start_angle_deg: 0.0,
+            clockwise: true,
+        }
+    }
+}
+
+/// The noise of the AUV's INS reports (standard deviations; Table 1, true column).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Reports {
+    pub heading_noise_deg: f64,
+    pub speed_noise_m_s: f64,
+    pub depth_noise_m: f64,
+}
+
+impl Default for Reports {
+    fn default() -> Self {
+        Self {
+            heading_noise_deg: 0.13f64.sqrt().to_degrees(),
+            speed_noise_m_s: 0.05f64.sqrt(),
+            depth_noise_m: 0.1f64.sqrt(),
+        }
+    }
+}
+
+/// The USBL on the ASV (Table 1, true column).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct UsblSpec {
+    /// sigma_USBL: the standard deviation of each angle per metre of range, deg/m (eq. 3).
+    pub noise_deg_per_m: f64,
+    pub transducer_depth_m: f64,
+}
+
+impl Default for UsblSpec {
+    fn default() -> Self {
+        Self { noise_deg_per_m: 0.01, transducer_depth_m: 0.0 }
+    }
+}
+
+/// The surface vehicle: kinematic, with speed and turn-rate limits, following
+/// straight legs with the time assignment of eq. 24-26.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Asv {
+    pub max_speed_m_s: f64,
+    pub max_turn_rate_deg_s: f64,
+    /// u_nom: the speed legs are planned at (eq. 15), below the top speed.
+    pub nominal_speed_m_s: f64,
+    /// c_u: the along-track gain of the speed law (eq. 26), 1/s.
+    pub along_track_gain: f64,
+    /// Line-of-sight lookahead distance along the leg, m.
+    pub lookahead_m: f64,
+    /// GPS error per horizontal axis and compass error of the ASV (the paper: exact).
+    pub gps_noise_m: f64,
+    pub compass_noise_deg: f64,
+    /// Where it starts: this far from the first AUV, in this direction (deg from north).
+    pub start_distance_m: f64,
+    pub start_bearing_deg: f64,
+}
+
+impl Default for Asv {
+    fn default() -> Self {
+        Self {
+            max_speed_m_s: 3.09,
+            max_turn_rate_deg_s: 20.0,
+            nominal_speed_m_s: 2.2,
+            along_track_gain: 0.2,
+            lookahead_m: 5.0,
+            gps_noise_m: 0.0,
+            compass_noise_deg: 0.0,
+            start_distance_m: 20.0,
+            start_bearing_deg: 180.0,
+        }
+    }
+}
+
+/// How the ASV chooses where to go.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum GuidanceKind {
+    /// The half-annulus point of largest det C (eq. 10-12, generalised variance).
+    #[serde(rename = "det")]
+    Determinant,
+    /// The half-annulus point of largest eigenvalue of C (eq. 10-12).
+    #[serde(rename = "max-eig")]
+    MaxEigenvalue,
+    /// Stay at the start (baseline).
+    #[serde(rename = "static")]
+    Static,
+    /// Circle the belief at `circle_radius_m` (baseline).
+    #[serde(rename = "circle")]
+    Circle,
+    /// Hold `offset_m` behind the belief, along its course (baseline).
+    #[serde(rename = "offset")]
+    Offset,
+}
+
+impl GuidanceKind {
+    pub fn label(self) -> &'static str {
+        match self {
+            GuidanceKind::Determinant => "det",
+            GuidanceKind::MaxEigenvalue => "max-eig",
+            GuidanceKind::Static => "static",
+            GuidanceKind::Circle => "circle",
+            GuidanceKind::Offset => "offset",
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Guidance {
+    pub kind: GuidanceKind,
+    /// The half-annulus r1..r2 around the belief (m), sampled at `radii` radii and
+    /// `angles` rotations.
+    pub r1_m: f64,
+    pub r2_m: f64,
+    pub radii: usize,
+    pub angles: usize,
+    /// Particles the planner scores a candidate on (a subsample of the filter's).
+    pub planner_particles: usize,
+    /// The message periods the ASV is assumed to take to the next point: the belief is
+    /// shifted by the AUV's estimated velocity over them (sec. 3).
+    pub lead_periods: f64,
+    pub circle_radius_m: f64,
+    pub offset_m: f64,
+}
+
+impl Default for Guidance {
+    fn default() -> Self {
+        Self {
+            kind: GuidanceKind::Determinant,
+            r1_m: 16.0,
+            r2_m: 26.0,
+            radii: 3,
+            angles: 19,
+            planner_particles: 20_000,
+            lead_periods: 2.0,
+            circle_radius_m: 20.0,
+            offset_m: 20.0,
+        }
+    }
+}
+
+/// The trackers' initial uncertainty (standard deviations; each starts at the truth
+/// plus one draw of these).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Initial {
+    pub position_sigma_m: f64,
+    pub depth_sigma_m: f64,
+    pub pitch_sigma_deg: f64,
+    pub heading_sigma_deg: f64,
+    pub speed_sigma_m_s: f64,
+    /// The pitch and heading rate biases, deg/s.
+    pub rate_bias_sigma_deg_s: f64,
+}
+
+impl Default for Initial {
+    fn default() -> Self {
+        Self {
+            position_sigma_m: 5.0,
+            depth_sigma_m: 1.0,
+            pitch_sigma_deg: 2.0,
+            heading_sigma_deg: 10.0,
+            speed_sigma_m_s: 0.3,
+            rate_bias_sigma_deg_s: 0.05,
+        }
+    }
+}
+
+/// Values swept by `mc`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Sweep {
+    pub guidance: Option<Vec<GuidanceKind>>,
+}
+
+/// One sweep cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PassiveUsblCell {
+    pub guidance: GuidanceKind,
+}
+
+impl PassiveUsbl {
+    pub fn base_cell(&self) -> PassiveUsblCell {
+        PassiveUsblCell { guidance: self.guidance.kind }
+    }
+
+    pub fn cells(&self) -> Vec<PassiveUsblCell> {
+        let kinds = self.sweep.guidance.clone().unwrap_or_else(|| vec![self.guidance.kind]);
+        kinds.into_iter().map(|guidance| PassiveUsblCell { guidance }).collect()
+    }
+
+    /// Steps (message periods) after the start.
+    pub fn steps(&self) -> usize {
+        (self.mission.duration_s / self.mission.message_period_s).round() as usize
+    }
+
+    /// The noise of the world's measurements, which the trackers assume unless told
+    /// otherwise (a matched filter).
+    pub fn tracker_noise(&self) -> onebeacon::nav::TrackerNoise {
+        onebeacon::nav::TrackerNoise {
+            usbl_sigma_rad_per_m: self.usbl.noise_deg_per_m.to_radians(),
+            station_heading_sigma_rad: self.asv.compass_noise_deg.to_radians(),
+            heading_sigma_rad: self.reports.heading_noise_deg.to_radians(),
+            speed_sigma_m_s: self.reports.speed_noise_m_s,
+            depth_sigma_m: self.reports.depth_noise_m,
+        }
+    }
+
+    /// The AUVs, each with its name set.
+    pub fn auvs(&self) -> Vec<Auv> {
+        std::iter::once(self.auv.clone())
+            .chain(self.other_auvs.iter().cloned())
+            .enumerate()
+            .map(|(i, mut a)| {
+                a.name = Some(a.name.unwrap_or_else(|| if i == 0 { "auv".into() } else { format!("auv{}", i + 1) }));
+                a
+            })
+            .collect()
+    }
+}

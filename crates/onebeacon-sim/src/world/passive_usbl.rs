@@ -1,0 +1,489 @@
+//! The passive-USBL world (hoff2024): AUVs on circles send a message every period with
+//! their INS heading, speed and depth; a surface vehicle (ASV) hears each message on
+//! its USBL (azimuth and elevation, eq. 1-3) and moves, between messages, along the
+//! legs its guidance plans on what the first estimator of the AUVs believes (eq.
+//! 10-16, 24-26). One engine step is one message period; the ASV is integrated within
+//! it at `mission.dt_s`. Messages travel instantly (at 40 m the 27 ms of flight move
+//! the ASV 6 cm).
+
+use crate::engine::{Track, VehicleTruth, World};
+use crate::run::{BearingSnapshot, GuidanceSnapshot};
+use crate::scenario::passive_usbl::{Auv, GuidanceKind};
+use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
+use crate::seed::{Stream, gauss, vehicle_rng};
+use crate::vehicles::asv::{AsvLimits, AsvState};
+use nalgebra::{Matrix2, SVector, Vector2, Vector3};
+use onebeacon::geo::wrap_angle;
+use onebeacon::guidance::bearing::{BearingPlanner, Belief, SpreadMetric, leg_done, leg_target};
+use onebeacon::measure::{ScalarModel, Usbl, UsblAngle};
+use onebeacon::models::hoff::{DIM, idx};
+use onebeacon::nav::{BeaconFix, Estimate, GaussianTracker, Kind, Measurement, Navigator, ParticleTracker};
+use rand::RngExt;
+use rand_pcg::Pcg64Mcg;
+use std::f64::consts::FRAC_PI_2;
+
+/// One AUV on its circle: where it is at time t, in closed form.
+struct Circle {
+    spec: Auv,
+    /// Turning sense: +1 clockwise seen from above (north to east).
+    sense: f64,
+}
+
+/// One AUV: its circle and the random streams of its reports and bearings.
+struct AuvTruth {
+    circle: Circle,
+    report_rng: Pcg64Mcg,
+    usbl_rng: Pcg64Mcg,
+}
+
+impl Circle {
+    fn new(spec: Auv) -> Self {
+        Self { sense: if spec.clockwise { 1.0 } else { -1.0 }, spec }
+    }
+
+    /// The angle about the centre (from north toward east) at `t_s`.
+    fn angle(&self, t_s: f64) -> f64 {
+        self.spec.start_angle_deg.to_radians() + self.sense * self.spec.speed_m_s / self.spec.circle_radius_m * t_s
+    }
+
+    fn position(&self, t_s: f64) -> Vector3<f64> {
+        let (s, c) = self.angle(t_s).sin_cos();
+        let r = self.spec.circle_radius_m;
+        Vector3::new(self.spec.centre_north_m + r * c, self.spec.centre_east_m + r * s, self.spec.depth_m)
+    }
+
+    fn heading(&self, t_s: f64) -> f64 {
+        wrap_angle(self.angle(t_s) + self.sense * FRAC_PI_2)
+    }
+
+    /// The full state of eq. 4 at `t_s`: level, at constant speed, turning at v / R.
+    fn state(&self, t_s: f64) -> SVector<f64, DIM> {
+        let p = self.position(t_s);
+        let yaw_rate = self.sense * self.spec.speed_m_s / self.spec.circle_radius_m;
+        SVector::from([p.x, p.y, p.z, 0.0, self.heading(t_s), self.spec.speed_m_s, 0.0, yaw_rate])
+    }
+}
+
+/// The leg the ASV follows: from the previous waypoint to the current (eq. 13-16).
+#[derive(Debug, Clone, Copy)]
+struct Leg {
+    from: Vector2<f64>,
+    to: Vector2<f64>,
+}
+
+pub(crate) struct PassiveUsblWorld<'a> {
+    s: &'a PassiveUsbl,
+    guidance: GuidanceKind,
+    auvs: Vec<AuvTruth>,
+    lim: AsvLimits,
+    asv0: Vector2<f64>,
+    asv: AsvState,
+    /// The ASV's speed at the end of the last step (for the side of the half-annulus).
+    asv_speed: f64,
+    leg: Option<Leg>,
+    /// GPS and compass errors of the ASV.
+    station_rng: Pcg64Mcg,
+    k: usize,
+}
+
+impl<'a> PassiveUsblWorld<'a> {
+    pub(crate) fn new(s: &'a PassiveUsbl, cell: &PassiveUsblCell, seed: u64, run: u64) -> Self {
+        let auvs: Vec<AuvTruth> = s
+            .auvs()
+            .into_iter()
+            .enumerate()
+            .map(|(v, spec)| AuvTruth {
+                circle: Circle::new(spec),
+                report_rng: vehicle_rng(seed, run, v, Stream::Imu),
+                usbl_rng: vehicle_rng(seed, run, v, Stream::Acoustic),
+            })
+            .collect();
+        let start = auvs[0].circle.position(0.0).xy();
+        let b = s.asv.start_bearing_deg.to_radians();
+        let asv0 = start + Vector2::new(b.cos(), b.sin()) * s.asv.start_distance_m;
+        let to_auv = start - asv0;
+        Self {
+            s,
+            guidance: cell.guidance,
+            auvs,
+            lim: AsvLimits {
+                max_speed_m_s: s.asv.max_speed_m_s,
+                max_turn_rate_rad_s: s.asv.max_turn_rate_deg_s.to_radians(),
+            },
+            asv0,
+            asv: AsvState { pos: asv0, psi: to_auv.y.atan2(to_auv.x) },
+            asv_speed: 0.0,
+            leg: None,
+            station_rng: vehicle_rng(seed, run, 0, Stream::Heading),
+            k: 0,
+        }
+    }
+
+    /// The true state of eq. 4 of AUV `v` at `t_s`.
+    pub(crate) fn truth_state(s: &PassiveUsbl, v: usize, t_s: f64) -> SVector<f64, DIM> {
+        Circle::new(s.auvs().swap_remove(v)).state(t_s)
+    }
+
+    /// The trackers' initial standard deviations, state order.
+    pub(crate) fn initial_sigma(s: &PassiveUsbl) -> SVector<f64, DIM> {
+        let i = &s.initial;
+        let bias = i.rate_bias_sigma_deg_s.to_radians();
+        SVector::<f64, DIM>::from([
+            i.position_sigma_m,
+            i.position_sigma_m,
+            i.depth_sigma_m,
+            i.pitch_sigma_deg.to_radians(),
+            i.heading_sigma_deg.to_radians(),
+            i.speed_sigma_m_s,
+            bias,
+            bias,
+        ])
+    }
+
+    /// Every estimator on every AUV, each AUV's started at its truth plus one draw (the
+    /// same for all its estimators; its particle filters share one seed).
+    pub(crate) fn tracks(&self, s: &PassiveUsbl, seed: u64, run: u64) -> Vec<Track> {
+        let sigma0 = Self::initial_sigma(s);
+        let mut tracks = Vec::new();
+        for (v, auv) in self.auvs.iter().enumerate() {
+            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
+            let mut x0 = auv.circle.state(0.0) + sigma0.map(|sd| gauss(&mut init_rng, sd));
+            x0[idx::PSI] = wrap_angle(x0[idx::PSI]);
+            let pf_seed: u64 = init_rng.random();
+            for e in &s.estimators {
+                let config = e.tracker_config(s.tracker_noise());
+                let navigator: Box<dyn Navigator> = match e.kind {
+                    EstimatorKind::Particle => {
+                        let (n, settings) = e.particle_settings();
+                        Box::new(ParticleTracker::new(config, settings, n, 0.0, &x0, &sigma0, pf_seed))
+                    }
+                    _ => Box::new(GaussianTracker::new(config, e.filter_kind(), 0.0, &x0, &sigma0)),
+                };
+                tracks.push(Track { vehicle: v, navigator });
+            }
+        }
+        tracks
+    }
+
+    fn planner(&self) -> BearingPlanner {
+        let g = &self.s.guidance;
+        BearingPlanner {
+            metric: if self.guidance == GuidanceKind::MaxEigenvalue {
+                SpreadMetric::MaxEigenvalue
+            } else {
+                SpreadMetric::Determinant
+            },
+            r1_m: g.r1_m,
+            r2_m: g.r2_m,
+            radii: g.radii,
+            angles: g.angles,
+            // the planner knows the USBL as the first estimator assumes it
+            sigma_usbl_rad_per_m: self.s.estimators[0]
+                .tracker_config(self.s.tracker_noise())
+                .noise
+                .usbl_sigma_rad_per_m,
+        }
+    }
+
+    /// The next waypoint of the planners (eq. 10-12): on the half-annulus of the AUV
+    /// whose estimate is the least certain (det of its horizontal covariance), scored
+    /// on its belief. With one AUV, the paper's planner.
+    fn plan(&self, t_s: f64, beliefs: &[&dyn Navigator]) -> BearingSnapshot {
+        let estimates: Vec<Estimate> = beliefs.iter().map(|b| b.estimate()).collect();
+        let worst = (0..estimates.len())
+            .max_by(|&a, &b| {
+                estimates[a].horizontal_cov_m2.determinant().total_cmp(&estimates[b].horizontal_cov_m2.determinant())
+            })
+            .unwrap_or(0);
+        let g = &self.s.guidance;
+        let e = &estimates[worst];
+        let positions = beliefs[worst]
+            .position_sample(g.planner_particles)
+            .unwrap_or_else(|| gaussian_sample(e, g.planner_particles));
+        let weights = vec![1.0 / positions.len() as f64; positions.len()];
+        let pitch = e.body_to_ned();
+        let course = pitch * Vector3::new(e.speed_m_s.unwrap_or(0.0), 0.0, 0.0);
+        let belief = Belief {
+            positions: &positions,
+            weights: &weights,
+            velocity_m_s: course.xy(),
+            lead_s: g.lead_periods * self.s.mission.message_period_s,
+        };
+        let asv_velocity = Vector2::new(self.asv.psi.cos(), self.asv.psi.sin()) * self.asv_speed.max(0.1);
+        let planner = self.planner();
+        let decision = planner.decide(&belief, self.asv.pos, asv_velocity);
+        BearingSnapshot {
+            t_s,
+            vehicle: worst,
+            asv: self.asv.pos,
+            belief_mean: belief.shifted_mean(),
+            candidates: decision.candidates,
+            waypoint: decision.waypoint,
+        }
+    }
+
+    /// Where the ASV is to go in this period: the straight path from p_a to p_t (eq. 24),
+    /// and a guidance decision when one was taken.
+    fn path(&mut self, t_s: f64, beliefs: &[&dyn Navigator]) -> (Vector2<f64>, Vector2<f64>, Option<BearingSnapshot>) {
+        let s = self.s;
+        let (u_nom, period) = (s.asv.nominal_speed_m_s, s.mission.message_period_s);
+        let here = self.asv.pos;
+        // the baselines steer toward a point, at most u_nom x period away this period
+        let toward = |target: Vector2<f64>| {
+            let d = target - here;
+            let reach = u_nom * period;
+            (here, if d.norm() > reach { here + d / d.norm() * reach } else { target })
+        };
+        match self.guidance {
+            GuidanceKind::Determinant | GuidanceKind::MaxEigenvalue => {
+                let mut snapshot = None;
+                let need = self.leg.is_none_or(|l| leg_done(l.to, here, u_nom, period)); // eq. 16
+                if need {
+                    let plan = self.plan(t_s, beliefs);
+                    let from = self.leg.map_or(here, |l| l.to);
+                    self.leg = Some(Leg { from, to: plan.waypoint });
+                    snapshot = Some(plan);
+                }
+                let leg = self.leg.expect("planned above");
+                let (p_a, p_t) = leg_target(leg.from, leg.to, here, u_nom, period); // eq. 13-15
+                // a leg shorter than one period ends at its waypoint
+                let p_t = if (p_t - p_a).norm() > (leg.to - p_a).norm() { leg.to } else { p_t };
+                (p_a, p_t, snapshot)
+            }
+            GuidanceKind::Static => (here, self.asv0, None),
+            GuidanceKind::Circle => {
+                let e = beliefs[0].estimate();
+                let centre = e.position_ned_m.xy();
+                let r = s.guidance.circle_radius_m;
+                let rel = here - centre;
+                let angle = rel.y.atan2(rel.x) + (u_nom * period / r).min(FRAC_PI_2);
+                let (p_a, p_t) = toward(centre + Vector2::new(angle.cos(), angle.sin()) * r);
+                (p_a, p_t, None)
+            }
+            GuidanceKind::Offset => {
+                let e = beliefs[0].estimate();
+                let h = e.heading_rad();
+                let target = e.position_ned_m.xy() - Vector2::new(h.cos(), h.sin()) * s.guidance.offset_m;
+                let (p_a, p_t) = toward(target);
+                (p_a, p_t, None)
+            }
+        }
+    }
+
+    /// Moves the ASV over one period along the path from `p_a` to `p_t`, timed by
+    /// eq. 25 with the speed law of eq. 26 and line-of-sight steering.
+    fn follow(&mut self, p_a: Vector2<f64>, p_t: Vector2<f64>) {
+        let a = &self.s.asv;
+        let period = self.s.mission.message_period_s;
+        let steps = (period / self.s.mission.dt_s).round().max(1.0) as usize;
+        let dt = period / steps as f64;
+        let leg = p_t - p_a;
+        let len = leg.norm();
+        for j in 0..steps {
+            let s = j as f64 / steps as f64; // eq. 25
+            let (u, r) = if len < 1e-6 {
+                // hold a point: head for it, slowing down on the last metres
+                let d = p_t - self.asv.pos;
+                let (mut u, r) = self.asv.command(p_t, 1.0, &self.lim);
+                u = u.min(0.5 * d.norm());
+                (u, r)
+            } else {
+                let tau = leg / len;
+                let reference = p_a + leg * s; // eq. 24
+                let e = self.asv.pos - reference;
+                let along = e.dot(&tau); // eq. 21, epsilon_1
+                let cross = tau.x * e.y - tau.y * e.x; // epsilon_2
+                let u_d = (len / period - a.along_track_gain * along).clamp(0.0, self.lim.max_speed_m_s); // eq. 26
+                let course = tau.y.atan2(tau.x) - (cross / a.lookahead_m).atan();
+                let err = wrap_angle(course - self.asv.psi);
+                let r = err.clamp(-self.lim.max_turn_rate_rad_s, self.lim.max_turn_rate_rad_s);
+                (u_d * err.cos().max(0.0), r)
+            };
+            self.asv = self.asv.step(u, r, dt);
+            self.asv_speed = u;
+        }
+    }
+}
+
+/// `m` points standing for a Gaussian estimate's horizontal belief at its depth (a
+/// planner's fallback when the first estimator is not a particle filter): a
+/// deterministic grid of normal quantiles through the Cholesky factor.
+fn gaussian_sample(e: &Estimate, m: usize) -> Vec<Vector3<f64>> {
+    let side = (m as f64).sqrt().ceil().max(2.0) as usize;
+    let l = e.horizontal_cov_m2.cholesky().map_or(Matrix2::zeros(), |c| c.l());
+    let q = |i: usize| {
+        statrs::function::erf::erf_inv(2.0 * (i as f64 + 0.5) / side as f64 - 1.0) * std::f64::consts::SQRT_2
+    };
+    let mut out = Vec::with_capacity(side * side);
+    for i in 0..side {
+        for j in 0..side {
+            let d = l * Vector2::new(q(i), q(j));
+            out.push(e.position_ned_m + Vector3::new(d.x, d.y, 0.0));
+        }
+    }
+    out
+}
+
+impl World for PassiveUsblWorld<'_> {
+    fn vehicles(&self) -> usize {
+        self.auvs.len()
+    }
+
+    fn steps(&self) -> usize {
+        self.s.steps()
+    }
+
+    fn t_s(&self, k: usize) -> f64 {
+        k as f64 * self.s.mission.message_period_s
+    }
+
+    fn truth(&self, v: usize) -> VehicleTruth {
+        let a = &self.auvs[v].circle;
+        let t = self.t_s(self.k);
+        let p = a.position(t);
+        VehicleTruth {
+            eta: [p.x, p.y, p.z, 0.0, 0.0, a.heading(t)].into(),
+            speed_m_s: a.spec.speed_m_s,
+            distance_m: a.spec.speed_m_s * t,
+        }
+    }
+
+    fn beacon_ned_m(&self) -> Vector3<f64> {
+        Vector3::new(self.asv.pos.x, self.asv.pos.y, self.s.usbl.transducer_depth_m)
+    }
+
+    fn advance(
+        &mut self,
+        k: usize,
+        beliefs: &[&dyn Navigator],
+        heard: &mut [Vec<Measurement>],
+    ) -> Option<GuidanceSnapshot> {
+        let t0 = self.t_s(k - 1);
+        let (p_a, p_t, snapshot) = self.path(t0, beliefs);
+        self.follow(p_a, p_t);
+        self.k = k;
+        let t1 = self.t_s(k);
+
+        // each AUV's message at t1: its report, and its bearing on the USBL
+        let s = self.s;
+        let station = self.beacon_ned_m();
+        let usbl = Usbl::exact(station, self.asv.psi, s.usbl.noise_deg_per_m.to_radians());
+        let gps = station
+            + Vector3::new(
+                gauss(&mut self.station_rng, s.asv.gps_noise_m),
+                gauss(&mut self.station_rng, s.asv.gps_noise_m),
+                0.0,
+            );
+        let compass = wrap_angle(self.asv.psi + gauss(&mut self.station_rng, s.asv.compass_noise_deg.to_radians()));
+        let r = &s.reports;
+        for (auv, out) in self.auvs.iter_mut().zip(heard.iter_mut()) {
+            let x = auv.circle.state(t1);
+            let rng = &mut auv.report_rng;
+            out.push(Measurement::new(
+                t1,
+                Kind::Report {
+                    heading_rad: wrap_angle(x[idx::PSI] + gauss(rng, r.heading_noise_deg.to_radians())),
+                    speed_m_s: x[idx::U] + gauss(rng, r.speed_noise_m_s),
+                    depth_m: x[idx::Z] + gauss(rng, r.depth_noise_m),
+                },
+            ));
+            // the angles drawn from the USBL model (eq. 1-3) at the true station pose
+            let azimuth = usbl.model(UsblAngle::Azimuth).sample(&x, &mut auv.usbl_rng);
+            let elevation = usbl.model(UsblAngle::Elevation).sample(&x, &mut auv.usbl_rng);
+            out.push(Measurement::new(
+                t1,
+                Kind::Bearing {
+                    station: BeaconFix { id: 0, position_ned_m: gps, sigma_m: s.asv.gps_noise_m, t_tx_s: None },
+                    station_heading_rad: compass,
+                    azimuth_rad: wrap_angle(azimuth),
+                    elevation_rad: elevation.clamp(0.0, std::f64::consts::PI),
+                },
+            ));
+        }
+        snapshot.map(GuidanceSnapshot::Bearing)
+    }
+}
+
+/// For the bound: the Fisher information H' R^-1 H of every bearing each AUV is heard
+/// at, from the world's USBL noise (the matched trackers'), at the truth.
+pub(crate) struct BearingInformation {
+    noise: onebeacon::nav::TrackerNoise,
+    info: Vec<(usize, usize, nalgebra::DMatrix<f64>)>,
+}
+
+impl BearingInformation {
+    pub(crate) fn new(noise: onebeacon::nav::TrackerNoise) -> Self {
+        Self { noise, info: Vec::new() }
+    }
+
+    pub(crate) fn into_inner(self) -> Vec<(usize, usize, nalgebra::DMatrix<f64>)> {
+        self.info
+    }
+}
+
+impl crate::engine::Observer for BearingInformation {
+    fn step(&mut self, s: &crate::engine::Step<'_>) {
+        for (v, (heard, truth)) in s.heard.iter().zip(s.truth).enumerate() {
+            for m in heard {
+                if let Kind::Bearing { station, station_heading_rad, .. } = m.kind {
+                    let usbl = Usbl {
+                        position_ned_m: station.position_ned_m,
+                        heading_rad: station_heading_rad,
+                        sigma_rad_per_m: self.noise.usbl_sigma_rad_per_m,
+                        position_sigma_m: station.sigma_m,
+                        heading_sigma_rad: self.noise.station_heading_sigma_rad,
+                    };
+                    let mut x = SVector::<f64, DIM>::zeros();
+                    x.fixed_rows_mut::<3>(0).copy_from(&truth.eta.fixed_rows::<3>(0));
+                    let info = [UsblAngle::Azimuth, UsblAngle::Elevation].iter().fold(
+                        nalgebra::SMatrix::<f64, DIM, DIM>::zeros(),
+                        |acc, &a| {
+                            let model = usbl.model(a);
+                            let h = ScalarModel::<DIM>::jacobian(&model, &x);
+                            acc + h.transpose() * h / model.variance(&x)
+                        },
+                    );
+                    self.info.push((v, s.k, nalgebra::DMatrix::from_column_slice(DIM, DIM, info.as_slice())));
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{Scenario, builtin, parse};
+
+    fn scenario() -> PassiveUsbl {
+        let Scenario::PassiveUsbl(s) = parse(builtin("hoff2024").unwrap().toml, "hoff2024").unwrap() else {
+            unreachable!()
+        };
+        s
+    }
+
+    /// On its leg and heading along it, the ASV keeps the time assignment of eq. 25
+    /// exactly: u = |p_t - p_a| / dt, one straight period ends at p_t. Set off 10 m to the
+    /// side, line-of-sight steering brings it onto the line within a few periods, and the
+    /// speed law (eq. 26) brings it back in time.
+    #[test]
+    fn follows_legs_timed_by_eq_24_to_26() {
+        let s = scenario();
+        let mut w = PassiveUsblWorld::new(&s, &s.base_cell(), 1, 0);
+        let period = s.mission.message_period_s;
+        w.asv = AsvState { pos: Vector2::new(0.0, 0.0), psi: 0.0 };
+        let step = Vector2::new(2.0 * period, 0.0);
+        w.follow(Vector2::zeros(), step);
+        assert!((w.asv.pos - step).norm() < 1e-9, "{:?}", w.asv.pos);
+
+        w.asv = AsvState { pos: Vector2::new(0.0, 10.0), psi: 0.0 };
+        let mut p_a = Vector2::zeros();
+        for _ in 0..8 {
+            let p_t = p_a + step;
+            w.follow(p_a, p_t);
+            p_a = p_t;
+        }
+        let (along, cross) = (w.asv.pos.x - p_a.x, w.asv.pos.y);
+        assert!(cross.abs() < 0.3 && along.abs() < 1.5, "along {along}, cross {cross}");
+    }
+}
