@@ -5,7 +5,10 @@ use crate::{BadInput, plot, report};
 use anyhow::{Context, Result};
 use onebeacon::guidance::{PolarGrid, best_standoff};
 use onebeacon_sim::montecarlo::monte_carlo;
-use onebeacon_sim::run::{GuidanceSnapshot, simulate};
+use onebeacon_sim::run::{GuidanceSnapshot, simulate, simulate_with_belief};
+
+/// Particles drawn (by weight) for belief.png.
+const BELIEF_SAMPLES: usize = 50_000;
 use onebeacon_sim::scenario::{self, BUILTINS};
 use std::io::Write;
 use std::path::PathBuf;
@@ -23,17 +26,18 @@ pub fn scenarios(show: Option<&str>) -> Result<()> {
             out.write_all(b.toml.as_bytes())?;
         }
         None => {
+            let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
             for b in BUILTINS {
                 let s = scenario::parse(b.toml, b.name)?;
-                writeln!(out, "{:<12} {}", b.name, s.description())?;
+                writeln!(out, "{:<width$} {}", b.name, s.description())?;
             }
         }
     }
     Ok(())
 }
 
-/// `onebeacon run SCENARIO [--seed N] [--run I] [--ping K] [--out DIR]`
-pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, out: Option<PathBuf>) -> Result<()> {
+/// `onebeacon run SCENARIO [--seed N] [--run I] [--ping K] [--message M] [--out DIR]`
+pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, message: usize, out: Option<PathBuf>) -> Result<()> {
     let s = scenario::load(name)?;
     // `run` records every step for its plots and CSV: refuse up front what would not fit
     const MOST_BYTES: f64 = 4e9;
@@ -53,7 +57,15 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, out: Option<Pat
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name())));
     let staging = Staging::new(&dir)?;
     let cell = s.base_cell();
-    let result = simulate(&s, &cell, seed, run, true);
+    let passive = matches!(s, onebeacon_sim::Scenario::PassiveUsbl(_));
+    if passive && !(1..=s.steps()).contains(&message) {
+        return Err(BadInput(format!("--message {message}: the run has messages 1 to {}", s.steps())).into());
+    }
+    let result = if passive {
+        simulate_with_belief(&s, &cell, seed, run, message, BELIEF_SAMPLES)
+    } else {
+        simulate(&s, &cell, seed, run, true)
+    };
 
     let (vehicles, names) = (s.vehicle_names(), s.track_labels());
     staging.write("trajectory.csv", &report::trajectory_csv(&vehicles, &names, &result.trajectory)?)?;
@@ -63,6 +75,9 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, out: Option<Pat
         .context("cannot draw top_view.png")?;
     plot::error_vs_time(&staging.file("error.png"), &names, &title, &result.trajectory)
         .context("cannot draw error.png")?;
+    if let Some(b) = &result.belief {
+        plot::belief_density(&staging.file("belief.png"), b).context("cannot draw belief.png")?;
+    }
     if !result.guidance.is_empty() {
         let snapshot = result
             .guidance

@@ -60,9 +60,14 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         run: u64,
         /// Moving-beacon scenarios: the ping whose guidance metric is mapped in
-        /// guidance.png (0 is the first).
+        /// guidance.png (0 is the first); passive-USBL scenarios: the planner decision.
         #[arg(long, default_value_t = 1)]
         ping: usize,
+        /// Passive-USBL scenarios: the message (1 is the first, one period after the
+        /// start) whose particle cloud belief.png draws with its bearing [default: 9, at
+        /// 36 s as hoff2024 Fig. 4-5].
+        #[arg(long, default_value_t = 9)]
+        message: usize,
         /// Output directory (default: out/<scenario>-run).
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
@@ -272,7 +277,9 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Scenarios { show } => commands::scenarios(show.as_deref()),
-        Command::Run { scenario, seed, run, ping, out } => commands::run(&scenario, seed, run, ping, out),
+        Command::Run { scenario, seed, run, ping, message, out } => {
+            commands::run(&scenario, seed, run, ping, message, out)
+        }
         Command::Mc { scenario, runs, seed, threads, out, json } => {
             commands::mc(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), out, json)
         }

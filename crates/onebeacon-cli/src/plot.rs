@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use onebeacon::guidance::Metric;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::montecarlo::{CellResult, McResult};
-use onebeacon_sim::run::{BearingSnapshot, Estimate, FimSnapshot, StepRecord};
+use onebeacon_sim::run::{BearingSnapshot, BeliefSnapshot, Estimate, FimSnapshot, StepRecord};
 use onebeacon_sim::scenario::SweepValue;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -550,6 +550,73 @@ pub fn bearing_map(path: &Path, g: &BearingSnapshot) -> Result<()> {
         chart
             .draw_series(std::iter::once(Cross::new((g.waypoint.y, g.waypoint.x), 9, BLACK.stroke_width(3))))?
             .label("chosen waypoint")
+            .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        root.present()?;
+        Ok(())
+    })())
+}
+
+/// The particle density at one message (hoff2024 Fig. 4-6): a histogram of the belief's
+/// positions around the estimate, brighter where denser, the measured bearing from the
+/// ASV with a +-3 deg wedge, the truth and the estimate.
+pub fn belief_density(path: &Path, b: &BeliefSnapshot) -> Result<()> {
+    register_fonts();
+    let centre = b.estimate.xy();
+    // a window four times the spread of the cloud about the estimate, the truth in it
+    let spread =
+        b.positions.iter().map(|p| (p.xy() - centre).norm_squared()).sum::<f64>() / b.positions.len().max(1) as f64;
+    let half = (4.0 * spread.sqrt()).max(1.5 * (b.truth.xy() - centre).norm()).max(0.5);
+    let (n0, e0) = (centre.x - half, centre.y - half);
+    let cells = 80usize;
+    let size = 2.0 * half / cells as f64;
+    let mut counts = vec![0u32; cells * cells];
+    for p in &b.positions {
+        let (i, j) = (((p.x - n0) / size).floor(), ((p.y - e0) / size).floor());
+        if (0.0..cells as f64).contains(&i) && (0.0..cells as f64).contains(&j) {
+            counts[i as usize * cells + j as usize] += 1;
+        }
+    }
+    let peak = f64::from(counts.iter().copied().max().unwrap_or(1).max(1));
+    both!(path, (950, 780), |root| (|| -> Result<()> {
+        let caption = format!("particle density at t = {:.0} s ({} particles drawn)", b.t_s, b.positions.len());
+        root.fill(&WHITE)?;
+        let (main, side) = root.split_horizontally(800);
+        colour_bar(&side, 0.0, peak, "particles per cell")?;
+        let root = main;
+        let mut chart = chart(&root, &caption, e0..e0 + 2.0 * half, n0..n0 + 2.0 * half, ("east (m)", "north (m)"))?;
+        chart.draw_series((0..cells).flat_map(|i| {
+            let counts = &counts;
+            (0..cells).map(move |j| {
+                let (n, e) = (n0 + i as f64 * size, e0 + j as f64 * size);
+                let v = f64::from(counts[i * cells + j]) / peak;
+                Rectangle::new([(e, n), (e + size, n + size)], viridis(v).filled())
+            })
+        }))?;
+        if let Some((station, heading, azimuth, _)) = b.bearing {
+            // the bearing's ray from the ASV across the window, and the +-3 deg wedge
+            let d = (centre - station.xy()).norm();
+            for (offset, style, label) in [
+                (0.0, RGBColor(148, 0, 211).stroke_width(3), Some("measured bearing")),
+                (3f64.to_radians(), WHITE.stroke_width(1), Some("+-3 deg")),
+                (-3f64.to_radians(), WHITE.stroke_width(1), None),
+            ] {
+                let a = heading + azimuth + offset;
+                let u = nalgebra::Vector2::new(a.cos(), a.sin());
+                let ray = [d - 2.0 * half, d + 2.0 * half].map(|r| {
+                    let p = station.xy() + u * r.max(0.0);
+                    (p.y, p.x)
+                });
+                line(&mut chart, ray, style, label)?;
+            }
+        }
+        chart
+            .draw_series(std::iter::once(Circle::new((b.truth.y, b.truth.x), 7, RED.filled())))?
+            .label("truth")
+            .legend(|(x, y)| Circle::new((x + 10, y), 5, RED.filled()));
+        chart
+            .draw_series(std::iter::once(Cross::new((b.estimate.y, b.estimate.x), 9, WHITE.stroke_width(3))))?
+            .label("estimate (mean)")
             .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
         legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present()?;

@@ -31,6 +31,8 @@ pub const TARGETS: [(&str, Target); 6] = [
 /// Longest scenario the target simulates (steps x vehicles): longer ones are only
 /// parsed and checked, to keep each input under a second.
 const MAX_SIMULATED_STEPS: usize = 2000;
+/// Most particles x steps the target simulates (about a second).
+const MAX_PARTICLE_STEPS: usize = 20_000_000;
 
 /// A scenario TOML: parsed and checked; a valid short one is simulated once (its first
 /// cell), and every estimator's mean error is a number (finite, or infinite when it
@@ -40,6 +42,18 @@ pub fn scenario(data: &[u8]) {
     let Ok(s) = onebeacon_sim::scenario::parse(text, "fuzz") else { return };
     if s.steps().saturating_mul(s.vehicle_names().len()) > MAX_SIMULATED_STEPS {
         return;
+    }
+    // a particle filter costs its particles at every step
+    if let onebeacon_sim::Scenario::PassiveUsbl(p) = &s {
+        let particles: usize = p
+            .estimators
+            .iter()
+            .filter(|e| e.kind == onebeacon_sim::scenario::EstimatorKind::Particle)
+            .map(|e| e.particle_settings().0)
+            .sum();
+        if particles.saturating_mul(s.steps()).saturating_mul(s.vehicle_names().len()) > MAX_PARTICLE_STEPS {
+            return;
+        }
     }
     let cell = &s.cells()[0];
     let out = onebeacon_sim::run::simulate(&s, cell, s.seed(), 0, false);

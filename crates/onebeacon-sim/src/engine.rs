@@ -75,6 +75,9 @@ pub(crate) trait Observer {
     fn guidance(&mut self, _snapshot: &GuidanceSnapshot) {}
     /// The outcome of track `track`'s processing of one measurement.
     fn outcome(&mut self, _track: usize, _outcome: &Outcome) {}
+    /// Every track's navigator as it stands at step `k` (before [`Observer::step`]),
+    /// for an observer that records more than estimates (a particle cloud).
+    fn inspect(&mut self, _k: usize, _tracks: &[Track]) {}
 }
 
 /// Runs `world` from its start to its last step with `tracks`, shown to `observers`.
@@ -90,6 +93,7 @@ pub(crate) fn run(world: &mut dyn World, tracks: &mut [Track], observers: &mut [
     let mut estimates: Vec<Estimate> = tracks.iter().map(|t| t.navigator.estimate()).collect();
     let mut k = 0;
     loop {
+        observers.iter_mut().for_each(|o| o.inspect(k, tracks));
         let step = Step {
             k,
             t_s: world.t_s(k),

@@ -137,6 +137,24 @@ pub struct RunOutput {
     pub information: Vec<(usize, usize, DMatrix<f64>)>,
     /// The guidance decisions of a recorded moving-beacon run, one per ping.
     pub guidance: Vec<GuidanceSnapshot>,
+    /// The first vehicle's first estimator's belief at the step asked for
+    /// ([`simulate_with_belief`]).
+    pub belief: Option<BeliefSnapshot>,
+}
+
+/// What the first estimator of the first vehicle believed at one step, with what it
+/// had just measured: for a picture of the particle cloud (hoff2024 Fig. 4-6).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeliefSnapshot {
+    pub t_s: f64,
+    /// Equally weighted samples of its position belief (a particle filter's particles,
+    /// drawn by weight), NED.
+    pub positions: Vec<Vector3<f64>>,
+    pub estimate: Vector3<f64>,
+    pub truth: Vector3<f64>,
+    /// The bearing measured at this step: the station's reported position and heading,
+    /// azimuth, elevation (rad).
+    pub bearing: Option<(Vector3<f64>, f64, f64, f64)>,
 }
 
 /// Bytes a recorded run of `s` holds (its trajectory), about.
@@ -150,17 +168,28 @@ pub fn recorded_bytes(s: &Scenario) -> f64 {
 /// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
 /// A cell of another world than the scenario's is a programming error.
 pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) -> RunOutput {
+    simulate_recording(s, cell, seed, run, Recorder::new(record, None))
+}
+
+/// [`simulate`] recording every step, and the belief of the first vehicle's first
+/// estimator at step `step` (up to `samples` samples of it; None if it has none or the
+/// run is shorter).
+pub fn simulate_with_belief(s: &Scenario, cell: &Cell, seed: u64, run: u64, step: usize, samples: usize) -> RunOutput {
+    simulate_recording(s, cell, seed, run, Recorder::new(true, Some((step, samples))))
+}
+
+fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: Recorder) -> RunOutput {
     match (s, cell) {
         (Scenario::FixedBeacon(s), Cell::FixedBeacon(c)) => {
             let mut world = FixedBeaconWorld::new(s, c, seed, run);
             let mut tracks = world.tracks(s, seed, run);
-            drive(&mut world, &mut tracks, None, record)
+            drive(&mut world, &mut tracks, None, recorder)
         }
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let mut world = MovingBeaconWorld::new(s, c, seed, run);
             let mut tracks = world.tracks(s, seed, run);
             let mut info = RangeInformation::new(s.sensor_noise());
-            let mut out = drive(&mut world, &mut tracks, Some(&mut info), record);
+            let mut out = drive(&mut world, &mut tracks, Some(&mut info), recorder);
             out.information = info.into_inner();
             out
         }
@@ -168,7 +197,7 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
             let mut world = PassiveUsblWorld::new(s, c, seed, run);
             let mut tracks = world.tracks(s, seed, run);
             let mut info = BearingInformation::new(s.tracker_noise());
-            let mut out = drive(&mut world, &mut tracks, Some(&mut info), record);
+            let mut out = drive(&mut world, &mut tracks, Some(&mut info), recorder);
             out.information = info.into_inner();
             out
         }
@@ -177,9 +206,13 @@ pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) ->
 }
 
 /// Runs the engine with the scoring and recording observers (and `extra`).
-fn drive(world: &mut dyn World, tracks: &mut [Track], extra: Option<&mut dyn Observer>, record: bool) -> RunOutput {
+fn drive(
+    world: &mut dyn World,
+    tracks: &mut [Track],
+    extra: Option<&mut dyn Observer>,
+    mut recorder: Recorder,
+) -> RunOutput {
     let mut scoring = Scoring::new(tracks.iter().map(|t| t.vehicle).collect(), world.steps());
-    let mut recorder = Recorder { on: record, trajectory: Vec::new(), guidance: Vec::new() };
     {
         let mut observers: Vec<&mut dyn Observer> = vec![&mut scoring, &mut recorder];
         if let Some(extra) = extra {
@@ -194,6 +227,7 @@ fn drive(world: &mut dyn World, tracks: &mut [Track], extra: Option<&mut dyn Obs
         frames_decoded: scoring.heard,
         information: Vec::new(),
         guidance: recorder.guidance,
+        belief: recorder.belief,
     }
 }
 
@@ -237,15 +271,48 @@ impl Observer for Scoring {
     }
 }
 
-/// Every step and every guidance decision, when asked for.
+/// Every step and every guidance decision, when asked for, and the belief at one step.
 struct Recorder {
     on: bool,
     trajectory: Vec<StepRecord>,
     guidance: Vec<GuidanceSnapshot>,
+    /// The step whose belief to keep, and how many samples of it.
+    belief_at: Option<(usize, usize)>,
+    belief: Option<BeliefSnapshot>,
+}
+
+impl Recorder {
+    fn new(on: bool, belief_at: Option<(usize, usize)>) -> Self {
+        Self { on, trajectory: Vec::new(), guidance: Vec::new(), belief_at, belief: None }
+    }
 }
 
 impl Observer for Recorder {
+    fn inspect(&mut self, k: usize, tracks: &[Track]) {
+        let Some((_, samples)) = self.belief_at.filter(|(at, _)| *at == k) else { return };
+        let Some(first) = tracks.iter().find(|t| t.vehicle == 0) else { return };
+        if let Some(positions) = first.navigator.position_sample(samples) {
+            let e = first.navigator.estimate();
+            self.belief = Some(BeliefSnapshot {
+                t_s: e.t_s,
+                positions,
+                estimate: e.position_ned_m,
+                truth: Vector3::from_element(f64::NAN),
+                bearing: None,
+            });
+        }
+    }
+
     fn step(&mut self, s: &Step<'_>) {
+        if let Some(b) = self.belief.as_mut().filter(|_| self.belief_at.is_some_and(|(at, _)| at == s.k)) {
+            b.truth = s.truth[0].eta.fixed_rows::<3>(0).into_owned();
+            b.bearing = s.heard[0].iter().find_map(|m| match m.kind {
+                onebeacon::nav::Kind::Bearing { station, station_heading_rad, azimuth_rad, elevation_rad } => {
+                    Some((station.position_ned_m, station_heading_rad, azimuth_rad, elevation_rad))
+                }
+                _ => None,
+            });
+        }
         if !self.on {
             return;
         }
