@@ -9,6 +9,19 @@ pub fn wrap_angle(a: f64) -> f64 {
     if w > PI { w - TAU } else { w }
 }
 
+/// Wraps an angle in (-3 pi, 3 pi] to (-pi, pi] with one add or subtract: the
+/// difference or sum of two wrapped angles, in a hot loop (no remainder).
+#[inline]
+pub fn wrap_near(a: f64) -> f64 {
+    if a > PI {
+        a - TAU
+    } else if a <= -PI {
+        a + TAU
+    } else {
+        a
+    }
+}
+
 /// The horizontal frame of external data (logs, streams), converted to NED at the
 /// boundary. In both, headings turn from the x axis toward the y axis.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -71,6 +84,13 @@ mod tests {
         assert_abs_diff_eq!(wrap_angle(3.0 * PI / 2.0), -PI / 2.0, epsilon = 1e-12);
         assert_abs_diff_eq!(wrap_angle(-7.0 * PI / 2.0), PI / 2.0, epsilon = 1e-12);
         assert_abs_diff_eq!(wrap_angle(10.0 * TAU + 0.1), 0.1, epsilon = 1e-9);
+        // one add or subtract agrees with the remainder across (-3 pi, 3 pi]
+        for k in -3000..=3000 {
+            let a = k as f64 * 3.0 * PI / 3000.0 + 1e-6;
+            if a > -3.0 * PI && a <= 3.0 * PI {
+                assert_abs_diff_eq!(wrap_near(a), wrap_angle(a), epsilon = 1e-12);
+            }
+        }
     }
 
     /// Plaza-style ENU data: moving along +y (north) with yaw pi/2 is NED heading 0;

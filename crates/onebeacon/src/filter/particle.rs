@@ -253,28 +253,26 @@ impl<const D: usize> ParticleFilter<D> {
             let heaviest = w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b });
             x[k][heaviest.0]
         });
-        let wrap = |d: f64| {
-            if d > std::f64::consts::PI {
-                d - std::f64::consts::TAU
-            } else if d <= -std::f64::consts::PI {
-                d + std::f64::consts::TAU
-            } else {
-                d
-            }
-        };
-        // per chunk: sum w x and sum w x x', reduced in chunk order
+        // per chunk: sum w x_k and sum w x_k x_l (k <= l), each a loop over contiguous
+        // arrays (vectorised), reduced in chunk order
         let partial: Vec<(SVector<f64, D>, SMatrix<f64, D, D>)> = (0..w.len().div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
                 let (start, end) = (c * CHUNK, ((c + 1) * CHUNK).min(w.len()));
+                let w = &w[start..end];
+                let wrapped: Vec<f64> = angle.map_or_else(Vec::new, |k| {
+                    x[k][start..end].iter().map(|a| crate::geo::wrap_near(a - reference)).collect()
+                });
+                let comp = |k: usize| if Some(k) == angle { &wrapped[..] } else { &x[k][start..end] };
                 let (mut s, mut ss) = (SVector::<f64, D>::zeros(), SMatrix::<f64, D, D>::zeros());
-                for i in start..end {
-                    let mut p = SVector::<f64, D>::from_fn(|k, _| x[k][i]);
-                    if let Some(k) = angle {
-                        p[k] = wrap(p[k] - reference);
+                for k in 0..D {
+                    let xk = comp(k);
+                    s[k] = dot(w, xk);
+                    let wx: Vec<f64> = w.iter().zip(xk).map(|(w, x)| w * x).collect();
+                    for l in k..D {
+                        ss[(k, l)] = dot(&wx, comp(l));
+                        ss[(l, k)] = ss[(k, l)];
                     }
-                    s += w[i] * p;
-                    ss += w[i] * p * p.transpose();
                 }
                 (s, ss)
             })
@@ -286,7 +284,7 @@ impl<const D: usize> ParticleFilter<D> {
         }
         let cov = second - mean * mean.transpose();
         if let Some(k) = angle {
-            mean[k] = wrap(mean[k] + reference);
+            mean[k] = crate::geo::wrap_near(mean[k] + reference);
         }
         (mean, cov)
     }
@@ -344,6 +342,20 @@ fn chunk_views(x: &mut [Vec<f64>]) -> Vec<Vec<&mut [f64]>> {
         }
     }
     views
+}
+
+/// sum a_i b_i with four accumulators (a loop the compiler vectorises; the order is
+/// fixed, so the result is the same on every run).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = a4.remainder().iter().zip(b4.remainder()).map(|(a, b)| a * b).sum();
+    for (a, b) in a4.zip(b4) {
+        for j in 0..4 {
+            acc[j] += a[j] * b[j];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// The effective sample size of normalised weights, 1 / sum w_i^2.

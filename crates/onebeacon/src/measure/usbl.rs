@@ -3,7 +3,9 @@
 //! angle from the vertical, each with a standard deviation that grows with the range.
 
 use super::ScalarModel;
+use crate::geo::{wrap_angle, wrap_near};
 use nalgebra::{SMatrix, SVector, Vector3};
+use std::f64::consts::PI;
 
 /// The USBL on the surface vehicle: its NED position and heading when the message
 /// arrives, the baseline noise sigma_USBL in rad per metre of range (the paper's deg/m,
@@ -35,7 +37,9 @@ impl Usbl {
         // sqrt, not hypot: metres cannot overflow, and hypot's care costs
         let h2 = d.x * d.x + d.y * d.y;
         let h = h2.sqrt();
-        let alpha = crate::geo::wrap_angle(d.y.atan2(d.x) - self.heading_rad); // eq. 1
+        let a = d.y.atan2(d.x) - self.heading_rad; // eq. 1
+        // a wrapped heading needs one add or subtract (the hot loops' case)
+        let alpha = if self.heading_rad.abs() <= PI { wrap_near(a) } else { wrap_angle(a) };
         let phi = h.atan2(d.z); // eq. 2: acos(dz / r), the angle of (dz, h)
         (alpha, phi, (h2 + d.z * d.z).sqrt() * self.sigma_rad_per_m) // eq. 3
     }

@@ -7,7 +7,7 @@
 use crate::filter::ProcessModel;
 use crate::filter::particle::{ParticleLikelihood, ParticleProcess};
 use crate::filter::truncated::truncated_normal;
-use crate::geo::wrap_angle;
+use crate::geo::{wrap_angle, wrap_near};
 use crate::measure::Usbl;
 use nalgebra::{SMatrix, SVector, Vector3};
 use rand::RngExt;
@@ -187,8 +187,11 @@ impl ParticleLikelihood for InsReport {
             -0.5 / (self.sigma_speed_m_s * self.sigma_speed_m_s),
             -0.5 / (self.sigma_depth_m * self.sigma_depth_m),
         );
+        // particles' headings are in (-pi, pi] (after a first step; within 3 pi at the
+        // start): a difference from a wrapped heading wraps with one add or subtract
+        let heading = wrap_angle(self.heading_rad);
         for (i, lw) in log_w.iter_mut().enumerate() {
-            let dh = wrap_angle(x[idx::PSI][i] - self.heading_rad);
+            let dh = wrap_near(x[idx::PSI][i] - heading);
             let du = x[idx::U][i] - self.speed_m_s;
             let dz = x[idx::Z][i] - self.depth_m;
             *lw += kh * dh * dh + ku * du * du + kz * dz * dz; // eq. 8
@@ -208,13 +211,14 @@ pub struct UsblBearing {
 
 impl ParticleLikelihood for UsblBearing {
     fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+        let azimuth = wrap_angle(self.azimuth_rad);
         if self.usbl.position_sigma_m > 0.0 || self.usbl.heading_sigma_rad > 0.0 {
             // the station's pose errors make the two angles' variances differ
             for (i, lw) in log_w.iter_mut().enumerate() {
                 let p = Vector3::new(x[idx::X][i], x[idx::Y][i], x[idx::Z][i]);
                 let (alpha, phi, _) = self.usbl.angles(&p);
                 let (var_a, var_p) = self.usbl.variances(&p);
-                let (da, dp) = (wrap_angle(self.azimuth_rad - alpha), self.elevation_rad - phi);
+                let (da, dp) = (wrap_near(azimuth - alpha), self.elevation_rad - phi);
                 *lw += -da * da / (2.0 * var_a) - dp * dp / (2.0 * var_p) - 0.5 * (var_a * var_p).ln(); // eq. 6
             }
             return;
@@ -222,7 +226,7 @@ impl ParticleLikelihood for UsblBearing {
         for (i, lw) in log_w.iter_mut().enumerate() {
             let p = Vector3::new(x[idx::X][i], x[idx::Y][i], x[idx::Z][i]);
             let (alpha, phi, sigma) = self.usbl.angles(&p);
-            let (da, dp) = (wrap_angle(self.azimuth_rad - alpha), self.elevation_rad - phi);
+            let (da, dp) = (wrap_near(azimuth - alpha), self.elevation_rad - phi);
             let var = (sigma * sigma).max(1e-12);
             *lw += -(da * da + dp * dp) / (2.0 * var) - var.ln(); // eq. 6, two angles
         }
