@@ -203,7 +203,11 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["fly"], &["fly"]),
         (vec!["run", &escape], &["escape.toml", "name", "a name, not a path"]),
         (vec!["run", &huge, "--out", out], &["huge.toml", "100000000 steps", "GB"]),
-        (vec!["run", &estimator, "--out", out], &["est.toml", "estimators[0].nis_gate", "applies to: log"]),
+        (
+            vec!["run", &estimator, "--out", out],
+            &["est.toml", "estimators[0].nis_gate", "applies to: passive_usbl world, log"],
+        ),
+        (vec!["run", "hoff2024", "--message", "0", "--out", out], &["--message 0", "messages 1 to 900"]),
     ];
     for (args, needles) in cases {
         let o = run(&args);
@@ -274,6 +278,55 @@ fn moving_beacon_run_and_mc() {
     let o = run(&["run", scenario, "--ping", "500", "--out", dir.join("none").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("--ping 500"));
+    assert!(!dir.join("none").exists());
+}
+
+/// A short passive-USBL scenario: 2000 particles, 80 s (20 messages).
+const SHORT_HOFF: &str = r#"kind = "passive_usbl"
+name = "short-hoff"
+runs = 2
+[mission]
+duration_s = 80
+[guidance]
+planner_particles = 500
+[[estimators]]
+kind = "pf"
+particles = 2000
+[[estimators]]
+kind = "bearing"
+[sweep]
+guidance = ["det", "static"]
+"#;
+
+/// `run` on a passive-USBL scenario draws the particle cloud at `--message` and the
+/// planner's score; `mc --json` has one cell per guidance and estimator, with a bound.
+#[test]
+fn passive_usbl_run_and_mc() {
+    let dir = scratch("hoff");
+    let p = dir.join("short-hoff.toml");
+    std::fs::write(&p, SHORT_HOFF).unwrap();
+    let scenario = p.to_str().unwrap();
+    let out_dir = dir.join("run");
+    let out = run(&["run", scenario, "--message", "5", "--ping", "0", "--out", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for png in ["top_view.png", "error.png", "guidance.png", "belief.png"] {
+        assert!(std::fs::read(out_dir.join(png)).unwrap().starts_with(b"\x89PNG"), "{png}");
+    }
+    let csv = std::fs::read_to_string(out_dir.join("trajectory.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 22); // a header and steps 0 to 20
+    let out = run(&["mc", scenario, "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+    let cells = v["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 4);
+    assert_eq!(
+        (cells[0]["sweep"]["guidance"].as_str(), cells[2]["sweep"]["guidance"].as_str()),
+        (Some("det"), Some("static"))
+    );
+    assert!(cells[0]["pcrb_rmse_m"].as_f64().unwrap() > 0.0);
+    let o = run(&["run", scenario, "--message", "21", "--out", dir.join("none").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("messages 1 to 20"), "{}", text(&o.stderr));
     assert!(!dir.join("none").exists());
 }
 
