@@ -6,7 +6,9 @@
 use crate::engine::{self, Observer, Step, Track, VehicleTruth, World};
 use crate::metrics::{ErrorAccumulator, RunMetrics};
 use crate::scenario::{Cell, Scenario};
-use crate::world::{BearingInformation, FixedBeaconWorld, MovingBeaconWorld, PassiveUsblWorld, RangeInformation};
+use crate::world::{
+    FixedBeaconWorld, Information, MovingBeaconWorld, PassiveUsblWorld, bearing_information, range_information,
+};
 use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::filter::consistency::nees;
 use onebeacon::guidance::FimPlanner;
@@ -188,7 +190,7 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let mut world = MovingBeaconWorld::new(s, c, seed, run);
             let mut tracks = world.tracks(s, seed, run);
-            let mut info = RangeInformation::new(s.sensor_noise());
+            let mut info = Information::new(range_information(s.sensor_noise()));
             let mut out = drive(&mut world, &mut tracks, Some(&mut info), recorder);
             out.information = info.into_inner();
             out
@@ -196,7 +198,7 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
         (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(c)) => {
             let mut world = PassiveUsblWorld::new(s, c, seed, run);
             let mut tracks = world.tracks(s, seed, run);
-            let mut info = BearingInformation::new(s.tracker_noise());
+            let mut info = Information::new(bearing_information(s.tracker_noise()));
             let mut out = drive(&mut world, &mut tracks, Some(&mut info), recorder);
             out.information = info.into_inner();
             out

@@ -534,7 +534,7 @@ mod tests {
 
         assert_eq!(
             error("kind = \"rosb\"\nnis_gate = 3.0", Host::FixedBeacon),
-            "estimators[0].nis_gate = 3.0: does not apply to a fixed_beacon world (it applies to: log)"
+            "estimators[0].nis_gate = 3.0: does not apply to a fixed_beacon world (it applies to: passive_usbl world, log)"
         );
         assert_eq!(
             error("kind = \"range+doppler\"", Host::MovingBeacon),

@@ -210,7 +210,14 @@ pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<()
                 Host::PassiveUsbl => "USBL bearings only",
                 Host::FixedBeacon | Host::Log => "ranges and Doppler speeds only",
             };
-            return Err(Violation { key: k, value, allowed: format!("a {} gives {gives}", host.label()) });
+            let uses = if asked.doppler && !has.doppler {
+                "Doppler speeds"
+            } else if asked.range && !has.range {
+                "ranges"
+            } else {
+                "USBL bearings"
+            };
+            return Err(Violation { key: k, value, allowed: format!("uses {uses}; a {} gives {gives}", host.label()) });
         }
     }
     Ok(())
@@ -251,10 +258,34 @@ fn check_list_nonempty<T>(key: &str, v: &Option<Vec<T>>) -> Result<(), Violation
     }
 }
 
+/// The numbers of a vehicle's table (`prefix`: its key) and its optional name.
+fn check_table(prefix: &str, fields: &[(&str, f64, Rule)], name: Option<&String>) -> Result<(), Violation> {
+    for &(field, value, rule) in fields {
+        check(&format!("{prefix}.{field}"), value, rule)?;
+    }
+    if let Some(name) = name.filter(|n| !valid_name(n)) {
+        return Err(Violation { key: format!("{prefix}.name"), value: format!("{name:?}"), allowed: NAME_RULE.into() });
+    }
+    Ok(())
+}
+
+/// Names of a world's vehicles, all different: the first repeat is reported at the
+/// key `{others}[k].name` (the first vehicle has its own table).
+fn check_vehicle_names(names: &[String], others: &str, rule: &str) -> Result<(), Violation> {
+    match (1..names.len()).find(|&k| names[..k].contains(&names[k])) {
+        Some(k) => Err(Violation {
+            key: format!("{others}[{}].name", k - 1),
+            value: format!("{:?}", names[k]),
+            allowed: rule.into(),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// One underwater vehicle's table (`prefix`: its key).
 fn check_vehicle(prefix: &str, v: &Vehicle) -> Result<(), Violation> {
     use Rule::*;
-    for (field, value, rule) in [
+    let fields = [
         ("depth_m", v.depth_m, NonNegative),
         ("start_north_m", v.start_north_m, Finite),
         ("start_east_m", v.start_east_m, Finite),
@@ -264,13 +295,8 @@ fn check_vehicle(prefix: &str, v: &Vehicle) -> Result<(), Violation> {
         ("spiral_descent_m_s", v.spiral_descent_m_s, NonNegative),
         ("leg_length_m", v.leg_length_m, Positive),
         ("leg_spacing_m", v.leg_spacing_m, Positive),
-    ] {
-        check(&format!("{prefix}.{field}"), value, rule)?;
-    }
-    if let Some(name) = v.name.as_ref().filter(|n| !valid_name(n)) {
-        return Err(Violation { key: format!("{prefix}.name"), value: format!("{name:?}"), allowed: NAME_RULE.into() });
-    }
-    Ok(())
+    ];
+    check_table(prefix, &fields, v.name.as_ref())
 }
 
 fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
@@ -288,13 +314,11 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
     }
     let vehicles = s.vehicles(&s.base_cell());
     let names: Vec<String> = vehicles.into_iter().filter_map(|v| v.name).collect();
-    if let Some(k) = (1..names.len()).find(|&k| names[..k].contains(&names[k])) {
-        return Err(Violation {
-            key: format!("other_vehicles[{}].name", k - 1),
-            value: format!("{:?}", names[k]),
-            allowed: "must differ from the other vehicles' names (`auv` for `vehicle`, `auvN` for the N-th)".into(),
-        });
-    }
+    check_vehicle_names(
+        &names,
+        "other_vehicles",
+        "must differ from the other vehicles' names (`auv` for `vehicle`, `auvN` for the N-th)",
+    )?;
     let n = &s.sensors;
     check_fields!("sensors", n, {
         velocity_noise_m_s: Positive,
@@ -340,20 +364,15 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
 /// One AUV's table of a passive_usbl scenario (`prefix`: its key).
 fn check_auv(prefix: &str, a: &Auv) -> Result<(), Violation> {
     use Rule::*;
-    for (field, value, rule) in [
+    let fields = [
         ("centre_north_m", a.centre_north_m, Finite),
         ("centre_east_m", a.centre_east_m, Finite),
         ("circle_radius_m", a.circle_radius_m, Positive),
         ("depth_m", a.depth_m, NonNegative),
         ("speed_m_s", a.speed_m_s, NonNegative),
         ("start_angle_deg", a.start_angle_deg, Finite),
-    ] {
-        check(&format!("{prefix}.{field}"), value, rule)?;
-    }
-    if let Some(name) = a.name.as_ref().filter(|n| !valid_name(n)) {
-        return Err(Violation { key: format!("{prefix}.name"), value: format!("{name:?}"), allowed: NAME_RULE.into() });
-    }
-    Ok(())
+    ];
+    check_table(prefix, &fields, a.name.as_ref())
 }
 
 fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
@@ -378,13 +397,11 @@ fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
         check_auv(&format!("other_auvs[{k}]"), a)?;
     }
     let names: Vec<String> = s.auvs().into_iter().filter_map(|a| a.name).collect();
-    if let Some(k) = (1..names.len()).find(|&k| names[..k].contains(&names[k])) {
-        return Err(Violation {
-            key: format!("other_auvs[{}].name", k - 1),
-            value: format!("{:?}", names[k]),
-            allowed: "must differ from the other AUVs' names (`auv` for `auv`, `auvN` for the N-th)".into(),
-        });
-    }
+    check_vehicle_names(
+        &names,
+        "other_auvs",
+        "must differ from the other AUVs' names (`auv` for `auv`, `auvN` for the N-th)",
+    )?;
     // the trackers assume these unless told otherwise: a zero would be a likelihood
     // of zero width
     check_fields!("reports", s.reports, {

@@ -4,7 +4,7 @@
 //! reaches each vehicle when the wavefront meets it.
 
 use crate::acoustics::Ping;
-use crate::engine::{Observer, Step, Track, VehicleTruth, World};
+use crate::engine::{Track, VehicleTruth, World};
 use crate::run::{FimSnapshot, GuidanceSnapshot};
 use crate::scenario::moving_beacon::{GuidanceKind, Vehicle};
 use crate::scenario::{Host, MovingBeacon, MovingBeaconCell};
@@ -311,34 +311,14 @@ impl World for MovingBeaconWorld<'_> {
     }
 }
 
-/// For the bound: the Fisher information H' R^-1 H of every range each vehicle hears,
-/// from the navigators' own range model, at the truth.
-pub(crate) struct RangeInformation {
-    noise: SensorNoise,
-    info: Vec<(usize, usize, DMatrix<f64>)>,
-}
-
-impl RangeInformation {
-    pub(crate) fn new(noise: SensorNoise) -> Self {
-        Self { noise, info: Vec::new() }
-    }
-
-    pub(crate) fn into_inner(self) -> Vec<(usize, usize, DMatrix<f64>)> {
-        self.info
-    }
-}
-
-impl Observer for RangeInformation {
-    fn step(&mut self, s: &Step<'_>) {
-        for (v, (heard, truth)) in s.heard.iter().zip(s.truth).enumerate() {
-            for m in heard {
-                if let Kind::Range { beacon, .. } = m.kind {
-                    let model = self.noise.range_model(&beacon);
-                    let h = ScalarModel::<6>::jacobian(&model, &truth.eta);
-                    let info = h.transpose() * h / model.variance(&truth.eta);
-                    self.info.push((v, s.k, DMatrix::from_column_slice(6, 6, info.as_slice())));
-                }
-            }
-        }
+/// For the bound: the Fisher information H' R^-1 H of a range, from the navigators' own
+/// range model, at the truth (None for another kind).
+pub(crate) fn range_information(noise: SensorNoise) -> impl FnMut(&Kind, &VehicleTruth) -> Option<DMatrix<f64>> {
+    move |kind, truth| {
+        let Kind::Range { beacon, .. } = kind else { return None };
+        let model = noise.range_model(beacon);
+        let h = ScalarModel::<6>::jacobian(&model, &truth.eta);
+        let info = h.transpose() * h / model.variance(&truth.eta);
+        Some(DMatrix::from_column_slice(6, 6, info.as_slice()))
     }
 }

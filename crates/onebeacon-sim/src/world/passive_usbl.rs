@@ -12,12 +12,14 @@ use crate::scenario::passive_usbl::{Auv, GuidanceKind};
 use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
-use nalgebra::{Matrix2, SVector, Vector2, Vector3};
+use nalgebra::{DMatrix, Matrix2, SMatrix, SVector, Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
 use onebeacon::guidance::bearing::{BearingPlanner, Belief, SpreadMetric, leg_done, leg_target};
 use onebeacon::measure::{ScalarModel, Usbl, UsblAngle};
 use onebeacon::models::hoff::{DIM, idx};
-use onebeacon::nav::{BeaconFix, Estimate, GaussianTracker, Kind, Measurement, Navigator, ParticleTracker};
+use onebeacon::nav::{
+    BeaconFix, Estimate, GaussianTracker, Kind, Measurement, Navigator, ParticleTracker, TrackerNoise,
+};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::FRAC_PI_2;
@@ -404,49 +406,27 @@ impl World for PassiveUsblWorld<'_> {
     }
 }
 
-/// For the bound: the Fisher information H' R^-1 H of every bearing each AUV is heard
-/// at, from the world's USBL noise (the matched trackers'), at the truth.
-pub(crate) struct BearingInformation {
-    noise: onebeacon::nav::TrackerNoise,
-    info: Vec<(usize, usize, nalgebra::DMatrix<f64>)>,
-}
-
-impl BearingInformation {
-    pub(crate) fn new(noise: onebeacon::nav::TrackerNoise) -> Self {
-        Self { noise, info: Vec::new() }
-    }
-
-    pub(crate) fn into_inner(self) -> Vec<(usize, usize, nalgebra::DMatrix<f64>)> {
-        self.info
-    }
-}
-
-impl crate::engine::Observer for BearingInformation {
-    fn step(&mut self, s: &crate::engine::Step<'_>) {
-        for (v, (heard, truth)) in s.heard.iter().zip(s.truth).enumerate() {
-            for m in heard {
-                if let Kind::Bearing { station, station_heading_rad, .. } = m.kind {
-                    let usbl = Usbl {
-                        position_ned_m: station.position_ned_m,
-                        heading_rad: station_heading_rad,
-                        sigma_rad_per_m: self.noise.usbl_sigma_rad_per_m,
-                        position_sigma_m: station.sigma_m,
-                        heading_sigma_rad: self.noise.station_heading_sigma_rad,
-                    };
-                    let mut x = SVector::<f64, DIM>::zeros();
-                    x.fixed_rows_mut::<3>(0).copy_from(&truth.eta.fixed_rows::<3>(0));
-                    let info = [UsblAngle::Azimuth, UsblAngle::Elevation].iter().fold(
-                        nalgebra::SMatrix::<f64, DIM, DIM>::zeros(),
-                        |acc, &a| {
-                            let model = usbl.model(a);
-                            let h = ScalarModel::<DIM>::jacobian(&model, &x);
-                            acc + h.transpose() * h / model.variance(&x)
-                        },
-                    );
-                    self.info.push((v, s.k, nalgebra::DMatrix::from_column_slice(DIM, DIM, info.as_slice())));
-                }
-            }
-        }
+/// For the bound: the Fisher information H' R^-1 H of a bearing, from the world's USBL
+/// noise (the matched trackers'), at the truth (None for another kind).
+pub(crate) fn bearing_information(noise: TrackerNoise) -> impl FnMut(&Kind, &VehicleTruth) -> Option<DMatrix<f64>> {
+    move |kind, truth| {
+        let Kind::Bearing { station, station_heading_rad, .. } = *kind else { return None };
+        let usbl = Usbl {
+            position_ned_m: station.position_ned_m,
+            heading_rad: station_heading_rad,
+            sigma_rad_per_m: noise.usbl_sigma_rad_per_m,
+            position_sigma_m: station.sigma_m,
+            heading_sigma_rad: noise.station_heading_sigma_rad,
+        };
+        let mut x = SVector::<f64, DIM>::zeros();
+        x.fixed_rows_mut::<3>(0).copy_from(&truth.eta.fixed_rows::<3>(0));
+        let info =
+            [UsblAngle::Azimuth, UsblAngle::Elevation].iter().fold(SMatrix::<f64, DIM, DIM>::zeros(), |acc, &a| {
+                let model = usbl.model(a);
+                let h = ScalarModel::<DIM>::jacobian(&model, &x);
+                acc + h.transpose() * h / model.variance(&x)
+            });
+        Some(DMatrix::from_column_slice(DIM, DIM, info.as_slice()))
     }
 }
 
