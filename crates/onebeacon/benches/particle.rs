@@ -12,7 +12,12 @@ use std::hint::black_box;
 fn bench(c: &mut Criterion) {
     let mean = SVector::<f64, DIM>::from([100.0, 50.0, 30.0, 0.0, 0.3, 1.5, 0.0, 0.002]);
     let sigma = SVector::<f64, DIM>::from([10.0, 10.0, 2.0, 0.05, 0.2, 0.3, 0.001, 0.003]);
-    let settings = ParticleSettings { resampler: Resampler::Systematic, ess_fraction: 1.0, roughening_k: None };
+    let settings = ParticleSettings {
+        resampler: Resampler::Systematic,
+        ess_fraction: 1.0,
+        roughening_k: None,
+        min_effective: 0.0,
+    };
     let ins = InsReport {
         heading_rad: 0.3,
         speed_m_s: 1.5,

@@ -76,7 +76,12 @@ fn main() {
     let sig = 1f64.to_radians();
     let truth0 = SVector::<f64, 8>::from([100.0, 1.0, 50.0, 0.5, -40.0, 0.0, 0.0, 0.0]);
     let spread = SVector::<f64, 8>::from([10.0, 0.5, 10.0, 0.5, 5.0, 0.1, 0.01, 0.01]);
-    let settings = ParticleSettings { resampler: Resampler::Systematic, ess_fraction: 1.0 + 1e-9, roughening_k: None };
+    let settings = ParticleSettings {
+        resampler: Resampler::Systematic,
+        ess_fraction: 1.0 + 1e-9,
+        roughening_k: None,
+        min_effective: 0.0,
+    };
     let mut pf = ParticleFilter::<8>::gaussian(n, &truth0, &spread, settings, 1);
     // the truth and its measurements, drawn from the same model
     let mut rng = Pcg64::seed_from_u64(7);

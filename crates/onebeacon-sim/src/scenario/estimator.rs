@@ -167,6 +167,9 @@ pub struct EstimatorSpec {
     pub ess_fraction: Option<f64>,
     /// Roughening after resampling, K of Gordon et al. (pf; default off).
     pub roughening_k: Option<f64>,
+    /// The fewest effective particles an update may leave: a sharper measurement is
+    /// tempered (pf; default 20; 0: off).
+    pub min_effective_particles: Option<f64>,
     /// Yaw rate, rad/s, and forward acceleration, m/s^2 (fixed_beacon).
     pub yaw_rate_sigma_rad_s: Option<f64>,
     pub accel_sigma_m_s2: Option<f64>,
@@ -211,6 +214,8 @@ pub struct EstimatorSpec {
 
 /// Particles of a `pf` estimator without `particles` (hoff2024 sec. 5).
 pub const DEFAULT_PARTICLES: usize = 500_000;
+/// A `pf` estimator's `min_effective_particles` when not given.
+pub const DEFAULT_MIN_EFFECTIVE: f64 = 20.0;
 
 /// The noise keys a log's `[noise]` table may give its estimators, and whether each
 /// must be > 0 (else >= 0).
@@ -257,6 +262,7 @@ impl EstimatorSpec {
             resampler: None,
             ess_fraction: None,
             roughening_k: None,
+            min_effective_particles: None,
             yaw_rate_sigma_rad_s: None,
             accel_sigma_m_s2: None,
             q_diag: None,
@@ -344,6 +350,7 @@ impl EstimatorSpec {
             ("particles", self.particles.map(|n| n as f64), Positive, USBL),
             ("ess_fraction", self.ess_fraction, Positive, USBL),
             ("roughening_k", self.roughening_k, Positive, USBL),
+            ("min_effective_particles", self.min_effective_particles, NonNegative, USBL),
             ("yaw_rate_sigma_rad_s", self.yaw_rate_sigma_rad_s, Positive, &[FixedBeacon]),
             ("accel_sigma_m_s2", self.accel_sigma_m_s2, Positive, &[FixedBeacon]),
             ("distance_sigma_frac", self.distance_sigma_frac, NonNegative, &[Log]),
@@ -434,6 +441,7 @@ impl EstimatorSpec {
             resampler,
             ess_fraction: self.ess_fraction.unwrap_or(d.ess_fraction),
             roughening_k: self.roughening_k.or(d.roughening_k),
+            min_effective: self.min_effective_particles.unwrap_or(DEFAULT_MIN_EFFECTIVE),
         };
         (self.particles.unwrap_or(DEFAULT_PARTICLES), settings)
     }

@@ -179,14 +179,14 @@ pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<()
             };
             return Err(Violation { key: key("kind"), value: format!("{:?}", e.kind.label()), allowed });
         }
-        if !particle
-            && (e.particles.is_some() || e.resampler.is_some() || e.ess_fraction.is_some() || e.roughening_k.is_some())
-        {
-            let name = ["particles", "resampler", "ess_fraction", "roughening_k"]
-                .into_iter()
-                .zip([e.particles.is_some(), e.resampler.is_some(), e.ess_fraction.is_some(), e.roughening_k.is_some()])
-                .find_map(|(n, set)| set.then_some(n))
-                .unwrap_or("particles");
+        let pf_only = [
+            ("particles", e.particles.is_some()),
+            ("resampler", e.resampler.is_some()),
+            ("ess_fraction", e.ess_fraction.is_some()),
+            ("roughening_k", e.roughening_k.is_some()),
+            ("min_effective_particles", e.min_effective_particles.is_some()),
+        ];
+        if let Some((name, _)) = pf_only.iter().find(|(_, set)| *set).filter(|_| !particle) {
             return Err(Violation {
                 key: key(name),
                 value: "(set)".into(),

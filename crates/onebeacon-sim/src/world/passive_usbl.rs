@@ -203,12 +203,12 @@ impl<'a> PassiveUsblWorld<'a> {
             .position_sample(g.planner_particles)
             .unwrap_or_else(|| gaussian_sample(e, g.planner_particles));
         let weights = vec![1.0 / positions.len() as f64; positions.len()];
-        let pitch = e.body_to_ned();
-        let course = pitch * Vector3::new(e.speed_m_s.unwrap_or(0.0), 0.0, 0.0);
+        // the velocity over ground of the estimated heading, pitch and speed
+        let velocity = e.body_to_ned() * Vector3::new(e.speed_m_s.unwrap_or(0.0), 0.0, 0.0);
         let belief = Belief {
             positions: &positions,
             weights: &weights,
-            velocity_m_s: course.xy(),
+            velocity_m_s: velocity.xy(),
             lead_s: g.lead_periods * self.s.mission.message_period_s,
         };
         let asv_velocity = Vector2::new(self.asv.psi.cos(), self.asv.psi.sin()) * self.asv_speed.max(0.1);

@@ -63,11 +63,17 @@ pub struct ParticleSettings {
     /// Roughening after resampling (Gordon, Salmond and Smith 1993): each component
     /// jittered by K E_k N^(-1/d), E_k its spread over the particles; None: off.
     pub roughening_k: Option<f64>,
+    /// The fewest effective particles an update may leave: a measurement that would
+    /// leave fewer is applied tempered, its log-likelihood times the largest lambda in
+    /// (0, 1] that leaves this many (its noise variance inflated by 1 / lambda), so that
+    /// a likelihood far sharper than the cloud (a USBL azimuth from almost overhead)
+    /// cannot collapse it onto one particle; 0: off.
+    pub min_effective: f64,
 }
 
 impl Default for ParticleSettings {
     fn default() -> Self {
-        Self { resampler: Resampler::Systematic, ess_fraction: 0.5, roughening_k: None }
+        Self { resampler: Resampler::Systematic, ess_fraction: 0.5, roughening_k: None, min_effective: 0.0 }
     }
 }
 
@@ -79,6 +85,10 @@ pub struct ParticleFilter<const D: usize> {
     /// Resampling's target buffers, kept to avoid an allocation per step.
     spare: Vec<Vec<f64>>,
     log_w: Vec<f64>,
+    /// The log-likelihood of the last update, kept apart to temper it.
+    increment: Vec<f64>,
+    /// The tempering of the last update (1: none).
+    tempering: f64,
     /// The normalised weights, computed once per change of the log-weights.
     normalised: std::cell::OnceCell<Vec<f64>>,
     pub settings: ParticleSettings,
@@ -111,6 +121,8 @@ impl<const D: usize> ParticleFilter<D> {
             x: vec![vec![0.0; n]; D],
             spare: vec![vec![0.0; n]; D],
             log_w: vec![0.0; n],
+            increment: Vec::new(),
+            tempering: 1.0,
             normalised: std::cell::OnceCell::new(),
             settings,
             seed,
@@ -175,26 +187,54 @@ impl<const D: usize> ParticleFilter<D> {
     /// no particle explains, or a NaN), every weight is reset to equal and false is
     /// returned, so that one absurd measurement does not end the filter.
     pub fn reweight(&mut self, likelihood: &impl ParticleLikelihood) -> bool {
+        let n = self.len();
         let x = &self.x;
         self.normalised = std::cell::OnceCell::new();
-        self.log_w.par_chunks_mut(CHUNK).enumerate().for_each(|(c, lw)| {
+        let mut inc = std::mem::take(&mut self.increment);
+        inc.clear();
+        inc.resize(n, 0.0);
+        inc.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
             let start = c * CHUNK;
-            let view: Vec<&[f64]> = x.iter().map(|comp| &comp[start..start + lw.len()]).collect();
-            likelihood.add_log_likelihood(&view, lw);
+            let view: Vec<&[f64]> = x.iter().map(|comp| &comp[start..start + l.len()]).collect();
+            likelihood.add_log_likelihood(&view, l);
         });
         self.step += 1;
         // NaN compares false both ways: a NaN anywhere makes the maximum NaN
         let max = self
             .log_w
             .par_iter()
-            .copied()
+            .zip(inc.par_iter())
+            .map(|(w, l)| w + l)
             .reduce(|| f64::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) });
-        if max.is_finite() {
-            return true;
+        if !max.is_finite() {
+            self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
+            self.increment = inc;
+            return false;
         }
-        self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
-        self.normalised = std::cell::OnceCell::new();
-        false
+        let floor = self.settings.min_effective.min(n as f64);
+        self.tempering = if floor > 0.0 && ess_tempered(&self.log_w, &inc, 1.0) < floor {
+            // the largest lambda that leaves `floor` effective particles: bisection on
+            // log2 lambda in [-30, 0] to 1 % (the ESS falls as lambda grows)
+            let (mut lo, mut hi) = (-30.0f64, 0.0f64);
+            while hi - lo > 0.015 {
+                let mid = 0.5 * (lo + hi);
+                if ess_tempered(&self.log_w, &inc, mid.exp2()) >= floor { lo = mid } else { hi = mid }
+            }
+            lo.exp2()
+        } else {
+            1.0
+        };
+        let lambda = self.tempering;
+        self.log_w.par_iter_mut().zip(inc.par_iter()).for_each(|(w, l)| *w += lambda * l);
+        self.increment = inc;
+        true
+    }
+
+    /// The factor the last update's log-likelihood was tempered by (1: applied whole;
+    /// below 1 when it would have left fewer effective particles than
+    /// [`ParticleSettings::min_effective`]).
+    pub fn tempering(&self) -> f64 {
+        self.tempering
     }
 
     /// Resamples when the effective sample size is below the threshold; whether it did.
@@ -342,6 +382,24 @@ fn chunk_views(x: &mut [Vec<f64>]) -> Vec<Vec<&mut [f64]>> {
         }
     }
     views
+}
+
+/// The effective sample size of log-weights `log_w + lambda inc`, summed by chunks in
+/// order.
+fn ess_tempered(log_w: &[f64], inc: &[f64], lambda: f64) -> f64 {
+    let at = |i: usize| log_w[i] + lambda * inc[i];
+    let max = (0..log_w.len()).into_par_iter().map(at).reduce(|| f64::NEG_INFINITY, f64::max);
+    let partial: Vec<(f64, f64)> = (0..log_w.len().div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            (c * CHUNK..((c + 1) * CHUNK).min(log_w.len())).fold((0.0, 0.0), |(s, s2), i| {
+                let e = (at(i) - max).exp();
+                (s + e, s2 + e * e)
+            })
+        })
+        .collect();
+    let (s, s2) = partial.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
+    s * s / s2
 }
 
 /// sum a_i b_i with four accumulators (a loop the compiler vectorises; the order is
@@ -495,7 +553,12 @@ mod tests {
                 }
             }
         }
-        let settings = ParticleSettings { resampler: Resampler::Systematic, ess_fraction: 0.5, roughening_k: None };
+        let settings = ParticleSettings {
+            resampler: Resampler::Systematic,
+            ess_fraction: 0.5,
+            roughening_k: None,
+            min_effective: 0.0,
+        };
         let n = 200_000;
         let mut pf = ParticleFilter::<2>::gaussian(n, &Vector2::new(0.0, 1.0), &Vector2::new(1.0, 0.5), settings, 7);
         // the Kalman filter
@@ -546,8 +609,12 @@ mod tests {
         let run = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let settings =
-                    ParticleSettings { resampler: Resampler::Residual, ess_fraction: 1.0, roughening_k: Some(0.2) };
+                let settings = ParticleSettings {
+                    resampler: Resampler::Residual,
+                    ess_fraction: 1.0,
+                    roughening_k: Some(0.2),
+                    min_effective: 0.0,
+                };
                 let mut pf =
                     ParticleFilter::<2>::gaussian(50_000, &Vector2::zeros(), &Vector2::repeat(3.0), settings, 5);
                 for _ in 0..3 {
@@ -576,5 +643,47 @@ mod tests {
         // linear: the mean is near 0 and the spread near pi^2
         let (m, c) = pf.mean_covariance();
         assert!(m[1].abs() < 1e-12 && c[(1, 1)] > 9.0);
+    }
+
+    /// A likelihood far sharper than the cloud: N(0, 1) particles weighed by
+    /// exp(-x^2 / (2 sigma^2)), sigma = 1e-4. Whole, it leaves a handful of effective
+    /// particles (closed form: N sqrt(v (2 + v)) / (1 + v) with v = sigma^2, 1.4 of 1e5);
+    /// with a floor of 1000 it is tempered by the lambda of the closed form, v = sigma^2 /
+    /// lambda solving sqrt(v (2 + v)) / (1 + v) = 0.01 (lambda = 2.0e-4), and leaves 1000.
+    /// A mild likelihood is applied whole.
+    #[test]
+    fn a_likelihood_sharper_than_the_cloud_is_tempered_to_the_floor() {
+        struct Sharp(f64);
+        impl ParticleLikelihood for Sharp {
+            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+                for (l, v) in log_w.iter_mut().zip(x[0]) {
+                    *l += -v * v / (2.0 * self.0 * self.0);
+                }
+            }
+        }
+        let n = 100_000;
+        let mean = SVector::<f64, 1>::zeros();
+        let sigma = SVector::<f64, 1>::from([1.0]);
+        let settings = ParticleSettings { min_effective: 1000.0, ess_fraction: 0.0, ..ParticleSettings::default() };
+        let mut pf = ParticleFilter::<1>::gaussian(n, &mean, &sigma, settings, 3);
+        let mut whole = pf.clone();
+        whole.settings.min_effective = 0.0;
+        whole.reweight(&Sharp(1e-4));
+        assert!(whole.ess() < 20.0, "{}", whole.ess());
+        assert_eq!(whole.tempering(), 1.0);
+        pf.reweight(&Sharp(1e-4));
+        let ess_fraction = |v: f64| (v * (2.0 + v)).sqrt() / (1.0 + v);
+        // v solving ess_fraction(v) = 0.01, by bisection
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if ess_fraction(mid) < 0.01 { lo = mid } else { hi = mid }
+        }
+        let lambda = 1e-8 / lo;
+        assert!((pf.tempering() / lambda - 1.0).abs() < 0.1, "{} against {lambda}", pf.tempering());
+        assert!((pf.ess() / 1000.0 - 1.0).abs() < 0.05, "{}", pf.ess());
+        let mut mild = ParticleFilter::<1>::gaussian(n, &mean, &sigma, settings, 3);
+        mild.reweight(&Sharp(2.0));
+        assert_eq!(mild.tempering(), 1.0);
     }
 }
