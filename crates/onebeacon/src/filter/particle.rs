@@ -187,46 +187,42 @@ impl<const D: usize> ParticleFilter<D> {
     /// no particle explains, or a NaN), every weight is reset to equal and false is
     /// returned, so that one absurd measurement does not end the filter.
     pub fn reweight(&mut self, likelihood: &impl ParticleLikelihood) -> bool {
-        let n = self.len();
-        let x = &self.x;
         self.normalised = std::cell::OnceCell::new();
-        let mut inc = std::mem::take(&mut self.increment);
-        inc.clear();
-        inc.resize(n, 0.0);
-        inc.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
-            let start = c * CHUNK;
-            let view: Vec<&[f64]> = x.iter().map(|comp| &comp[start..start + l.len()]).collect();
-            likelihood.add_log_likelihood(&view, l);
-        });
+        add_log_likelihood(&self.x, &mut self.log_w, likelihood);
         self.step += 1;
+        self.tempering = 1.0;
         // NaN compares false both ways: a NaN anywhere makes the maximum NaN
         let max = self
             .log_w
             .par_iter()
-            .zip(inc.par_iter())
-            .map(|(w, l)| w + l)
+            .copied()
             .reduce(|| f64::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) });
         if !max.is_finite() {
             self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
-            self.increment = inc;
             return false;
         }
-        let floor = self.settings.min_effective.min(n as f64);
-        self.tempering = if floor > 0.0 && ess_tempered(&self.log_w, &inc, 1.0) < floor {
-            // the largest lambda that leaves `floor` effective particles: bisection on
-            // log2 lambda in [-30, 0] to 1 % (the ESS falls as lambda grows)
+        let floor = self.settings.min_effective.min(self.len() as f64);
+        if floor > 0.0 && ess_of(self.normalised()) < floor {
+            // too sharp: take the update back (its increments once more, a rare second
+            // pass) and apply it times the largest lambda that leaves `floor` effective
+            // particles: bisection on log2 lambda in [-30, 0] to 1 % (the ESS falls as
+            // lambda grows)
+            let mut inc = std::mem::take(&mut self.increment);
+            inc.clear();
+            inc.resize(self.len(), 0.0);
+            add_log_likelihood(&self.x, &mut inc, likelihood);
+            self.log_w.par_iter_mut().zip(inc.par_iter()).for_each(|(w, l)| *w -= l);
             let (mut lo, mut hi) = (-30.0f64, 0.0f64);
             while hi - lo > 0.015 {
                 let mid = 0.5 * (lo + hi);
                 if ess_tempered(&self.log_w, &inc, mid.exp2()) >= floor { lo = mid } else { hi = mid }
             }
-            lo.exp2()
-        } else {
-            1.0
-        };
-        let lambda = self.tempering;
-        self.log_w.par_iter_mut().zip(inc.par_iter()).for_each(|(w, l)| *w += lambda * l);
-        self.increment = inc;
+            let lambda = lo.exp2();
+            self.log_w.par_iter_mut().zip(inc.par_iter()).for_each(|(w, l)| *w += lambda * l);
+            self.increment = inc;
+            self.tempering = lambda;
+            self.normalised = std::cell::OnceCell::new();
+        }
         true
     }
 
@@ -382,6 +378,16 @@ fn chunk_views(x: &mut [Vec<f64>]) -> Vec<Vec<&mut [f64]>> {
         }
     }
     views
+}
+
+/// Adds `likelihood`'s log-likelihood of every particle of `x` to `log_w`, chunk by
+/// chunk in parallel.
+fn add_log_likelihood(x: &[Vec<f64>], log_w: &mut [f64], likelihood: &impl ParticleLikelihood) {
+    log_w.par_chunks_mut(CHUNK).enumerate().for_each(|(c, lw)| {
+        let start = c * CHUNK;
+        let view: Vec<&[f64]> = x.iter().map(|comp| &comp[start..start + lw.len()]).collect();
+        likelihood.add_log_likelihood(&view, lw);
+    });
 }
 
 /// The effective sample size of log-weights `log_w + lambda inc`, summed by chunks in
