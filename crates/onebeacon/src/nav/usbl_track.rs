@@ -129,10 +129,6 @@ impl ParticleTracker {
         Self { pf, config, t_s: t0_s, cache: OnceCell::new() }
     }
 
-    pub fn particles(&self) -> &ParticleFilter<DIM> {
-        &self.pf
-    }
-
     fn advance_to(&mut self, t_s: f64) {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
