@@ -99,7 +99,8 @@ pub fn bearing_rmse_bound(
         StateComponent::value(idx::U, noise.speed_sigma_m_s.powi(2)),
         StateComponent::value(idx::Z, noise.depth_sigma_m.powi(2)),
     ];
-    let x0 = PassiveUsblWorld::truth_state(s, v, 0.0);
+    let truth = PassiveUsblWorld::truth_state(s, v);
+    let x0 = truth(0.0);
     let report_info = reports.iter().fold(Cov8::zeros(), |acc, m| {
         let h = ScalarModel::<DIM>::jacobian(m, &x0);
         acc + h.transpose() * h / m.variance(&x0)
@@ -108,7 +109,7 @@ pub fn bearing_rmse_bound(
     let mut sum = c[(0, 0)] + c[(1, 1)];
     let (steps, dt) = (s.steps(), s.mission.message_period_s);
     for k in 1..=steps {
-        let x = PassiveUsblWorld::truth_state(s, v, (k - 1) as f64 * dt);
+        let x = truth((k - 1) as f64 * dt);
         let f = ProcessModel::jacobian(&process, &x, dt);
         let q = ProcessModel::noise_covariance(&process, &x, dt);
         let info = information_sum.get(&k).map_or(report_info, |i| report_info + mean_information::<DIM>(i, runs));

@@ -121,9 +121,10 @@ impl<'a> PassiveUsblWorld<'a> {
         }
     }
 
-    /// The true state of eq. 4 of AUV `v` at `t_s`.
-    pub(crate) fn truth_state(s: &PassiveUsbl, v: usize, t_s: f64) -> SVector<f64, DIM> {
-        Circle::new(s.auvs().swap_remove(v)).state(t_s)
+    /// The true state of eq. 4 of AUV `v`, as a function of time.
+    pub(crate) fn truth_state(s: &PassiveUsbl, v: usize) -> impl Fn(f64) -> SVector<f64, DIM> {
+        let circle = Circle::new(s.auvs().swap_remove(v));
+        move |t_s| circle.state(t_s)
     }
 
     /// The trackers' initial standard deviations, state order.
@@ -411,13 +412,7 @@ impl World for PassiveUsblWorld<'_> {
 pub(crate) fn bearing_information(noise: TrackerNoise) -> impl FnMut(&Kind, &VehicleTruth) -> Option<DMatrix<f64>> {
     move |kind, truth| {
         let Kind::Bearing { station, station_heading_rad, .. } = *kind else { return None };
-        let usbl = Usbl {
-            position_ned_m: station.position_ned_m,
-            heading_rad: station_heading_rad,
-            sigma_rad_per_m: noise.usbl_sigma_rad_per_m,
-            position_sigma_m: station.sigma_m,
-            heading_sigma_rad: noise.station_heading_sigma_rad,
-        };
+        let usbl = noise.usbl(&station, station_heading_rad);
         let mut x = SVector::<f64, DIM>::zeros();
         x.fixed_rows_mut::<3>(0).copy_from(&truth.eta.fixed_rows::<3>(0));
         let info =

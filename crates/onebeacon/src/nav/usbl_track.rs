@@ -66,15 +66,16 @@ impl Default for TrackerConfig {
     }
 }
 
-impl TrackerConfig {
-    /// The USBL of a bearing measurement, with the noise this tracker assumes.
-    fn usbl(&self, station: &super::BeaconFix, station_heading_rad: f64) -> Usbl {
+impl TrackerNoise {
+    /// The USBL of a bearing measured from `station` (its GPS position and error) at
+    /// compass heading `station_heading_rad`, with this noise.
+    pub fn usbl(&self, station: &super::BeaconFix, station_heading_rad: f64) -> Usbl {
         Usbl {
             position_ned_m: station.position_ned_m,
             heading_rad: station_heading_rad,
-            sigma_rad_per_m: self.noise.usbl_sigma_rad_per_m,
+            sigma_rad_per_m: self.usbl_sigma_rad_per_m,
             position_sigma_m: station.sigma_m,
-            heading_sigma_rad: self.noise.station_heading_sigma_rad,
+            heading_sigma_rad: self.station_heading_sigma_rad,
         }
     }
 }
@@ -158,7 +159,7 @@ impl Navigator for ParticleTracker {
                 if self.config.aiding.bearing =>
             {
                 self.advance_to(m.t_s);
-                let usbl = self.config.usbl(&station, station_heading_rad);
+                let usbl = self.config.noise.usbl(&station, station_heading_rad);
                 self.pf.reweight(&UsblBearing { usbl, azimuth_rad, elevation_rad })
             }
             _ => return Outcome::Skipped,
@@ -225,7 +226,7 @@ impl Navigator for GaussianTracker {
                 if self.config.aiding.bearing =>
             {
                 self.advance_to(m.t_s);
-                let usbl = self.config.usbl(&station, station_heading_rad);
+                let usbl = self.config.noise.usbl(&station, station_heading_rad);
                 let models = [usbl.model(UsblAngle::Azimuth), usbl.model(UsblAngle::Elevation)]; // eq. 1-3
                 let z = Vector2::new(azimuth_rad, elevation_rad);
                 gated_update(&mut self.filter, &models, z, self.config.nis_gate, None)
