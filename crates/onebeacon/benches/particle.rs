@@ -40,6 +40,24 @@ fn bench(c: &mut Criterion) {
         });
     }
     group.finish();
+    // the cycle's stages apart, at N = 5e5
+    let mut group = c.benchmark_group("hoff2024 particle filter stages, 500000");
+    group.sample_size(10);
+    // each from the state a cycle leaves it in (setup not timed)
+    use criterion::BatchSize::LargeInput;
+    let fresh = ParticleFilter::<DIM>::gaussian(500_000, &mean, &sigma, settings, 1);
+    let mut predicted = fresh.clone();
+    predicted.predict(&HoffProcess::default(), 4.0);
+    let mut weighed = predicted.clone();
+    weighed.reweight(&(ins, bearing));
+    group.bench_function("predict", |b| {
+        b.iter_batched_ref(|| fresh.clone(), |pf| pf.predict(&HoffProcess::default(), 4.0), LargeInput)
+    });
+    group.bench_function("reweight", |b| {
+        b.iter_batched_ref(|| predicted.clone(), |pf| black_box(pf.reweight(&(ins, bearing))), LargeInput)
+    });
+    group.bench_function("resample", |b| b.iter_batched_ref(|| weighed.clone(), |pf| pf.resample(), LargeInput));
+    group.finish();
 }
 
 /// One planner decision (3 radii x 19 angles, hoff2024.toml's) on a belief of n

@@ -91,11 +91,29 @@ pub struct ParticleFilter<const D: usize> {
     tempering: f64,
     /// The normalised weights, computed once per change of the log-weights.
     normalised: std::cell::OnceCell<Vec<f64>>,
+    /// The normalised weights' buffer while they are stale, kept for the next ones.
+    weight_buffer: Recycled,
     pub settings: ParticleSettings,
     seed: u64,
     /// Steps so far (predictions, updates and resamplings each take one): the random
     /// streams' second coordinate.
     step: u64,
+}
+
+/// A buffer kept for reuse (a clone starts without one).
+#[derive(Default)]
+struct Recycled(std::cell::Cell<Vec<f64>>);
+
+impl Clone for Recycled {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl std::fmt::Debug for Recycled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Recycled")
+    }
 }
 
 /// The random stream of (seed, step, chunk): a PCG with the chunk as its stream
@@ -124,6 +142,7 @@ impl<const D: usize> ParticleFilter<D> {
             increment: Vec::new(),
             tempering: 1.0,
             normalised: std::cell::OnceCell::new(),
+            weight_buffer: Recycled::default(),
             settings,
             seed,
             step: 0,
@@ -187,16 +206,10 @@ impl<const D: usize> ParticleFilter<D> {
     /// no particle explains, or a NaN), every weight is reset to equal and false is
     /// returned, so that one absurd measurement does not end the filter.
     pub fn reweight(&mut self, likelihood: &impl ParticleLikelihood) -> bool {
-        self.normalised = std::cell::OnceCell::new();
-        add_log_likelihood(&self.x, &mut self.log_w, likelihood);
+        self.invalidate_weights();
+        let max = add_log_likelihood(&self.x, &mut self.log_w, likelihood);
         self.step += 1;
         self.tempering = 1.0;
-        // NaN compares false both ways: a NaN anywhere makes the maximum NaN
-        let max = self
-            .log_w
-            .par_iter()
-            .copied()
-            .reduce(|| f64::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) });
         if !max.is_finite() {
             self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
             return false;
@@ -221,7 +234,7 @@ impl<const D: usize> ParticleFilter<D> {
             self.log_w.par_iter_mut().zip(inc.par_iter()).for_each(|(w, l)| *w += lambda * l);
             self.increment = inc;
             self.tempering = lambda;
-            self.normalised = std::cell::OnceCell::new();
+            self.invalidate_weights();
         }
         true
     }
@@ -236,8 +249,7 @@ impl<const D: usize> ParticleFilter<D> {
     /// Resamples when the effective sample size is below the threshold; whether it did.
     pub fn resample_if_degenerate(&mut self) -> bool {
         if ess_of(self.normalised()) < self.settings.ess_fraction * self.len() as f64 {
-            let w = self.normalised.take().expect("computed above");
-            self.resample_with(&w);
+            self.resample();
             return true;
         }
         false
@@ -256,16 +268,30 @@ impl<const D: usize> ParticleFilter<D> {
         self.normalised().to_vec()
     }
 
-    /// The normalised weights, computed once per change of the log-weights.
+    /// The normalised weights, computed once per change of the log-weights (into the
+    /// buffer of the last ones).
     fn normalised(&self) -> &[f64] {
         self.normalised.get_or_init(|| {
             // the maximum is exact in any order; the sum is taken in chunk order
             let max = self.log_w.par_iter().copied().reduce(|| f64::NEG_INFINITY, f64::max);
-            let mut w: Vec<f64> = self.log_w.par_iter().map(|l| (l - max).exp()).collect();
-            let total = sum_in_order(&w);
-            w.par_iter_mut().for_each(|v| *v /= total);
+            let mut w = self.weight_buffer.0.take();
+            w.resize(self.len(), 0.0);
+            let partial: Vec<f64> = w
+                .par_chunks_mut(CHUNK)
+                .zip(self.log_w.par_chunks(CHUNK))
+                .map(|(w, l)| crate::filter::lanes::exp_shifted(l, max, w))
+                .collect();
+            let scale = 1.0 / partial.iter().sum::<f64>();
+            w.par_iter_mut().for_each(|v| *v *= scale);
             w
         })
+    }
+
+    /// Marks the normalised weights stale, keeping their buffer.
+    fn invalidate_weights(&mut self) {
+        if let Some(w) = self.normalised.take() {
+            self.weight_buffer.0.set(w);
+        }
     }
 
     /// The effective sample size, 1 / sum w_i^2.
@@ -326,27 +352,46 @@ impl<const D: usize> ParticleFilter<D> {
     }
 
     /// Draws the particles again in proportion to their weights, resets the weights,
-    /// and roughens when asked.
+    /// and roughens when asked. Systematic and stratified resampling run chunk by chunk
+    /// in parallel: each output chunk finds its first ancestor by bisection on the
+    /// cumulative weights and walks from there, and copies its particles' components.
     pub fn resample(&mut self) {
-        let w = self.normalised.take().unwrap_or_else(|| self.weights());
-        self.resample_with(&w);
-    }
-
-    /// [`ParticleFilter::resample`] with the normalised weights `w` in hand.
-    fn resample_with(&mut self, w: &[f64]) {
-        let mut rng = stream(self.seed, self.step, u64::MAX);
+        let (seed, step) = (self.seed, self.step);
         self.step += 1;
-        let ancestors = ancestors(self.settings.resampler, w, &mut rng);
-        for (from, to) in self.x.iter().zip(self.spare.iter_mut()) {
-            to.par_chunks_mut(CHUNK).zip(ancestors.par_chunks(CHUNK)).for_each(|(t, a)| {
-                for (v, &i) in t.iter_mut().zip(a) {
-                    *v = from[i];
+        let n = self.len();
+        let w = self.normalised();
+        let mut rng = stream(seed, step, u64::MAX);
+        let resampler = self.settings.resampler;
+        let sequential = match resampler {
+            Resampler::Systematic | Resampler::Stratified => None,
+            Resampler::Multinomial | Resampler::Residual => Some(ancestors(resampler, w, &mut rng)),
+        };
+        let cumulative = cumulative_in_order(w);
+        let u0: f64 = rng.random();
+        let from = &self.x;
+        let mut views = chunk_views(&mut self.spare);
+        views.par_iter_mut().enumerate().for_each(|(c, to)| {
+            let first = c * CHUNK;
+            let len = to[0].len();
+            let picked: Vec<usize> = match (&sequential, resampler) {
+                (Some(a), _) => a[first..first + len].to_vec(),
+                (None, Resampler::Systematic) => {
+                    walk_from(&cumulative, (first..first + len).map(|j| (j as f64 + u0) / n as f64))
                 }
-            });
-        }
+                (None, _) => {
+                    let mut rng = stream(seed, step, c as u64);
+                    walk_from(&cumulative, (first..first + len).map(|j| (j as f64 + rng.random::<f64>()) / n as f64))
+                }
+            };
+            for (k, to) in to.iter_mut().enumerate() {
+                for (v, &i) in to.iter_mut().zip(&picked) {
+                    *v = from[k][i];
+                }
+            }
+        });
         std::mem::swap(&mut self.x, &mut self.spare);
         self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
-        self.normalised = std::cell::OnceCell::new();
+        self.invalidate_weights();
         if let Some(k) = self.settings.roughening_k {
             let n = self.len() as f64;
             let sigma: Vec<f64> = self
@@ -381,13 +426,19 @@ fn chunk_views(x: &mut [Vec<f64>]) -> Vec<Vec<&mut [f64]>> {
 }
 
 /// Adds `likelihood`'s log-likelihood of every particle of `x` to `log_w`, chunk by
-/// chunk in parallel.
-fn add_log_likelihood(x: &[Vec<f64>], log_w: &mut [f64], likelihood: &impl ParticleLikelihood) {
-    log_w.par_chunks_mut(CHUNK).enumerate().for_each(|(c, lw)| {
-        let start = c * CHUNK;
-        let view: Vec<&[f64]> = x.iter().map(|comp| &comp[start..start + lw.len()]).collect();
-        likelihood.add_log_likelihood(&view, lw);
-    });
+/// chunk in parallel; the largest of the results, NaN if any is NaN.
+fn add_log_likelihood(x: &[Vec<f64>], log_w: &mut [f64], likelihood: &impl ParticleLikelihood) -> f64 {
+    log_w
+        .par_chunks_mut(CHUNK)
+        .enumerate()
+        .map(|(c, lw)| {
+            let start = c * CHUNK;
+            let view: Vec<&[f64]> = x.iter().map(|comp| &comp[start..start + lw.len()]).collect();
+            likelihood.add_log_likelihood(&view, lw);
+            let (max, nan) = lw.iter().fold((f64::NEG_INFINITY, false), |(m, nan), v| (m.max(*v), nan | v.is_nan()));
+            if nan { f64::NAN } else { max }
+        })
+        .reduce(|| f64::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) })
 }
 
 /// The effective sample size of log-weights `log_w + lambda inc`, summed by chunks in
@@ -428,10 +479,43 @@ fn ess_of(w: &[f64]) -> f64 {
     1.0 / partial.iter().sum::<f64>()
 }
 
-/// A sum in index order by chunks (the same whatever the thread count).
-fn sum_in_order(v: &[f64]) -> f64 {
-    let partial: Vec<f64> = v.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect();
-    partial.iter().sum()
+/// The running sum of `w`, by chunks in parallel (each chunk from the sum of those
+/// before it: the same whatever the thread count).
+fn cumulative_in_order(w: &[f64]) -> Vec<f64> {
+    let totals: Vec<f64> = w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect();
+    let offsets: Vec<f64> = totals
+        .iter()
+        .scan(0.0, |acc, t| {
+            let before = *acc;
+            *acc += t;
+            Some(before)
+        })
+        .collect();
+    let mut cum = vec![0.0; w.len()];
+    cum.par_chunks_mut(CHUNK).zip(w.par_chunks(CHUNK)).zip(offsets.par_iter()).for_each(|((c, w), off)| {
+        let mut acc = *off;
+        for (c, w) in c.iter_mut().zip(w) {
+            acc += w;
+            *c = acc;
+        }
+    });
+    cum
+}
+
+/// The particle whose cell of the cumulative weights `cum` holds each of `points`
+/// (ascending, in [0, 1)): the first by bisection, the rest by a walk from it.
+fn walk_from(cum: &[f64], points: impl Iterator<Item = f64>) -> Vec<usize> {
+    let mut points = points.peekable();
+    let last = cum.len() - 1;
+    let mut i = points.peek().map_or(0, |u| cum.partition_point(|c| c <= u).min(last));
+    points
+        .map(|u| {
+            while u >= cum[i] && i < last {
+                i += 1;
+            }
+            i
+        })
+        .collect()
 }
 
 /// The index of the particle each new particle copies, for normalised weights `w`.

@@ -5,12 +5,12 @@
 //! (eq. 8) and by the USBL bearing (eq. 6-7).
 
 use crate::filter::ProcessModel;
+use crate::filter::lanes;
 use crate::filter::particle::{ParticleLikelihood, ParticleProcess};
 use crate::filter::truncated::truncated_normal;
 use crate::geo::{wrap_angle, wrap_near};
 use crate::measure::Usbl;
-use nalgebra::{SMatrix, SVector, Vector3};
-use rand::RngExt;
+use nalgebra::{SMatrix, SVector};
 use rand_pcg::Pcg64;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -84,35 +84,68 @@ impl Default for HoffProcess {
     }
 }
 
+/// Particles a propagation or a likelihood handles at a time: its scratch arrays stay
+/// in the first-level cache.
+const BLOCK: usize = 256;
+
 impl ParticleProcess for HoffProcess {
+    /// Block by block: the block's normal draws and its sines and cosines first, eight
+    /// lanes at a time ([`crate::filter::lanes`]), then eq. 4's step. A truncated
+    /// component takes the plain draw when it falls within its bounds and otherwise a
+    /// draw of the truncated law (rejection's first try, then an exact draw: the result
+    /// follows the truncated law).
     fn propagate(&self, x: &mut [&mut [f64]], dt: f64, rng: &mut Pcg64) {
         let s = self.sigma.map(|v| v * dt);
-        let decay = dt / self.t_b_s;
-        let inf = f64::INFINITY;
-        for i in 0..x[0].len() {
-            let (theta, psi, u) = (x[idx::THETA][i], x[idx::PSI][i], x[idx::U][i]);
-            let (b_theta, b_psi) = (x[idx::B_THETA][i], x[idx::B_PSI][i]);
-            let (st, ct) = theta.sin_cos();
-            let (sp, cp) = psi.sin_cos();
-            let gauss = |rng: &mut Pcg64, sd: f64| sd * rng.sample::<f64, _>(rand_distr::StandardNormal);
+        let keep = 1.0 - dt / self.t_b_s;
+        let [px, py, pz, pt, pp, pu, pbt, pbp] = x else { panic!("hoff2024's state has {DIM} components") };
+        let n = px.len();
+        let mut noise = [0.0; DIM * BLOCK];
+        let (mut st, mut ct, mut sp, mut cp) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+        for start in (0..n).step_by(BLOCK) {
+            let m = BLOCK.min(n - start);
+            let r = start..start + m;
+            let (x, y, z, theta, psi) =
+                (&mut px[r.clone()], &mut py[r.clone()], &mut pz[r.clone()], &mut pt[r.clone()], &mut pp[r.clone()]);
+            let (u, b_theta, b_psi) = (&mut pu[r.clone()], &mut pbt[r.clone()], &mut pbp[r]);
+            lanes::standard_normals(rng, &mut noise[..DIM * m]);
+            let (st, ct, sp, cp) = (&mut st[..m], &mut ct[..m], &mut sp[..m], &mut cp[..m]);
+            lanes::sin_cos(theta, st, ct);
+            lanes::sin_cos(psi, sp, cp);
+            let e: [&[f64]; DIM] = std::array::from_fn(|k| &noise[k * m..(k + 1) * m]);
             // eq. 4: the mean step f(x) dt, noise sigma dt, truncated on z, theta and u
-            x[idx::X][i] += u * ct * cp * dt + gauss(rng, s[idx::X]);
-            x[idx::Y][i] += u * ct * sp * dt + gauss(rng, s[idx::Y]);
-            let z = x[idx::Z][i] - u * st * dt;
-            x[idx::Z][i] = truncated_normal(rng, z, s[idx::Z], self.z_min_m, inf);
-            x[idx::THETA][i] = truncated_normal(rng, theta + b_theta * dt, s[idx::THETA], -FRAC_PI_2, FRAC_PI_2);
-            // a step of the heading is far below a turn: one add or subtract wraps it
-            let p = psi + b_psi * dt + gauss(rng, s[idx::PSI]);
-            x[idx::PSI][i] = if p > PI {
-                p - TAU
-            } else if p <= -PI {
-                p + TAU
-            } else {
-                p
-            };
-            x[idx::U][i] = truncated_normal(rng, u, s[idx::U], 0.0, inf);
-            x[idx::B_THETA][i] = b_theta * (1.0 - decay) + gauss(rng, s[idx::B_THETA]);
-            x[idx::B_PSI][i] = b_psi * (1.0 - decay) + gauss(rng, s[idx::B_PSI]);
+            for j in 0..m {
+                x[j] += u[j] * ct[j] * cp[j] * dt + s[idx::X] * e[idx::X][j];
+                y[j] += u[j] * ct[j] * sp[j] * dt + s[idx::Y] * e[idx::Y][j];
+                z[j] += -u[j] * st[j] * dt + s[idx::Z] * e[idx::Z][j];
+                theta[j] += b_theta[j] * dt + s[idx::THETA] * e[idx::THETA][j];
+                // a step of the heading is far below a turn: one add or subtract wraps it
+                let p = psi[j] + b_psi[j] * dt + s[idx::PSI] * e[idx::PSI][j];
+                psi[j] = if p > PI {
+                    p - TAU
+                } else if p <= -PI {
+                    p + TAU
+                } else {
+                    p
+                };
+                u[j] += s[idx::U] * e[idx::U][j];
+                b_theta[j] = b_theta[j] * keep + s[idx::B_THETA] * e[idx::B_THETA][j];
+                b_psi[j] = b_psi[j] * keep + s[idx::B_PSI] * e[idx::B_PSI][j];
+            }
+            // the truncations (eq. 4), rarely needed: drawn again from the step's mean
+            for j in 0..m {
+                if z[j] < self.z_min_m {
+                    let mean = z[j] - s[idx::Z] * e[idx::Z][j];
+                    z[j] = truncated_normal(rng, mean, s[idx::Z], self.z_min_m, f64::INFINITY);
+                }
+                if theta[j].abs() > FRAC_PI_2 {
+                    let mean = theta[j] - s[idx::THETA] * e[idx::THETA][j];
+                    theta[j] = truncated_normal(rng, mean, s[idx::THETA], -FRAC_PI_2, FRAC_PI_2);
+                }
+                if u[j] < 0.0 {
+                    let mean = u[j] - s[idx::U] * e[idx::U][j];
+                    u[j] = truncated_normal(rng, mean, s[idx::U], 0.0, f64::INFINITY);
+                }
+            }
         }
     }
 }
@@ -190,10 +223,11 @@ impl ParticleLikelihood for InsReport {
         // particles' headings are in (-pi, pi] (after a first step; within 3 pi at the
         // start): a difference from a wrapped heading wraps with one add or subtract
         let heading = wrap_angle(self.heading_rad);
+        let n = log_w.len();
+        let (psi, u, z) = (&x[idx::PSI][..n], &x[idx::U][..n], &x[idx::Z][..n]);
         for (i, lw) in log_w.iter_mut().enumerate() {
-            let dh = wrap_near(x[idx::PSI][i] - heading);
-            let du = x[idx::U][i] - self.speed_m_s;
-            let dz = x[idx::Z][i] - self.depth_m;
+            let dh = wrap_near(psi[i] - heading);
+            let (du, dz) = (u[i] - self.speed_m_s, z[i] - self.depth_m);
             *lw += kh * dh * dh + ku * du * du + kz * dz * dz; // eq. 8
         }
     }
@@ -210,25 +244,49 @@ pub struct UsblBearing {
 }
 
 impl ParticleLikelihood for UsblBearing {
+    /// Each residual is the angle between the measured direction and the particle's,
+    /// one atan2 of their cross and dot products: for the azimuth, of the horizontal
+    /// unit vector at the measured world bearing alpha + psi_ASV and the particle's
+    /// (dx, dy); for the elevation, of (cos phi, sin phi) and (dz, h). It equals the
+    /// wrapped difference of the angles (eq. 6), with no wrap and no atan2 of the
+    /// particle's own angles.
     fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
-        let azimuth = wrap_angle(self.azimuth_rad);
-        if self.usbl.position_sigma_m > 0.0 || self.usbl.heading_sigma_rad > 0.0 {
-            // the station's pose errors make the two angles' variances differ
-            for (i, lw) in log_w.iter_mut().enumerate() {
-                let p = Vector3::new(x[idx::X][i], x[idx::Y][i], x[idx::Z][i]);
-                let (alpha, phi, _) = self.usbl.angles(&p);
-                let (var_a, var_p) = self.usbl.variances(&p);
-                let (da, dp) = (wrap_near(azimuth - alpha), self.elevation_rad - phi);
-                *lw += -da * da / (2.0 * var_a) - dp * dp / (2.0 * var_p) - 0.5 * (var_a * var_p).ln(); // eq. 6
+        let u = &self.usbl;
+        let (sb, cb) = (self.azimuth_rad + u.heading_rad).sin_cos();
+        let (se, ce) = self.elevation_rad.sin_cos();
+        let s2 = u.sigma_rad_per_m * u.sigma_rad_per_m;
+        let (g2, c2) = (u.position_sigma_m * u.position_sigma_m, u.heading_sigma_rad * u.heading_sigma_rad);
+        let o = u.position_ned_m;
+        let [px, py, pz, ..] = x else { panic!("hoff2024's state has {DIM} components") };
+        let n = log_w.len();
+        let (mut cross_a, mut dot_a, mut cross_e, mut dot_e) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+        let (mut var_a, mut var_e, mut prod) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+        let (mut da, mut de, mut ln_prod) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+        for start in (0..n).step_by(BLOCK) {
+            let m = BLOCK.min(n - start);
+            let (bx, by, bz) = (&px[start..start + m], &py[start..start + m], &pz[start..start + m]);
+            for j in 0..m {
+                let (dx, dy, dz) = (bx[j] - o.x, by[j] - o.y, bz[j] - o.z);
+                let h2 = dx * dx + dy * dy;
+                let h = h2.sqrt();
+                let r2 = h2 + dz * dz;
+                cross_a[j] = sb * dx - cb * dy; // sin(measured - particle's azimuth), times h
+                dot_a[j] = cb * dx + sb * dy;
+                cross_e[j] = se * dz - ce * h; // the same for the elevation (eq. 2), times r
+                dot_e[j] = ce * dz + se * h;
+                // eq. 3, plus the station's pose errors to first order (Usbl::variances)
+                let base = (s2 * r2).max(1e-12);
+                var_a[j] = base + g2 / h2.max(1e-12) + c2;
+                var_e[j] = base + g2 * dz * dz / (r2 * r2).max(1e-24);
+                prod[j] = var_a[j] * var_e[j];
             }
-            return;
-        }
-        for (i, lw) in log_w.iter_mut().enumerate() {
-            let p = Vector3::new(x[idx::X][i], x[idx::Y][i], x[idx::Z][i]);
-            let (alpha, phi, sigma) = self.usbl.angles(&p);
-            let (da, dp) = (wrap_near(azimuth - alpha), self.elevation_rad - phi);
-            let var = (sigma * sigma).max(1e-12);
-            *lw += -(da * da + dp * dp) / (2.0 * var) - var.ln(); // eq. 6, two angles
+            lanes::atan2(&cross_a[..m], &dot_a[..m], &mut da[..m]);
+            lanes::atan2(&cross_e[..m], &dot_e[..m], &mut de[..m]);
+            lanes::ln(&prod[..m], &mut ln_prod[..m]);
+            for (j, lw) in log_w[start..start + m].iter_mut().enumerate() {
+                // eq. 6, the two angles
+                *lw += -da[j] * da[j] / (2.0 * var_a[j]) - de[j] * de[j] / (2.0 * var_e[j]) - 0.5 * ln_prod[j];
+            }
         }
     }
 }
@@ -250,9 +308,10 @@ mod tests {
         pf.predict(&still, 10.0);
         let (m, _) = pf.mean_covariance();
         let (u, dt) = (2.0, 10.0);
-        assert!((m[idx::X] - u * 0.1f64.cos() * 0.5f64.cos() * dt).abs() < 1e-9);
-        assert!((m[idx::Y] - u * 0.1f64.cos() * 0.5f64.sin() * dt).abs() < 1e-9);
-        assert!((m[idx::Z] - (30.0 - u * 0.1f64.sin() * dt)).abs() < 1e-9);
+        // the particles' sines are single precision (filter::lanes): 1e-7 of the 20 m step
+        assert!((m[idx::X] - u * 0.1f64.cos() * 0.5f64.cos() * dt).abs() < 4e-6);
+        assert!((m[idx::Y] - u * 0.1f64.cos() * 0.5f64.sin() * dt).abs() < 4e-6);
+        assert!((m[idx::Z] - (30.0 - u * 0.1f64.sin() * dt)).abs() < 4e-6);
         assert!((m[idx::PSI] - (0.5 + 0.01 * dt)).abs() < 1e-12);
         assert!((m[idx::B_PSI] - 0.01 * (1.0 - dt / 1000.0)).abs() < 1e-12);
 
@@ -289,8 +348,9 @@ mod tests {
             pf.predict(&still, 4.0);
             let (mean, _) = pf.mean_covariance();
             let n = ProcessModel::propagate(&m, &x, 4.0);
+            // single-precision sines in the particles' step (filter::lanes)
             for i in 0..DIM {
-                assert!((mean[i] - n[i]).abs() < 1e-12, "{i}");
+                assert!((mean[i] - n[i]).abs() < 1e-12 + 1e-6 * (n[i] - x[i]).abs(), "{i}");
             }
         }
         let q = ProcessModel::noise_covariance(&m, &SVector::zeros(), 4.0);
