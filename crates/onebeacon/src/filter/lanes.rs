@@ -29,13 +29,19 @@ fn round(x: f64) -> (f64, i32) {
 }
 
 /// sin x and cos x (|x| below some 1e6): x reduced by pi/2 in double precision (so the
-/// input's own rounding to single precision does not count), Cephes' polynomials on
-/// [-pi/4, pi/4], the quadrant applied by selects.
+/// input's own rounding to single precision does not count), then [`sin_cos_reduced`].
 #[inline(always)]
 fn sin_cos1(x: f64) -> (f32, f32) {
     let (q, quadrant) = round(x * std::f64::consts::FRAC_2_PI);
     // pi / 2 in two parts (the second, what f64 leaves of it)
     let r = ((x - q * std::f64::consts::FRAC_PI_2) - q * 6.123_233_995_736_766e-17) as f32;
+    sin_cos_reduced(r, quadrant)
+}
+
+/// sin and cos of quadrant pi / 2 + r, |r| <= pi / 4: Cephes' polynomials in r, the
+/// quadrant applied by selects.
+#[inline(always)]
+fn sin_cos_reduced(r: f32, quadrant: i32) -> (f32, f32) {
     let z = r * r;
     let s = r + r * z * (-1.666_665_5e-1 + z * (8.332_161e-3 + z * -1.951_529_6e-4));
     let c = 1.0 - 0.5 * z + z * z * (4.166_664_6e-2 + z * (-1.388_731_6e-3 + z * 2.443_315_7e-5));
@@ -163,8 +169,10 @@ pub fn ln(x: &[f64], out: &mut [f64]) {
 
 /// Box-Muller on 32-bit uniform pairs, `n = out.len() / 2` of them: the i-th 64-bit
 /// draw is SplitMix64's output for the counter `key + (i + 1) gamma` (Steele, Lea and
-/// Flood 2014: a mixing of a Weyl sequence that passes BigCrush), computed in lanes; its
-/// high half gives u1 = (k + 1/2) 2^-32, its low half u2 = k' 2^-32, and the pair gives
+/// Flood 2014: a mixing of a Weyl sequence that passes BigCrush), computed in lanes. Its
+/// high half gives u1 = (k + 1/2) 2^-32 and the radius sqrt(-2 ln u1); its low half a
+/// uniform angle, as a quadrant (its top two bits) and an offset within it (the other
+/// 30, centred: within +-pi/4), so that no range reduction is needed. The pair gives
 /// draws `out[i]` and `out[n + i]`.
 #[multiversion(targets("x86_64+avx512f+avx512bw+avx512vl+avx512dq", "x86_64+avx2+avx", "aarch64+neon"))]
 fn box_muller(key: u64, out: &mut [f64]) {
@@ -179,10 +187,9 @@ fn box_muller(key: u64, out: &mut [f64]) {
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^= z >> 31;
         let (k1, k2) = ((z >> 32) as u32, z as u32);
-        let u1 = (k1 as f32 + 0.5) * SCALE;
-        let u2 = k2 as f32 * SCALE;
-        let radius = (-2.0 * ln1(u1)).sqrt();
-        let (s, c) = sin_cos1(f64::from(std::f32::consts::TAU * u2 - PI));
+        let radius = (-2.0 * ln1((k1 as f32 + 0.5) * SCALE)).sqrt();
+        let offset = ((k2 & 0x3fff_ffff) as i32 - 0x2000_0000) as f32 * (FRAC_PI_2 / 1_073_741_824.0);
+        let (s, c) = sin_cos_reduced(offset, (k2 >> 30) as i32);
         first[i] = f64::from(radius * s);
         second[i] = f64::from(radius * c);
     }
@@ -267,5 +274,18 @@ mod tests {
         let r: f64 = z.chunks_exact(2048).map(|b| (0..1024).map(|i| b[i] * b[1024 + i]).sum::<f64>()).sum::<f64>()
             / pairs as f64;
         assert!(r.abs() < 5.0 / (pairs as f64).sqrt(), "pair correlation {r}");
+        // the pair's angle is uniform: a quarter of the pairs in each quadrant, and an
+        // eighth in each half of one (its offset's sign)
+        let mut counts = [0.0; 8];
+        for b in z.chunks_exact(2048) {
+            for i in 0..1024 {
+                let (s, c) = (b[i], b[1024 + i]);
+                let octant = (s.atan2(c).rem_euclid(std::f64::consts::TAU) / std::f64::consts::FRAC_PI_4) as usize;
+                counts[octant.min(7)] += 1.0 / pairs as f64;
+            }
+        }
+        for c in counts {
+            assert!((c - 0.125).abs() < 5.0 * (0.125 * 0.875 / pairs as f64).sqrt(), "octants {counts:?}");
+        }
     }
 }

@@ -359,28 +359,29 @@ impl<const D: usize> ParticleFilter<D> {
         let (seed, step) = (self.seed, self.step);
         self.step += 1;
         let n = self.len();
-        let w = self.normalised();
+        self.normalised();
+        let mut w = self.normalised.take().expect("computed above");
         let mut rng = stream(seed, step, u64::MAX);
         let resampler = self.settings.resampler;
         let sequential = match resampler {
             Resampler::Systematic | Resampler::Stratified => None,
-            Resampler::Multinomial | Resampler::Residual => Some(ancestors(resampler, w, &mut rng)),
+            Resampler::Multinomial | Resampler::Residual => Some(ancestors(resampler, &w, &mut rng)),
         };
-        let cumulative = cumulative_in_order(w);
+        let cumulative = cumulative_in_place(&mut w);
         let u0: f64 = rng.random();
         let from = &self.x;
         let mut views = chunk_views(&mut self.spare);
-        views.par_iter_mut().enumerate().for_each(|(c, to)| {
+        views.par_iter_mut().zip(self.log_w.par_chunks_mut(CHUNK)).enumerate().for_each(|(c, (to, log_w))| {
             let first = c * CHUNK;
-            let len = to[0].len();
+            let len = log_w.len();
             let picked: Vec<usize> = match (&sequential, resampler) {
                 (Some(a), _) => a[first..first + len].to_vec(),
                 (None, Resampler::Systematic) => {
-                    walk_from(&cumulative, (first..first + len).map(|j| (j as f64 + u0) / n as f64))
+                    walk_from(cumulative, (first..first + len).map(|j| (j as f64 + u0) / n as f64))
                 }
                 (None, _) => {
                     let mut rng = stream(seed, step, c as u64);
-                    walk_from(&cumulative, (first..first + len).map(|j| (j as f64 + rng.random::<f64>()) / n as f64))
+                    walk_from(cumulative, (first..first + len).map(|j| (j as f64 + rng.random::<f64>()) / n as f64))
                 }
             };
             for (k, to) in to.iter_mut().enumerate() {
@@ -388,10 +389,10 @@ impl<const D: usize> ParticleFilter<D> {
                     *v = from[k][i];
                 }
             }
+            log_w.fill(0.0);
         });
         std::mem::swap(&mut self.x, &mut self.spare);
-        self.log_w.par_iter_mut().for_each(|l| *l = 0.0);
-        self.invalidate_weights();
+        self.weight_buffer.0.set(w);
         if let Some(k) = self.settings.roughening_k {
             let n = self.len() as f64;
             let sigma: Vec<f64> = self
@@ -479,9 +480,9 @@ fn ess_of(w: &[f64]) -> f64 {
     1.0 / partial.iter().sum::<f64>()
 }
 
-/// The running sum of `w`, by chunks in parallel (each chunk from the sum of those
-/// before it: the same whatever the thread count).
-fn cumulative_in_order(w: &[f64]) -> Vec<f64> {
+/// Turns `w` into its running sum, by chunks in parallel (each chunk from the sum of
+/// those before it: the same whatever the thread count).
+fn cumulative_in_place(w: &mut [f64]) -> &[f64] {
     let totals: Vec<f64> = w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect();
     let offsets: Vec<f64> = totals
         .iter()
@@ -491,15 +492,14 @@ fn cumulative_in_order(w: &[f64]) -> Vec<f64> {
             Some(before)
         })
         .collect();
-    let mut cum = vec![0.0; w.len()];
-    cum.par_chunks_mut(CHUNK).zip(w.par_chunks(CHUNK)).zip(offsets.par_iter()).for_each(|((c, w), off)| {
+    w.par_chunks_mut(CHUNK).zip(offsets.par_iter()).for_each(|(c, off)| {
         let mut acc = *off;
-        for (c, w) in c.iter_mut().zip(w) {
-            acc += w;
-            *c = acc;
+        for v in c.iter_mut() {
+            acc += *v;
+            *v = acc;
         }
     });
-    cum
+    w
 }
 
 /// The particle whose cell of the cumulative weights `cum` holds each of `points`
@@ -583,6 +583,41 @@ mod tests {
     use approx::assert_abs_diff_eq;
     use nalgebra::{Matrix2, Vector2};
     use std::f64::consts::PI;
+
+    /// Systematic and stratified resampling by chunks in parallel, over several chunks:
+    /// every particle of 3 chunks and a part (drawn from N(0, 1), each value its own)
+    /// weighed by exp(-x^2) is copied floor(N w_i) or ceil(N w_i) times (systematic), or
+    /// within 2 of N w_i (stratified: one draw per stratum); N particles in all.
+    #[test]
+    fn parallel_resampling_keeps_counts_across_chunks() {
+        struct Bell;
+        impl ParticleLikelihood for Bell {
+            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+                for (lw, v) in log_w.iter_mut().zip(x[0]) {
+                    *lw -= v * v;
+                }
+            }
+        }
+        let n = 3 * CHUNK + 77;
+        for r in [Resampler::Systematic, Resampler::Stratified] {
+            let settings = ParticleSettings { resampler: r, ..ParticleSettings::default() };
+            let mut pf = ParticleFilter::<1>::gaussian(n, &SVector::zeros(), &SVector::from([1.0]), settings, 4);
+            pf.reweight(&Bell);
+            let before: Vec<(u64, f64)> = pf.component(0).iter().map(|v| v.to_bits()).zip(pf.weights()).collect();
+            pf.resample();
+            let mut counts = std::collections::HashMap::new();
+            pf.component(0).iter().for_each(|v| *counts.entry(v.to_bits()).or_insert(0usize) += 1);
+            assert_eq!(counts.values().sum::<usize>(), n);
+            for (bits, w) in before {
+                let (c, expected) = (*counts.get(&bits).unwrap_or(&0) as f64, n as f64 * w);
+                let ok = match r {
+                    Resampler::Systematic => c >= expected.floor() - 1e-9 && c <= expected.ceil() + 1e-9,
+                    _ => (c - expected).abs() < 2.0,
+                };
+                assert!(ok, "{r:?}: {c} copies of a particle of N w = {expected}");
+            }
+        }
+    }
 
     /// Each resampler copies particle i N w_i times on average (2000 resamplings of 7
     /// particles, within 4 standard errors); systematic and residual copy it at least
