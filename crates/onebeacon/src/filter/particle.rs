@@ -356,6 +356,37 @@ impl<const D: usize> ParticleFilter<D> {
     /// in parallel: each output chunk finds its first ancestor by bisection on the
     /// cumulative weights and walks from there, and copies its particles' components.
     pub fn resample(&mut self) {
+        self.resample_then(|_, _| {});
+        self.roughen();
+    }
+
+    /// Resamples when the effective sample size is below the threshold, then propagates
+    /// every particle through `model` over `dt` seconds: the same as
+    /// [`ParticleFilter::resample_if_degenerate`] then [`ParticleFilter::predict`], to
+    /// the bit, in one pass over the particles (each chunk copied and moved while in
+    /// cache) unless roughening is on. For a filter that resamples just before it
+    /// predicts, its estimate taken from the weighted particles (the lower-variance
+    /// one); whether it resampled.
+    pub fn predict_resampled(&mut self, model: &impl ParticleProcess, dt: f64) -> bool {
+        if ess_of(self.normalised()) >= self.settings.ess_fraction * self.len() as f64 {
+            self.predict(model, dt);
+            return false;
+        }
+        if self.settings.roughening_k.is_some() {
+            self.resample();
+            self.predict(model, dt);
+            return true;
+        }
+        let step = self.step + 1; // the prediction's step, after the resampling's
+        let seed = self.seed;
+        self.resample_then(|x, c| model.propagate(x, dt, &mut stream(seed, step, c as u64)));
+        self.step += 1;
+        true
+    }
+
+    /// Draws the particles again, then applies `then` to each chunk of the new particles
+    /// (with the chunk's index) while it is in cache.
+    fn resample_then(&mut self, then: impl Fn(&mut [&mut [f64]], usize) + Sync) {
         let (seed, step) = (self.seed, self.step);
         self.step += 1;
         let n = self.len();
@@ -390,9 +421,14 @@ impl<const D: usize> ParticleFilter<D> {
                 }
             }
             log_w.fill(0.0);
+            then(to, c);
         });
         std::mem::swap(&mut self.x, &mut self.spare);
         self.weight_buffer.0.set(w);
+    }
+
+    /// Roughening (when asked) after a resampling.
+    fn roughen(&mut self) {
         if let Some(k) = self.settings.roughening_k {
             let n = self.len() as f64;
             let sigma: Vec<f64> = self
@@ -583,6 +619,38 @@ mod tests {
     use approx::assert_abs_diff_eq;
     use nalgebra::{Matrix2, Vector2};
     use std::f64::consts::PI;
+
+    /// predict_resampled equals resample_if_degenerate then predict, to the bit, on
+    /// hoff2024's model over 3 chunks and a part, resampling or not.
+    #[test]
+    fn fused_resampling_and_prediction_equal_the_two_steps() {
+        use crate::models::hoff::{DIM, HoffProcess, InsReport};
+        let mean = SVector::<f64, DIM>::from([100.0, 50.0, 30.0, 0.0, 0.3, 1.5, 0.0, 0.002]);
+        let sigma = SVector::<f64, DIM>::from([10.0, 10.0, 2.0, 0.05, 0.2, 0.3, 0.001, 0.003]);
+        let report = InsReport {
+            heading_rad: 0.3,
+            speed_m_s: 1.5,
+            depth_m: 30.0,
+            sigma_heading_rad: 0.1,
+            sigma_speed_m_s: 0.2,
+            sigma_depth_m: 0.4,
+        };
+        for ess_fraction in [0.5, 1e-9] {
+            let settings = ParticleSettings { ess_fraction, ..ParticleSettings::default() };
+            let mut a = ParticleFilter::<DIM>::gaussian(3 * CHUNK + 77, &mean, &sigma, settings, 9);
+            a.reweight(&report);
+            let mut b = a.clone();
+            let resampled = a.predict_resampled(&HoffProcess::default(), 4.0);
+            assert_eq!(resampled, b.resample_if_degenerate());
+            assert_eq!(resampled, ess_fraction > 0.1);
+            b.predict(&HoffProcess::default(), 4.0);
+            for k in 0..DIM {
+                assert!(a.component(k).iter().zip(b.component(k)).all(|(u, v)| u.to_bits() == v.to_bits()), "{k}");
+            }
+            assert_eq!(a.log_weights(), b.log_weights());
+            assert_eq!(a.step, b.step);
+        }
+    }
 
     /// Systematic and stratified resampling by chunks in parallel, over several chunks:
     /// every particle of 3 chunks and a part (drawn from N(0, 1), each value its own)

@@ -133,8 +133,7 @@ impl ParticleTracker {
     fn advance_to(&mut self, t_s: f64) {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
-            self.pf.resample_if_degenerate();
-            self.pf.predict(&self.config.process, dt);
+            self.pf.predict_resampled(&self.config.process, dt);
             self.t_s = t_s;
         }
     }
