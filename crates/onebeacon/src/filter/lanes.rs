@@ -11,7 +11,7 @@
 //! Single precision is far finer than what these values feed: a step of a few metres
 //! (relative error 1e-7: under a micrometre), an angle residual against a noise of
 //! milliradians, a log-likelihood against a spread of units. At N = 5e5 this is what
-//! makes a hoff2024 filter cycle fit its budget (README, hoff2024's speed): libm's
+//! makes a hoff2024 filter cycle fit its budget (README, Benchmarks): libm's
 //! scalar atan2 and sin_cos cost some 20 ns a call.
 
 use multiversion::multiversion;

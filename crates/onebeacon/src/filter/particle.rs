@@ -389,15 +389,11 @@ impl<const D: usize> ParticleFilter<D> {
     fn resample_then(&mut self, then: impl Fn(&mut [&mut [f64]], usize) + Sync) {
         let (seed, step) = (self.seed, self.step);
         self.step += 1;
-        let n = self.len();
         self.normalised();
         let mut w = self.normalised.take().expect("computed above");
         let mut rng = stream(seed, step, u64::MAX);
         let resampler = self.settings.resampler;
-        let sequential = match resampler {
-            Resampler::Systematic | Resampler::Stratified => None,
-            Resampler::Multinomial | Resampler::Residual => Some(ancestors(resampler, &w, &mut rng)),
-        };
+        let drawn = drawn_ancestors(resampler, &w, &mut rng);
         let cumulative = cumulative_in_place(&mut w);
         let u0: f64 = rng.random();
         let from = &self.x;
@@ -405,16 +401,8 @@ impl<const D: usize> ParticleFilter<D> {
         views.par_iter_mut().zip(self.log_w.par_chunks_mut(CHUNK)).enumerate().for_each(|(c, (to, log_w))| {
             let first = c * CHUNK;
             let len = log_w.len();
-            let picked: Vec<usize> = match (&sequential, resampler) {
-                (Some(a), _) => a[first..first + len].to_vec(),
-                (None, Resampler::Systematic) => {
-                    walk_from(cumulative, (first..first + len).map(|j| (j as f64 + u0) / n as f64))
-                }
-                (None, _) => {
-                    let mut rng = stream(seed, step, c as u64);
-                    walk_from(cumulative, (first..first + len).map(|j| (j as f64 + rng.random::<f64>()) / n as f64))
-                }
-            };
+            let mut rng = stream(seed, step, c as u64);
+            let picked = chunk_ancestors(resampler, cumulative, drawn.as_deref(), first..first + len, u0, &mut rng);
             for (k, to) in to.iter_mut().enumerate() {
                 for (v, &i) in to.iter_mut().zip(&picked) {
                     *v = from[k][i];
@@ -554,16 +542,14 @@ fn walk_from(cum: &[f64], points: impl Iterator<Item = f64>) -> Vec<usize> {
         .collect()
 }
 
-/// The index of the particle each new particle copies, for normalised weights `w`.
-pub(crate) fn ancestors(resampler: Resampler, w: &[f64], rng: &mut Pcg64) -> Vec<usize> {
+/// The whole draw of the resamplers that draw all new particles at once (multinomial
+/// and residual), for normalised weights `w`: the index of the particle each copies;
+/// None for those drawn chunk by chunk.
+fn drawn_ancestors(resampler: Resampler, w: &[f64], rng: &mut Pcg64) -> Option<Vec<usize>> {
     let n = w.len();
     match resampler {
-        Resampler::Systematic => {
-            let u0: f64 = rng.random();
-            walk(w, (0..n).map(|k| (k as f64 + u0) / n as f64))
-        }
-        Resampler::Stratified => walk(w, (0..n).map(|k| (k as f64 + rng.random::<f64>()) / n as f64)),
-        Resampler::Multinomial => multinomial(w, n, rng),
+        Resampler::Systematic | Resampler::Stratified => None,
+        Resampler::Multinomial => Some(multinomial(w, n, rng)),
         Resampler::Residual => {
             let mut out = Vec::with_capacity(n);
             let mut residual: Vec<f64> = Vec::with_capacity(n);
@@ -578,8 +564,28 @@ pub(crate) fn ancestors(resampler: Resampler, w: &[f64], rng: &mut Pcg64) -> Vec
                 residual.iter_mut().for_each(|r| *r /= total);
                 out.extend(multinomial(&residual, rest, rng));
             }
-            out
+            Some(out)
         }
+    }
+}
+
+/// The index of the particle each new particle of `range` copies: its share of `drawn`
+/// (multinomial, residual), or a walk along the cumulative weights `cum` from the
+/// range's first point: (j + u0) / N for systematic, (j + U_j) / N for stratified with
+/// U_j drawn from `rng`.
+fn chunk_ancestors(
+    resampler: Resampler,
+    cum: &[f64],
+    drawn: Option<&[usize]>,
+    range: std::ops::Range<usize>,
+    u0: f64,
+    rng: &mut Pcg64,
+) -> Vec<usize> {
+    let n = cum.len() as f64;
+    match (drawn, resampler) {
+        (Some(a), _) => a[range].to_vec(),
+        (None, Resampler::Stratified) => walk_from(cum, range.map(|j| (j as f64 + rng.random::<f64>()) / n)),
+        (None, _) => walk_from(cum, range.map(|j| (j as f64 + u0) / n)),
     }
 }
 
@@ -699,7 +705,10 @@ mod tests {
             let reps = 2000;
             let mut counts = [0.0; 7];
             for _ in 0..reps {
-                let a = ancestors(r, &w, &mut rng);
+                let drawn = drawn_ancestors(r, &w, &mut rng);
+                let mut cum = w.to_vec();
+                let u0 = rng.random();
+                let a = chunk_ancestors(r, cumulative_in_place(&mut cum), drawn.as_deref(), 0..n, u0, &mut rng);
                 assert_eq!(a.len(), n);
                 let mut c = [0usize; 7];
                 a.iter().for_each(|&i| c[i] += 1);
