@@ -73,7 +73,17 @@ fn ln1(x: f32) -> f32 {
     let p = p * m + 3.333_333e-1;
     let e = e as f32;
     let y = m * z * p + e * -2.121_944_4e-4 - 0.5 * z;
-    m + y + e * 0.693_359_4
+    let r = m + y + e * 0.693_359_4;
+    // IEEE's special cases, so that an absurd value cannot pass for a likely one
+    if x.is_nan() || x < 0.0 {
+        f32::NAN
+    } else if x == 0.0 {
+        f32::NEG_INFINITY
+    } else if x == f32::INFINITY {
+        f32::INFINITY
+    } else {
+        r
+    }
 }
 
 /// e^x for x <= 0 (0 below -87, where single precision ends): x = k ln 2 + r with
@@ -156,8 +166,9 @@ pub fn exp_shifted(x: &[f64], shift: f64, out: &mut [f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// ln x_i for every i (x_i positive, within f32's normal range, 1.2e-38 to 3.4e38: a
-/// value outside it gives a meaningless result).
+/// ln x_i for every i: to single precision for x_i within f32's normal range (1.2e-38
+/// to 3.4e38; a subnormal gives a meaningless result), -inf at 0, +inf above the range,
+/// NaN for a negative or NaN x_i.
 #[multiversion(targets("x86_64+avx512f+avx512bw+avx512vl+avx512dq", "x86_64+avx2+avx", "aarch64+neon"))]
 pub fn ln(x: &[f64], out: &mut [f64]) {
     let n = out.len();
@@ -242,6 +253,8 @@ mod tests {
             assert!((t[i] - e).abs() <= 3e-7 * e + 2e-38, "exp {}: {} against {e}", v[i], t[i]);
         }
         assert!((total / t.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        ln(&[0.0, 1e39, -1.0, f64::NAN], &mut t[..4]);
+        assert!(t[0] == f64::NEG_INFINITY && t[1] == f64::INFINITY && t[2].is_nan() && t[3].is_nan());
         let v: Vec<f64> = (0..2003).map(|i| 1e-30 * 1.1f64.powi(i % 1400)).collect();
         ln(&v, &mut t);
         for i in 0..v.len() {
