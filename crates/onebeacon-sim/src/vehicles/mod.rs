@@ -2,6 +2,7 @@
 
 pub mod asv;
 pub mod path;
+pub mod rigid_body;
 pub mod rov;
 pub mod unicycle;
 
