@@ -3,11 +3,13 @@
 //! with its centre of gravity at [0.2, 0, -0.2] m, radii of gyration 0.4 B and 0.25 L,
 //! payload 25 kg at [0.05, 0, -0.35] m).
 
-use super::rigid_body::{rigid_body_mass, skew};
+use super::rigid_body::{BodyState, Vessel, rigid_body_mass, skew};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 /// Sea water density, kg/m^3.
 pub const RHO: f64 = 1025.0;
+/// Gravity, m/s^2.
+pub const G: f64 = 9.81;
 
 /// The Otter's mass properties.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,6 +78,128 @@ impl OtterMass {
     }
 }
 
+/// The Otter's hull geometry and propulsion (vehicles.md).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OtterHull {
+    /// Beam of each pontoon and its centre line's distance from the middle, m.
+    pub pontoon_beam_m: f64,
+    pub pontoon_y_m: f64,
+    /// Waterplane and block coefficients of a pontoon.
+    pub cw: f64,
+    pub cb: f64,
+    /// Propeller thrust coefficients k (T = k n |n|, n in rad/s) forward and astern.
+    pub k_forward: f64,
+    pub k_reverse: f64,
+    /// Shaft speed limits, rad/s.
+    pub n_max: f64,
+    pub n_min: f64,
+    /// Top speed at full thrust (defines the linear surge damping), m/s.
+    pub u_max_m_s: f64,
+    /// Sway and yaw time constants, s; heave, roll and pitch damping ratios.
+    pub t_sway_s: f64,
+    pub t_yaw_s: f64,
+    pub zeta: [f64; 3],
+}
+
+impl Default for OtterHull {
+    fn default() -> Self {
+        Self {
+            pontoon_beam_m: 0.25,
+            pontoon_y_m: 0.395,
+            cw: 0.75,
+            cb: 0.4,
+            k_forward: 0.01108,
+            k_reverse: 0.00645,
+            n_max: 993.0 * std::f64::consts::TAU / 60.0,
+            n_min: -972.0 * std::f64::consts::TAU / 60.0,
+            u_max_m_s: 6.0 * 1852.0 / 3600.0,
+            t_sway_s: 1.0,
+            t_yaw_s: 1.0,
+            zeta: [0.3, 0.2, 0.4],
+        }
+    }
+}
+
+/// The Otter as a [`Vessel`]: its actuators are the two shaft speeds [port,
+/// starboard], rad/s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Otter {
+    pub mass: OtterMass,
+    pub hull: OtterHull,
+    m: Matrix6<f64>,
+    m_inv: Matrix6<f64>,
+    /// Linear damping coefficients (positive) of the six degrees of freedom.
+    damping: Vector6<f64>,
+    /// Restoring stiffness in heave, roll and pitch, N/m and N m/rad.
+    stiffness: Vector3<f64>,
+}
+
+impl Otter {
+    pub fn new(mass: OtterMass, hull: OtterHull) -> Self {
+        let m = mass.mass_matrix();
+        let m_inv = m.try_inverse().expect("a mass matrix is positive definite");
+        // hydrostatics of two box-like pontoons (Fossen 2021, sec. 4.2): the draft that
+        // floats the craft, the waterplane's area and moments, the metacentric heights
+        // with the centre of buoyancy at half the draft below the waterline (the origin)
+        let (l, bp, yp) = (mass.length_m, hull.pontoon_beam_m, hull.pontoon_y_m);
+        let volume = mass.mass_kg() / RHO;
+        let draft = volume / (2.0 * hull.cb * bp * l);
+        let area = 2.0 * hull.cw * bp * l;
+        let i_t = 2.0 * (hull.cw * bp.powi(3) * l / 12.0 + hull.cw * bp * l * yp * yp);
+        let i_l = 2.0 * hull.cw * bp * l.powi(3) / 12.0;
+        let bg = draft / 2.0 - mass.cg_m().z; // G above B
+        let (gm_t, gm_l) = (i_t / volume - bg, i_l / volume - bg);
+        let stiffness = Vector3::new(RHO * G * area, RHO * G * volume * gm_t, RHO * G * volume * gm_l);
+        // linear damping: surge from the top speed at full thrust, sway and yaw from their
+        // time constants, heave, roll and pitch from damping ratios of their natural
+        // frequencies (vehicles.md)
+        let full = 2.0 * hull.k_forward * hull.n_max * hull.n_max;
+        let mut damping =
+            Vector6::new(full / hull.u_max_m_s, m[(1, 1)] / hull.t_sway_s, 0.0, 0.0, 0.0, m[(5, 5)] / hull.t_yaw_s);
+        for (j, k) in [2, 3, 4].into_iter().enumerate() {
+            let wn = (stiffness[j] / m[(k, k)]).sqrt();
+            damping[k] = 2.0 * hull.zeta[j] * wn * m[(k, k)];
+        }
+        Self { mass, hull, m, m_inv, damping, stiffness }
+    }
+
+    /// A propeller's thrust at shaft speed `n`, N.
+    pub fn thrust(&self, n: f64) -> f64 {
+        let n = n.clamp(self.hull.n_min, self.hull.n_max);
+        let k = if n >= 0.0 { self.hull.k_forward } else { self.hull.k_reverse };
+        k * n * n.abs()
+    }
+}
+
+impl Default for Otter {
+    fn default() -> Self {
+        Self::new(OtterMass::default(), OtterHull::default())
+    }
+}
+
+impl Vessel for Otter {
+    fn mass_matrix(&self) -> &Matrix6<f64> {
+        &self.m
+    }
+
+    fn mass_inverse(&self) -> &Matrix6<f64> {
+        &self.m_inv
+    }
+
+    fn forces(&self, state: &BodyState, nu_r: &Vector6<f64>, actuators: &[f64]) -> Vector6<f64> {
+        let (t1, t2) = (self.thrust(actuators[0]), self.thrust(actuators[1]));
+        let yp = self.hull.pontoon_y_m;
+        // the port propeller at y = -yp, the starboard one at +yp
+        let tau = Vector6::new(t1 + t2, 0.0, 0.0, 0.0, 0.0, yp * (t1 - t2));
+        let mut d = self.damping.component_mul(nu_r);
+        d[5] *= 1.0 + 10.0 * nu_r[5].abs(); // N = Nr (1 + 10 |r|) r (vehicles.md)
+        let (phi, theta, _) = state.euler();
+        let z = state.position_ned_m.z;
+        let g = Vector6::new(0.0, 0.0, self.stiffness[0] * z, self.stiffness[1] * phi, self.stiffness[2] * theta, 0.0);
+        tau - d - g
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -92,5 +216,23 @@ mod tests {
         }
         assert!((m - m.transpose()).norm() < 1e-12);
         assert!(m.cholesky().is_some());
+    }
+
+    /// Full thrust on both shafts from rest: the speed settles at the top speed of 6 kn
+    /// (3.09 m/s, vehicles.md) within 1 %, the craft going straight (RK4 at
+    /// 0.05 s, 120 s); the draft that floats it is vehicles.md's 0.195 m.
+    #[test]
+    fn full_thrust_reaches_the_top_speed() {
+        let otter = Otter::default();
+        let n = otter.hull.n_max;
+        let mut s = BodyState::at_rest(Vector3::zeros(), 0.0);
+        for _ in 0..2400 {
+            s = super::super::rigid_body::rk4_step(&otter, &s, &[n, n], &Vector3::zeros(), 0.05);
+        }
+        assert!((s.nu[0] / 3.087 - 1.0).abs() < 0.01, "{}", s.nu[0]);
+        assert!(s.position_ned_m.y.abs() < 1e-6 && s.nu[5].abs() < 1e-9);
+        let draft =
+            otter.mass.mass_kg() / RHO / (2.0 * otter.hull.cb * otter.hull.pontoon_beam_m * otter.mass.length_m);
+        assert!((draft - 0.195).abs() < 0.001, "{draft}");
     }
 }
