@@ -3,6 +3,7 @@
 pub mod asv;
 pub mod otter;
 pub mod path;
+pub mod remus100;
 pub mod rigid_body;
 pub mod rov;
 pub mod unicycle;
