@@ -2,8 +2,10 @@
 //! eq. 28-29): the along- and cross-track errors of a position from a planar path
 //! (hoff2024 eq. 20-21), the heading command
 //!
-//!     psi_d = theta_p - atan((e2 + kappa y_int) / Delta),
-//!     y_int' = Delta e2 / (Delta^2 + (e2 + kappa y_int)^2),
+//! ```text
+//! psi_d = theta_p - atan((e2 + kappa y_int) / Delta),
+//! y_int' = Delta e2 / (Delta^2 + (e2 + kappa y_int)^2),
+//! ```
 //!
 //! whose integral term removes the steady cross-track error a current causes, and
 //! the circle's path parameter law (eq. 23).

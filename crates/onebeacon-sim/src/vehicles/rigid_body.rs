@@ -1,8 +1,10 @@
 //! 6-DOF rigid-body dynamics of a marine craft (Fossen, Handbook of Marine Craft
 //! Hydrodynamics and Motion Control, 2021; hoff2024 eq. 17-19):
 //!
-//!     p' = R(q) v,   q' = 1/2 q (0, omega),
-//!     M nu_r' + C(nu_r) nu_r + d(nu_r) + g(q) = tau,   nu_r = nu - nu_c,
+//! ```text
+//! p' = R(q) v,   q' = 1/2 q (0, omega),
+//! M nu_r' + C(nu_r) nu_r + d(nu_r) + g(q) = tau,   nu_r = nu - nu_c,
+//! ```
 //!
 //! in NED with body axes forward, starboard, down. The attitude is a unit quaternion (no
 //! singularity at +-90 deg of pitch). The current is constant and irrotational in NED:
