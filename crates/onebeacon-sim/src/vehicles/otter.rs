@@ -163,6 +163,22 @@ impl Otter {
         Self { mass, hull, m, m_inv, damping, stiffness }
     }
 
+    /// The shaft speeds [port, starboard] that give surge force `x` and yaw moment `n`
+    /// (control allocation: t_port + t_stbd = x, y_p (t_port - t_stbd) = n), each
+    /// inverted from k n |n| and clamped to the shaft limits.
+    pub fn allocate(&self, x: f64, n: f64) -> [f64; 2] {
+        let yp = self.hull.pontoon_y_m;
+        [0.5 * x + 0.5 * n / yp, 0.5 * x - 0.5 * n / yp].map(|t| {
+            let k = if t >= 0.0 { self.hull.k_forward } else { self.hull.k_reverse };
+            (t.signum() * (t.abs() / k).sqrt()).clamp(self.hull.n_min, self.hull.n_max)
+        })
+    }
+
+    /// The linear damping coefficient of degree of freedom `k` (positive).
+    pub fn damping(&self, k: usize) -> f64 {
+        self.damping[k]
+    }
+
     /// A propeller's thrust at shaft speed `n`, N.
     pub fn thrust(&self, n: f64) -> f64 {
         let n = n.clamp(self.hull.n_min, self.hull.n_max);
@@ -200,6 +216,79 @@ impl Vessel for Otter {
     }
 }
 
+/// The Otter's autopilots (vehicles.md): a PID on heading with gains from the yaw
+/// inertia, Kp = M66 wn^2, Kd = 2 zeta wn M66 - d66, Ki = Kp wn / 10, tracking a
+/// third-order reference model of the commanded heading (critically damped, bandwidth
+/// wn / 3, our choice; yaw rate limited to 10 deg/s) with its yaw acceleration fed
+/// forward; a PI on surge speed with the damping fed forward; both through the control
+/// allocation, the shafts following their commands with a first-order lag.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OtterPilot {
+    pub otter: Otter,
+    pub state: BodyState,
+    /// Shaft speeds [port, starboard], rad/s, and their lag, s.
+    pub shafts: [f64; 2],
+    pub lag_s: f64,
+    heading_integral: f64,
+    speed_integral: f64,
+    /// The reference model's heading, yaw rate and yaw acceleration.
+    reference: [f64; 3],
+    /// Closed-loop heading bandwidth wn (rad/s) and damping ratio.
+    pub wn: f64,
+    pub zeta: f64,
+}
+
+impl OtterPilot {
+    /// vehicles.md's heading loop: wn = 1.5 rad/s, zeta = 1; shaft lag 0.1 s.
+    pub fn new(otter: Otter, state: BodyState) -> Self {
+        let psi = state.euler().2;
+        Self {
+            otter,
+            state,
+            shafts: [0.0; 2],
+            lag_s: 0.1,
+            heading_integral: 0.0,
+            speed_integral: 0.0,
+            reference: [psi, 0.0, 0.0],
+            wn: 1.5,
+            zeta: 1.0,
+        }
+    }
+
+    /// One step of `h` seconds toward heading `psi_d` (rad) and surge speed `u_d` (m/s):
+    /// the autopilots' forces allocated to the shafts, the shafts' lag integrated
+    /// exactly, then the vessel by RK4.
+    pub fn step(&mut self, psi_d: f64, u_d: f64, h: f64) {
+        let m = self.otter.mass_matrix();
+        let (m11, m66) = (m[(0, 0)], m[(5, 5)]);
+        let (u, r) = (self.state.nu[0], self.state.nu[5]);
+        let (_, _, psi) = self.state.euler();
+        // the reference model: d3 psi_r = w^3 (psi_d - psi_r) - 3 w d2 psi_r - 3 w^2 d psi_r
+        let w = self.wn / 3.0;
+        let [psi_r, r_r, a_r] = self.reference;
+        let jerk = w.powi(3) * onebeacon::geo::wrap_angle(psi_d - psi_r) - 3.0 * w * a_r - 3.0 * w * w * r_r;
+        let r_max = 10f64.to_radians();
+        self.reference =
+            [onebeacon::geo::wrap_angle(psi_r + h * r_r), (r_r + h * a_r).clamp(-r_max, r_max), a_r + h * jerk];
+        let e = onebeacon::geo::wrap_angle(psi - psi_r);
+        let (kp, kd) = (m66 * self.wn * self.wn, 2.0 * self.zeta * self.wn * m66 - self.otter.damping(5));
+        let ki = kp * self.wn / 10.0;
+        let n_cmd = m66 * a_r + self.otter.damping(5) * r_r - kp * e - kd * (r - r_r) - ki * self.heading_integral;
+        // speed: the damping at u_d fed forward, a PI on the error (time constant 1 s)
+        let eu = u - u_d;
+        let x_cmd = self.otter.damping(0) * u_d - m11 * eu - 0.1 * m11 * self.speed_integral;
+        let cmd = self.otter.allocate(x_cmd, n_cmd);
+        let decay = (-h / self.lag_s).exp();
+        for (n, c) in self.shafts.iter_mut().zip(cmd) {
+            *n = c + (*n - c) * decay;
+        }
+        self.state =
+            super::rigid_body::rk4_step(&self.otter, &self.state, &self.shafts, &nalgebra::Vector3::zeros(), h);
+        self.heading_integral += e * h;
+        self.speed_integral += eu * h;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -216,6 +305,46 @@ mod tests {
         }
         assert!((m - m.transpose()).norm() < 1e-12);
         assert!(m.cholesky().is_some());
+    }
+
+    /// Step responses at 0.05 s, printed for the closing note: a 30 deg heading step at
+    /// 2 m/s settles within 0.5 deg, and a speed step from 1 to 2 m/s within 2 %, both
+    /// in 60 s; the heading's overshoot stays below 10 % (the loop is designed critically
+    /// damped; the shafts' lag and the integral add some).
+    #[test]
+    fn autopilot_step_responses() {
+        let mut p = OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::zeros(), 0.0));
+        for _ in 0..1200 {
+            p.step(0.0, 2.0, 0.05);
+        }
+        let target = 30f64.to_radians();
+        let (mut rise, mut peak) = (f64::NAN, 0.0f64);
+        for i in 0..1200 {
+            p.step(target, 2.0, 0.05);
+            let psi = p.state.euler().2;
+            if rise.is_nan() && psi >= 0.9 * target {
+                rise = i as f64 * 0.05;
+            }
+            peak = peak.max(psi);
+        }
+        let overshoot = (peak - target) / target;
+        eprintln!("heading 30 deg: rise (to 90 %) {rise:.2} s, overshoot {:.1} %", 100.0 * overshoot);
+        assert!((p.state.euler().2 - target).abs() < 0.5f64.to_radians() && overshoot < 0.1);
+        let mut t98 = f64::NAN;
+        let mut q = OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::zeros(), 0.0));
+        for _ in 0..1200 {
+            q.step(0.0, 1.0, 0.05);
+        }
+        for i in 0..1200 {
+            q.step(0.0, 2.0, 0.05);
+            if (q.state.nu[0] - 2.0).abs() > 0.04 {
+                t98 = f64::NAN;
+            } else if t98.is_nan() {
+                t98 = i as f64 * 0.05;
+            }
+        }
+        eprintln!("speed 1 -> 2 m/s: within 2 % from {t98:.2} s on");
+        assert!(!t98.is_nan());
     }
 
     /// Full thrust on both shafts from rest: the speed settles at the top speed of 6 kn
