@@ -148,6 +148,20 @@ pub struct Asv {
     /// Where it starts: this far from the first AUV, in this direction (deg from north).
     pub start_distance_m: f64,
     pub start_bearing_deg: f64,
+    /// The truth model of the ASV.
+    pub vehicle: AsvVehicle,
+}
+
+/// The truth model of the ASV.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AsvVehicle {
+    /// A unicycle with speed and turn-rate limits, steered and sped exactly as asked.
+    #[default]
+    Kinematic,
+    /// The Otter's 6-DOF dynamics under its heading and speed autopilots
+    /// (`vehicles::otter`), the guidance's heading and speed as their commands.
+    Otter,
 }
 
 impl Default for Asv {
@@ -162,6 +176,7 @@ impl Default for Asv {
             compass_noise_deg: 0.0,
             start_distance_m: 20.0,
             start_bearing_deg: 180.0,
+            vehicle: AsvVehicle::Kinematic,
         }
     }
 }

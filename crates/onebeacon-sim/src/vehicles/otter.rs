@@ -273,8 +273,11 @@ impl OtterPilot {
         let [psi_r, r_r, a_r] = self.reference;
         let jerk = w.powi(3) * onebeacon::geo::wrap_angle(psi_d - psi_r) - 3.0 * w * a_r - 3.0 * w * w * r_r;
         let r_max = 10f64.to_radians();
-        self.reference =
-            [onebeacon::geo::wrap_angle(psi_r + h * r_r), (r_r + h * a_r).clamp(-r_max, r_max), a_r + h * jerk];
+        let r_next = (r_r + h * a_r).clamp(-r_max, r_max);
+        // at the rate limit, the acceleration that pushes past it is dropped (no windup)
+        let a_next = a_r + h * jerk;
+        let a_next = if r_next.abs() >= r_max && a_next * r_next > 0.0 { 0.0 } else { a_next };
+        self.reference = [onebeacon::geo::wrap_angle(psi_r + h * r_r), r_next, a_next];
         let e = onebeacon::geo::wrap_angle(psi - psi_r);
         let (kp, kd) = (m66 * self.wn * self.wn, 2.0 * self.zeta * self.wn * m66 - self.otter.damping(5));
         let ki = kp * self.wn / 10.0;

@@ -8,10 +8,12 @@
 
 use crate::engine::{Track, VehicleTruth, World};
 use crate::run::{BearingSnapshot, GuidanceSnapshot};
-use crate::scenario::passive_usbl::{Auv, GuidanceKind};
+use crate::scenario::passive_usbl::{AsvVehicle, Auv, GuidanceKind};
 use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
+use crate::vehicles::otter::{Otter, OtterPilot};
+use crate::vehicles::rigid_body::BodyState;
 use nalgebra::{DMatrix, Matrix2, SMatrix, SVector, Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
 use onebeacon::guidance::bearing::{BearingPlanner, Belief, SpreadMetric, leg_done, leg_target};
@@ -80,6 +82,8 @@ pub(crate) struct PassiveUsblWorld<'a> {
     lim: AsvLimits,
     asv0: Vector2<f64>,
     asv: AsvState,
+    /// The Otter's dynamics and autopilots when the ASV is one (`asv.vehicle`).
+    otter: Option<OtterPilot>,
     /// The ASV's speed at the end of the last step (for the side of the half-annulus).
     asv_speed: f64,
     leg: Option<Leg>,
@@ -114,6 +118,10 @@ impl<'a> PassiveUsblWorld<'a> {
             },
             asv0,
             asv: AsvState { pos: asv0, psi: to_auv.y.atan2(to_auv.x) },
+            otter: (s.asv.vehicle == AsvVehicle::Otter).then(|| {
+                let at = Vector3::new(asv0.x, asv0.y, 0.0);
+                OtterPilot::new(Otter::default(), BodyState::at_rest(at, to_auv.y.atan2(to_auv.x)))
+            }),
             asv_speed: 0.0,
             leg: None,
             station_rng: vehicle_rng(seed, run, 0, Stream::Heading),
@@ -284,12 +292,12 @@ impl<'a> PassiveUsblWorld<'a> {
         let len = leg.norm();
         for j in 0..steps {
             let s = j as f64 / steps as f64; // eq. 25
-            let (u, r) = if len < 1e-6 {
+            // the course and speed asked of the ASV
+            let (course, u_d) = if len < 1e-6 {
                 // hold a point: head for it, slowing down on the last metres
                 let d = p_t - self.asv.pos;
-                let (mut u, r) = self.asv.command(p_t, 1.0, &self.lim);
-                u = u.min(0.5 * d.norm());
-                (u, r)
+                let (u, _) = self.asv.command(p_t, 1.0, &self.lim);
+                (d.y.atan2(d.x), u.min(0.5 * d.norm()))
             } else {
                 let tau = leg / len;
                 let reference = p_a + leg * s; // eq. 24
@@ -297,11 +305,22 @@ impl<'a> PassiveUsblWorld<'a> {
                 let along = e.dot(&tau); // eq. 21, epsilon_1
                 let cross = tau.x * e.y - tau.y * e.x; // epsilon_2
                 let u_d = (len / period - a.along_track_gain * along).clamp(0.0, self.lim.max_speed_m_s); // eq. 26
-                let course = tau.y.atan2(tau.x) - (cross / a.lookahead_m).atan();
-                let err = wrap_angle(course - self.asv.psi);
-                let r = err.clamp(-self.lim.max_turn_rate_rad_s, self.lim.max_turn_rate_rad_s);
-                (u_d * err.cos().max(0.0), r)
+                (tau.y.atan2(tau.x) - (cross / a.lookahead_m).atan(), u_d)
             };
+            if let Some(otter) = &mut self.otter {
+                // the autopilots at 0.05 s or finer (RK4 on the Otter's heave and roll)
+                let sub = (dt / 0.05).ceil().max(1.0) as usize;
+                for _ in 0..sub {
+                    otter.step(course, u_d, dt / sub as f64);
+                }
+                let p = otter.state.position_ned_m;
+                self.asv = AsvState { pos: p.xy(), psi: otter.state.euler().2 };
+                self.asv_speed = otter.state.nu[0];
+                continue;
+            }
+            let err = wrap_angle(course - self.asv.psi);
+            let r = err.clamp(-self.lim.max_turn_rate_rad_s, self.lim.max_turn_rate_rad_s);
+            let u = if len < 1e-6 { u_d } else { u_d * err.cos().max(0.0) };
             self.asv = self.asv.step(u, r, dt);
             self.asv_speed = u;
         }
@@ -429,6 +448,30 @@ pub(crate) fn bearing_information(noise: TrackerNoise) -> impl FnMut(&Kind, &Veh
 mod tests {
     use super::*;
     use crate::scenario::{Scenario, builtin, parse};
+
+    /// `asv.vehicle = "otter"`: the Otter's dynamics under its autopilots follow the same
+    /// legs (2 m/s, 10 m to the side at the start, from rest): after 20 legs (80 s) it is
+    /// on the line and on time within what its dynamics allow (printed).
+    #[test]
+    fn an_otter_follows_the_legs() {
+        let mut s = scenario();
+        s.asv.vehicle = AsvVehicle::Otter;
+        let mut w = PassiveUsblWorld::new(&s, &s.base_cell(), 1, 0);
+        let period = s.mission.message_period_s;
+        w.otter = Some(OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::new(0.0, 10.0, 0.0), 0.0)));
+        w.asv = AsvState { pos: Vector2::new(0.0, 10.0), psi: 0.0 };
+        let step = Vector2::new(2.0 * period, 0.0);
+        let mut p_a = Vector2::zeros();
+        for _ in 0..20 {
+            let p_t = p_a + step;
+            w.follow(p_a, p_t);
+            p_a = p_t;
+        }
+        let (along, cross) = (w.asv.pos.x - p_a.x, w.asv.pos.y);
+        eprintln!("Otter after 20 legs: along {along:.3} m, cross {cross:.3} m, speed {:.3} m/s", w.asv_speed);
+        assert!(cross.abs() < 0.3 && along.abs() < 1.5, "along {along}, cross {cross}");
+        assert!((w.asv_speed - 2.0).abs() < 0.2);
+    }
 
     fn scenario() -> PassiveUsbl {
         let Scenario::PassiveUsbl(s) = parse(builtin("hoff2024").unwrap().toml, "hoff2024").unwrap() else {
