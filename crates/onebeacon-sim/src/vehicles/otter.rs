@@ -291,7 +291,10 @@ impl OtterPilot {
             *n = c + (*n - c) * decay;
         }
         self.state = super::rigid_body::rk4_step(&self.otter, &self.state, &self.shafts, &self.current_ned, h);
-        self.heading_integral += e * h;
+        // conditional integration: only near the reference (no windup while turning hard)
+        if e.abs() < 0.2 {
+            self.heading_integral += e * h;
+        }
         self.speed_integral += eu * h;
     }
 }
