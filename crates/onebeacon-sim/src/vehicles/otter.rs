@@ -3,15 +3,13 @@
 //! with its centre of gravity at [0.2, 0, -0.2] m, radii of gyration 0.4 B and 0.25 L,
 //! payload 25 kg at [0.05, 0, -0.35] m).
 
-use super::rigid_body::{BodyState, Vessel, rigid_body_mass, skew};
+use super::rigid_body::{BodyState, G, Inertia, Vessel, rigid_body_mass, skew};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 #[cfg(test)]
 use std::f64::consts::FRAC_PI_2;
 
 /// Sea water density, kg/m^3.
 pub const RHO: f64 = 1025.0;
-/// Gravity, m/s^2.
-pub const G: f64 = 9.81;
 
 /// The Otter's mass properties.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -128,8 +126,7 @@ impl Default for OtterHull {
 pub struct Otter {
     pub mass: OtterMass,
     pub hull: OtterHull,
-    m: Matrix6<f64>,
-    m_inv: Matrix6<f64>,
+    inertia: Inertia,
     /// Linear damping coefficients (positive) of the six degrees of freedom.
     damping: Vector6<f64>,
     /// Restoring stiffness in heave, roll and pitch, N/m and N m/rad.
@@ -139,7 +136,6 @@ pub struct Otter {
 impl Otter {
     pub fn new(mass: OtterMass, hull: OtterHull) -> Self {
         let m = mass.mass_matrix();
-        let m_inv = m.try_inverse().expect("a mass matrix is positive definite");
         // hydrostatics of two box-like pontoons (Fossen 2021, sec. 4.2): the draft that
         // floats the craft, the waterplane's area and moments, the metacentric heights
         // with the centre of buoyancy at half the draft below the waterline (the origin)
@@ -162,7 +158,7 @@ impl Otter {
             let wn = (stiffness[j] / m[(k, k)]).sqrt();
             damping[k] = 2.0 * hull.zeta[j] * wn * m[(k, k)];
         }
-        Self { mass, hull, m, m_inv, damping, stiffness }
+        Self { mass, hull, inertia: Inertia::new(m), damping, stiffness }
     }
 
     /// The shaft speeds [port, starboard] that give surge force `x` and yaw moment `n`
@@ -196,12 +192,8 @@ impl Default for Otter {
 }
 
 impl Vessel for Otter {
-    fn mass_matrix(&self) -> &Matrix6<f64> {
-        &self.m
-    }
-
-    fn mass_inverse(&self) -> &Matrix6<f64> {
-        &self.m_inv
+    fn inertia(&self) -> &Inertia {
+        &self.inertia
     }
 
     fn forces(&self, state: &BodyState, nu_r: &Vector6<f64>, actuators: &[f64]) -> Vector6<f64> {
@@ -264,7 +256,7 @@ impl OtterPilot {
     /// the autopilots' forces allocated to the shafts, the shafts' lag integrated
     /// exactly, then the vessel by RK4.
     pub fn step(&mut self, psi_d: f64, u_d: f64, h: f64) {
-        let m = self.otter.mass_matrix();
+        let m = &self.otter.inertia().m;
         let (m11, m66) = (m[(0, 0)], m[(5, 5)]);
         let (u, r) = (self.state.nu[0], self.state.nu[5]);
         let (_, _, psi) = self.state.euler();

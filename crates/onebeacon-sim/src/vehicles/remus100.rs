@@ -3,13 +3,11 @@
 //! prolate spheroid of eccentricity e by Lamb's k-factors (Lamb 1932, from alpha_0 and
 //! beta_0; the added mass of a spheroid in Fossen 2021, ch. 6).
 
-use super::rigid_body::{BodyState, Vessel, restoring, rigid_body_mass};
+use super::rigid_body::{BodyState, G, Inertia, Vessel, restoring, rigid_body_mass};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 /// Sea water density used for the REMUS, kg/m^3.
 pub const RHO: f64 = 1026.0;
-/// Gravity, m/s^2.
-pub const G: f64 = 9.81;
 
 /// A prolate spheroid's half axes a (along) and b (across), m.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,8 +49,7 @@ impl Spheroid {
 pub struct Remus100 {
     pub hull: Spheroid,
     pub cg_below_cb_m: f64,
-    m: Matrix6<f64>,
-    m_inv: Matrix6<f64>,
+    inertia: Inertia,
     damping: Vector6<f64>,
 }
 
@@ -70,7 +67,6 @@ impl Remus100 {
         let added = Vector6::new(k1 * mass, k2 * mass, k2 * mass, 0.0, kp * inertia[(1, 1)], kp * inertia[(2, 2)]);
         let m =
             rigid_body_mass(mass, &Vector3::new(0.0, 0.0, cg_below_cb_m), &inertia) + Matrix6::from_diagonal(&added);
-        let m_inv = m.try_inverse().expect("a mass matrix is positive definite");
         // roll and pitch: the restoring stiffness W BG and the damping ratio's share of
         // the critical damping 2 sqrt(K M)
         let stiffness = mass * G * cg_below_cb_m;
@@ -83,7 +79,7 @@ impl Remus100 {
             0.8 * critical(4),
             m[(5, 5)] / 1.0,
         );
-        Self { hull, cg_below_cb_m, m, m_inv, damping }
+        Self { hull, cg_below_cb_m, inertia: Inertia::new(m), damping }
     }
 }
 
@@ -94,12 +90,8 @@ impl Default for Remus100 {
 }
 
 impl Vessel for Remus100 {
-    fn mass_matrix(&self) -> &Matrix6<f64> {
-        &self.m
-    }
-
-    fn mass_inverse(&self) -> &Matrix6<f64> {
-        &self.m_inv
+    fn inertia(&self) -> &Inertia {
+        &self.inertia
     }
 
     fn forces(&self, state: &BodyState, nu_r: &Vector6<f64>, _actuators: &[f64]) -> Vector6<f64> {

@@ -85,12 +85,28 @@ impl BodyState {
     }
 }
 
+/// Gravity, m/s^2.
+pub const G: f64 = 9.81;
+
+/// A vehicle's mass matrix M = M_RB + M_A (symmetric positive definite) and its inverse,
+/// computed once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inertia {
+    pub m: Matrix6<f64>,
+    pub inverse: Matrix6<f64>,
+}
+
+impl Inertia {
+    pub fn new(m: Matrix6<f64>) -> Self {
+        let inverse = m.try_inverse().expect("a mass matrix is positive definite");
+        Self { m, inverse }
+    }
+}
+
 /// What a vehicle model gives the integrator.
 pub trait Vessel {
-    /// M = M_RB + M_A, symmetric positive definite.
-    fn mass_matrix(&self) -> &Matrix6<f64>;
-    /// Its inverse, computed once.
-    fn mass_inverse(&self) -> &Matrix6<f64>;
+    /// M and its inverse.
+    fn inertia(&self) -> &Inertia;
     /// tau - d(nu_r) - g(q): every force but the inertial ones, at `state` with relative
     /// velocity `nu_r` and the actuators' state `actuators`.
     fn forces(&self, state: &BodyState, nu_r: &Vector6<f64>, actuators: &[f64]) -> Vector6<f64>;
@@ -107,9 +123,9 @@ fn derivative<V: Vessel>(
     let omega = s.nu.fixed_rows::<3>(3).into_owned();
     let nu_c = Vector6::new(v_c.x, v_c.y, v_c.z, 0.0, 0.0, 0.0);
     let nu_r = s.nu - nu_c;
-    let m = vessel.mass_matrix();
+    let inertia = vessel.inertia();
     // eq. 19 in relative velocity
-    let nu_r_dot = vessel.mass_inverse() * (vessel.forces(s, &nu_r, actuators) - coriolis(m, &nu_r) * nu_r);
+    let nu_r_dot = inertia.inverse * (vessel.forces(s, &nu_r, actuators) - coriolis(&inertia.m, &nu_r) * nu_r);
     let v_c_dot = -omega.cross(&v_c); // a current fixed in NED, seen from the turning body
     let nu_dot = nu_r_dot + Vector6::new(v_c_dot.x, v_c_dot.y, v_c_dot.z, 0.0, 0.0, 0.0);
     let p_dot = s.attitude * s.nu.fixed_rows::<3>(0).into_owned(); // eq. 17
@@ -150,10 +166,7 @@ mod tests {
     /// A free body: a full mass matrix (a box of 30 kg with its centre of gravity off
     /// the origin, plus an added-mass matrix), no damping, weight equal to buoyancy at
     /// the same point, no thrust.
-    struct Free {
-        m: Matrix6<f64>,
-        inv: Matrix6<f64>,
-    }
+    struct Free(Inertia);
 
     impl Free {
         fn new() -> Self {
@@ -163,17 +176,13 @@ mod tests {
             m += added;
             m[(1, 5)] += 0.7;
             m[(5, 1)] += 0.7;
-            let inv = m.try_inverse().unwrap();
-            Self { m, inv }
+            Self(Inertia::new(m))
         }
     }
 
     impl Vessel for Free {
-        fn mass_matrix(&self) -> &Matrix6<f64> {
-            &self.m
-        }
-        fn mass_inverse(&self) -> &Matrix6<f64> {
-            &self.inv
+        fn inertia(&self) -> &Inertia {
+            &self.0
         }
         fn forces(&self, _: &BodyState, _: &Vector6<f64>, _: &[f64]) -> Vector6<f64> {
             Vector6::zeros()
@@ -183,7 +192,7 @@ mod tests {
     /// C(nu) = -C(nu)^T for any nu (Fossen 2021, Property 3.2).
     #[test]
     fn coriolis_is_skew_symmetric() {
-        let m = Free::new().m;
+        let m = Free::new().0.m;
         for nu in [Vector6::new(1.0, -0.3, 0.2, 0.05, -0.1, 0.4), Vector6::new(-2.0, 0.7, 1.1, -0.6, 0.3, -0.2)] {
             let c = coriolis(&m, &nu);
             assert!((c + c.transpose()).norm() < 1e-12);
@@ -198,7 +207,7 @@ mod tests {
     #[test]
     fn energy_is_conserved_without_damping_or_thrust() {
         let body = Free::new();
-        let energy = |s: &BodyState| 0.5 * (s.nu.transpose() * body.m * s.nu)[(0, 0)];
+        let energy = |s: &BodyState| 0.5 * (s.nu.transpose() * body.0.m * s.nu)[(0, 0)];
         let drift = |h: f64| {
             let mut s = BodyState::at_rest(Vector3::zeros(), 0.3);
             s.nu = Vector6::new(1.5, 0.2, -0.1, 0.3, -0.2, 0.5);

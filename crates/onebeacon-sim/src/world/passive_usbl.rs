@@ -460,17 +460,22 @@ mod tests {
         let period = s.mission.message_period_s;
         w.otter = Some(OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::new(0.0, 10.0, 0.0), 0.0)));
         w.asv = AsvState { pos: Vector2::new(0.0, 10.0), psi: 0.0 };
-        let step = Vector2::new(2.0 * period, 0.0);
+        let (along, cross) = follow_legs(&mut w, Vector2::new(2.0 * period, 0.0), 20);
+        eprintln!("Otter after 20 legs: along {along:.3} m, cross {cross:.3} m, speed {:.3} m/s", w.asv_speed);
+        assert!(cross.abs() < 0.3 && along.abs() < 1.5, "along {along}, cross {cross}");
+        assert!((w.asv_speed - 2.0).abs() < 0.2);
+    }
+
+    /// Follows `legs` legs of `step` each from the origin along x; where the ASV ends
+    /// against the last leg's end: (along, cross).
+    fn follow_legs(w: &mut PassiveUsblWorld, step: Vector2<f64>, legs: usize) -> (f64, f64) {
         let mut p_a = Vector2::zeros();
-        for _ in 0..20 {
+        for _ in 0..legs {
             let p_t = p_a + step;
             w.follow(p_a, p_t);
             p_a = p_t;
         }
-        let (along, cross) = (w.asv.pos.x - p_a.x, w.asv.pos.y);
-        eprintln!("Otter after 20 legs: along {along:.3} m, cross {cross:.3} m, speed {:.3} m/s", w.asv_speed);
-        assert!(cross.abs() < 0.3 && along.abs() < 1.5, "along {along}, cross {cross}");
-        assert!((w.asv_speed - 2.0).abs() < 0.2);
+        (w.asv.pos.x - p_a.x, w.asv.pos.y)
     }
 
     fn scenario() -> PassiveUsbl {
@@ -495,13 +500,7 @@ mod tests {
         assert!((w.asv.pos - step).norm() < 1e-9, "{:?}", w.asv.pos);
 
         w.asv = AsvState { pos: Vector2::new(0.0, 10.0), psi: 0.0 };
-        let mut p_a = Vector2::zeros();
-        for _ in 0..8 {
-            let p_t = p_a + step;
-            w.follow(p_a, p_t);
-            p_a = p_t;
-        }
-        let (along, cross) = (w.asv.pos.x - p_a.x, w.asv.pos.y);
+        let (along, cross) = follow_legs(&mut w, step, 8);
         assert!(cross.abs() < 0.3 && along.abs() < 1.5, "along {along}, cross {cross}");
     }
 }

@@ -248,11 +248,16 @@ impl<const D: usize> ParticleFilter<D> {
 
     /// Resamples when the effective sample size is below the threshold; whether it did.
     pub fn resample_if_degenerate(&mut self) -> bool {
-        if ess_of(self.normalised()) < self.settings.ess_fraction * self.len() as f64 {
+        if self.degenerate() {
             self.resample();
             return true;
         }
         false
+    }
+
+    /// Whether the effective sample size is below the resampling threshold.
+    fn degenerate(&self) -> bool {
+        ess_of(self.normalised()) < self.settings.ess_fraction * self.len() as f64
     }
 
     /// `m` particles drawn systematically in proportion to their weights (offset one
@@ -368,7 +373,7 @@ impl<const D: usize> ParticleFilter<D> {
     /// predicts, its estimate taken from the weighted particles (the lower-variance
     /// one); whether it resampled.
     pub fn predict_resampled(&mut self, model: &impl ParticleProcess, dt: f64) -> bool {
-        if ess_of(self.normalised()) >= self.settings.ess_fraction * self.len() as f64 {
+        if !self.degenerate() {
             self.predict(model, dt);
             return false;
         }
