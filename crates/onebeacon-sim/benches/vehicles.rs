@@ -4,6 +4,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
+use onebeacon_sim::vehicles::autopilot::{Command, Piloted};
 use onebeacon_sim::vehicles::otter::{Otter, OtterPilot};
 use onebeacon_sim::vehicles::rigid_body::BodyState;
 use std::hint::black_box;
@@ -16,7 +17,7 @@ fn bench(c: &mut Criterion) {
             let mut p = OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::zeros(), 0.0));
             for k in 0..72_000 {
                 let psi_d = if (k / 1200) % 2 == 0 { 0.0 } else { 1.0 };
-                p.step(psi_d, 2.0, 0.05);
+                p.step(&Command { heading_rad: psi_d, speed_m_s: 2.0, depth_m: None }, &Vector3::zeros(), 0.05);
             }
             black_box(p.state)
         })

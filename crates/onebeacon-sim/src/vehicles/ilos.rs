@@ -10,6 +10,7 @@
 //! whose integral term removes the steady cross-track error a current causes, and
 //! the circle's path parameter law (eq. 23).
 
+use super::autopilot::Command;
 use nalgebra::Vector2;
 
 /// A planar path gamma(s) with its derivative.
@@ -34,20 +35,35 @@ impl PlanarPath for Line {
     }
 }
 
-/// The circle of radius R about `centre`, gamma(s) = centre + R (cos s, sin s) (hoff2024
-/// eq. 22, the paper's p_c taken as the centre), run with s increasing.
+/// The circle of radius R about `centre`, gamma(s) = centre + R (cos a, sin a) with a =
+/// s clockwise seen from above (north toward east; hoff2024 eq. 22, the paper's p_c
+/// taken as the centre), a = -s otherwise; run with s increasing.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Circle {
     pub centre: Vector2<f64>,
     pub radius_m: f64,
+    pub clockwise: bool,
+}
+
+impl Circle {
+    fn sense(&self) -> f64 {
+        if self.clockwise { 1.0 } else { -1.0 }
+    }
+
+    /// The path parameter of the point at angle `a` about the centre (from north).
+    pub fn parameter_at(&self, a: f64) -> f64 {
+        self.sense() * a
+    }
 }
 
 impl PlanarPath for Circle {
     fn point(&self, s: f64) -> Vector2<f64> {
-        self.centre + Vector2::new(s.cos(), s.sin()) * self.radius_m
+        let a = self.sense() * s;
+        self.centre + Vector2::new(a.cos(), a.sin()) * self.radius_m
     }
     fn tangent(&self, s: f64) -> Vector2<f64> {
-        Vector2::new(-s.sin(), s.cos()) * self.radius_m
+        let a = self.sense() * s;
+        Vector2::new(-a.sin(), a.cos()) * (self.sense() * self.radius_m)
     }
 }
 
@@ -93,6 +109,60 @@ pub fn circle_parameter_rate(u_d: f64, delta_m: f64, radius_m: f64, e1: f64, e2:
     u_d * delta_m / (radius_m * (delta_m * delta_m + e2 * e2).sqrt()) + mu * e1
 }
 
+/// ILOS on a circle with the path parameter of eq. 23: the heading (and the speed and
+/// depth held) a vehicle is commanded at each step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CircleFollower {
+    pub circle: Circle,
+    pub ilos: Ilos,
+    /// The path parameter, and the gain mu of eq. 23 (1/(m s)).
+    pub s: f64,
+    pub mu: f64,
+    pub speed_m_s: f64,
+    pub depth_m: Option<f64>,
+}
+
+impl CircleFollower {
+    /// The command for a vehicle at `p`, and its cross-track error; the ILOS integral
+    /// and the path parameter advanced over `h`.
+    pub fn command(&mut self, p: &Vector2<f64>, h: f64) -> (Command, f64) {
+        let (theta, e1, e2) = track_errors(&self.circle, self.s, p);
+        let heading_rad = self.ilos.heading(theta, e2, h);
+        self.s += h * circle_parameter_rate(self.speed_m_s, self.ilos.delta_m, self.circle.radius_m, e1, e2, self.mu);
+        (Command { heading_rad, speed_m_s: self.speed_m_s, depth_m: self.depth_m }, e2)
+    }
+}
+
+/// A dynamic vehicle made by `make(start, heading)` follows the 500 m circle at `u_d`
+/// (ILOS with Delta 10 m, integral gain `kappa`, mu 0.01) for two laps in a 0.2 m/s
+/// current from the west, at `depth` (None: on the surface): the RMS of its cross-track
+/// error over the second lap.
+#[cfg(test)]
+pub(crate) fn circle_cross_track_rms<P: super::autopilot::Piloted>(
+    make: impl Fn(nalgebra::Vector3<f64>, f64) -> P,
+    depth: Option<f64>,
+    u_d: f64,
+    kappa: f64,
+    h: f64,
+) -> f64 {
+    let circle = Circle { centre: Vector2::zeros(), radius_m: 500.0, clockwise: true };
+    let mut follower =
+        CircleFollower { circle, ilos: Ilos::new(10.0, kappa), s: 0.0, mu: 0.01, speed_m_s: u_d, depth_m: depth };
+    let mut p = make(nalgebra::Vector3::new(500.0, 0.0, depth.unwrap_or(0.0)), std::f64::consts::FRAC_PI_2);
+    let current = nalgebra::Vector3::new(0.0, 0.2, 0.0);
+    let lap = std::f64::consts::TAU * 500.0 / u_d;
+    let (mut sum, mut count) = (0.0, 0.0);
+    for k in 0..(2.0 * lap / h) as usize {
+        let (command, e2) = follower.command(&p.body().position_ned_m.xy(), h);
+        if k as f64 * h > lap {
+            sum += e2 * e2;
+            count += 1.0;
+        }
+        p.step(&command, &current, h);
+    }
+    (sum / count).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,7 +198,7 @@ mod tests {
     /// left) has e1 = 0 and e2 = -3; on the path, the parameter advances at u_d / R.
     #[test]
     fn circle_errors_and_parameter_rate() {
-        let c = Circle { centre: Vector2::new(10.0, -5.0), radius_m: 500.0 };
+        let c = Circle { centre: Vector2::new(10.0, -5.0), radius_m: 500.0, clockwise: true };
         let (theta, e1, e2) = track_errors(&c, 0.3, &c.point(0.3));
         assert!((theta - (0.3 + std::f64::consts::FRAC_PI_2)).abs() < 1e-12 && e1.abs() < 1e-9 && e2.abs() < 1e-9);
         let outside = c.point(0.0) + Vector2::new(3.0, 0.0); // further north at s = 0

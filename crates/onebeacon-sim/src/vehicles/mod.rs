@@ -1,6 +1,7 @@
 //! Truth vehicles: paths to follow, controllers, and the dynamics that move them.
 
 pub mod asv;
+pub mod autopilot;
 pub mod ilos;
 pub mod otter;
 pub mod path;

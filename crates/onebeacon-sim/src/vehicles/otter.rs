@@ -3,10 +3,9 @@
 //! with its centre of gravity at [0.2, 0, -0.2] m, radii of gyration 0.4 B and 0.25 L,
 //! payload 25 kg at [0.05, 0, -0.35] m).
 
+use super::autopilot::{AngleLoop, Command, Piloted};
 use super::rigid_body::{BodyState, G, Inertia, Vessel, rigid_body_mass, skew};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
-#[cfg(test)]
-use std::f64::consts::FRAC_PI_2;
 
 /// Sea water density, kg/m^3.
 pub const RHO: f64 = 1025.0;
@@ -211,11 +210,11 @@ impl Vessel for Otter {
 }
 
 /// The Otter's autopilots (vehicles.md): a PID on heading with gains from the yaw
-/// inertia, Kp = M66 wn^2, Kd = 2 zeta wn M66 - d66, Ki = Kp wn / 10, tracking a
-/// third-order reference model of the commanded heading (critically damped, bandwidth
-/// wn / 3, our choice; yaw rate limited to 10 deg/s) with its yaw acceleration fed
-/// forward; a PI on surge speed with the damping fed forward; both through the control
-/// allocation, the shafts following their commands with a first-order lag.
+/// inertia (wn = 1.5 rad/s, zeta = 1: Kp = M66 wn^2 ~ 90, Kd = 2 zeta wn M66 - d66 ~
+/// 80, Ki = Kp wn / 10) tracking a third-order reference model of the commanded heading
+/// (yaw rate limited to 10 deg/s) with its yaw acceleration fed forward
+/// ([`AngleLoop`]); a PI on surge speed with the damping fed forward; both through the
+/// control allocation, the shafts following their commands with a first-order lag.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OtterPilot {
     pub otter: Otter,
@@ -223,15 +222,8 @@ pub struct OtterPilot {
     /// Shaft speeds [port, starboard], rad/s, and their lag, s.
     pub shafts: [f64; 2],
     pub lag_s: f64,
-    heading_integral: f64,
+    pub heading: AngleLoop,
     speed_integral: f64,
-    /// The reference model's heading, yaw rate and yaw acceleration.
-    reference: [f64; 3],
-    /// Closed-loop heading bandwidth wn (rad/s) and damping ratio.
-    pub wn: f64,
-    pub zeta: f64,
-    /// The current, constant in NED, m/s (the autopilots are not told).
-    pub current_ned: Vector3<f64>,
 }
 
 impl OtterPilot {
@@ -243,38 +235,24 @@ impl OtterPilot {
             state,
             shafts: [0.0; 2],
             lag_s: 0.1,
-            heading_integral: 0.0,
+            heading: AngleLoop::new(psi, 1.5, 1.0, 10f64.to_radians()),
             speed_integral: 0.0,
-            reference: [psi, 0.0, 0.0],
-            wn: 1.5,
-            zeta: 1.0,
-            current_ned: Vector3::zeros(),
         }
     }
+}
 
-    /// One step of `h` seconds toward heading `psi_d` (rad) and surge speed `u_d` (m/s):
-    /// the autopilots' forces allocated to the shafts, the shafts' lag integrated
-    /// exactly, then the vessel by RK4.
-    pub fn step(&mut self, psi_d: f64, u_d: f64, h: f64) {
+impl Piloted for OtterPilot {
+    /// One step of `h` seconds toward the commanded heading and surge speed: the
+    /// autopilots' forces allocated to the shafts, the shafts' lag integrated exactly,
+    /// then the vessel by RK4.
+    fn step(&mut self, command: &Command, current_ned: &Vector3<f64>, h: f64) {
         let m = &self.otter.inertia().m;
         let (m11, m66) = (m[(0, 0)], m[(5, 5)]);
         let (u, r) = (self.state.nu[0], self.state.nu[5]);
         let (_, _, psi) = self.state.euler();
-        // the reference model: d3 psi_r = w^3 (psi_d - psi_r) - 3 w d2 psi_r - 3 w^2 d psi_r
-        let w = self.wn / 3.0;
-        let [psi_r, r_r, a_r] = self.reference;
-        let jerk = w.powi(3) * onebeacon::geo::wrap_angle(psi_d - psi_r) - 3.0 * w * a_r - 3.0 * w * w * r_r;
-        let r_max = 10f64.to_radians();
-        let r_next = (r_r + h * a_r).clamp(-r_max, r_max);
-        // at the rate limit, the acceleration that pushes past it is dropped (no windup)
-        let a_next = a_r + h * jerk;
-        let a_next = if r_next.abs() >= r_max && a_next * r_next > 0.0 { 0.0 } else { a_next };
-        self.reference = [onebeacon::geo::wrap_angle(psi_r + h * r_r), r_next, a_next];
-        let e = onebeacon::geo::wrap_angle(psi - psi_r);
-        let (kp, kd) = (m66 * self.wn * self.wn, 2.0 * self.zeta * self.wn * m66 - self.otter.damping(5));
-        let ki = kp * self.wn / 10.0;
-        let n_cmd = m66 * a_r + self.otter.damping(5) * r_r - kp * e - kd * (r - r_r) - ki * self.heading_integral;
+        let n_cmd = self.heading.moment(psi, r, command.heading_rad, m66, self.otter.damping(5), h);
         // speed: the damping at u_d fed forward, a PI on the error (time constant 1 s)
+        let u_d = command.speed_m_s;
         let eu = u - u_d;
         let x_cmd = self.otter.damping(0) * u_d - m11 * eu - 0.1 * m11 * self.speed_integral;
         let cmd = self.otter.allocate(x_cmd, n_cmd);
@@ -282,12 +260,12 @@ impl OtterPilot {
         for (n, c) in self.shafts.iter_mut().zip(cmd) {
             *n = c + (*n - c) * decay;
         }
-        self.state = super::rigid_body::rk4_step(&self.otter, &self.state, &self.shafts, &self.current_ned, h);
-        // conditional integration: only near the reference (no windup while turning hard)
-        if e.abs() < 0.2 {
-            self.heading_integral += e * h;
-        }
+        self.state = super::rigid_body::rk4_step(&self.otter, &self.state, &self.shafts, current_ned, h);
         self.speed_integral += eu * h;
+    }
+
+    fn body(&self) -> &BodyState {
+        &self.state
     }
 }
 
@@ -313,16 +291,20 @@ mod tests {
     /// 2 m/s settles within 0.5 deg, and a speed step from 1 to 2 m/s within 2 %, both
     /// in 60 s; the heading's overshoot stays below 10 % (the loop is designed critically
     /// damped; the shafts' lag and the integral add some).
+    fn cmd(heading_rad: f64, speed_m_s: f64) -> Command {
+        Command { heading_rad, speed_m_s, depth_m: None }
+    }
+
     #[test]
     fn autopilot_step_responses() {
         let mut p = OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::zeros(), 0.0));
         for _ in 0..1200 {
-            p.step(0.0, 2.0, 0.05);
+            p.step(&cmd(0.0, 2.0), &Vector3::zeros(), 0.05);
         }
         let target = 30f64.to_radians();
         let (mut rise, mut peak) = (f64::NAN, 0.0f64);
         for i in 0..1200 {
-            p.step(target, 2.0, 0.05);
+            p.step(&cmd(target, 2.0), &Vector3::zeros(), 0.05);
             let psi = p.state.euler().2;
             if rise.is_nan() && psi >= 0.9 * target {
                 rise = i as f64 * 0.05;
@@ -335,10 +317,10 @@ mod tests {
         let mut t98 = f64::NAN;
         let mut q = OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::zeros(), 0.0));
         for _ in 0..1200 {
-            q.step(0.0, 1.0, 0.05);
+            q.step(&cmd(0.0, 1.0), &Vector3::zeros(), 0.05);
         }
         for i in 0..1200 {
-            q.step(0.0, 2.0, 0.05);
+            q.step(&cmd(0.0, 2.0), &Vector3::zeros(), 0.05);
             if (q.state.nu[0] - 2.0).abs() > 0.04 {
                 t98 = f64::NAN;
             } else if t98.is_nan() {
@@ -358,32 +340,19 @@ mod tests {
     /// (the current acts).
     #[test]
     fn ilos_on_the_circle_in_a_current() {
-        use crate::vehicles::ilos::{Circle, Ilos, circle_parameter_rate, track_errors};
-        use nalgebra::Vector2;
-        let circle = Circle { centre: Vector2::zeros(), radius_m: 500.0 };
-        let (h, u_d, delta) = (0.05, 2.0, 10.0);
-        let lap = std::f64::consts::TAU * 500.0 / u_d;
+        use crate::vehicles::ilos::circle_cross_track_rms;
         let rms = |kappa: f64| {
-            let mut p = OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::new(500.0, 0.0, 0.0), FRAC_PI_2));
-            p.current_ned = Vector3::new(0.0, 0.2, 0.0);
-            let mut ilos = Ilos::new(delta, kappa);
-            let (mut s, mut sum, mut count) = (0.0, 0.0, 0.0);
-            for k in 0..(2.0 * lap / h) as usize {
-                let pos = p.state.position_ned_m.xy();
-                let (theta, e1, e2) = track_errors(&circle, s, &pos);
-                if k as f64 * h > lap {
-                    sum += e2 * e2;
-                    count += 1.0;
-                }
-                let psi_d = ilos.heading(theta, e2, h);
-                p.step(psi_d, u_d, h);
-                s += h * circle_parameter_rate(u_d, delta, 500.0, e1, e2, 0.01);
-            }
-            (sum / count).sqrt()
+            circle_cross_track_rms(
+                |at, psi| OtterPilot::new(Otter::default(), BodyState::at_rest(at, psi)),
+                None,
+                2.0,
+                kappa,
+                0.05,
+            )
         };
         let (los, with) = (rms(0.0), rms(0.1));
         eprintln!(
-            "500 m circle, 0.2 m/s current: cross-track RMS over the second lap {los:.3} m (LOS), {with:.3} m (ILOS, kappa 0.1)"
+            "Otter, 500 m circle, 0.2 m/s current: cross-track RMS over the second lap {los:.3} m (LOS), {with:.3} m (ILOS, kappa 0.1)"
         );
         assert!(los > 0.5 && with < 0.5 * los, "{with} against {los}");
     }

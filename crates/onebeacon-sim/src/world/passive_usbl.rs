@@ -12,6 +12,7 @@ use crate::scenario::passive_usbl::{AsvVehicle, Auv, GuidanceKind};
 use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
+use crate::vehicles::autopilot::{Command, Piloted};
 use crate::vehicles::otter::{Otter, OtterPilot};
 use crate::vehicles::rigid_body::BodyState;
 use nalgebra::{DMatrix, Matrix2, SMatrix, SVector, Vector2, Vector3};
@@ -311,7 +312,8 @@ impl<'a> PassiveUsblWorld<'a> {
                 // the autopilots at 0.05 s or finer (RK4 on the Otter's heave and roll)
                 let sub = (dt / 0.05).ceil().max(1.0) as usize;
                 for _ in 0..sub {
-                    otter.step(course, u_d, dt / sub as f64);
+                    let command = Command { heading_rad: course, speed_m_s: u_d, depth_m: None };
+                    otter.step(&command, &Vector3::zeros(), dt / sub as f64);
                 }
                 let p = otter.state.position_ned_m;
                 self.asv = AsvState { pos: p.xy(), psi: otter.state.euler().2 };
