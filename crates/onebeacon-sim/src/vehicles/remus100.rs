@@ -415,8 +415,7 @@ mod tests {
     /// linear damping is defined by (1 s and 20 s): within 1e-8 after 3 s and 60 s.
     #[test]
     fn linear_damping_time_constants_match_their_definitions() {
-        let mut remus = Remus100::default();
-        remus.cd_cross = 0.0;
+        let remus = Remus100 { cd_cross: 0.0, ..Remus100::default() };
         for (k, t) in [(5, 1.0), (2, 20.0)] {
             let mut s = BodyState::at_rest(Vector3::new(0.0, 0.0, 30.0), 0.0);
             s.nu[k] = 0.2;
