@@ -8,7 +8,7 @@
 //! no estimator or scoring code, an observer no world code, so a new estimator runs in
 //! every world and a new world scores every estimator.
 
-use crate::run::GuidanceSnapshot;
+use crate::run::{GuidanceSnapshot, PilotRecord};
 use nalgebra::{Vector3, Vector6};
 use onebeacon::nav::{Estimate, Measurement, Navigator, Outcome};
 
@@ -36,6 +36,9 @@ pub(crate) trait World {
     fn truth(&self, v: usize) -> VehicleTruth;
     /// Where the beacon is now.
     fn beacon_ned_m(&self) -> Vector3<f64>;
+    /// Appends what the dynamic vehicles' autopilots were last commanded, and what the
+    /// vehicles do now (none in a world of kinematic vehicles).
+    fn pilots(&self, _out: &mut Vec<PilotRecord>) {}
     /// Moves from step `k - 1` to `k` and appends to `heard[v]` what was measured of
     /// vehicle `v` during the step, in the order its estimators must process it.
     /// `beliefs[v]` is vehicle `v`'s first estimator as it stands after step `k - 1`:
@@ -64,6 +67,7 @@ pub(crate) struct Step<'a> {
     pub truth: &'a [VehicleTruth],
     pub heard: &'a [Vec<Measurement>],
     pub beacon_ned_m: Vector3<f64>,
+    pub pilots: &'a [PilotRecord],
     /// Per track: which vehicle it is on, and its estimate now.
     pub vehicle_of: &'a [usize],
     pub estimates: &'a [Estimate],
@@ -91,15 +95,19 @@ pub(crate) fn run(world: &mut dyn World, tracks: &mut [Track], observers: &mut [
     let mut heard = vec![Vec::new(); vehicles];
     let mut truth: Vec<VehicleTruth> = (0..vehicles).map(|v| world.truth(v)).collect();
     let mut estimates: Vec<Estimate> = tracks.iter().map(|t| t.navigator.estimate()).collect();
+    let mut pilots = Vec::new();
     let mut k = 0;
     loop {
         observers.iter_mut().for_each(|o| o.inspect(k, tracks));
+        pilots.clear();
+        world.pilots(&mut pilots);
         let step = Step {
             k,
             t_s: world.t_s(k),
             truth: &truth,
             heard: &heard,
             beacon_ned_m: world.beacon_ned_m(),
+            pilots: &pilots,
             vehicle_of: &vehicle_of,
             estimates: &estimates,
         };

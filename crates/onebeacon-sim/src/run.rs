@@ -68,6 +68,28 @@ impl TruthRecord {
     }
 }
 
+/// What a dynamic vehicle's autopilots were commanded at the end of one step, and
+/// what the vehicle did: heading (rad), surge speed (m/s), depth (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PilotRecord {
+    /// The underwater vehicle's index, or None for the beacon's surface vehicle.
+    pub vehicle: Option<usize>,
+    pub command: crate::vehicles::autopilot::Command,
+    pub heading_rad: f64,
+    pub speed_m_s: f64,
+    pub depth_m: f64,
+}
+
+impl PilotRecord {
+    pub(crate) fn of(
+        vehicle: Option<usize>,
+        command: crate::vehicles::autopilot::Command,
+        body: &crate::vehicles::rigid_body::BodyState,
+    ) -> Self {
+        Self { vehicle, command, heading_rad: body.euler().2, speed_m_s: body.nu[0], depth_m: body.position_ned_m.z }
+    }
+}
+
 /// Truth and all estimates at one step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepRecord {
@@ -80,6 +102,8 @@ pub struct StepRecord {
     pub frame: bool,
     /// Every (vehicle, estimator) track, in the order of [`Scenario::tracks`].
     pub estimates: Vec<Estimate>,
+    /// The dynamic vehicles' autopilots (empty in a world without them).
+    pub pilots: Vec<PilotRecord>,
 }
 
 /// What a beacon vehicle's guidance knew and chose at one decision (recorded runs).
@@ -333,6 +357,7 @@ impl Observer for Recorder {
             beacon: s.beacon_ned_m,
             frame: s.heard.iter().flatten().any(|m| m.kind.beacon().is_some()),
             estimates,
+            pilots: s.pilots.to_vec(),
         });
     }
 

@@ -13,6 +13,8 @@ pub enum Stream {
     Imu = 2,
     Heading = 3,
     Acoustic = 4,
+    /// The water's current (its slow variation).
+    Current = 5,
 }
 
 /// SplitMix64 finaliser: a bijective mixing of 64 bits.

@@ -97,5 +97,6 @@ fn to_record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepReco
         beacon: beacon.unwrap_or(Vector3::repeat(f64::NAN)),
         frame: heard,
         estimates,
+        pilots: Vec::new(),
     }
 }

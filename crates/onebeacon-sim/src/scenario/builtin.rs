@@ -13,6 +13,7 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "sousa", toml: include_str!("../../../../scenarios/sousa.toml") },
     Builtin { name: "sousa-pair", toml: include_str!("../../../../scenarios/sousa-pair.toml") },
     Builtin { name: "hoff2024", toml: include_str!("../../../../scenarios/hoff2024.toml") },
+    Builtin { name: "hoff2024-kinematic", toml: include_str!("../../../../scenarios/hoff2024-kinematic.toml") },
     Builtin { name: "hoff2024-pair", toml: include_str!("../../../../scenarios/hoff2024-pair.toml") },
     Builtin { name: "hoff2024-consistency", toml: include_str!("../../../../scenarios/hoff2024-consistency.toml") },
 ];

@@ -32,6 +32,10 @@ pub struct PassiveUsbl {
     pub usbl: UsblSpec,
     #[serde(default)]
     pub asv: Asv,
+    /// The water's current, felt by the dynamic vehicles (`otter`, `remus100`); the
+    /// estimators are not told.
+    #[serde(default)]
+    pub current: Current,
     #[serde(default)]
     pub guidance: Guidance,
     #[serde(default)]
@@ -63,7 +67,8 @@ impl Default for Mission {
     }
 }
 
-/// An AUV on a circle (eq. 22), at constant depth and speed.
+/// An AUV on a circle (eq. 22), at constant depth and speed: on it exactly
+/// (`kinematic`), or following it by ILOS under its autopilots (`remus100`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Auv {
@@ -78,6 +83,60 @@ pub struct Auv {
     pub start_angle_deg: f64,
     /// Turning clockwise seen from above (to starboard) or not.
     pub clockwise: bool,
+    /// The truth model of the AUV.
+    pub vehicle: AuvVehicle,
+    /// ILOS on the circle (`remus100`): lookahead Delta (m), integral gain kappa, and
+    /// the path parameter's gain mu of eq. 23 (1/(m s)).
+    pub ilos_lookahead_m: f64,
+    pub ilos_integral_gain: f64,
+    pub path_gain: f64,
+}
+
+/// The truth model of an AUV.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AuvVehicle {
+    /// On its circle in closed form, at constant speed and depth, level.
+    #[default]
+    Kinematic,
+    /// REMUS 100's 6-DOF dynamics (`vehicles::remus100`) under its heading, depth and
+    /// speed autopilots, steered by ILOS on the circle.
+    Remus100,
+}
+
+/// A current constant in the water column, or slowly varying: its speed and direction
+/// each a first-order Gauss-Markov process about their means (drawn once per message
+/// period).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Current {
+    pub speed_m_s: f64,
+    /// The direction it flows toward, deg from north.
+    pub toward_deg: f64,
+    /// Stationary standard deviations of the speed and the direction about their means,
+    /// and their correlation time.
+    pub speed_sigma_m_s: f64,
+    pub direction_sigma_deg: f64,
+    pub time_constant_s: f64,
+}
+
+impl Default for Current {
+    fn default() -> Self {
+        Self {
+            speed_m_s: 0.0,
+            toward_deg: 0.0,
+            speed_sigma_m_s: 0.0,
+            direction_sigma_deg: 0.0,
+            time_constant_s: 1800.0,
+        }
+    }
+}
+
+impl Current {
+    /// Whether there is any.
+    pub fn flows(&self) -> bool {
+        self.speed_m_s > 0.0 || self.speed_sigma_m_s > 0.0
+    }
 }
 
 impl Default for Auv {
@@ -91,6 +150,10 @@ impl Default for Auv {
             speed_m_s: 1.5,
             start_angle_deg: 0.0,
             clockwise: true,
+            vehicle: AuvVehicle::Kinematic,
+            ilos_lookahead_m: 10.0,
+            ilos_integral_gain: 0.1,
+            path_gain: 0.01,
         }
     }
 }
@@ -140,8 +203,10 @@ pub struct Asv {
     pub nominal_speed_m_s: f64,
     /// c_u: the along-track gain of the speed law (eq. 26), 1/s.
     pub along_track_gain: f64,
-    /// Line-of-sight lookahead distance along the leg, m.
+    /// Line-of-sight lookahead distance along the leg, m, and the gain kappa of an ILOS
+    /// integral across legs (0: plain LOS).
     pub lookahead_m: f64,
+    pub ilos_integral_gain: f64,
     /// GPS error per horizontal axis and compass error of the ASV (the paper: exact).
     pub gps_noise_m: f64,
     pub compass_noise_deg: f64,
@@ -172,6 +237,7 @@ impl Default for Asv {
             nominal_speed_m_s: 2.2,
             along_track_gain: 0.2,
             lookahead_m: 5.0,
+            ilos_integral_gain: 0.0,
             gps_noise_m: 0.0,
             compass_noise_deg: 0.0,
             start_distance_m: 20.0,

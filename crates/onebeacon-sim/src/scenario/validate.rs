@@ -2,7 +2,7 @@
 
 use super::estimator::{EstimatorKind, EstimatorSpec, Host, NOISE_KEYS, Sign};
 use super::moving_beacon::Vehicle;
-use super::passive_usbl::Auv;
+use super::passive_usbl::{AsvVehicle, Auv, AuvVehicle};
 use super::{FixedBeacon, MovingBeacon, PassiveUsbl, Scenario};
 use crate::replay::log::{COLUMN_KEYS, InitialFrom, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
 
@@ -371,8 +371,20 @@ fn check_auv(prefix: &str, a: &Auv) -> Result<(), Violation> {
         ("depth_m", a.depth_m, NonNegative),
         ("speed_m_s", a.speed_m_s, NonNegative),
         ("start_angle_deg", a.start_angle_deg, Finite),
+        ("ilos_lookahead_m", a.ilos_lookahead_m, Positive),
+        ("ilos_integral_gain", a.ilos_integral_gain, NonNegative),
+        ("path_gain", a.path_gain, NonNegative),
     ];
-    check_table(prefix, &fields, a.name.as_ref())
+    check_table(prefix, &fields, a.name.as_ref())?;
+    // REMUS 100 tops out at 2.48 m/s (1525 rpm) and needs way on for its fins
+    if a.vehicle == AuvVehicle::Remus100 && !(0.5..=2.4).contains(&a.speed_m_s) {
+        return Err(Violation {
+            key: format!("{prefix}.speed_m_s"),
+            value: format!("{:?}", a.speed_m_s),
+            allowed: "must be from 0.5 to 2.4 m/s for a remus100 (its top speed is 2.48 m/s)".into(),
+        });
+    }
+    Ok(())
 }
 
 fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
@@ -419,11 +431,27 @@ fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
         nominal_speed_m_s: Positive,
         along_track_gain: NonNegative,
         lookahead_m: Positive,
+        ilos_integral_gain: NonNegative,
         gps_noise_m: NonNegative,
         compass_noise_deg: NonNegative,
         start_distance_m: NonNegative,
         start_bearing_deg: Finite,
     });
+    check_fields!("current", s.current, {
+        speed_m_s: NonNegative,
+        toward_deg: Finite,
+        speed_sigma_m_s: NonNegative,
+        direction_sigma_deg: NonNegative,
+        time_constant_s: Positive,
+    });
+    let dynamic = s.asv.vehicle == AsvVehicle::Otter || s.auvs().iter().any(|a| a.vehicle == AuvVehicle::Remus100);
+    if s.current.flows() && !dynamic {
+        return Err(Violation {
+            key: "current.speed_m_s".into(),
+            value: format!("{:?}", s.current.speed_m_s),
+            allowed: "must be 0 unless a vehicle feels it (asv.vehicle = \"otter\" or an AUV's vehicle = \"remus100\"; kinematic vehicles move as commanded)".into(),
+        });
+    }
     let g = &s.guidance;
     check_fields!("guidance", g, {
         r1_m: Positive,

@@ -7,13 +7,17 @@
 //! the ASV 6 cm).
 
 use crate::engine::{Track, VehicleTruth, World};
+use crate::run::PilotRecord;
 use crate::run::{BearingSnapshot, GuidanceSnapshot};
+use crate::scenario::passive_usbl::AuvVehicle;
 use crate::scenario::passive_usbl::{AsvVehicle, Auv, GuidanceKind};
 use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
-use crate::vehicles::autopilot::{Command, Piloted};
+use crate::vehicles::autopilot::{Command, Piloted, step_over};
+use crate::vehicles::ilos::{self, CircleFollower, Ilos};
 use crate::vehicles::otter::{Otter, OtterPilot};
+use crate::vehicles::remus100::{Remus100, Remus100Pilot};
 use crate::vehicles::rigid_body::BodyState;
 use nalgebra::{DMatrix, Matrix2, SMatrix, SVector, Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
@@ -27,6 +31,9 @@ use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::FRAC_PI_2;
 
+/// The dynamic vehicles' integration step, at most (RK4; MSS uses 0.05 s).
+const VEHICLE_STEP_S: f64 = 0.05;
+
 /// One AUV on its circle: where it is at time t, in closed form.
 struct Circle {
     spec: Auv,
@@ -34,11 +41,147 @@ struct Circle {
     sense: f64,
 }
 
-/// One AUV: its circle and the random streams of its reports and bearings.
+/// One AUV: its circle, how it moves, and the random streams of its reports and
+/// bearings.
 struct AuvTruth {
     circle: Circle,
+    motion: AuvMotion,
     report_rng: Pcg64Mcg,
     usbl_rng: Pcg64Mcg,
+}
+
+/// How an AUV moves: on its circle in closed form, or REMUS 100's dynamics following it
+/// by ILOS (the last command kept for the record, the distance travelled summed).
+enum AuvMotion {
+    Circle,
+    Remus { pilot: Box<Remus100Pilot>, follower: CircleFollower, command: Command, distance_m: f64 },
+}
+
+impl AuvTruth {
+    fn new(spec: Auv, report_rng: Pcg64Mcg, usbl_rng: Pcg64Mcg) -> Self {
+        let circle = Circle::new(spec);
+        let motion = match circle.spec.vehicle {
+            AuvVehicle::Kinematic => AuvMotion::Circle,
+            AuvVehicle::Remus100 => {
+                let a = &circle.spec;
+                let path = ilos::Circle {
+                    centre: Vector2::new(a.centre_north_m, a.centre_east_m),
+                    radius_m: a.circle_radius_m,
+                    clockwise: a.clockwise,
+                };
+                let follower = CircleFollower {
+                    circle: path,
+                    ilos: Ilos::new(a.ilos_lookahead_m, a.ilos_integral_gain),
+                    s: path.parameter_at(a.start_angle_deg.to_radians()),
+                    mu: a.path_gain,
+                    speed_m_s: a.speed_m_s,
+                    depth_m: Some(a.depth_m),
+                };
+                let pilot = Remus100Pilot::cruising(
+                    Remus100::default(),
+                    circle.position(0.0),
+                    circle.heading(0.0),
+                    a.speed_m_s,
+                );
+                let command =
+                    Command { heading_rad: circle.heading(0.0), speed_m_s: a.speed_m_s, depth_m: Some(a.depth_m) };
+                AuvMotion::Remus { pilot: Box::new(pilot), follower, command, distance_m: 0.0 }
+            }
+        };
+        Self { circle, motion, report_rng, usbl_rng }
+    }
+
+    /// Moves over `dt` s ending at `t1_s` in `current_ned`, in steps of at most `h_max`.
+    fn advance(&mut self, dt: f64, h_max: f64, current_ned: &Vector3<f64>) {
+        let AuvMotion::Remus { pilot, follower, command, distance_m } = &mut self.motion else { return };
+        let steps = (dt / h_max).ceil().max(1.0) as usize;
+        let h = dt / steps as f64;
+        for _ in 0..steps {
+            let (c, _) = follower.command(&pilot.state.position_ned_m.xy(), h);
+            let before = pilot.state.position_ned_m;
+            pilot.step(&c, current_ned, h);
+            *distance_m += (pilot.state.position_ned_m - before).xy().norm();
+            *command = c;
+        }
+    }
+
+    /// The full state of eq. 4 at `t_s` (now, for a dynamic AUV): its pitch, heading,
+    /// speed over ground, and its pitch and heading rates where the model has biases.
+    fn state(&self, t_s: f64) -> SVector<f64, DIM> {
+        match &self.motion {
+            AuvMotion::Circle => self.circle.state(t_s),
+            AuvMotion::Remus { pilot, .. } => {
+                let b = &pilot.state;
+                let (phi, theta, psi) = b.euler();
+                let (q, r) = (b.nu[4], b.nu[5]);
+                let p = b.position_ned_m;
+                let theta_rate = q * phi.cos() - r * phi.sin();
+                let psi_rate = (q * phi.sin() + r * phi.cos()) / theta.cos();
+                SVector::from([p.x, p.y, p.z, theta, psi, b.velocity_ned().norm(), theta_rate, psi_rate])
+            }
+        }
+    }
+
+    fn truth(&self, t_s: f64) -> VehicleTruth {
+        match &self.motion {
+            AuvMotion::Circle => {
+                let p = self.circle.position(t_s);
+                VehicleTruth {
+                    eta: [p.x, p.y, p.z, 0.0, 0.0, self.circle.heading(t_s)].into(),
+                    speed_m_s: self.circle.spec.speed_m_s,
+                    distance_m: self.circle.spec.speed_m_s * t_s,
+                }
+            }
+            AuvMotion::Remus { pilot, distance_m, .. } => {
+                let b = &pilot.state;
+                let (phi, theta, psi) = b.euler();
+                let p = b.position_ned_m;
+                VehicleTruth {
+                    eta: [p.x, p.y, p.z, phi, theta, psi].into(),
+                    speed_m_s: b.velocity_ned().xy().norm(),
+                    distance_m: *distance_m,
+                }
+            }
+        }
+    }
+
+    /// The autopilots' command and what the vehicle does, for a dynamic AUV.
+    fn pilot_record(&self, v: usize) -> Option<PilotRecord> {
+        let AuvMotion::Remus { pilot, command, .. } = &self.motion else { return None };
+        Some(PilotRecord::of(Some(v), *command, &pilot.state))
+    }
+}
+
+/// The current the dynamic vehicles feel: its speed and direction, each drifting as a
+/// first-order Gauss-Markov process about its mean.
+struct Water {
+    spec: crate::scenario::passive_usbl::Current,
+    speed_dev: f64,
+    direction_dev: f64,
+    rng: Pcg64Mcg,
+}
+
+impl Water {
+    fn new(spec: crate::scenario::passive_usbl::Current, mut rng: Pcg64Mcg) -> Self {
+        let speed_dev = gauss(&mut rng, spec.speed_sigma_m_s);
+        let direction_dev = gauss(&mut rng, spec.direction_sigma_deg.to_radians());
+        Self { spec, speed_dev, direction_dev, rng }
+    }
+
+    fn ned(&self) -> Vector3<f64> {
+        let dir = self.spec.toward_deg.to_radians() + self.direction_dev;
+        let speed = (self.spec.speed_m_s + self.speed_dev).max(0.0);
+        Vector3::new(dir.cos(), dir.sin(), 0.0) * speed
+    }
+
+    /// Drifts over `dt` s (exact discretisation of the first-order process).
+    fn drift(&mut self, dt: f64) {
+        let a = (-dt / self.spec.time_constant_s).exp();
+        let b = (1.0 - a * a).sqrt();
+        self.speed_dev = a * self.speed_dev + gauss(&mut self.rng, b * self.spec.speed_sigma_m_s);
+        self.direction_dev =
+            a * self.direction_dev + gauss(&mut self.rng, b * self.spec.direction_sigma_deg.to_radians());
+    }
 }
 
 impl Circle {
@@ -83,8 +226,13 @@ pub(crate) struct PassiveUsblWorld<'a> {
     lim: AsvLimits,
     asv0: Vector2<f64>,
     asv: AsvState,
-    /// The Otter's dynamics and autopilots when the ASV is one (`asv.vehicle`).
+    /// The Otter's dynamics and autopilots when the ASV is one (`asv.vehicle`), and its
+    /// last command.
     otter: Option<OtterPilot>,
+    asv_command: Option<Command>,
+    /// Line-of-sight steering on the legs, with its integral across them.
+    asv_ilos: Ilos,
+    water: Water,
     /// The ASV's speed at the end of the last step (for the side of the half-annulus).
     asv_speed: f64,
     leg: Option<Leg>,
@@ -99,10 +247,8 @@ impl<'a> PassiveUsblWorld<'a> {
             .auvs()
             .into_iter()
             .enumerate()
-            .map(|(v, spec)| AuvTruth {
-                circle: Circle::new(spec),
-                report_rng: vehicle_rng(seed, run, v, Stream::Imu),
-                usbl_rng: vehicle_rng(seed, run, v, Stream::Acoustic),
+            .map(|(v, spec)| {
+                AuvTruth::new(spec, vehicle_rng(seed, run, v, Stream::Imu), vehicle_rng(seed, run, v, Stream::Acoustic))
             })
             .collect();
         let start = auvs[0].circle.position(0.0).xy();
@@ -123,6 +269,9 @@ impl<'a> PassiveUsblWorld<'a> {
                 let at = Vector3::new(asv0.x, asv0.y, 0.0);
                 OtterPilot::new(Otter::default(), BodyState::at_rest(at, to_auv.y.atan2(to_auv.x)))
             }),
+            asv_command: None,
+            asv_ilos: Ilos::new(s.asv.lookahead_m, s.asv.ilos_integral_gain),
+            water: Water::new(s.current.clone(), vehicle_rng(seed, run, 0, Stream::Current)),
             asv_speed: 0.0,
             leg: None,
             station_rng: vehicle_rng(seed, run, 0, Stream::Heading),
@@ -159,7 +308,7 @@ impl<'a> PassiveUsblWorld<'a> {
         let mut tracks = Vec::new();
         for (v, auv) in self.auvs.iter().enumerate() {
             let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
-            let mut x0 = auv.circle.state(0.0) + sigma0.map(|sd| gauss(&mut init_rng, sd));
+            let mut x0 = auv.state(0.0) + sigma0.map(|sd| gauss(&mut init_rng, sd));
             x0[idx::PSI] = wrap_angle(x0[idx::PSI]);
             let pf_seed: u64 = init_rng.random();
             for e in &s.estimators {
@@ -249,7 +398,7 @@ impl<'a> PassiveUsblWorld<'a> {
         match self.guidance {
             GuidanceKind::Determinant | GuidanceKind::MaxEigenvalue => {
                 let mut snapshot = None;
-                let need = self.leg.is_none_or(|l| leg_done(l.to, here, u_nom, period)); // eq. 16
+                let need = self.leg.is_none_or(|l| leg_done(l.from, l.to, here, u_nom, period)); // eq. 16
                 if need {
                     let plan = self.plan(t_s, beliefs);
                     let from = self.leg.map_or(here, |l| l.to);
@@ -306,15 +455,13 @@ impl<'a> PassiveUsblWorld<'a> {
                 let along = e.dot(&tau); // eq. 21, epsilon_1
                 let cross = tau.x * e.y - tau.y * e.x; // epsilon_2
                 let u_d = (len / period - a.along_track_gain * along).clamp(0.0, self.lim.max_speed_m_s); // eq. 26
-                (tau.y.atan2(tau.x) - (cross / a.lookahead_m).atan(), u_d)
+                (self.asv_ilos.heading(tau.y.atan2(tau.x), cross, dt), u_d)
             };
             if let Some(otter) = &mut self.otter {
                 // the autopilots at 0.05 s or finer (RK4 on the Otter's heave and roll)
-                let sub = (dt / 0.05).ceil().max(1.0) as usize;
-                for _ in 0..sub {
-                    let command = Command { heading_rad: course, speed_m_s: u_d, depth_m: None };
-                    otter.step(&command, &Vector3::zeros(), dt / sub as f64);
-                }
+                let command = Command { heading_rad: course, speed_m_s: u_d, depth_m: None };
+                step_over(otter, &command, &self.water.ned(), dt, VEHICLE_STEP_S);
+                self.asv_command = Some(command);
                 let p = otter.state.position_ned_m;
                 self.asv = AsvState { pos: p.xy(), psi: otter.state.euler().2 };
                 self.asv_speed = otter.state.nu[0];
@@ -362,14 +509,14 @@ impl World for PassiveUsblWorld<'_> {
     }
 
     fn truth(&self, v: usize) -> VehicleTruth {
-        let a = &self.auvs[v].circle;
-        let t = self.t_s(self.k);
-        let p = a.position(t);
-        VehicleTruth {
-            eta: [p.x, p.y, p.z, 0.0, 0.0, a.heading(t)].into(),
-            speed_m_s: a.spec.speed_m_s,
-            distance_m: a.spec.speed_m_s * t,
+        self.auvs[v].truth(self.t_s(self.k))
+    }
+
+    fn pilots(&self, out: &mut Vec<PilotRecord>) {
+        if let (Some(otter), Some(c)) = (&self.otter, self.asv_command) {
+            out.push(PilotRecord::of(None, c, &otter.state));
         }
+        out.extend(self.auvs.iter().enumerate().filter_map(|(v, a)| a.pilot_record(v)));
     }
 
     fn beacon_ned_m(&self) -> Vector3<f64> {
@@ -387,6 +534,13 @@ impl World for PassiveUsblWorld<'_> {
         self.follow(p_a, p_t);
         self.k = k;
         let t1 = self.t_s(k);
+        let current = self.water.ned();
+        for auv in &mut self.auvs {
+            auv.advance(t1 - t0, self.s.mission.dt_s.min(VEHICLE_STEP_S), &current);
+        }
+        if self.s.current.flows() {
+            self.water.drift(t1 - t0);
+        }
 
         // each AUV's message at t1: its report, and its bearing on the USBL
         let s = self.s;
@@ -401,7 +555,7 @@ impl World for PassiveUsblWorld<'_> {
         let compass = wrap_angle(self.asv.psi + gauss(&mut self.station_rng, s.asv.compass_noise_deg.to_radians()));
         let r = &s.reports;
         for (auv, out) in self.auvs.iter_mut().zip(heard.iter_mut()) {
-            let x = auv.circle.state(t1);
+            let x = auv.state(t1);
             let rng = &mut auv.report_rng;
             out.push(Measurement::new(
                 t1,

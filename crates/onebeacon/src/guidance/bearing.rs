@@ -165,10 +165,13 @@ pub fn leg_target(
     (along, along + a / len2.sqrt() * u_nom_m_s * dt_s) // eq. 15
 }
 
-/// Whether the surface vehicle will reach waypoint `to` within the next cycle, so that
-/// the next one is to be planned (eq. 16).
-pub fn leg_done(to: Vector2<f64>, asv: Vector2<f64>, u_nom_m_s: f64, dt_s: f64) -> bool {
-    (to - asv).norm() < u_nom_m_s * dt_s
+/// Whether the surface vehicle is done with the leg from `from` to `to`, so that the
+/// next waypoint is to be planned: it will reach `to` within the next cycle (eq. 16), or
+/// it has passed it (its along-track point beyond `to`: a vehicle that cannot turn on
+/// the spot may pass a waypoint wider than eq. 16's radius, and would orbit it).
+pub fn leg_done(from: Vector2<f64>, to: Vector2<f64>, asv: Vector2<f64>, u_nom_m_s: f64, dt_s: f64) -> bool {
+    let a = to - from;
+    (to - asv).norm() < u_nom_m_s * dt_s || a.dot(&(asv - to)) > 0.0
 }
 
 #[cfg(test)]
@@ -267,15 +270,19 @@ mod tests {
     }
 
     /// Eq. 13-16: the along-track point is the projection on the leg; the target is
-    /// u_nom dt further along; a waypoint closer than u_nom dt is done.
+    /// u_nom dt further along; a waypoint closer than u_nom dt is done, and so is one
+    /// passed however wide.
     #[test]
     fn legs_follow_eq_13_to_16() {
         let (from, to) = (Vector2::new(0.0, 0.0), Vector2::new(100.0, 0.0));
         let (along, target) = leg_target(from, to, Vector2::new(30.0, 7.0), 2.2, 4.0);
         assert_abs_diff_eq!(along, Vector2::new(30.0, 0.0), epsilon = 1e-12);
         assert_abs_diff_eq!(target, Vector2::new(38.8, 0.0), epsilon = 1e-12);
-        assert!(leg_done(to, Vector2::new(92.0, 0.0), 2.2, 4.0));
-        assert!(!leg_done(to, Vector2::new(90.0, 0.0), 2.2, 4.0));
+        assert!(leg_done(from, to, Vector2::new(92.0, 0.0), 2.2, 4.0));
+        assert!(!leg_done(from, to, Vector2::new(90.0, 0.0), 2.2, 4.0));
+        // passed wide of the waypoint: done; as wide but short of it: not yet
+        assert!(leg_done(from, to, Vector2::new(100.5, 12.0), 2.2, 4.0));
+        assert!(!leg_done(from, to, Vector2::new(99.5, 12.0), 2.2, 4.0));
     }
 
     /// The planner on a subsample of a particle cloud against the planner on all of it:
