@@ -159,6 +159,12 @@ mod tests {
         assert!(e.contains("sweep.guidance[1]") && e.contains("max-eig"), "{e}");
         let e = err(&format!("{p}[usbl]\nnoise_deg_per_m = 0.0\n"));
         assert!(e.contains("usbl.noise_deg_per_m") && e.contains("> 0"), "{e}");
+        let e = err(&format!("{p}[current]\nspeed_m_s = 0.2\n"));
+        assert!(e.contains("current.speed_m_s") && e.contains("otter"), "{e}");
+        let e = err(&format!("{p}[auv]\nvehicle = \"remus100\"\nspeed_m_s = 3.0\n"));
+        assert!(e.contains("auv.speed_m_s") && e.contains("2.4"), "{e}");
+        let e = err(&format!("{p}[auv]\nvehicle = \"remus\"\n"));
+        assert!(e.contains("auv.vehicle") && e.contains("remus100"), "{e}");
 
         for e in [err("name = 1\n"), err("name=\"x\"\n[mission]\ndt_s = inf\n")] {
             assert!(!e.contains('\n'), "{e}");
