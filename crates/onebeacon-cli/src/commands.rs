@@ -78,6 +78,10 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, message: usize,
     if let Some(b) = &result.belief {
         plot::belief_density(&staging.file("belief.png"), b).context("cannot draw belief.png")?;
     }
+    if result.trajectory.iter().any(|r| !r.pilots.is_empty()) {
+        plot::autopilots(&staging.file("autopilots.png"), &vehicles, &title, &result.trajectory)
+            .context("cannot draw autopilots.png")?;
+    }
     if !result.guidance.is_empty() {
         let snapshot = result
             .guidance

@@ -354,6 +354,75 @@ pub fn error_vs_time(path: &Path, names: &[String], title: &str, traj: &[StepRec
     })())
 }
 
+/// The dynamic vehicles' autopilots: commanded (dashed) against actual (solid) heading,
+/// surge speed and depth versus time, one colour per vehicle (the surface vehicle as
+/// `asv`; depth for the underwater ones). Headings are unwrapped, each command drawn on
+/// the turn of the heading it was given to.
+pub fn autopilots(path: &Path, vehicles: &[String], title: &str, traj: &[StepRecord]) -> Result<()> {
+    register_fonts();
+    let mut keys: Vec<Option<usize>> = Vec::new();
+    for p in traj.iter().flat_map(|r| &r.pilots) {
+        if !keys.contains(&p.vehicle) {
+            keys.push(p.vehicle);
+        }
+    }
+    let label = |k: Option<usize>| k.and_then(|v| vehicles.get(v).cloned()).unwrap_or_else(|| "asv".into());
+    // per vehicle: (t, commanded, actual) of heading (deg, unwrapped), speed, depth
+    type Series = Vec<(f64, f64, f64)>;
+    let series: Vec<[Series; 3]> = keys
+        .iter()
+        .map(|&k| {
+            let (mut heading, mut speed, mut depth) = (Vec::new(), Vec::new(), Vec::new());
+            let mut unwrapped: Option<f64> = None;
+            for r in traj {
+                let Some(p) = r.pilots.iter().find(|p| p.vehicle == k) else { continue };
+                let actual = match unwrapped {
+                    None => p.heading_rad,
+                    Some(last) => last + onebeacon::geo::wrap_angle(p.heading_rad - last),
+                };
+                unwrapped = Some(actual);
+                let commanded = actual + onebeacon::geo::wrap_angle(p.command.heading_rad - p.heading_rad);
+                heading.push((r.t_s, commanded.to_degrees(), actual.to_degrees()));
+                speed.push((r.t_s, p.command.speed_m_s, p.speed_m_s));
+                if let Some(d) = p.command.depth_m {
+                    depth.push((r.t_s, d, p.depth_m));
+                }
+            }
+            [heading, speed, depth]
+        })
+        .collect();
+    let t1 = traj.last().map_or(1.0, |r| r.t_s).max(1e-3);
+    // (axis, legend word, the least span shown)
+    let panels = [("heading (deg)", "heading", 10.0), ("surge speed (m/s)", "speed", 0.5), ("depth (m)", "depth", 1.0)];
+    both!(path, (1200, 1100), |root| (|| -> Result<()> {
+        root.fill(&WHITE)?;
+        let (head, body) = root.split_vertically(40);
+        head.draw(&Text::new(
+            format!("{title}: autopilots, commanded (dashed) and actual (solid)"),
+            (15, 10),
+            (FONT, 22).into_font(),
+        ))?;
+        for (j, area) in body.split_evenly((3, 1)).iter().enumerate() {
+            let all = series.iter().flat_map(|s| s[j].iter().flat_map(|&(_, c, a)| [c, a]));
+            let (lo, hi) = span(all, 0.05);
+            let (mid, half) = (0.5 * (lo + hi), (0.5 * (hi - lo)).max(0.5 * panels[j].2));
+            let mut chart = chart(area, "", 0.0..t1, mid - half..mid + half, ("time (s)", panels[j].0))?;
+            for (i, (s, &k)) in series.iter().zip(&keys).enumerate() {
+                if s[j].is_empty() {
+                    continue;
+                }
+                let c = colour(i);
+                let name = format!("{} {}", label(k), panels[j].1);
+                styled_line(&mut chart, s[j].iter().map(|&(t, cmd, _)| (t, cmd)), c.stroke_width(1), true, None)?;
+                line(&mut chart, s[j].iter().map(|&(t, _, a)| (t, a)), c.stroke_width(2), Some(&name))?;
+            }
+            legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        }
+        root.present()?;
+        Ok(())
+    })())
+}
+
 /// Monte Carlo: mean error (inliers) and RMSE versus the first numeric swept key. With
 /// text keys too (path, guidance), one panel per value of the first text key and one
 /// line per value of the others, for the first estimator, with the PCRB dashed where

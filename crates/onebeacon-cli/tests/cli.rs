@@ -281,12 +281,19 @@ fn moving_beacon_run_and_mc() {
     assert!(!dir.join("none").exists());
 }
 
-/// A short passive-USBL scenario: 2000 particles, 80 s (20 messages).
+/// A short passive-USBL scenario: 2000 particles, 80 s (20 messages), REMUS 100 and
+/// Otter in a current.
 const SHORT_HOFF: &str = r#"kind = "passive_usbl"
 name = "short-hoff"
 runs = 2
 [mission]
 duration_s = 80
+[auv]
+vehicle = "remus100"
+[asv]
+vehicle = "otter"
+[current]
+speed_m_s = 0.1
 [guidance]
 planner_particles = 500
 [[estimators]]
@@ -298,8 +305,9 @@ kind = "bearing"
 guidance = ["det", "static"]
 "#;
 
-/// `run` on a passive-USBL scenario draws the particle cloud at `--message` and the
-/// planner's score; `mc --json` has one cell per guidance and estimator, with a bound.
+/// `run` on a passive-USBL scenario draws the particle cloud at `--message`, the
+/// planner's score and the autopilots; `mc --json` has one cell per guidance and
+/// estimator, with a bound.
 #[test]
 fn passive_usbl_run_and_mc() {
     let dir = scratch("hoff");
@@ -309,7 +317,7 @@ fn passive_usbl_run_and_mc() {
     let out_dir = dir.join("run");
     let out = run(&["run", scenario, "--message", "5", "--ping", "0", "--out", out_dir.to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    for png in ["top_view.png", "error.png", "guidance.png", "belief.png"] {
+    for png in ["top_view.png", "error.png", "guidance.png", "belief.png", "autopilots.png"] {
         assert!(std::fs::read(out_dir.join(png)).unwrap().starts_with(b"\x89PNG"), "{png}");
     }
     let csv = std::fs::read_to_string(out_dir.join("trajectory.csv")).unwrap();
