@@ -157,6 +157,8 @@ pub struct Asv {
     /// Direction from the vehicle to the ASV at the start, deg; the distance is the
     /// best standoff for the vehicle's depth (sousa Fig. 4.7).
     pub start_bearing_deg: f64,
+    /// The truth model of the ASV.
+    pub vehicle: super::passive_usbl::AsvVehicle,
 }
 
 impl Default for Asv {
@@ -167,6 +169,7 @@ impl Default for Asv {
             gps_noise_m: 1.0,
             transducer_depth_m: 0.0,
             start_bearing_deg: 0.0,
+            vehicle: super::passive_usbl::AsvVehicle::Kinematic,
         }
     }
 }

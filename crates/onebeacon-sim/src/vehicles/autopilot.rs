@@ -102,6 +102,9 @@ pub trait Piloted {
     fn body(&self) -> &BodyState;
 }
 
+/// The dynamic vehicles' integration step in the worlds, at most (RK4; MSS uses 0.05 s).
+pub const MAX_STEP_S: f64 = 0.05;
+
 /// Steps `vehicle` over `dt` toward `command` in sub-steps of at most `h_max`.
 pub fn step_over(vehicle: &mut dyn Piloted, command: &Command, current_ned: &Vector3<f64>, dt: f64, h_max: f64) {
     let sub = (dt / h_max).ceil().max(1.0) as usize;

@@ -227,6 +227,11 @@ pub struct OtterPilot {
 }
 
 impl OtterPilot {
+    /// The default Otter afloat at rest at `pos` (NED, on the surface), heading `psi`.
+    pub fn on_surface(pos: nalgebra::Vector2<f64>, psi: f64) -> Self {
+        Self::new(Otter::default(), BodyState::at_rest(Vector3::new(pos.x, pos.y, 0.0), psi))
+    }
+
     /// vehicles.md's heading loop: wn = 1.5 rad/s, zeta = 1; shaft lag 0.1 s.
     pub fn new(otter: Otter, state: BodyState) -> Self {
         let psi = state.euler().2;

@@ -5,11 +5,14 @@
 
 use crate::acoustics::Ping;
 use crate::engine::{Track, VehicleTruth, World};
-use crate::run::{FimSnapshot, GuidanceSnapshot};
+use crate::run::{FimSnapshot, GuidanceSnapshot, PilotRecord};
 use crate::scenario::moving_beacon::{GuidanceKind, Vehicle};
+use crate::scenario::passive_usbl::AsvVehicle;
 use crate::scenario::{Host, MovingBeacon, MovingBeaconCell};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
+use crate::vehicles::autopilot::{Command, MAX_STEP_S, step_over};
+use crate::vehicles::otter::OtterPilot;
 use crate::vehicles::rov::{body_velocity, rk4_step};
 use nalgebra::{DMatrix, SVector, Vector2, Vector3};
 use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, ReachingSet, best_standoff};
@@ -89,6 +92,10 @@ pub(crate) struct MovingBeaconWorld<'a> {
     lim: AsvLimits,
     asv0: Vector2<f64>,
     asv: AsvState,
+    /// The Otter's dynamics and autopilots when the ASV is one (`asv.vehicle`), and its
+    /// last command.
+    otter: Option<OtterPilot>,
+    asv_command: Option<Command>,
     waypoint: Vector2<f64>,
     arrive_at: f64,
     next_ping: f64,
@@ -129,6 +136,9 @@ impl<'a> MovingBeaconWorld<'a> {
             },
             asv0,
             asv: AsvState { pos: asv0, psi: toward_vehicle.y.atan2(toward_vehicle.x) },
+            otter: (s.asv.vehicle == AsvVehicle::Otter)
+                .then(|| OtterPilot::on_surface(asv0, toward_vehicle.y.atan2(toward_vehicle.x))),
+            asv_command: None,
             waypoint: asv0,
             arrive_at: 0.0,
             next_ping: 0.0,
@@ -244,6 +254,12 @@ impl World for MovingBeaconWorld<'_> {
         Vector3::new(self.asv.pos.x, self.asv.pos.y, self.s.asv.transducer_depth_m)
     }
 
+    fn pilots(&self, out: &mut Vec<PilotRecord>) {
+        if let (Some(otter), Some(c)) = (&self.otter, self.asv_command) {
+            out.push(PilotRecord::of(None, c, &otter.state));
+        }
+    }
+
     fn advance(
         &mut self,
         k: usize,
@@ -257,7 +273,17 @@ impl World for MovingBeaconWorld<'_> {
         let snapshot =
             (t0 + 1e-9 >= self.next_ping).then(|| GuidanceSnapshot::Fim(self.ping(t0, &beliefs[0].estimate())));
         let (u, r) = self.asv.command(self.waypoint, self.arrive_at - t0, &self.lim);
-        self.asv = self.asv.step(u, r, dt);
+        if let Some(otter) = &mut self.otter {
+            // the same speed, and the course to the waypoint, as the autopilots' commands
+            let d = self.waypoint - self.asv.pos;
+            let course = if d.norm() < 0.05 { self.asv.psi } else { d.y.atan2(d.x) };
+            let command = Command { heading_rad: course, speed_m_s: u, depth_m: None };
+            step_over(otter, &command, &Vector3::zeros(), dt, MAX_STEP_S);
+            self.asv_command = Some(command);
+            self.asv = AsvState { pos: otter.state.position_ned_m.xy(), psi: otter.state.euler().2 };
+        } else {
+            self.asv = self.asv.step(u, r, dt);
+        }
 
         let noise = self.noise;
         for (v, (veh, out)) in self.vehicles.iter_mut().zip(heard.iter_mut()).enumerate() {

@@ -14,11 +14,10 @@ use crate::scenario::passive_usbl::{AsvVehicle, Auv, GuidanceKind};
 use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
-use crate::vehicles::autopilot::{Command, Piloted, step_over};
+use crate::vehicles::autopilot::{Command, MAX_STEP_S, Piloted, step_over};
 use crate::vehicles::ilos::{self, CircleFollower, Ilos};
-use crate::vehicles::otter::{Otter, OtterPilot};
+use crate::vehicles::otter::OtterPilot;
 use crate::vehicles::remus100::{Remus100, Remus100Pilot};
-use crate::vehicles::rigid_body::BodyState;
 use nalgebra::{DMatrix, Matrix2, SMatrix, SVector, Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
 use onebeacon::guidance::bearing::{BearingPlanner, Belief, SpreadMetric, leg_done, leg_target};
@@ -30,9 +29,6 @@ use onebeacon::nav::{
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::FRAC_PI_2;
-
-/// The dynamic vehicles' integration step, at most (RK4; MSS uses 0.05 s).
-const VEHICLE_STEP_S: f64 = 0.05;
 
 /// One AUV on its circle: where it is at time t, in closed form.
 struct Circle {
@@ -265,10 +261,7 @@ impl<'a> PassiveUsblWorld<'a> {
             },
             asv0,
             asv: AsvState { pos: asv0, psi: to_auv.y.atan2(to_auv.x) },
-            otter: (s.asv.vehicle == AsvVehicle::Otter).then(|| {
-                let at = Vector3::new(asv0.x, asv0.y, 0.0);
-                OtterPilot::new(Otter::default(), BodyState::at_rest(at, to_auv.y.atan2(to_auv.x)))
-            }),
+            otter: (s.asv.vehicle == AsvVehicle::Otter).then(|| OtterPilot::on_surface(asv0, to_auv.y.atan2(to_auv.x))),
             asv_command: None,
             asv_ilos: Ilos::new(s.asv.lookahead_m, s.asv.ilos_integral_gain),
             water: Water::new(s.current.clone(), vehicle_rng(seed, run, 0, Stream::Current)),
@@ -464,7 +457,7 @@ impl<'a> PassiveUsblWorld<'a> {
             if let Some(otter) = &mut self.otter {
                 // the autopilots at 0.05 s or finer (RK4 on the Otter's heave and roll)
                 let command = Command { heading_rad: course, speed_m_s: u, depth_m: None };
-                step_over(otter, &command, &self.water.ned(), dt, VEHICLE_STEP_S);
+                step_over(otter, &command, &self.water.ned(), dt, MAX_STEP_S);
                 self.asv_command = Some(command);
                 let p = otter.state.position_ned_m;
                 self.asv = AsvState { pos: p.xy(), psi: otter.state.euler().2 };
@@ -538,7 +531,7 @@ impl World for PassiveUsblWorld<'_> {
         let t1 = self.t_s(k);
         let current = self.water.ned();
         for auv in &mut self.auvs {
-            auv.advance(t1 - t0, self.s.mission.dt_s.min(VEHICLE_STEP_S), &current);
+            auv.advance(t1 - t0, self.s.mission.dt_s.min(MAX_STEP_S), &current);
         }
         if self.s.current.flows() {
             self.water.drift(t1 - t0);
@@ -616,7 +609,7 @@ mod tests {
         s.asv.vehicle = AsvVehicle::Otter;
         let mut w = PassiveUsblWorld::new(&s, &s.base_cell(), 1, 0);
         let period = s.mission.message_period_s;
-        w.otter = Some(OtterPilot::new(Otter::default(), BodyState::at_rest(Vector3::new(0.0, 10.0, 0.0), 0.0)));
+        w.otter = Some(OtterPilot::on_surface(Vector2::new(0.0, 10.0), 0.0));
         w.asv = AsvState { pos: Vector2::new(0.0, 10.0), psi: 0.0 };
         let (along, cross) = follow_legs(&mut w, Vector2::new(2.0 * period, 0.0), 20);
         eprintln!("Otter after 20 legs: along {along:.3} m, cross {cross:.3} m, speed {:.3} m/s", w.asv_speed);
