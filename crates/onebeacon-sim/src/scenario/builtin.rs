@@ -14,6 +14,7 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "sousa-pair", toml: include_str!("../../../../scenarios/sousa-pair.toml") },
     Builtin { name: "hoff2024", toml: include_str!("../../../../scenarios/hoff2024.toml") },
     Builtin { name: "hoff2024-kinematic", toml: include_str!("../../../../scenarios/hoff2024-kinematic.toml") },
+    Builtin { name: "hoff2024-current", toml: include_str!("../../../../scenarios/hoff2024-current.toml") },
     Builtin { name: "hoff2024-pair", toml: include_str!("../../../../scenarios/hoff2024-pair.toml") },
     Builtin { name: "hoff2024-consistency", toml: include_str!("../../../../scenarios/hoff2024-consistency.toml") },
 ];
