@@ -84,7 +84,9 @@ pub fn horizontal_rmse_bound(
 /// passive-USBL scenario over the mission, given the sum over `runs` runs of the
 /// information of the bearings it was heard at (by step): the reports' information every
 /// step, the process of eq. 4 (its Gaussian form, that of the first estimator) on the
-/// AUV's true circle, the start of the trackers' initial uncertainty.
+/// AUV's circle (a `remus100` follows it by ILOS within decimetres; the bound is taken on
+/// the path, the bearings' information at the truth), the start of the trackers' initial
+/// uncertainty.
 pub fn bearing_rmse_bound(
     s: &PassiveUsbl,
     v: usize,

@@ -7,10 +7,8 @@
 //! the ASV 6 cm).
 
 use crate::engine::{Track, VehicleTruth, World};
-use crate::run::PilotRecord;
-use crate::run::{BearingSnapshot, GuidanceSnapshot};
-use crate::scenario::passive_usbl::AuvVehicle;
-use crate::scenario::passive_usbl::{AsvVehicle, Auv, GuidanceKind};
+use crate::run::{BearingSnapshot, GuidanceSnapshot, PilotRecord};
+use crate::scenario::passive_usbl::{AsvVehicle, Auv, AuvVehicle, Current, GuidanceKind};
 use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
@@ -87,7 +85,8 @@ impl AuvTruth {
         Self { circle, motion, report_rng, usbl_rng }
     }
 
-    /// Moves over `dt` s ending at `t1_s` in `current_ned`, in steps of at most `h_max`.
+    /// Moves a dynamic AUV over `dt` s in `current_ned`, ILOS and the autopilots in steps
+    /// of at most `h_max`.
     fn advance(&mut self, dt: f64, h_max: f64, current_ned: &Vector3<f64>) {
         let AuvMotion::Remus { pilot, follower, command, distance_m } = &mut self.motion else { return };
         let steps = (dt / h_max).ceil().max(1.0) as usize;
@@ -151,14 +150,14 @@ impl AuvTruth {
 /// The current the dynamic vehicles feel: its speed and direction, each drifting as a
 /// first-order Gauss-Markov process about its mean.
 struct Water {
-    spec: crate::scenario::passive_usbl::Current,
+    spec: Current,
     speed_dev: f64,
     direction_dev: f64,
     rng: Pcg64Mcg,
 }
 
 impl Water {
-    fn new(spec: crate::scenario::passive_usbl::Current, mut rng: Pcg64Mcg) -> Self {
+    fn new(spec: Current, mut rng: Pcg64Mcg) -> Self {
         let speed_dev = gauss(&mut rng, spec.speed_sigma_m_s);
         let direction_dev = gauss(&mut rng, spec.direction_sigma_deg.to_radians());
         Self { spec, speed_dev, direction_dev, rng }
@@ -666,7 +665,7 @@ mod tests {
     /// (within 0.05).
     #[test]
     fn the_current_varies_as_a_gauss_markov_process() {
-        let spec = crate::scenario::passive_usbl::Current {
+        let spec = Current {
             speed_m_s: 0.3,
             speed_sigma_m_s: 0.1,
             direction_sigma_deg: 10.0,
