@@ -205,5 +205,18 @@ mod tests {
         let (_, e1, e2) = track_errors(&c, 0.0, &outside);
         assert!(e1.abs() < 1e-12 && (e2 + 3.0).abs() < 1e-12, "{e1} {e2}");
         assert!((circle_parameter_rate(1.5, 10.0, 500.0, 0.0, 0.0, 0.1) - 1.5 / 500.0).abs() < 1e-15);
+        // counter-clockwise: the point at angle a (from north) is at s = -a, the path
+        // heads a - pi/2 there (west at the north point), and s still increases along it
+        let ccw = Circle { clockwise: false, ..c };
+        let s = ccw.parameter_at(0.0);
+        let (theta, e1, e2) = track_errors(&ccw, s, &ccw.point(s));
+        assert!(
+            (theta.abs() - std::f64::consts::FRAC_PI_2).abs() < 1e-12
+                && theta < 0.0
+                && e1.abs() < 1e-9
+                && e2.abs() < 1e-9
+        );
+        let ahead = ccw.point(s + 0.01) - ccw.point(s);
+        assert!(ahead.y < 0.0 && (ccw.point(ccw.parameter_at(0.3)) - c.point(0.3)).norm() < 1e-9);
     }
 }

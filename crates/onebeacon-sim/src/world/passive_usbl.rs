@@ -706,7 +706,9 @@ mod tests {
         };
         let (los, ilos) = (offset(0.0), offset(0.2));
         let expected = 20.0 * (0.3f64 / 2.0).asin().tan();
-        eprintln!("Otter on legs in a 0.3 m/s cross current: {los:.2} m off (LOS; closed form {expected:.2}), {ilos:.2} m (ILOS)");
+        eprintln!(
+            "Otter on legs in a 0.3 m/s cross current: {los:.2} m off (LOS; closed form {expected:.2}), {ilos:.2} m (ILOS)"
+        );
         assert!((los / expected - 1.0).abs() < 0.3 && ilos.abs() < 0.5, "{los} {ilos}");
     }
 
