@@ -18,7 +18,7 @@ const STEPS: usize = 72_000;
 const H: f64 = 0.05;
 
 fn otter_hour(p: &mut OtterPilot, k: usize) {
-    let psi_d = if (k / 1200) % 2 == 0 { 0.0 } else { 1.0 };
+    let psi_d = if (k / 1200).is_multiple_of(2) { 0.0 } else { 1.0 };
     p.step(&Command { heading_rad: psi_d, speed_m_s: 2.0, depth_m: None }, &Vector3::zeros(), H);
 }
 
