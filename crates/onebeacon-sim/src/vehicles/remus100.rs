@@ -1,7 +1,9 @@
 //! The REMUS 100 AUV (hoff2024's AUV) as a prolate spheroid of length 1.6 m and
 //! diameter 0.19 m (../shared/vehicles.md): its displaced mass, and the added mass of a
 //! prolate spheroid of eccentricity e by Lamb's k-factors (Lamb 1932, from alpha_0 and
-//! beta_0; the added mass of a spheroid in Fossen 2021, ch. 6).
+//! beta_0; the added mass of a spheroid in Fossen 2021, ch. 6); the hull's damping,
+//! cross-flow drag, tail fins and propeller ([`Remus100`]), and its heading, depth and
+//! speed autopilots ([`Remus100Pilot`]).
 
 use super::autopilot::{AngleLoop, Command, Piloted};
 use super::rigid_body::{BodyState, G, Inertia, Vessel, restoring, rigid_body_mass, rk4_step};
