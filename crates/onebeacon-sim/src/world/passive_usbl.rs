@@ -3,8 +3,10 @@
 //! its USBL (azimuth and elevation, eq. 1-3) and moves, between messages, along the
 //! legs its guidance plans on what the first estimator of the AUVs believes (eq.
 //! 10-16, 24-26). One engine step is one message period; the ASV is integrated within
-//! it at `mission.dt_s`. Messages travel instantly (at 40 m the 27 ms of flight move
-//! the ASV 6 cm).
+//! it at `mission.dt_s`. Each vehicle is kinematic (an AUV on its circle in closed form,
+//! a unicycle ASV) or dynamic (REMUS 100 following its circle by ILOS, the Otter its
+//! legs, both under their autopilots by RK4 at 0.05 s or finer, in the water's current).
+//! Messages travel instantly (at 40 m the 27 ms of flight move the ASV 6 cm).
 
 use crate::engine::{Track, VehicleTruth, World};
 use crate::run::{BearingSnapshot, GuidanceSnapshot, PilotRecord};
