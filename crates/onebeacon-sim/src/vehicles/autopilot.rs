@@ -84,6 +84,23 @@ impl AngleLoop {
     }
 }
 
+/// The PI on surge speed of both vehicles: the drag at the commanded speed fed forward
+/// (`drag_at_command`), a proportional term of time constant 1 s and an integral of 10 s
+/// on the surge inertia `m11`; the surge force asked of the propulsion.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SpeedLoop {
+    integral: f64,
+}
+
+impl SpeedLoop {
+    pub fn force(&mut self, u: f64, u_d: f64, drag_at_command: f64, m11: f64, h: f64) -> f64 {
+        let eu = u - u_d;
+        let x = drag_at_command - m11 * eu - 0.1 * m11 * self.integral;
+        self.integral += eu * h;
+        x
+    }
+}
+
 /// What a world asks of a vehicle's autopilots.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Command {

@@ -3,7 +3,7 @@
 //! with its centre of gravity at [0.2, 0, -0.2] m, radii of gyration 0.4 B and 0.25 L,
 //! payload 25 kg at [0.05, 0, -0.35] m).
 
-use super::autopilot::{AngleLoop, Command, Piloted};
+use super::autopilot::{AngleLoop, Command, Piloted, SpeedLoop};
 use super::rigid_body::{BodyState, G, Inertia, Vessel, rigid_body_mass, skew};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
@@ -223,7 +223,7 @@ pub struct OtterPilot {
     pub shafts: [f64; 2],
     pub lag_s: f64,
     pub heading: AngleLoop,
-    speed_integral: f64,
+    speed: SpeedLoop,
 }
 
 impl OtterPilot {
@@ -241,7 +241,7 @@ impl OtterPilot {
             shafts: [0.0; 2],
             lag_s: 0.1,
             heading: AngleLoop::new(psi, 1.5, 1.0, 10f64.to_radians()),
-            speed_integral: 0.0,
+            speed: SpeedLoop::default(),
         }
     }
 }
@@ -256,17 +256,15 @@ impl Piloted for OtterPilot {
         let (u, r) = (self.state.nu[0], self.state.nu[5]);
         let (_, _, psi) = self.state.euler();
         let n_cmd = self.heading.moment(psi, r, command.heading_rad, m66, self.otter.damping(5), h);
-        // speed: the damping at u_d fed forward, a PI on the error (time constant 1 s)
+        // speed: the linear damping at u_d fed forward
         let u_d = command.speed_m_s;
-        let eu = u - u_d;
-        let x_cmd = self.otter.damping(0) * u_d - m11 * eu - 0.1 * m11 * self.speed_integral;
+        let x_cmd = self.speed.force(u, u_d, self.otter.damping(0) * u_d, m11, h);
         let cmd = self.otter.allocate(x_cmd, n_cmd);
         let decay = (-h / self.lag_s).exp();
         for (n, c) in self.shafts.iter_mut().zip(cmd) {
             *n = c + (*n - c) * decay;
         }
         self.state = super::rigid_body::rk4_step(&self.otter, &self.state, &self.shafts, current_ned, h);
-        self.speed_integral += eu * h;
     }
 
     fn body(&self) -> &BodyState {

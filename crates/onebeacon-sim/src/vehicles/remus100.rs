@@ -5,7 +5,7 @@
 //! cross-flow drag, tail fins and propeller ([`Remus100`]), and its heading, depth and
 //! speed autopilots ([`Remus100Pilot`]).
 
-use super::autopilot::{AngleLoop, Command, Piloted};
+use super::autopilot::{AngleLoop, Command, Piloted, SpeedLoop};
 use super::rigid_body::{BodyState, G, Inertia, Vessel, restoring, rigid_body_mass, rk4_step};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
@@ -320,7 +320,7 @@ pub struct Remus100Pilot {
     pub t_z_s: f64,
     pub max_pitch_rad: f64,
     depth_integral: f64,
-    speed_integral: f64,
+    speed: SpeedLoop,
 }
 
 impl Remus100Pilot {
@@ -337,7 +337,7 @@ impl Remus100Pilot {
             t_z_s: 100.0,
             max_pitch_rad: 20f64.to_radians(),
             depth_integral: 0.0,
-            speed_integral: 0.0,
+            speed: SpeedLoop::default(),
         }
     }
 
@@ -376,9 +376,8 @@ impl Piloted for Remus100Pilot {
         let m_cmd = self.pitch.moment(theta, nu[4], theta_d, m55, self.remus.damping(4), h) + restoring * theta_d.sin();
         let stern = m_cmd / self.remus.fin_moment_per_rad(self.remus.fins.cl_stern, fin_speed);
         // speed
-        let eu = nu[0] - command.speed_m_s;
-        let x_cmd = self.remus.surge_drag(command.speed_m_s) - m11 * eu - 0.1 * m11 * self.speed_integral;
-        self.speed_integral += eu * h;
+        let u_d = command.speed_m_s;
+        let x_cmd = self.speed.force(nu[0], u_d, self.remus.surge_drag(u_d), m11, h);
         let shaft = self.remus.propeller.shaft_for(x_cmd, u_r);
         let max = self.remus.fins.max_rad;
         let cmd = [rudder.clamp(-max, max), stern.clamp(-max, max), shaft];

@@ -434,6 +434,7 @@ impl<'a> PassiveUsblWorld<'a> {
         let dt = period / steps as f64;
         let leg = p_t - p_a;
         let len = leg.norm();
+        let current = self.water.ned();
         for j in 0..steps {
             let s = j as f64 / steps as f64; // eq. 25
             // the course and speed asked of the ASV
@@ -458,7 +459,7 @@ impl<'a> PassiveUsblWorld<'a> {
             if let Some(otter) = &mut self.otter {
                 // the autopilots at 0.05 s or finer (RK4 on the Otter's heave and roll)
                 let command = Command { heading_rad: course, speed_m_s: u, depth_m: None };
-                step_over(otter, &command, &self.water.ned(), dt, MAX_STEP_S);
+                step_over(otter, &command, &current, dt, MAX_STEP_S);
                 self.asv_command = Some(command);
                 let p = otter.state.position_ned_m;
                 self.asv = AsvState { pos: p.xy(), psi: otter.state.euler().2 };
