@@ -24,15 +24,15 @@ fn bench(c: &mut Criterion) {
         c.bench_function(&format!("{name} predict + proprioceptive update (M=3)"), |b| {
             b.iter(|| {
                 t += 0.25;
-                black_box(f.process(black_box(&Measurement::new(t, inertial))))
+                black_box(f.process(black_box(&Measurement::new(t, inertial.clone()))))
             })
         });
         c.bench_function(&format!("{name} predict + comm frame update (M=5)"), |b| {
             b.iter(|| {
                 // from the same operating point every time
                 let mut f = navigator(kind);
-                f.process(&Measurement::new(0.25, frame));
-                black_box(f.process(black_box(&Measurement::new(0.25, inertial))))
+                f.process(&Measurement::new(0.25, frame.clone()));
+                black_box(f.process(black_box(&Measurement::new(0.25, inertial.clone()))))
             })
         });
     }

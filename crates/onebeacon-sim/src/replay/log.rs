@@ -1247,8 +1247,8 @@ mod tests {
     }
 
     fn measurement(item: &Item) -> Kind {
-        match item.input {
-            Input::Measurement(m) => m,
+        match &item.input {
+            Input::Measurement(m) => m.clone(),
             other => panic!("not a measurement: {other:?}"),
         }
     }
@@ -1410,7 +1410,7 @@ y = "y"
         let log = load("order", body, &files).unwrap();
         let order: Vec<String> = items(&log)
             .iter()
-            .map(|i| match i.input {
+            .map(|i| match i.input.clone() {
                 Input::Measurement(Kind::Speed { speed_m_s }) => format!("speed {speed_m_s}"),
                 Input::Measurement(Kind::Heading { heading_rad }) => format!("heading {heading_rad}"),
                 Input::BeaconPosition { .. } => "beacon".into(),
@@ -1477,9 +1477,9 @@ z = "z"
         let files = [("truth.csv", "t,x,y,h\n1.0,3.0,4.0,0.0\n"), ("track.csv", "t,id,x,y,z\n1.0,1,3.0,4.0,-2.0\n")];
         let log = load("enu", body, &files).unwrap();
         let items = items(&log);
-        let Input::BeaconPosition { position, .. } = items[0].input.to_ned(log.frame) else { panic!() };
+        let Input::BeaconPosition { position, .. } = items[0].input.clone().to_ned(log.frame) else { panic!() };
         assert_eq!(position, Vector3::new(4.0, 3.0, 2.0));
-        let Input::Truth(p) = items[1].input.to_ned(log.frame) else { panic!() };
+        let Input::Truth(p) = items[1].input.clone().to_ned(log.frame) else { panic!() };
         assert_eq!((p.north_m, p.east_m), (4.0, 3.0));
         assert_abs_diff_eq!(p.heading_rad.unwrap(), FRAC_PI_2, epsilon = 1e-12);
     }
@@ -1638,7 +1638,7 @@ heading_clockwise = true
         let files = [("compass.csv", "t,h\n1.0,0\n2.0,90\n3.0,-30\n"), ("odo.csv", "t,dx,dy,dh\n4.0,1.0,0.2,0.1\n")];
         let log = load("compass", body, &files).unwrap();
         let ned: Vec<Kind> =
-            items(&log).iter().map(|i| measurement(&Item { t_s: i.t_s, input: i.input.to_ned(log.frame) })).collect();
+            items(&log).iter().map(|i| measurement(&Item { t_s: i.t_s, input: i.input.clone().to_ned(log.frame) })).collect();
         for (k, expected_deg) in ned.iter().zip([0.0, 90.0, -30.0]) {
             let Kind::Heading { heading_rad } = k else { panic!("{k:?}") };
             assert_abs_diff_eq!(*heading_rad, f64::to_radians(expected_deg), epsilon = 1e-12);
@@ -1740,7 +1740,7 @@ heading_clockwise = true
         assert_abs_diff_eq!(nu[0], 1.2, epsilon = 1e-12);
         assert_abs_diff_eq!(nu[1], -0.15, epsilon = 1e-12);
         assert_abs_diff_eq!(nu[5], -PI / 6.0, epsilon = 1e-12);
-        let Kind::BodyVelocity { nu } = measurement(&Item { t_s: 1.0, input: item.input.to_ned(log.frame) }) else {
+        let Kind::BodyVelocity { nu } = measurement(&Item { t_s: 1.0, input: item.input.clone().to_ned(log.frame) }) else {
             panic!()
         };
         assert_abs_diff_eq!(nu[1], 0.15, epsilon = 1e-12);

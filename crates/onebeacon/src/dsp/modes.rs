@@ -149,6 +149,11 @@ impl ModeConfirmation {
         }
         self.confirmed
     }
+
+    /// The mode confirmed last, if any.
+    pub fn confirmed(&self) -> Option<usize> {
+        self.confirmed
+    }
 }
 
 #[cfg(test)]

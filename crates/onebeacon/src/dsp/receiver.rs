@@ -55,6 +55,9 @@ pub struct Receiver {
     filter: MatchedFilter,
     spd: SpdBf,
     grid: DirectionGrid,
+    /// Number of elements, and the last snapshot's total in-band energy.
+    elements: usize,
+    energy: f64,
 }
 
 impl Receiver {
@@ -63,7 +66,7 @@ impl Receiver {
             MatchedFilter::new(&waveform.samples(config.fs_hz), waveform.band(), config.fs_hz, config.capture_len);
         let spd = SpdBf::new(elements, config.sound_speed_m_s, config.conical_resolution_rad);
         let grid = DirectionGrid::new(config.search_step_rad);
-        Self { config, waveform, filter, spd, grid }
+        Self { config, waveform, filter, spd, grid, elements: elements.len(), energy: 0.0 }
     }
 
     /// Range and direction from one capture per element.
@@ -75,6 +78,19 @@ impl Receiver {
     /// [`Receiver::process`] with the captures' spectra already computed (by a
     /// [`crate::dsp::modes::ModeBank`] of the same lengths, say).
     pub fn process_spectra(&mut self, captures: &[Vec<f64>], spectra: &[Vec<super::Complex>]) -> PingEstimate {
+        let range = self.distributions(captures, spectra);
+        let spd = &self.spd;
+        let (direction, _) = self.grid.search(|u| spd.power(u));
+        let (azimuth, inclination) = azimuth_inclination(&direction);
+        PingEstimate { range, direction, azimuth, inclination }
+    }
+
+    /// The pseudo-distributions of one ping without the direction search: the range
+    /// distribution (eq. 4-5, returned) and the SPD-BF tables of the direct-path segment,
+    /// read afterwards at any direction with [`Receiver::beam_power`] or
+    /// [`Receiver::beam_pattern`] (what the iUSBL particle filter does, at its
+    /// particles only: rypkema sec. 3.3.4).
+    pub fn distributions(&mut self, captures: &[Vec<f64>], spectra: &[Vec<super::Complex>]) -> RangeEstimate {
         let c = &self.config;
         let envelopes: Vec<Vec<f64>> = spectra.iter().map(|x| self.filter.envelope_of(x)).collect();
         let range = estimate_range(&envelopes, c.gate_samples, c.fs_hz, c.sound_speed_m_s);
@@ -84,15 +100,86 @@ impl Receiver {
         let start = (range.lag.round() as usize).saturating_sub(pulse / 8);
         let snap = Snapshot::from_segment(captures, start, len, self.waveform.band(), c.fs_hz);
         self.spd.compute(&snap);
-        let spd = &self.spd;
-        let (direction, _) = self.grid.search(|u| spd.power(u));
-        let (azimuth, inclination) = azimuth_inclination(&direction);
-        PingEstimate { range, direction, azimuth, inclination }
+        self.energy = snap.energies().iter().sum();
+        range
     }
 
     /// The SPD-BF power toward `u` for the last processed ping (the beam map).
     pub fn beam_power(&self, u: &Vector3<f64>) -> f64 {
         self.spd.power(u)
+    }
+
+    /// The beam pattern toward `u` for the last processed ping, in [0, 1]: the SPD power
+    /// less its constant (M - 2) sum E_m (the CBF power, by the identity of
+    /// [`SpdBf`]) over its largest possible value M sum E_m (Cauchy-Schwarz), 1 only
+    /// where every element adds in phase.
+    pub fn beam_pattern(&self, u: &Vector3<f64>) -> f64 {
+        let m = self.elements as f64;
+        if self.energy <= 0.0 {
+            return 0.0;
+        }
+        ((self.spd.power(u) - (m - 2.0) * self.energy) / (m * self.energy)).clamp(0.0, 1.0)
+    }
+
+    /// The waveform this receiver is matched to.
+    pub fn waveform(&self) -> &Lfm {
+        &self.waveform
+    }
+}
+
+/// The receiver of a vehicle commanded by a beacon's choice of chirp (rypkema sec. 4.2):
+/// the mode bank identifies which template the ping is, then that mode's PHAT matched
+/// filter and SPD beamformer produce the pseudo-distributions. Every capture is
+/// transformed once, for the bank and the mode's receiver alike.
+#[derive(Debug)]
+pub struct ModeReceiver {
+    bank: super::modes::ModeBank,
+    receivers: Vec<Receiver>,
+}
+
+/// What a [`ModeReceiver`] made of one ping.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModePing {
+    /// The mode identified (index into the waveforms).
+    pub mode: usize,
+    /// The range pseudo-distribution of that mode's matched filter.
+    pub range: RangeEstimate,
+}
+
+impl ModeReceiver {
+    /// A receiver for `waveforms` (one per mode) on the array `elements`.
+    pub fn new(waveforms: &[Lfm], elements: &[Vector3<f64>], config: ReceiverConfig) -> Self {
+        let fs = config.fs_hz;
+        let filters = waveforms
+            .iter()
+            .map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, config.capture_len))
+            .collect();
+        let centres = waveforms.iter().map(|m| (m.f0_hz + m.f1_hz) / 2.0).collect();
+        let bank =
+            super::modes::ModeBank::with_array(filters, centres, elements.to_vec(), config.sound_speed_m_s);
+        let receivers = waveforms.iter().map(|w| Receiver::new(*w, elements, config.clone())).collect();
+        Self { bank, receivers }
+    }
+
+    /// Identifies the mode with the bank's search gated to `lags` (samples from the
+    /// capture start: around the navigation filter's predicted range once it has
+    /// converged, the whole capture otherwise), then computes that mode's
+    /// pseudo-distributions.
+    pub fn process(&mut self, captures: &[Vec<f64>], lags: std::ops::Range<usize>) -> ModePing {
+        let spectra = self.bank.spectra(captures);
+        let mode = self.bank.identify_within(&spectra, lags);
+        let range = self.receivers[mode].distributions(captures, &spectra);
+        ModePing { mode, range }
+    }
+
+    /// The receiver of mode `mode` (its beam pattern is the last ping's when that ping
+    /// was of this mode).
+    pub fn receiver(&self, mode: usize) -> &Receiver {
+        &self.receivers[mode]
+    }
+
+    pub fn modes(&self) -> usize {
+        self.receivers.len()
     }
 }
 

@@ -8,6 +8,7 @@
 
 pub mod consistency;
 pub mod ekf;
+pub mod factored;
 pub mod lanes;
 pub mod particle;
 pub mod truncated;

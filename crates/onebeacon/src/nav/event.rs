@@ -2,6 +2,7 @@
 //! all hand to a navigator. SI units, NED frame, radians.
 
 use nalgebra::Vector3;
+use std::sync::Arc;
 
 /// A beacon as an acoustic measurement carries it: its id, its position when it
 /// transmitted (NED, m; NaN until a tracked beacon's position is resolved), how well it
@@ -22,10 +23,22 @@ impl BeaconFix {
     }
 }
 
+/// One ping as the vehicle's own receiving array recorded it (rypkema's inverted USBL,
+/// sec. 3.1.2): every element's samples from the transmit epoch (the PPS both ends
+/// share) on. The sample rate and the array are the receiver's settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Capture {
+    /// The beacon as its GPS logged it at the transmit epoch, `t_tx_s` the epoch.
+    pub beacon: BeaconFix,
+    /// `samples[m]`: element m's capture.
+    pub samples: Vec<Vec<f64>>,
+}
+
 /// What was measured. Inputs (odometry, speed, body velocity, a held depth) drive the
 /// motion; the rest are corrections. Each navigator uses the kinds its model has and
-/// skips the others.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// skips the others. Every kind but a [`Kind::Capture`] (shared, not copied) is a few
+/// numbers.
+#[derive(Debug, Clone, PartialEq)]
 pub enum Kind {
     /// Distance travelled and heading change since the previous increment (wheels, DVL).
     Odometry { distance_m: f64, heading_change_rad: f64 },
@@ -62,6 +75,14 @@ pub enum Kind {
     /// What the vehicle reports of itself in an acoustic message: its INS heading,
     /// speed over ground and depth (hoff2024 eq. 8).
     Report { heading_rad: f64, speed_m_s: f64, depth_m: f64 },
+    /// The hydrophone data of one ping on the vehicle's own array, for a navigator that
+    /// runs the receiver chain itself (rypkema sec. 3.2).
+    Capture(Arc<Capture>),
+    /// One ping already reduced by the vehicle's receiver: slant range, the direction
+    /// toward the beacon in the array frame (azimuth from x toward y, inclination from
+    /// +z down, rad, as [`crate::dsp::beamform::direction`]) and the identified command
+    /// mode (index into the mode bank).
+    ArrayFix { beacon: BeaconFix, range_m: f64, azimuth_rad: f64, inclination_rad: f64, mode: usize },
 }
 
 impl Kind {
@@ -72,6 +93,8 @@ impl Kind {
                 Some(beacon)
             }
             Kind::Bearing { station, .. } => Some(station),
+            Kind::Capture(c) => Some(&c.beacon),
+            Kind::ArrayFix { beacon, .. } => Some(beacon),
             _ => None,
         }
     }
@@ -82,6 +105,8 @@ impl Kind {
                 Some(beacon)
             }
             Kind::Bearing { station, .. } => Some(station),
+            Kind::Capture(c) => Some(&mut Arc::make_mut(c).beacon),
+            Kind::ArrayFix { beacon, .. } => Some(beacon),
             _ => None,
         }
     }
@@ -102,12 +127,14 @@ impl Kind {
             Kind::RangeDoppler { .. } => "range_doppler",
             Kind::Bearing { .. } => "bearing",
             Kind::Report { .. } => "report",
+            Kind::Capture(_) => "capture",
+            Kind::ArrayFix { .. } => "array_fix",
         }
     }
 }
 
 /// One measurement: when it was taken (received, for an acoustic one), s, and what.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
     pub t_s: f64,
     pub kind: Kind,

@@ -8,6 +8,7 @@
 
 pub mod event;
 pub mod fix;
+pub mod iusbl;
 pub mod planar;
 pub mod range_6dof;
 pub mod session;
@@ -15,7 +16,8 @@ pub mod single_beacon;
 pub mod tracking;
 pub mod usbl_track;
 
-pub use event::{BeaconFix, Kind, Measurement};
+pub use event::{BeaconFix, Capture, Kind, Measurement};
+pub use iusbl::{IusblConfig, IusblNavigator};
 pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
 
 pub use range_6dof::{Range6DofNavigator, SensorNoise};
@@ -200,6 +202,19 @@ pub trait Navigator: Send {
     /// that scores a belief by its spread: a particle filter's particles, drawn in
     /// proportion to their weights; None for a Gaussian belief.
     fn position_sample(&self, _m: usize) -> Option<Vec<Vector3<f64>>> {
+        None
+    }
+    /// The vehicle's position relative to the beacon it navigates on (NED, depth as
+    /// measured), for beacon-relative behaviours; None for an absolute navigator.
+    fn beacon_relative_ned_m(&self) -> Option<Vector3<f64>> {
+        None
+    }
+    /// The command mode the beacon's pings confirmed last (rypkema sec. 4.2), if any.
+    fn command_mode(&self) -> Option<usize> {
+        None
+    }
+    /// The range and angle sets of a factored particle filter's last update.
+    fn factored_sets(&self) -> Option<crate::filter::factored::FactoredSets> {
         None
     }
 }

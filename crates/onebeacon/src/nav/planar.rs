@@ -685,7 +685,7 @@ mod tests {
         assert_abs_diff_eq!(e.range_bias_m, bias, epsilon = 0.1);
         let outlier = Kind::Range { beacon: BeaconFix::fixed(0, beacons[0]), range_m: truth.norm() + bias + 20.0 };
         let before = nav.estimate();
-        assert!(matches!(nav.process(&Measurement::new(t, outlier)), Outcome::Rejected(nis, _) if nis > 10.83));
+        assert!(matches!(nav.process(&Measurement::new(t, outlier.clone())), Outcome::Rejected(nis, _) if nis > 10.83));
         assert_eq!(nav.estimate(), before);
         let mut dr = start(PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() });
         assert_eq!(dr.process(&Measurement::new(1.0, outlier)), Outcome::Skipped);

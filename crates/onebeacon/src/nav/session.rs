@@ -23,7 +23,7 @@ pub struct TruthPose {
 }
 
 /// One item of the time-ordered stream.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Input {
     Measurement(Kind),
     /// A beacon's position now (a moving beacon's track; fixes later measurements).
@@ -34,7 +34,7 @@ pub enum Input {
     Truth(TruthPose),
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Item {
     pub t_s: f64,
     pub input: Input,
@@ -212,7 +212,7 @@ impl Limits {
             }
         };
         let far = 1e8;
-        match *input {
+        match input.clone() {
             Input::Measurement(m) => {
                 if let Some(b) = m.beacon() {
                     within("beacon_sigma_m", b.sigma_m, 0.0, 1e4, "a position error in metres")?;
@@ -229,7 +229,7 @@ impl Limits {
                         "a turn of at most pi per step",
                     )
                 };
-                match m {
+                match m.clone() {
                     Kind::BodyOdometry { forward_m, lateral_m, heading_change_rad } => {
                         travel("body_odometry forward_m", forward_m)?;
                         travel("body_odometry lateral_m", lateral_m)?;
@@ -280,6 +280,15 @@ impl Limits {
                         speed("speed_m_s", speed_m_s)?;
                         within("depth_m", depth_m, -100.0, self.max_depth_m, "limits.max_depth_m")
                     }
+                    Kind::ArrayFix { range_m, azimuth_rad, inclination_rad, .. } => {
+                        range(range_m)?;
+                        angle("azimuth_rad", azimuth_rad)?;
+                        within("inclination_rad", inclination_rad, 0.0, std::f64::consts::PI, "[0, pi]")
+                    }
+                    Kind::Capture(c) => match c.samples.iter().flatten().find(|v| !v.is_finite()) {
+                        Some(v) => Err(format!("capture sample {v} is not a finite number")),
+                        None => Ok(()),
+                    },
                 }
             }
             Input::BeaconPosition { position, .. } => {
@@ -601,9 +610,9 @@ impl Session {
     /// Screens `item` out: counted, logged, reported.
     fn screen(&mut self, item: &Item, reason: String) -> Screened {
         self.screened += 1;
-        let (kind, beacon_id, value) = match item.input {
-            Input::Measurement(m) => (m.name(), m.beacon().map_or(0, |b| b.id), measured_value(&m)),
-            Input::BeaconPosition { beacon_id, .. } => ("beacon_position", beacon_id, f64::NAN),
+        let (kind, beacon_id, value) = match &item.input {
+            Input::Measurement(m) => (m.name(), m.beacon().map_or(0, |b| b.id), measured_value(m)),
+            Input::BeaconPosition { beacon_id, .. } => ("beacon_position", *beacon_id, f64::NAN),
             Input::Truth(_) => ("ground_truth", 0, f64::NAN),
         };
         let r = Rejection { estimator: None, t_s: item.t_s, kind, beacon_id, value, nis: f64::NAN, reason };
@@ -644,7 +653,7 @@ impl Session {
         if let Err(reason) = self.limits.check(&item.input, dt) {
             return Err(self.screen(item, reason));
         }
-        let item = &Item { t_s: t, input: item.input.to_ned(self.frame) };
+        let item = &Item { t_s: t, input: item.input.clone().to_ned(self.frame) };
         if let Input::BeaconPosition { beacon_id, position } = item.input {
             if !self.tracked.contains_key(&beacon_id) && self.tracked.len() >= self.limits.max_beacons {
                 let most = self.limits.max_beacons;
@@ -671,10 +680,10 @@ impl Session {
         let mut outcomes = vec![None; self.navs.len()];
         let mut truth = None;
         let mut reinitialised = Vec::new();
-        match item.input {
+        match item.input.clone() {
             Input::Measurement(m) => {
                 if let Some(kind) = self.resolve(m).map_err(|reason| self.screen(item, reason))? {
-                    let m = Measurement::new(t, kind);
+                    let m = Measurement::new(t, kind.clone());
                     for (i, nav) in self.navs.iter_mut().enumerate() {
                         let out = nav.navigator().process(&m);
                         self.stats[i].failed += usize::from(matches!(out, Outcome::Failed(_)));

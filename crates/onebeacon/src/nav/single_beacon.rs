@@ -326,10 +326,10 @@ mod tests {
                 });
                 let inertial = Kind::Inertial { heading_rad: FRAC_PI_2, yaw_rate_rad_s: 0.0, accel_m_s2: 0.0 };
                 for (f, e) in filters.iter_mut().zip(speed_err.iter_mut()) {
-                    if let Some(frame) = frame {
-                        assert_eq!(f.process(&Measurement::new(t, frame)), Outcome::Applied);
+                    if let Some(frame) = &frame {
+                        assert_eq!(f.process(&Measurement::new(t, frame.clone())), Outcome::Applied);
                     }
-                    assert!(matches!(f.process(&Measurement::new(t, inertial)), Outcome::Accepted(..)));
+                    assert!(matches!(f.process(&Measurement::new(t, inertial.clone())), Outcome::Accepted(..)));
                     *e = (f.state()[idx::V] - 1.0).abs();
                 }
                 for (sum, e) in speed_err_sum.iter_mut().zip(speed_err) {

@@ -280,8 +280,8 @@ mod tests {
                 depth_m: p.z + crate::measure::gauss(&mut rng, 0.3),
             };
             for nav in [&mut pf as &mut dyn Navigator, &mut ekf] {
-                nav.process(&Measurement::new(t, report));
-                assert!(matches!(nav.process(&Measurement::new(t, bearing)), Outcome::Accepted(..)));
+                nav.process(&Measurement::new(t, report.clone()));
+                assert!(matches!(nav.process(&Measurement::new(t, bearing.clone())), Outcome::Accepted(..)));
             }
         }
         for e in [pf.estimate(), ekf.estimate()] {
