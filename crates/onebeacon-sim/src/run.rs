@@ -7,7 +7,8 @@ use crate::engine::{self, Observer, Step, Track, VehicleTruth, World};
 use crate::metrics::{ErrorAccumulator, RunMetrics};
 use crate::scenario::{Cell, Scenario};
 use crate::world::{
-    FixedBeaconWorld, Information, MovingBeaconWorld, PassiveUsblWorld, bearing_information, range_information,
+    FixedBeaconWorld, FleetWorld, Information, MovingBeaconWorld, PassiveUsblWorld, bearing_information,
+    range_information,
 };
 use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::filter::consistency::nees;
@@ -78,6 +79,10 @@ pub struct PilotRecord {
     pub heading_rad: f64,
     pub speed_m_s: f64,
     pub depth_m: f64,
+    /// A fleet AUV's confirmed command mode (index into the bank) and what its autonomy
+    /// does (None elsewhere).
+    pub mode: Option<usize>,
+    pub phase: Option<onebeacon::autonomy::Phase>,
 }
 
 impl PilotRecord {
@@ -86,7 +91,15 @@ impl PilotRecord {
         command: crate::vehicles::autopilot::Command,
         body: &crate::vehicles::rigid_body::BodyState,
     ) -> Self {
-        Self { vehicle, command, heading_rad: body.euler().2, speed_m_s: body.nu[0], depth_m: body.position_ned_m.z }
+        Self {
+            vehicle,
+            command,
+            heading_rad: body.euler().2,
+            speed_m_s: body.nu[0],
+            depth_m: body.position_ned_m.z,
+            mode: None,
+            phase: None,
+        }
     }
 }
 
@@ -226,6 +239,11 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
             let mut out = drive(&mut world, &mut tracks, Some(&mut info), recorder);
             out.information = info.into_inner();
             out
+        }
+        (Scenario::Fleet(s), Cell::Fleet) => {
+            let mut world = FleetWorld::new(s, seed, run);
+            let mut tracks = world.tracks(s, seed, run);
+            drive(&mut world, &mut tracks, None, recorder)
         }
         _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),
     }

@@ -2,6 +2,7 @@
 //!
 //! What runs on a vehicle lives here, with lean dependencies (nalgebra, thiserror):
 //!
+//! - [`autonomy`]: beacon-relative behaviours selected by command modes (rypkema);
 //! - [`geo`]: NED frame conventions and angle wrapping;
 //! - [`dsp`]: receiver signal processing: matched filter, beamforming, modes;
 //! - [`models`]: process models used by the estimators;
@@ -15,6 +16,7 @@
 //! Conventions: NED frame (x north, y east, z down), SI units, radians, heading from
 //! north toward east. Equation numbers in comments refer to the source papers.
 
+pub mod autonomy;
 pub mod dsp;
 pub mod filter;
 pub mod geo;

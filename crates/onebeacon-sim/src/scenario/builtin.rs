@@ -17,6 +17,8 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "hoff2024-current", toml: include_str!("../../../../scenarios/hoff2024-current.toml") },
     Builtin { name: "hoff2024-pair", toml: include_str!("../../../../scenarios/hoff2024-pair.toml") },
     Builtin { name: "hoff2024-consistency", toml: include_str!("../../../../scenarios/hoff2024-consistency.toml") },
+    Builtin { name: "rypkema-m1", toml: include_str!("../../../../scenarios/rypkema-m1.toml") },
+    Builtin { name: "rypkema-m6", toml: include_str!("../../../../scenarios/rypkema-m6.toml") },
 ];
 
 /// The built-in scenario called `name`.

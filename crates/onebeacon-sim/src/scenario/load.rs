@@ -1,7 +1,7 @@
 //! Loading a scenario from a built-in name or a file, with one-line errors that name
 //! the source, the key and what is allowed.
 
-use super::{FixedBeacon, MovingBeacon, PassiveUsbl, Scenario, builtin, validate};
+use super::{FixedBeacon, Fleet, MovingBeacon, PassiveUsbl, Scenario, builtin, validate};
 use std::path::Path;
 
 /// Why a scenario could not be loaded. Each message is one line naming the source (file
@@ -77,6 +77,8 @@ pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
         Scenario::MovingBeacon(deserialize::<MovingBeacon>(text, source_name)?)
     } else if kind.as_deref() == Some("passive_usbl") {
         Scenario::PassiveUsbl(deserialize::<PassiveUsbl>(text, source_name)?)
+    } else if kind.as_deref() == Some("fleet") {
+        Scenario::Fleet(deserialize::<Fleet>(text, source_name)?)
     } else {
         Scenario::FixedBeacon(deserialize::<FixedBeacon>(text, source_name)?)
     };

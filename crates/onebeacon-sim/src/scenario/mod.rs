@@ -10,6 +10,7 @@
 mod builtin;
 pub mod estimator;
 pub mod fixed_beacon;
+pub mod fleet;
 pub(crate) mod load;
 pub mod moving_beacon;
 pub mod passive_usbl;
@@ -19,6 +20,7 @@ pub(crate) mod validate;
 pub use builtin::{BUILTINS, Builtin, builtin};
 pub use estimator::{EstimatorKind, EstimatorSpec, Host};
 pub use fixed_beacon::{FixedBeacon, FixedBeaconCell};
+pub use fleet::Fleet;
 pub use load::{ScenarioError, load, parse};
 pub use moving_beacon::{MovingBeacon, MovingBeaconCell};
 pub use passive_usbl::{PassiveUsbl, PassiveUsblCell};
@@ -37,6 +39,9 @@ pub enum World {
     MovingBeacon,
     /// AUVs sending messages and a surface vehicle listening with a USBL (hoff2024).
     PassiveUsbl,
+    /// AUVs navigating on one beacon with inverted USBLs, commanded by its chirps
+    /// (rypkema).
+    Fleet,
 }
 
 /// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table.
@@ -96,6 +101,7 @@ pub enum Scenario {
     FixedBeacon(FixedBeacon),
     MovingBeacon(MovingBeacon),
     PassiveUsbl(PassiveUsbl),
+    Fleet(Fleet),
 }
 
 /// One value of a swept key.
@@ -120,6 +126,8 @@ pub enum Cell {
     FixedBeacon(FixedBeaconCell),
     MovingBeacon(MovingBeaconCell),
     PassiveUsbl(PassiveUsblCell),
+    /// A fleet scenario has no sweep.
+    Fleet,
 }
 
 impl Cell {
@@ -133,6 +141,7 @@ impl Cell {
                 ("guidance", SweepValue::Text(c.guidance.label())),
             ],
             Cell::PassiveUsbl(c) => vec![("guidance", SweepValue::Text(c.guidance.label()))],
+            Cell::Fleet => Vec::new(),
         }
     }
 
@@ -148,6 +157,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => &s.name,
             Scenario::MovingBeacon(s) => &s.name,
             Scenario::PassiveUsbl(s) => &s.name,
+            Scenario::Fleet(s) => &s.name,
         }
     }
     pub fn description(&self) -> &str {
@@ -155,6 +165,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => &s.description,
             Scenario::MovingBeacon(s) => &s.description,
             Scenario::PassiveUsbl(s) => &s.description,
+            Scenario::Fleet(s) => &s.description,
         }
     }
     pub fn seed(&self) -> u64 {
@@ -162,6 +173,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => s.seed,
             Scenario::MovingBeacon(s) => s.seed,
             Scenario::PassiveUsbl(s) => s.seed,
+            Scenario::Fleet(s) => s.seed,
         }
     }
     pub fn runs(&self) -> usize {
@@ -169,6 +181,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => s.runs,
             Scenario::MovingBeacon(s) => s.runs,
             Scenario::PassiveUsbl(s) => s.runs,
+            Scenario::Fleet(s) => s.runs,
         }
     }
     /// The (vehicle, estimator) tracks, in the order of every run's metrics and
@@ -179,6 +192,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => s.estimators.iter().map(|e| e.name()).collect(),
             Scenario::MovingBeacon(s) => s.estimators.iter().map(|e| e.name()).collect(),
             Scenario::PassiveUsbl(s) => s.estimators.iter().map(|e| e.name()).collect(),
+            Scenario::Fleet(s) => s.estimators.iter().map(|e| e.label().to_string()).collect(),
         };
         let several = vehicles.len() > 1;
         let mut tracks = Vec::new();
@@ -207,6 +221,7 @@ impl Scenario {
             Scenario::FixedBeacon(_) => vec!["auv".into()],
             Scenario::MovingBeacon(s) => s.vehicles(&s.base_cell()).into_iter().filter_map(|v| v.name).collect(),
             Scenario::PassiveUsbl(s) => s.auvs().into_iter().filter_map(|a| a.name).collect(),
+            Scenario::Fleet(s) => s.auvs.iter().map(|a| a.name.clone()).collect(),
         }
     }
     /// The cell `run` simulates: the scenario's own values, no sweep.
@@ -215,6 +230,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => Cell::FixedBeacon(s.base_cell()),
             Scenario::MovingBeacon(s) => Cell::MovingBeacon(s.base_cell()),
             Scenario::PassiveUsbl(s) => Cell::PassiveUsbl(s.base_cell()),
+            Scenario::Fleet(_) => Cell::Fleet,
         }
     }
     /// The sweep cells of `mc`, in order.
@@ -223,6 +239,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => s.cells().into_iter().map(Cell::FixedBeacon).collect(),
             Scenario::MovingBeacon(s) => s.cells().into_iter().map(Cell::MovingBeacon).collect(),
             Scenario::PassiveUsbl(s) => s.cells().into_iter().map(Cell::PassiveUsbl).collect(),
+            Scenario::Fleet(_) => vec![Cell::Fleet],
         }
     }
     /// Steps of one run after the start.
@@ -231,6 +248,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => s.steps(),
             Scenario::MovingBeacon(s) => s.steps(),
             Scenario::PassiveUsbl(s) => s.steps(),
+            Scenario::Fleet(s) => s.steps(),
         }
     }
     /// Mission duration, s.
@@ -239,6 +257,7 @@ impl Scenario {
             Scenario::FixedBeacon(s) => s.duration_s(),
             Scenario::MovingBeacon(s) => s.mission.duration_s,
             Scenario::PassiveUsbl(s) => s.mission.duration_s,
+            Scenario::Fleet(s) => s.mission.duration_s,
         }
     }
 }

@@ -8,6 +8,7 @@ pub mod path;
 pub mod remus100;
 pub mod rigid_body;
 pub mod rov;
+pub mod sandshark;
 pub mod unicycle;
 
 pub use path::{Path, Reference};

@@ -2,10 +2,12 @@
 //! what, when; nothing else.
 
 mod fixed_beacon;
+mod fleet;
 mod moving_beacon;
 mod passive_usbl;
 
 pub(crate) use fixed_beacon::FixedBeaconWorld;
+pub(crate) use fleet::FleetWorld;
 pub(crate) use moving_beacon::{MovingBeaconWorld, range_information};
 pub use moving_beacon::{TruthPath, initial_asv_position};
 pub(crate) use passive_usbl::{PassiveUsblWorld, bearing_information};

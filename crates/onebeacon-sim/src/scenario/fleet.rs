@@ -1,0 +1,364 @@
+//! Scenarios of kind `fleet` (rypkema): AUVs without DVLs each hear one beacon on a
+//! 5-element array, navigate relative to it with the iUSBL particle filter and fly
+//! beacon-relative behaviours chosen by the chirp the beacon sends. The beacon rides on
+//! a boat along a scripted track; a fixed beacon at the dock can take over (the return
+//! of rypkema's missions). Unknown keys are errors.
+//!
+//! Frames: keys are NED (`north`, `east`), headings from north; the paper's tables give
+//! ENU offsets (x east, y north), converted in the built-in files.
+
+use super::{World, default_runs, default_seed};
+use crate::vehicles::sandshark::SandSharkParams;
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fleet {
+    /// `fleet`.
+    pub kind: World,
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    #[serde(default = "default_runs::<4>")]
+    pub runs: usize,
+    #[serde(default)]
+    pub mission: FleetMission,
+    #[serde(default)]
+    pub signal: Signal,
+    #[serde(default)]
+    pub sandshark: SandSharkParams,
+    #[serde(default)]
+    pub navigation: Navigation,
+    /// The boat's track: the beacon it tows follows it (linear between waypoints, held
+    /// after the last).
+    pub boat: Vec<Waypoint>,
+    #[serde(default)]
+    pub dock: Dock,
+    /// Which mode is sent from which beacon from when (in time order); mode 0: silent.
+    pub schedule: Vec<ScheduleEntry>,
+    pub auvs: Vec<FleetAuv>,
+    /// The estimators every AUV runs (the first flies the behaviours).
+    #[serde(default = "default_estimators")]
+    pub estimators: Vec<FleetEstimator>,
+}
+
+fn default_estimators() -> Vec<FleetEstimator> {
+    vec![FleetEstimator::Iusbl, FleetEstimator::IusblJoint, FleetEstimator::DeadReckoning]
+}
+
+/// The estimators of a fleet world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FleetEstimator {
+    /// The factored iUSBL particle filter (rypkema sec. 3.3).
+    Iusbl,
+    /// The same filter updated jointly (no factoring): what the factoring buys.
+    IusblJoint,
+    /// Speed and compass heading integrated from the launch position (GPS at launch).
+    DeadReckoning,
+}
+
+impl FleetEstimator {
+    pub fn label(self) -> &'static str {
+        match self {
+            FleetEstimator::Iusbl => "iusbl",
+            FleetEstimator::IusblJoint => "iusbl-joint",
+            FleetEstimator::DeadReckoning => "dead-reckoning",
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FleetMission {
+    pub duration_s: f64,
+    /// Vehicle integration and sensor step, s.
+    pub dt_s: f64,
+    /// The beacon's transmit period (its PPS), s.
+    pub ping_period_s: f64,
+}
+
+impl Default for FleetMission {
+    fn default() -> Self {
+        Self { duration_s: 3600.0, dt_s: 0.1, ping_period_s: 1.0 }
+    }
+}
+
+/// How a ping reaches the filter.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SignalModel {
+    /// The chirp through the channel simulation to every element of each AUV's moving
+    /// array, and the receiver chain on board (matched filter, mode bank, SPD-BF).
+    #[default]
+    Channel,
+    /// Range, direction and mode drawn from noise models with multipath outliers.
+    Abstract,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Signal {
+    pub model: SignalModel,
+    pub sound_speed_m_s: f64,
+    /// Channel: water depth, surface and bottom pressure reflection coefficients.
+    pub water_depth_m: f64,
+    pub surface_coef: f64,
+    pub bottom_coef: f64,
+    /// Channel: 2E/N0 per element of the direct path at 100 m, dB (spherical spreading
+    /// elsewhere: 20 log10 of the range).
+    pub snr_db_at_100m: f64,
+    /// Abstract: range and angle noise (1 sigma), m and deg.
+    pub range_sigma_m: f64,
+    pub angle_sigma_deg: f64,
+    /// Abstract: a ping is a multipath outlier with this probability: its range a
+    /// later arrival (up to `outlier_max_m` longer) and its direction uniform.
+    pub outlier_probability: f64,
+    pub outlier_max_m: f64,
+    /// Abstract: a ping's mode is identified wrongly with this probability.
+    pub mode_error_probability: f64,
+    /// No ping is heard from farther than this, m (the capture window: 290 m).
+    pub max_range_m: f64,
+}
+
+impl Default for Signal {
+    fn default() -> Self {
+        Self {
+            model: SignalModel::Channel,
+            sound_speed_m_s: 1481.0,
+            water_depth_m: 5.3,
+            surface_coef: -0.9,
+            bottom_coef: 0.3,
+            snr_db_at_100m: 20.0,
+            range_sigma_m: 0.3,
+            angle_sigma_deg: 3.0,
+            outlier_probability: 0.1,
+            outlier_max_m: 30.0,
+            mode_error_probability: 0.02,
+            max_range_m: 290.0,
+        }
+    }
+}
+
+/// The iUSBL navigator's tuning (defaults of `onebeacon::nav::IusblConfig`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Navigation {
+    pub particles: usize,
+    pub reinitialised: usize,
+    pub max_range_m: f64,
+    pub sigma_speed_m_s: f64,
+    pub sigma_heading_deg: f64,
+    pub beacon_speed_m_s: f64,
+    pub floor: f64,
+    pub beam_exponent: f64,
+    pub confirmations: usize,
+}
+
+impl Default for Navigation {
+    fn default() -> Self {
+        let c = onebeacon::nav::IusblConfig::default();
+        Self {
+            particles: c.filter.particles,
+            reinitialised: c.filter.reinitialised,
+            max_range_m: c.filter.max_range_m,
+            sigma_speed_m_s: c.sigma_speed_m_s,
+            sigma_heading_deg: c.sigma_heading_rad.to_degrees(),
+            beacon_speed_m_s: c.beacon_speed_m_s,
+            floor: c.floor,
+            beam_exponent: c.beam_exponent,
+            confirmations: c.confirmations,
+        }
+    }
+}
+
+/// One point of the boat's track.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Waypoint {
+    pub t_s: f64,
+    pub north_m: f64,
+    pub east_m: f64,
+}
+
+/// The beacons' depth and GPS, and the fixed beacon at the dock.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Dock {
+    pub north_m: f64,
+    pub east_m: f64,
+    /// Depth of both beacons (the towed one and the dock's), m.
+    pub beacon_depth_m: f64,
+    /// The boat's GPS error per axis, m.
+    pub gps_sigma_m: f64,
+}
+
+impl Default for Dock {
+    fn default() -> Self {
+        Self { north_m: 0.0, east_m: 0.0, beacon_depth_m: 1.0, gps_sigma_m: 0.1 }
+    }
+}
+
+/// Which beacon transmits.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Transmitter {
+    #[default]
+    Boat,
+    Dock,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScheduleEntry {
+    pub t_s: f64,
+    /// 1 to 4 (rypkema's chirps 7-9, 10-8, 8-6, 9-11 kHz); 0: silent.
+    pub mode: usize,
+    #[serde(default)]
+    pub from: Transmitter,
+}
+
+/// One AUV: where it is launched, when, and what it does in each mode.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FleetAuv {
+    pub name: String,
+    #[serde(default)]
+    pub start_north_m: f64,
+    #[serde(default)]
+    pub start_east_m: f64,
+    #[serde(default)]
+    pub start_heading_deg: f64,
+    /// When it is put in the water (at the surface until then), s.
+    #[serde(default)]
+    pub launch_s: f64,
+    #[serde(default = "default_speed")]
+    pub speed_m_s: f64,
+    #[serde(default = "default_depth")]
+    pub depth_m: f64,
+    pub modes: Vec<ModeBehaviour>,
+}
+
+fn default_speed() -> f64 {
+    1.0
+}
+fn default_depth() -> f64 {
+    2.5
+}
+
+/// The behaviours of `onebeacon::autonomy`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BehaviourName {
+    Loiter,
+    Trackline,
+    OffsetFollow,
+    Return,
+    Abort,
+}
+
+/// One mode's behaviour and its parameters (offsets from the beacon, NED).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModeBehaviour {
+    /// 1 to 4.
+    pub mode: usize,
+    pub behaviour: BehaviourName,
+    #[serde(default)]
+    pub offset_north_m: f64,
+    #[serde(default)]
+    pub offset_east_m: f64,
+    /// Loiter.
+    pub radius_m: Option<f64>,
+    #[serde(default)]
+    pub clockwise: bool,
+    /// Trackline and return: the line's heading, deg from north; its length, m.
+    pub heading_deg: Option<f64>,
+    pub length_m: Option<f64>,
+    /// Trackline and offset follow: the buffer, m.
+    pub buffer_m: Option<f64>,
+    /// Offset follow: the depth ceiling, m.
+    pub ceiling_m: Option<f64>,
+}
+
+impl ModeBehaviour {
+    /// The behaviour, its required keys checked by validation.
+    pub fn behaviour(&self) -> onebeacon::autonomy::Behaviour {
+        use onebeacon::autonomy::Behaviour as B;
+        let at = nalgebra::Vector2::new(self.offset_north_m, self.offset_east_m);
+        let heading = self.heading_deg.unwrap_or(0.0).to_radians();
+        let length = self.length_m.unwrap_or(0.0);
+        match self.behaviour {
+            BehaviourName::Loiter => {
+                B::Loiter { centre_m: at, radius_m: self.radius_m.unwrap_or(0.0), clockwise: self.clockwise }
+            }
+            BehaviourName::Trackline => B::Trackline {
+                centre_m: at,
+                heading_rad: heading,
+                length_m: length,
+                buffer_m: self.buffer_m.unwrap_or(0.0),
+            },
+            BehaviourName::OffsetFollow => B::OffsetFollow {
+                offset_m: at,
+                buffer_m: self.buffer_m.unwrap_or(0.0),
+                ceiling_m: self.ceiling_m.unwrap_or(0.0),
+            },
+            BehaviourName::Return => B::Return { end_m: at, heading_rad: heading, length_m: length },
+            BehaviourName::Abort => B::Abort,
+        }
+    }
+
+    /// The keys `behaviour` needs.
+    pub fn required(&self) -> &'static [&'static str] {
+        match self.behaviour {
+            BehaviourName::Loiter => &["radius_m"],
+            BehaviourName::Trackline => &["heading_deg", "length_m", "buffer_m"],
+            BehaviourName::OffsetFollow => &["buffer_m", "ceiling_m"],
+            BehaviourName::Return => &["heading_deg", "length_m"],
+            BehaviourName::Abort => &[],
+        }
+    }
+
+    pub fn value(&self, key: &str) -> Option<f64> {
+        match key {
+            "radius_m" => self.radius_m,
+            "heading_deg" => self.heading_deg,
+            "length_m" => self.length_m,
+            "buffer_m" => self.buffer_m,
+            "ceiling_m" => self.ceiling_m,
+            _ => None,
+        }
+    }
+}
+
+/// The mode numbers of rypkema's bank.
+pub const MODES: usize = 4;
+
+impl Fleet {
+    pub fn steps(&self) -> usize {
+        (self.mission.duration_s / self.mission.dt_s).round() as usize
+    }
+
+    /// The boat's position at `t` (NED, m; at the beacon's depth).
+    pub fn boat_at(&self, t: f64) -> nalgebra::Vector3<f64> {
+        let z = self.dock.beacon_depth_m;
+        let w = &self.boat;
+        let at = |p: &Waypoint| nalgebra::Vector3::new(p.north_m, p.east_m, z);
+        match w.iter().position(|p| p.t_s > t) {
+            Some(0) => at(&w[0]),
+            None => at(&w[w.len() - 1]),
+            Some(i) => {
+                let (a, b) = (&w[i - 1], &w[i]);
+                let f = (t - a.t_s) / (b.t_s - a.t_s);
+                at(a) + (at(b) - at(a)) * f
+            }
+        }
+    }
+
+    /// The schedule entry in force at `t`, if any.
+    pub fn scheduled(&self, t: f64) -> Option<&ScheduleEntry> {
+        self.schedule.iter().rev().find(|e| e.t_s <= t)
+    }
+}

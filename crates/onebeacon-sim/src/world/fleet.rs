@@ -1,0 +1,356 @@
+//! The fleet world (rypkema): SandShark-like AUVs, a beacon towed by a boat along a
+//! scripted track (and one fixed at the dock), the operator's schedule of command
+//! modes. Each AUV's first estimator (the iUSBL navigator) tells its autonomy the
+//! confirmed mode and where the vehicle is relative to the beacon; the autonomy's
+//! setpoint moves the vehicle. Every `ping_period_s` the transmitting beacon sends its
+//! mode's chirp: through the channel simulation to each AUV's array (the captures go to
+//! the navigators' receiver chains), or drawn as range, direction and mode (abstract).
+
+use crate::acoustics::channel::{Boundaries, Channel, simulate_ping};
+use crate::engine::{Track, VehicleTruth, World};
+use crate::run::{GuidanceSnapshot, PilotRecord};
+use crate::scenario::fleet::{Fleet, FleetEstimator, SignalModel, Transmitter};
+use crate::seed::{Stream, gauss, vehicle_rng};
+use crate::vehicles::autopilot::Command;
+use crate::vehicles::sandshark::{SandShark, SensorErrors};
+use nalgebra::Vector3;
+use onebeacon::autonomy::{Autonomy, AutonomySettings, Phase, Setpoint};
+use onebeacon::dsp::beamform::{azimuth_inclination, pyramid_8cm};
+use onebeacon::dsp::receiver::{ModeReceiver, ReceiverConfig};
+use onebeacon::dsp::waveform::{Lfm, rypkema_modes};
+use onebeacon::filter::FilterKind;
+use onebeacon::filter::factored::FactoredSettings;
+use onebeacon::nav::{
+    Aiding, BeaconFix, Capture, IusblConfig, IusblNavigator, Kind, Measurement, Navigator, PlanarConfig,
+    PlanarNavigator,
+};
+use rand::RngExt;
+use rand_pcg::Pcg64Mcg;
+use std::sync::Arc;
+
+/// The capture window after the transmit epoch, s (8000 samples at 37.5 kS/s).
+const WINDOW_S: f64 = 8000.0 / 37_500.0;
+/// Shallower than this an AUV hears nothing (its array is out of the water), m.
+const SURFACE_M: f64 = 0.3;
+
+/// One AUV: truth, autonomy, sensor errors and random streams.
+struct Auv {
+    truth: SandShark,
+    autonomy: Autonomy,
+    errors: SensorErrors,
+    launch_s: f64,
+    distance_m: f64,
+    setpoint: Setpoint,
+    phase: Phase,
+    mode: Option<usize>,
+    imu_rng: Pcg64Mcg,
+    acoustic_rng: Pcg64Mcg,
+}
+
+/// A ping sent, waiting for the end of the capture window.
+#[derive(Debug, Clone, Copy)]
+struct Sent {
+    t_tx: f64,
+    source: Vector3<f64>,
+    mode: usize,
+    from: Transmitter,
+}
+
+pub(crate) struct FleetWorld {
+    s: Fleet,
+    auvs: Vec<Auv>,
+    waveforms: [Lfm; 4],
+    elements: Vec<Vector3<f64>>,
+    sent: Vec<Sent>,
+    gps_rng: Pcg64Mcg,
+    /// The next transmit epoch.
+    next_ping_s: f64,
+    k: usize,
+}
+
+impl FleetWorld {
+    pub(crate) fn new(s: &Fleet, seed: u64, run: u64) -> Self {
+        let auvs = s
+            .auvs
+            .iter()
+            .enumerate()
+            .map(|(v, a)| {
+                let mut imu_rng = vehicle_rng(seed, run, v, Stream::Imu);
+                let settings = AutonomySettings { speed_m_s: a.speed_m_s, depth_m: a.depth_m, ..Default::default() };
+                let mut modes = vec![None; crate::scenario::fleet::MODES];
+                for m in &a.modes {
+                    modes[m.mode - 1] = Some(m.behaviour());
+                }
+                let heading = a.start_heading_deg.to_radians();
+                Auv {
+                    truth: SandShark::new(Vector3::new(a.start_north_m, a.start_east_m, 0.0), heading),
+                    autonomy: Autonomy::new(settings, modes),
+                    errors: SensorErrors::draw(&s.sandshark, &mut imu_rng),
+                    launch_s: a.launch_s,
+                    distance_m: 0.0,
+                    setpoint: Setpoint { heading_rad: heading, speed_m_s: 0.0, depth_m: 0.0 },
+                    phase: Phase::Waiting,
+                    mode: None,
+                    imu_rng,
+                    acoustic_rng: vehicle_rng(seed, run, v, Stream::Acoustic),
+                }
+            })
+            .collect();
+        Self {
+            s: s.clone(),
+            auvs,
+            waveforms: rypkema_modes(),
+            elements: pyramid_8cm(),
+            sent: Vec::new(),
+            gps_rng: vehicle_rng(seed, run, usize::MAX >> 8, Stream::Acoustic),
+            next_ping_s: 0.0,
+            k: 0,
+        }
+    }
+
+    /// The iUSBL navigator's settings from the scenario.
+    pub(crate) fn iusbl_config(s: &Fleet, factored: bool) -> IusblConfig {
+        let n = &s.navigation;
+        IusblConfig {
+            filter: FactoredSettings {
+                particles: n.particles,
+                max_range_m: n.max_range_m,
+                reinitialised: n.reinitialised,
+            },
+            factored,
+            sigma_speed_m_s: n.sigma_speed_m_s,
+            sigma_heading_rad: n.sigma_heading_deg.to_radians(),
+            beacon_speed_m_s: n.beacon_speed_m_s,
+            beacon_depth_m: s.dock.beacon_depth_m,
+            confirmations: n.confirmations,
+            floor: n.floor,
+            beam_exponent: n.beam_exponent,
+            fix_sigma_range_m: s.signal.range_sigma_m.max(0.05),
+            fix_sigma_angle_rad: s.signal.angle_sigma_deg.to_radians().max(0.5f64.to_radians()),
+            sound_speed_m_s: s.signal.sound_speed_m_s,
+            ..IusblConfig::default()
+        }
+    }
+
+    /// Every AUV's estimators, in the scenario's order.
+    pub(crate) fn tracks(&self, s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
+        let mut tracks = Vec::new();
+        for (v, a) in s.auvs.iter().enumerate() {
+            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
+            for e in &s.estimators {
+                let filter_seed: u64 = init_rng.random();
+                let navigator: Box<dyn Navigator> = match e {
+                    FleetEstimator::Iusbl | FleetEstimator::IusblJoint => {
+                        let config = Self::iusbl_config(s, *e == FleetEstimator::Iusbl);
+                        let receiver = (s.signal.model == SignalModel::Channel).then(|| {
+                            let rc = ReceiverConfig { sound_speed_m_s: s.signal.sound_speed_m_s, ..Default::default() };
+                            ModeReceiver::new(&self.waveforms, &self.elements, rc)
+                        });
+                        Box::new(IusblNavigator::new(config, receiver, filter_seed))
+                    }
+                    FleetEstimator::DeadReckoning => {
+                        let config = PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() };
+                        let pose = (a.start_north_m, a.start_east_m, a.start_heading_deg.to_radians());
+                        Box::new(PlanarNavigator::new(config, FilterKind::Ekf, 0.0, pose, 1.0, 0.05))
+                    }
+                };
+                tracks.push(Track { vehicle: v, navigator });
+            }
+        }
+        tracks
+    }
+
+    fn dt(&self) -> f64 {
+        self.s.mission.dt_s
+    }
+
+    /// Where beacon `from` is at `t`.
+    fn beacon_at(&self, from: Transmitter, t: f64) -> Vector3<f64> {
+        match from {
+            Transmitter::Boat => self.s.boat_at(t),
+            Transmitter::Dock => Vector3::new(self.s.dock.north_m, self.s.dock.east_m, self.s.dock.beacon_depth_m),
+        }
+    }
+
+    /// What AUV `v` hears of ping `p`, if anything.
+    fn hear(&mut self, v: usize, p: &Sent, gps: Vector3<f64>) -> Option<Measurement> {
+        let sig = self.s.signal.clone();
+        let auv = &mut self.auvs[v];
+        let at = auv.truth.position_ned_m;
+        if at.z < SURFACE_M || auv.launch_s > p.t_tx {
+            return None;
+        }
+        let d = p.source - at;
+        let r = d.norm();
+        if r > sig.max_range_m {
+            return None;
+        }
+        let beacon = BeaconFix {
+            id: p.from as u32,
+            position_ned_m: gps,
+            sigma_m: self.s.dock.gps_sigma_m,
+            t_tx_s: Some(p.t_tx),
+        };
+        let t = p.t_tx + WINDOW_S;
+        let att = auv.truth.attitude();
+        let rng = &mut auv.acoustic_rng;
+        let kind = match sig.model {
+            SignalModel::Channel => {
+                let (s, c) = auv.truth.heading_rad.sin_cos();
+                let velocity = Vector3::new(c, s, 0.0) * auv.truth.speed_m_s;
+                let ch = Channel {
+                    fs_hz: 37_500.0,
+                    capture_len: 8000,
+                    sound_speed_m_s: sig.sound_speed_m_s,
+                    snr_db: Some(sig.snr_db_at_100m - 20.0 * (r.max(1.0) / 100.0).log10()),
+                    boundaries: Some(Boundaries {
+                        water_depth_m: sig.water_depth_m,
+                        surface_coef: sig.surface_coef,
+                        bottom_coef: sig.bottom_coef,
+                        wall_east_m: None,
+                        wall_coef: 0.0,
+                    }),
+                    clock_offset_s: 0.0,
+                    clock_drift_ppm: 0.0,
+                    radial_speed_m_s: velocity.dot(&(d / r.max(1e-9))),
+                };
+                let samples = simulate_ping(&self.waveforms[p.mode], &p.source, &at, &att, &self.elements, &ch, rng);
+                Kind::Capture(Arc::new(Capture { beacon, samples }))
+            }
+            SignalModel::Abstract => {
+                let mut mode = p.mode;
+                if rng.random_bool(sig.mode_error_probability) {
+                    mode = (mode + rng.random_range(1..4usize)) % 4;
+                }
+                let truth = att.transpose() * d / r;
+                let (az, incl) = azimuth_inclination(&truth);
+                let sa = sig.angle_sigma_deg.to_radians();
+                let (range_m, azimuth_rad, inclination_rad) = if rng.random_bool(sig.outlier_probability) {
+                    let z: f64 = rng.random_range(-1.0..=1.0);
+                    (r + rng.random_range(0.0..=sig.outlier_max_m), rng.random_range(0.0..std::f64::consts::TAU), z.acos())
+                } else {
+                    (
+                        r + gauss(rng, sig.range_sigma_m),
+                        az + gauss(rng, sa),
+                        (incl + gauss(rng, sa)).clamp(0.0, std::f64::consts::PI),
+                    )
+                };
+                Kind::ArrayFix { beacon, range_m, azimuth_rad, inclination_rad, mode }
+            }
+        };
+        Some(Measurement::new(t, kind))
+    }
+}
+
+impl World for FleetWorld {
+    fn vehicles(&self) -> usize {
+        self.auvs.len()
+    }
+
+    fn steps(&self) -> usize {
+        self.s.steps()
+    }
+
+    fn t_s(&self, k: usize) -> f64 {
+        k as f64 * self.dt()
+    }
+
+    fn truth(&self, v: usize) -> VehicleTruth {
+        let a = &self.auvs[v];
+        let p = a.truth.position_ned_m;
+        VehicleTruth {
+            eta: nalgebra::Vector6::new(p.x, p.y, p.z, 0.0, a.truth.pitch_rad, a.truth.heading_rad),
+            speed_m_s: a.truth.speed_over_ground(),
+            distance_m: a.distance_m,
+        }
+    }
+
+    fn beacon_ned_m(&self) -> Vector3<f64> {
+        let t = self.t_s(self.k);
+        let from = self.s.scheduled(t).map_or(Transmitter::Boat, |e| e.from);
+        self.beacon_at(from, t)
+    }
+
+    fn pilots(&self, out: &mut Vec<PilotRecord>) {
+        for (v, a) in self.auvs.iter().enumerate() {
+            out.push(PilotRecord {
+                vehicle: Some(v),
+                command: Command {
+                    heading_rad: a.setpoint.heading_rad,
+                    speed_m_s: a.setpoint.speed_m_s,
+                    depth_m: Some(a.setpoint.depth_m),
+                },
+                heading_rad: a.truth.heading_rad,
+                speed_m_s: a.truth.speed_m_s,
+                depth_m: a.truth.position_ned_m.z,
+                mode: a.mode,
+                phase: Some(a.phase),
+            });
+        }
+    }
+
+    fn advance(&mut self, k: usize, beliefs: &[&dyn Navigator], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot> {
+        self.k = k;
+        let dt = self.dt();
+        let t1 = self.t_s(k);
+        // the beacon transmits at its epochs
+        while self.next_ping_s <= t1 {
+            let t_tx = self.next_ping_s;
+            self.next_ping_s += self.s.mission.ping_period_s;
+            if let Some(e) = self.s.scheduled(t_tx).filter(|e| e.mode > 0) {
+                let (mode, from) = (e.mode - 1, e.from);
+                self.sent.push(Sent { t_tx, source: self.beacon_at(from, t_tx), mode, from });
+            }
+        }
+        // pings whose capture window has closed are heard
+        let due: Vec<Sent> = self.sent.iter().copied().filter(|p| p.t_tx + WINDOW_S <= t1).collect();
+        self.sent.retain(|p| p.t_tx + WINDOW_S > t1);
+        for p in &due {
+            let gps = match p.from {
+                Transmitter::Boat => {
+                    let s = self.s.dock.gps_sigma_m;
+                    p.source + Vector3::new(gauss(&mut self.gps_rng, s), gauss(&mut self.gps_rng, s), 0.0)
+                }
+                Transmitter::Dock => p.source,
+            };
+            for (v, h) in heard.iter_mut().enumerate() {
+                if let Some(m) = self.hear(v, p, gps) {
+                    h.push(m);
+                }
+            }
+        }
+        let params = self.s.sandshark.clone();
+        for (v, a) in self.auvs.iter_mut().enumerate() {
+            if t1 < a.launch_s {
+                continue; // not in the water yet
+            }
+            let belief = beliefs[v];
+            a.mode = belief.command_mode();
+            let rel = belief.beacon_relative_ned_m().unwrap_or_default();
+            let e = belief.estimate();
+            let (setpoint, phase) = a.autonomy.step(a.mode, rel.xy(), rel.z, e.heading_rad());
+            (a.setpoint, a.phase) = (setpoint, phase);
+            a.truth.step(&params, &setpoint, dt);
+            a.distance_m += a.truth.speed_m_s * dt;
+            a.errors.advance(&params, dt, &mut a.imu_rng);
+            let rng = &mut a.imu_rng;
+            let white = params.attitude_white_deg.to_radians();
+            let sog = a.truth.speed_m_s * (1.0 + a.errors.speed_scale) * a.truth.pitch_rad.cos(); // eq. 1
+            let speed = if a.truth.thrusting { (sog + gauss(rng, params.speed_white_m_s)).max(0.0) } else { 0.0 };
+            let heading = a.truth.heading_rad + a.errors.heading_rad + gauss(rng, params.heading_white_deg.to_radians());
+            let h = &mut heard[v];
+            h.push(Measurement::new(t1, Kind::Speed { speed_m_s: speed }));
+            h.push(Measurement::new(
+                t1,
+                Kind::Attitude {
+                    roll_rad: gauss(rng, white),
+                    pitch_rad: a.truth.pitch_rad + gauss(rng, white),
+                    heading_rad: onebeacon::geo::wrap_angle(heading),
+                },
+            ));
+            let depth = a.truth.position_ned_m.z + gauss(rng, params.depth_white_m);
+            h.push(Measurement::new(t1, Kind::Depth { depth_m: depth }));
+        }
+        None
+    }
+}
