@@ -13,6 +13,7 @@
 
 pub mod acoustics;
 mod engine;
+pub mod fleet;
 pub mod metrics;
 pub mod montecarlo;
 pub mod pcrb;

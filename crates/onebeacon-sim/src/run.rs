@@ -194,6 +194,10 @@ pub struct BeliefSnapshot {
     /// The bearing measured at this step: the station's reported position and heading,
     /// azimuth, elevation (rad).
     pub bearing: Option<(Vector3<f64>, f64, f64, f64)>,
+    /// A factored particle filter's last range and angle sets (rypkema Fig. 6).
+    pub sets: Option<onebeacon::filter::factored::FactoredSets>,
+    /// The beacon's true position (for beacon-relative pictures).
+    pub beacon: Vector3<f64>,
 }
 
 /// Bytes a recorded run of `s` holds (its trajectory), about.
@@ -343,6 +347,8 @@ impl Observer for Recorder {
                 estimate: e.position_ned_m,
                 truth: Vector3::from_element(f64::NAN),
                 bearing: None,
+                sets: first.navigator.factored_sets(),
+                beacon: Vector3::from_element(f64::NAN),
             });
         }
     }
@@ -350,6 +356,7 @@ impl Observer for Recorder {
     fn step(&mut self, s: &Step<'_>) {
         if let Some(b) = self.belief.as_mut().filter(|_| self.belief_at.is_some_and(|(at, _)| at == s.k)) {
             b.truth = s.truth[0].eta.fixed_rows::<3>(0).into_owned();
+            b.beacon = s.beacon_ned_m;
             b.bearing = s.heard[0].iter().find_map(|m| match m.kind {
                 onebeacon::nav::Kind::Bearing { station, station_heading_rad, azimuth_rad, elevation_rad } => {
                     Some((station.position_ned_m, station_heading_rad, azimuth_rad, elevation_rad))
