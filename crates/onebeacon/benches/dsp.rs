@@ -8,7 +8,11 @@ use onebeacon::dsp::matched_filter::MatchedFilter;
 use onebeacon::dsp::modes::ModeBank;
 use onebeacon::dsp::receiver::{Receiver, ReceiverConfig};
 use onebeacon::dsp::waveform::rypkema_modes;
+use nalgebra::Vector3;
+use onebeacon::dsp::receiver::ModeReceiver;
+use onebeacon::nav::{BeaconFix, Capture, IusblConfig, IusblNavigator, Kind, Measurement, Navigator};
 use std::hint::black_box;
+use std::sync::Arc;
 
 fn bench(c: &mut Criterion) {
     let fs = 37_500.0;
@@ -36,6 +40,40 @@ fn bench(c: &mut Criterion) {
     });
     c.bench_function("ping: PHAT range + SPD-BF 0.25 deg only", |b| {
         b.iter(|| black_box(rx.process(black_box(&captures))))
+    });
+
+    // one second of one AUV with the signal in the loop (rypkema: about 500 ms on a
+    // Raspberry Pi 3): 10 speed and attitude samples, the ping's receiver chain (mode
+    // bank, PHAT range, SPD-BF tables) and the factored update of 500 particles
+    let mut nav = IusblNavigator::new(
+        IusblConfig::default(),
+        Some(ModeReceiver::new(&modes, &el, ReceiverConfig::default())),
+        1,
+    );
+    let capture = Arc::new(Capture { beacon: BeaconFix::fixed(0, Vector3::new(100.0, 60.0, 1.0)), samples: captures.clone() });
+    let mut t = 0.0;
+    c.bench_function("iusbl: one second of one AUV (receiver chain + 500-particle factored update)", |b| {
+        b.iter(|| {
+            for _ in 0..10 {
+                t += 0.1;
+                nav.process(&Measurement::new(t, Kind::Speed { speed_m_s: 1.0 }));
+                nav.process(&Measurement::new(t, Kind::Attitude { roll_rad: 0.0, pitch_rad: 0.0, heading_rad: 0.3 }));
+            }
+            black_box(nav.process(&Measurement::new(t, Kind::Capture(capture.clone()))))
+        })
+    });
+    let fix = Kind::ArrayFix {
+        beacon: BeaconFix::fixed(0, Vector3::new(100.0, 60.0, 1.0)),
+        range_m: 117.0,
+        azimuth_rad: 0.4,
+        inclination_rad: 1.6,
+        mode: 0,
+    };
+    c.bench_function("iusbl: the 500-particle factored update alone (a fix's likelihoods)", |b| {
+        b.iter(|| {
+            t += 1.0;
+            black_box(nav.process(&Measurement::new(t, fix.clone())))
+        })
     });
 
     // CBF against SPD-BF over the same 1 deg azimuth x inclination grid (65 160 looks)

@@ -41,27 +41,60 @@ impl Snapshot {
     /// FFT of `len` samples from `start` of each element's capture, keeping the bins in
     /// `band_hz`.
     pub fn from_segment(captures: &[Vec<f64>], start: usize, len: usize, band_hz: (f64, f64), fs: f64) -> Self {
-        let n = len.max(2);
-        let r2c = RealFftPlanner::<f64>::new().plan_fft_forward(n);
-        let df = fs / n as f64;
-        let lo = (band_hz.0 / df).ceil() as usize;
-        let hi = ((band_hz.1 / df).floor() as usize).min(n / 2);
-        let freqs_hz = (lo..=hi).map(|k| k as f64 * df).collect();
-        let spectra = captures
-            .iter()
-            .map(|x| {
-                let mut seg: Vec<f64> = (start..start + n).map(|i| x.get(i).copied().unwrap_or(0.0)).collect();
-                let mut out = r2c.make_output_vec();
-                r2c.process(&mut seg, &mut out).expect("sizes match the plan");
-                out[lo..=hi].to_vec()
-            })
-            .collect();
-        Self { freqs_hz, spectra }
+        let mut snap = Snapshot { freqs_hz: Vec::new(), spectra: Vec::new() };
+        SegmentTransform::new(len).transform(captures, start, band_hz, fs, &mut snap);
+        snap
     }
 
     /// Total in-band energy of each element, sum over k of |X_m(f_k)|^2.
     pub fn energies(&self) -> Vec<f64> {
         self.spectra.iter().map(|s| s.iter().map(|c| c.norm_sqr()).sum()).collect()
+    }
+}
+
+/// The FFT of one segment length, planned once, with its buffers: what a receiver
+/// keeps to take a [`Snapshot`] of every ping without planning or allocating.
+pub struct SegmentTransform {
+    r2c: std::sync::Arc<dyn realfft::RealToComplex<f64>>,
+    n: usize,
+    segment: Vec<f64>,
+    out: Vec<Complex>,
+    scratch: Vec<Complex>,
+}
+
+impl std::fmt::Debug for SegmentTransform {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SegmentTransform").field("n", &self.n).finish()
+    }
+}
+
+impl SegmentTransform {
+    pub fn new(len: usize) -> Self {
+        let n = len.max(2);
+        let r2c = RealFftPlanner::<f64>::new().plan_fft_forward(n);
+        let (out, scratch) = (r2c.make_output_vec(), r2c.make_scratch_vec());
+        Self { r2c, n, segment: vec![0.0; n], out, scratch }
+    }
+
+    /// `snap` becomes the in-band spectra of the segment from `start` of every capture.
+    pub fn transform(&mut self, captures: &[Vec<f64>], start: usize, band_hz: (f64, f64), fs: f64, snap: &mut Snapshot) {
+        let n = self.n;
+        let df = fs / n as f64;
+        let lo = (band_hz.0 / df).ceil() as usize;
+        let hi = ((band_hz.1 / df).floor() as usize).min(n / 2);
+        snap.freqs_hz.clear();
+        snap.freqs_hz.extend((lo..=hi).map(|k| k as f64 * df));
+        snap.spectra.resize_with(captures.len(), Vec::new);
+        for (x, spectrum) in captures.iter().zip(snap.spectra.iter_mut()) {
+            for (i, v) in self.segment.iter_mut().enumerate() {
+                *v = x.get(start + i).copied().unwrap_or(0.0);
+            }
+            self.r2c.process_with_scratch(&mut self.segment, &mut self.out, &mut self.scratch).expect("sizes match the plan");
+            spectrum.clear();
+            if hi >= lo {
+                spectrum.extend_from_slice(&self.out[lo..=hi]);
+            }
+        }
     }
 }
 
@@ -96,13 +129,25 @@ fn freq_step(f: &[f64]) -> f64 {
     if f.len() > 1 { f[1] - f[0] } else { 0.0 }
 }
 
-/// One element pair of SPD-BF: its axis and length.
+/// One element pair of SPD-BF: its axis, its length and the steering table of that
+/// length.
 #[derive(Debug, Clone, PartialEq)]
 struct Pair {
     i: usize,
     j: usize,
     axis: Vector3<f64>,
     length: f64,
+    steering: usize,
+}
+
+/// exp(-j 2 pi f_k L cz_g / c) for one pair length L, every conical grid point g and
+/// every frequency k of the snapshot (row g: the K frequencies, real then imaginary
+/// parts): geometry, computed once per receiver.
+#[derive(Debug, Clone, PartialEq)]
+struct Steering {
+    length: f64,
+    re: Vec<f64>,
+    im: Vec<f64>,
 }
 
 /// Sensor-pair decomposition beamforming: each of the M(M-1)/2 element pairs is
@@ -117,26 +162,57 @@ pub struct SpdBf {
     n_cos: usize,
     /// `tables[p][g]`: pair p at cos zeta = -1 + 2 g / (n_cos - 1).
     tables: Vec<Vec<f64>>,
+    /// One steering table per distinct pair length, for the frequencies `freqs`.
+    steering: Vec<Steering>,
+    freqs: Vec<f64>,
+    /// conj(X_i) X_j of the pair being computed.
+    cross: Vec<Complex>,
 }
+
+/// A direction's table positions in every pair: its grid cell and the weight of the
+/// cell's upper end ([`SpdBf::lookups`]).
+pub type Lookup = Vec<(u32, f32)>;
 
 impl SpdBf {
     /// An SPD beamformer whose conical grid is no coarser than `resolution_rad` at
     /// broadside (the grid is uniform in cos zeta).
     pub fn new(elements: &[Vector3<f64>], sound_speed_m_s: f64, resolution_rad: f64) -> Self {
         let mut pairs = Vec::new();
+        let mut lengths: Vec<f64> = Vec::new();
         for i in 0..elements.len() {
             for j in i + 1..elements.len() {
                 let d = elements[j] - elements[i];
-                pairs.push(Pair { i, j, axis: d.normalize(), length: d.norm() });
+                let length = d.norm();
+                let steering = match lengths.iter().position(|l| (l - length).abs() < 1e-9) {
+                    Some(s) => s,
+                    None => {
+                        lengths.push(length);
+                        lengths.len() - 1
+                    }
+                };
+                pairs.push(Pair { i, j, axis: d.normalize(), length, steering });
             }
         }
         let n_cos = (2.0 / resolution_rad).ceil() as usize + 1;
-        Self { tables: vec![vec![0.0; n_cos]; pairs.len()], pairs, sound_speed_m_s, n_cos }
+        let steering = lengths.into_iter().map(|length| Steering { length, re: Vec::new(), im: Vec::new() }).collect();
+        Self {
+            tables: vec![vec![0.0; n_cos]; pairs.len()],
+            pairs,
+            sound_speed_m_s,
+            n_cos,
+            steering,
+            freqs: Vec::new(),
+            cross: Vec::new(),
+        }
     }
 
     /// Number of conical grid points per pair and of pairs (memory: their product).
     pub fn size(&self) -> (usize, usize) {
         (self.n_cos, self.pairs.len())
+    }
+
+    fn cos_zeta(&self, g: usize) -> f64 {
+        -1.0 + 2.0 * g as f64 / (self.n_cos - 1) as f64
     }
 
     /// Power of pair `p` at cos zeta = `cz` straight from the snapshot.
@@ -154,15 +230,51 @@ impl SpdBf {
         sum
     }
 
-    /// Beamforms every pair over its conical grid for this snapshot.
+    /// The steering tables for the snapshot's frequencies (computed again only when
+    /// they change).
+    fn steer_for(&mut self, freqs: &[f64]) {
+        if self.freqs == freqs {
+            return;
+        }
+        self.freqs = freqs.to_vec();
+        let (n, c) = (self.n_cos, self.sound_speed_m_s);
+        let k = freqs.len();
+        let cos_zeta: Vec<f64> = (0..n).map(|g| self.cos_zeta(g)).collect();
+        for st in &mut self.steering {
+            st.re = vec![0.0; n * k];
+            st.im = vec![0.0; n * k];
+            for (g, cz) in cos_zeta.iter().enumerate() {
+                for (i, f) in freqs.iter().enumerate() {
+                    let (sn, cs) = (-TAU * f * st.length * cz / c).sin_cos();
+                    st.re[g * k + i] = cs;
+                    st.im[g * k + i] = sn;
+                }
+            }
+        }
+    }
+
+    /// Beamforms every pair over its conical grid for this snapshot: |X_i + X_j w|^2 =
+    /// |X_i|^2 + |X_j|^2 + 2 Re(conj(X_i) X_j w) summed over frequencies, w from the
+    /// pair length's steering table.
     pub fn compute(&mut self, snap: &Snapshot) {
-        let n = self.n_cos;
-        let tables: Vec<Vec<f64>> = self
-            .pairs
-            .iter()
-            .map(|p| (0..n).map(|g| self.pair_power(p, snap, -1.0 + 2.0 * g as f64 / (n - 1) as f64)).collect())
-            .collect();
-        self.tables = tables;
+        self.steer_for(&snap.freqs_hz);
+        let k = snap.freqs_hz.len();
+        for (p, table) in self.pairs.iter().zip(self.tables.iter_mut()) {
+            let (xi, xj) = (&snap.spectra[p.i], &snap.spectra[p.j]);
+            let energy: f64 = xi.iter().chain(xj).map(|c| c.norm_sqr()).sum();
+            self.cross.clear();
+            self.cross.extend(xi.iter().zip(xj).map(|(a, b)| a.conj() * b));
+            let (cr, ci): (Vec<f64>, Vec<f64>) = self.cross.iter().map(|c| (c.re, c.im)).unzip();
+            let st = &self.steering[p.steering];
+            for (g, out) in table.iter_mut().enumerate() {
+                let (wr, wi) = (&st.re[g * k..(g + 1) * k], &st.im[g * k..(g + 1) * k]);
+                let mut acc = 0.0;
+                for i in 0..k {
+                    acc += cr[i] * wr[i] - ci[i] * wi[i];
+                }
+                *out = energy + 2.0 * acc;
+            }
+        }
     }
 
     /// The SPD power toward `u` from the computed tables (one dot product and one
@@ -181,9 +293,44 @@ impl SpdBf {
             .sum()
     }
 
+    /// The table positions of every direction of `dirs` in every pair, to compute once
+    /// for a fixed set of directions (a search grid) and read with
+    /// [`SpdBf::power_at`].
+    pub fn lookups(&self, dirs: &[Vector3<f64>]) -> Lookup {
+        let scale = (self.n_cos - 1) as f64 / 2.0;
+        dirs.iter()
+            .flat_map(|u| {
+                self.pairs.iter().map(move |p| {
+                    let x = ((p.axis.dot(u) + 1.0) * scale).clamp(0.0, (self.n_cos - 1) as f64);
+                    let g = (x.floor() as usize).min(self.n_cos - 2);
+                    (g as u32, (x - g as f64) as f32)
+                })
+            })
+            .collect()
+    }
+
+    /// The power toward direction `d` of the set `lookups` was computed for.
+    pub fn power_at(&self, lookups: &Lookup, d: usize) -> f64 {
+        let n = self.pairs.len();
+        lookups[d * n..(d + 1) * n]
+            .iter()
+            .zip(&self.tables)
+            .map(|(&(g, f), t)| {
+                let (g, f) = (g as usize, f64::from(f));
+                t[g] * (1.0 - f) + t[g + 1] * f
+            })
+            .sum()
+    }
+
     /// The SPD power toward `u` evaluated exactly (no grid), for reference.
     pub fn power_exact(&self, snap: &Snapshot, u: &Vector3<f64>) -> f64 {
         self.pairs.iter().map(|p| self.pair_power(p, snap, p.axis.dot(u))).sum()
+    }
+
+    /// The table of pair `p` at grid point `g` against its exact value (tests).
+    #[cfg(test)]
+    fn table_error(&self, snap: &Snapshot, p: usize, g: usize) -> f64 {
+        self.tables[p][g] - self.pair_power(&self.pairs[p], snap, self.cos_zeta(g))
     }
 }
 
@@ -225,9 +372,16 @@ impl DirectionGrid {
     /// The best direction of `power`: the grid maximum (the first on ties), refined by a
     /// pattern search in azimuth and inclination down to 1/1024 of the grid step.
     pub fn search(&self, power: impl Fn(&Vector3<f64>) -> f64) -> (Vector3<f64>, f64) {
+        self.search_indexed(|i| power(&self.dirs[i].2), &power)
+    }
+
+    /// [`DirectionGrid::search`] with the grid's powers given by index (`at(i)`: look
+    /// direction i of [`DirectionGrid::directions`], from precomputed lookups, say) and
+    /// `power` for the refinement.
+    pub fn search_indexed(&self, at: impl Fn(usize) -> f64, power: impl Fn(&Vector3<f64>) -> f64) -> (Vector3<f64>, f64) {
         let mut best = (0.0, 0.0, f64::MIN);
-        for (az, inc, u) in &self.dirs {
-            let p = power(u);
+        for (i, (az, inc, _)) in self.dirs.iter().enumerate() {
+            let p = at(i);
             if p > best.2 {
                 best = (*az, *inc, p);
             }
@@ -371,6 +525,30 @@ mod tests {
         for (a, i) in [(0.0, 0.0), (1.0, 1.0), (3.0, 2.5), (5.5, 1.7), (0.7, 2.2)] {
             let u = direction(a, i);
             assert_relative_eq!(spd.power_exact(&snap, &u), cbf.power(&snap, &u) + extra, max_relative = 1e-10);
+        }
+    }
+
+    /// The tables (steering precomputed, cross-spectra) equal each pair's power computed
+    /// directly at its grid points, and the precomputed lookups read what `power` reads.
+    #[test]
+    fn tables_and_lookups_match_direct_evaluation() {
+        let fs = 37_500.0;
+        let chirp = Lfm::new(8e3, 6e3, 0.02);
+        let el = pyramid_8cm();
+        let snap =
+            Snapshot::from_segment(&captures(&el, &direction(2.0, 1.4), fs, &chirp, 0.004), 0, 1024, chirp.band(), fs);
+        let mut spd = SpdBf::new(&el, 1500.0, 0.25f64.to_radians());
+        spd.compute(&snap);
+        let scale: f64 = snap.energies().iter().sum();
+        for p in 0..10 {
+            for g in [0, 1, 77, 230, 459] {
+                assert!(spd.table_error(&snap, p, g).abs() < 1e-9 * scale, "pair {p} point {g}");
+            }
+        }
+        let dirs = DirectionGrid::new(7f64.to_radians()).directions();
+        let lookups = spd.lookups(&dirs);
+        for (d, u) in dirs.iter().enumerate() {
+            assert_relative_eq!(spd.power_at(&lookups, d), spd.power(u), max_relative = 1e-6);
         }
     }
 

@@ -18,6 +18,10 @@ pub struct MatchedFilter {
     phat: bool,
     r2c: Arc<dyn RealToComplex<f64>>,
     ifft: Arc<dyn Fft<f64>>,
+    /// The band shifted to zero frequency and transformed at 1/`decimation` of the rate
+    /// (the shortest length dividing n that holds twice the band): [`MatchedFilter::baseband_of`].
+    decimation: usize,
+    ifft_baseband: Arc<dyn Fft<f64>>,
 }
 
 impl std::fmt::Debug for MatchedFilter {
@@ -56,7 +60,9 @@ impl MatchedFilter {
         let norm = spectrum[lo..hi].iter().map(|c| c.norm_sqr()).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
         let scale = if phat { 1.0 } else { 1.0 / norm };
         let template_conj = spectrum[lo..hi].iter().map(|c| c.conj() * scale).collect();
-        Self { capture_len, n, template_conj, lo, hi, phat, r2c, ifft }
+        let decimation = (1..=n).rev().find(|d| n % d == 0 && n / d >= 2 * (hi - lo)).unwrap_or(1);
+        let ifft_baseband = FftPlanner::<f64>::new().plan_fft_inverse(n / decimation);
+        Self { capture_len, n, template_conj, lo, hi, phat, r2c, ifft, decimation, ifft_baseband }
     }
 
     pub fn capture_len(&self) -> usize {
@@ -71,12 +77,20 @@ impl MatchedFilter {
     /// The zero-padded spectrum of one capture, to be shared by every filter of the
     /// same FFT length.
     pub fn spectrum(&self, x: &[f64]) -> Vec<Complex> {
-        let mut padded = vec![0.0; self.n];
+        let mut spectrum = Vec::new();
+        self.spectrum_into(x, &mut Vec::new(), &mut spectrum);
+        spectrum
+    }
+
+    /// [`MatchedFilter::spectrum`] into `out`, with `padded` as the work buffer (both
+    /// kept by the caller from ping to ping: no allocation once they have grown).
+    pub fn spectrum_into(&self, x: &[f64], padded: &mut Vec<f64>, out: &mut Vec<Complex>) {
+        padded.clear();
+        padded.resize(self.n, 0.0);
         let m = x.len().min(self.capture_len);
         padded[..m].copy_from_slice(&x[..m]);
-        let mut spectrum = self.r2c.make_output_vec();
-        self.r2c.process(&mut padded, &mut spectrum).expect("sizes match the plan");
-        spectrum
+        out.resize(self.n / 2 + 1, Complex::new(0.0, 0.0));
+        self.r2c.process(padded, out).expect("sizes match the plan");
     }
 
     /// The analytic envelope |y[n]| of the PHAT-whitened correlation of `x` with the
@@ -88,31 +102,74 @@ impl MatchedFilter {
 
     /// [`MatchedFilter::envelope`] from a capture's spectrum.
     pub fn envelope_of(&self, spectrum: &[Complex]) -> Vec<f64> {
-        self.analytic_of(spectrum).iter().map(|c| c.norm_sqr().sqrt()).collect()
+        let mut out = Vec::new();
+        self.envelope_into(spectrum, &mut Vec::new(), &mut out);
+        out
+    }
+
+    /// [`MatchedFilter::envelope_of`] into `out`, with `work` as the FFT buffer (kept by
+    /// the caller).
+    pub fn envelope_into(&self, spectrum: &[Complex], work: &mut Vec<Complex>, out: &mut Vec<f64>) {
+        self.analytic_into(spectrum, work);
+        out.clear();
+        out.extend(work.iter().map(|c| c.norm_sqr().sqrt()));
+    }
+
+    /// Lags per sample of [`MatchedFilter::baseband_of`].
+    pub fn decimation(&self) -> usize {
+        self.decimation
+    }
+
+    /// The analytic correlation at every `decimation`-th lag, from a capture's spectrum:
+    /// the in-band bins shifted to zero frequency and inverse-transformed at the reduced
+    /// length (the band fits in it, so nothing aliases). Sample j is lag j d with the
+    /// modulus of [`MatchedFilter::analytic_of`] there, its phase turned by
+    /// exp(-j 2 pi lo j / (n / d)), a factor common to every element: what mode
+    /// identification needs at a tenth of the cost.
+    pub fn baseband_of(&self, spectrum: &[Complex]) -> Vec<Complex> {
+        assert_eq!(spectrum.len(), self.n / 2 + 1, "spectrum of another FFT length");
+        let m = self.n / self.decimation;
+        let mut y = vec![Complex::new(0.0, 0.0); m];
+        for (i, (k, s)) in (self.lo..self.hi).zip(&self.template_conj).enumerate() {
+            y[i] = self.whitened(spectrum[k] * s);
+        }
+        self.ifft_baseband.process(&mut y);
+        y.truncate(self.capture_len.div_ceil(self.decimation));
+        y.iter_mut().for_each(|c| *c /= self.n as f64);
+        y
+    }
+
+    /// One bin of the cross-spectrum, twice (one-sided), whitened by PHAT (eq. 2) or not.
+    fn whitened(&self, p: Complex) -> Complex {
+        if !self.phat {
+            return p * 2.0;
+        }
+        let mag = p.norm_sqr().sqrt();
+        if mag > 0.0 { p * (2.0 / mag) } else { Complex::new(0.0, 0.0) }
     }
 
     /// The complex analytic correlation from a capture's spectrum, lags 0..capture_len
     /// (its modulus is the envelope; its phase carries the carrier, for coherent
     /// combination across elements).
     pub fn analytic_of(&self, spectrum: &[Complex]) -> Vec<Complex> {
+        let mut y = Vec::new();
+        self.analytic_into(spectrum, &mut y);
+        y
+    }
+
+    /// [`MatchedFilter::analytic_of`] into `y`.
+    pub fn analytic_into(&self, spectrum: &[Complex], y: &mut Vec<Complex>) {
         assert_eq!(spectrum.len(), self.n / 2 + 1, "spectrum of another FFT length");
         // one-sided (analytic) spectrum of the whitened cross-spectrum, in band only
-        let mut y = vec![Complex::new(0.0, 0.0); self.n];
+        y.clear();
+        y.resize(self.n, Complex::new(0.0, 0.0));
         for (k, s) in (self.lo..self.hi).zip(&self.template_conj) {
-            let p = spectrum[k] * s;
-            if !self.phat {
-                y[k] = p * 2.0;
-                continue;
-            }
-            let mag = p.norm_sqr().sqrt();
-            if mag > 0.0 {
-                y[k] = p * (2.0 / mag); // eq. 2: keep the phase only
-            }
+            y[k] = self.whitened(spectrum[k] * s); // eq. 2: keep the phase only (PHAT)
         }
-        self.ifft.process(&mut y);
+        self.ifft.process(y);
         y.truncate(self.capture_len);
-        y.iter_mut().for_each(|c| *c /= self.n as f64);
-        y
+        let scale = 1.0 / self.n as f64;
+        y.iter_mut().for_each(|c| *c *= scale);
     }
 }
 
@@ -251,6 +308,26 @@ mod tests {
             assert_abs_diff_eq!(est.range_m, 1500.0 * delay / fs, epsilon = 0.1 * 1500.0 / fs);
             let energy: f64 = est.distribution.iter().map(|v| v * v).sum();
             assert_abs_diff_eq!(energy, 1.0, epsilon = 1e-9);
+        }
+    }
+
+    /// The decimated baseband correlation has the full-rate envelope at every d-th lag.
+    #[test]
+    fn baseband_matches_the_full_rate_envelope() {
+        let fs = 37_500.0;
+        let chirp = Lfm::new(10e3, 8e3, 0.02);
+        for mf in [
+            MatchedFilter::new(&chirp.samples(fs), chirp.band(), fs, 8000),
+            MatchedFilter::classical(&chirp.samples(fs), chirp.band(), fs, 8000),
+        ] {
+            let x: Vec<f64> =
+                (0..8000).map(|n| chirp.value((n as f64 - 3210.4) / fs) + 0.3 * ((n * 7919 % 13) as f64 - 6.0)).collect();
+            let spectrum = mf.spectrum(&x);
+            let (full, base, d) = (mf.analytic_of(&spectrum), mf.baseband_of(&spectrum), mf.decimation());
+            assert!(d > 4, "{d}");
+            for (j, b) in base.iter().enumerate() {
+                assert_abs_diff_eq!(b.norm(), full[j * d].norm(), epsilon = 1e-9 * (1.0 + full[j * d].norm()));
+            }
         }
     }
 

@@ -63,23 +63,39 @@ impl ModeBank {
     /// The spectra of the captures, shared by every filter of the bank (and by a
     /// [`crate::dsp::receiver::Receiver`] of the same lengths).
     pub fn spectra(&self, captures: &[Vec<f64>]) -> Vec<Vec<Complex>> {
-        match self.filters.first() {
-            Some(f) => captures.iter().map(|x| f.spectrum(x)).collect(),
-            None => Vec::new(),
+        let mut out = Vec::new();
+        self.spectra_into(captures, &mut Vec::new(), &mut out);
+        out
+    }
+
+    /// [`ModeBank::spectra`] into `out`, with `padded` as the work buffer (kept by the
+    /// caller).
+    pub fn spectra_into(&self, captures: &[Vec<f64>], padded: &mut Vec<f64>, out: &mut Vec<Vec<Complex>>) {
+        let Some(f) = self.filters.first() else {
+            out.clear();
+            return;
+        };
+        out.resize_with(captures.len(), Vec::new);
+        for (x, spectrum) in captures.iter().zip(out.iter_mut()) {
+            f.spectrum_into(x, padded, spectrum);
         }
     }
 
     /// Each mode's response: the peak over the lags in `lags` of the sum over elements of
     /// the squared envelopes (build the bank with [`MatchedFilter::classical`] filters for
     /// a statistic comparable across templates). Lags beyond the capture are ignored.
+    /// Computed on the decimated baseband correlation ([`MatchedFilter::baseband_of`]:
+    /// the envelope at every d-th lag).
     pub fn responses(&self, spectra: &[Vec<Complex>], lags: Range<usize>) -> Vec<f64> {
         self.filters
             .iter()
             .enumerate()
             .map(|(t, f)| {
-                let lags = lags.start.min(f.capture_len())..lags.end.min(f.capture_len());
-                let outputs: Vec<Vec<Complex>> = spectra.iter().map(|x| f.analytic_of(x)).collect();
-                let mut sum = vec![0.0; f.capture_len()];
+                let d = f.decimation();
+                let outputs: Vec<Vec<Complex>> = spectra.iter().map(|x| f.baseband_of(x)).collect();
+                let len = outputs.first().map_or(0, Vec::len);
+                let lags = (lags.start / d).min(len)..lags.end.div_ceil(d).min(len);
+                let mut sum = vec![0.0; len];
                 for y in &outputs {
                     for (s, v) in sum.iter_mut().zip(y) {
                         *s += v.norm_sqr();

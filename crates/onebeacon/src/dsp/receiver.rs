@@ -4,7 +4,7 @@
 //! speed from its tone, then range by synchronisation on the Doppler-compensated pilots
 //! ([`receive_frame`]).
 
-use super::beamform::{DirectionGrid, Snapshot, SpdBf, azimuth_inclination};
+use super::beamform::{DirectionGrid, Lookup, SegmentTransform, Snapshot, SpdBf, azimuth_inclination};
 use super::doppler::{baseband, periodogram_frequency, radial_speed};
 use super::matched_filter::{MatchedFilter, RangeEstimate, estimate_range};
 use super::waveform::{Lfm, PskFrame};
@@ -58,6 +58,14 @@ pub struct Receiver {
     /// Number of elements, and the last snapshot's total in-band energy.
     elements: usize,
     energy: f64,
+    /// Kept from ping to ping: the envelopes, the FFT buffer, the direct-path segment's
+    /// transform and snapshot, and the search grid's table positions (computed at the
+    /// first search).
+    envelopes: Vec<Vec<f64>>,
+    work: Vec<super::Complex>,
+    segment: SegmentTransform,
+    snapshot: Snapshot,
+    grid_lookups: std::sync::OnceLock<Lookup>,
 }
 
 impl Receiver {
@@ -66,7 +74,21 @@ impl Receiver {
             MatchedFilter::new(&waveform.samples(config.fs_hz), waveform.band(), config.fs_hz, config.capture_len);
         let spd = SpdBf::new(elements, config.sound_speed_m_s, config.conical_resolution_rad);
         let grid = DirectionGrid::new(config.search_step_rad);
-        Self { config, waveform, filter, spd, grid, elements: elements.len(), energy: 0.0 }
+        let pulse = (waveform.duration_s * config.fs_hz).ceil() as usize;
+        Self {
+            config,
+            waveform,
+            filter,
+            spd,
+            grid,
+            elements: elements.len(),
+            energy: 0.0,
+            envelopes: Vec::new(),
+            work: Vec::new(),
+            segment: SegmentTransform::new((pulse + pulse / 4).next_power_of_two()),
+            snapshot: Snapshot { freqs_hz: Vec::new(), spectra: Vec::new() },
+            grid_lookups: std::sync::OnceLock::new(),
+        }
     }
 
     /// Range and direction from one capture per element.
@@ -80,7 +102,8 @@ impl Receiver {
     pub fn process_spectra(&mut self, captures: &[Vec<f64>], spectra: &[Vec<super::Complex>]) -> PingEstimate {
         let range = self.distributions(captures, spectra);
         let spd = &self.spd;
-        let (direction, _) = self.grid.search(|u| spd.power(u));
+        let lookups = self.grid_lookups.get_or_init(|| spd.lookups(&self.grid.directions()));
+        let (direction, _) = self.grid.search_indexed(|i| spd.power_at(lookups, i), |u| spd.power(u));
         let (azimuth, inclination) = azimuth_inclination(&direction);
         PingEstimate { range, direction, azimuth, inclination }
     }
@@ -92,15 +115,17 @@ impl Receiver {
     /// particles only: rypkema sec. 3.3.4).
     pub fn distributions(&mut self, captures: &[Vec<f64>], spectra: &[Vec<super::Complex>]) -> RangeEstimate {
         let c = &self.config;
-        let envelopes: Vec<Vec<f64>> = spectra.iter().map(|x| self.filter.envelope_of(x)).collect();
-        let range = estimate_range(&envelopes, c.gate_samples, c.fs_hz, c.sound_speed_m_s);
+        self.envelopes.resize_with(spectra.len(), Vec::new);
+        for (x, e) in spectra.iter().zip(self.envelopes.iter_mut()) {
+            self.filter.envelope_into(x, &mut self.work, e);
+        }
+        let range = estimate_range(&self.envelopes, c.gate_samples, c.fs_hz, c.sound_speed_m_s);
         // the direct-path segment: the pulse from a little before the detected onset
         let pulse = (self.waveform.duration_s * c.fs_hz).ceil() as usize;
-        let len = (pulse + pulse / 4).next_power_of_two();
         let start = (range.lag.round() as usize).saturating_sub(pulse / 8);
-        let snap = Snapshot::from_segment(captures, start, len, self.waveform.band(), c.fs_hz);
-        self.spd.compute(&snap);
-        self.energy = snap.energies().iter().sum();
+        self.segment.transform(captures, start, self.waveform.band(), c.fs_hz, &mut self.snapshot);
+        self.spd.compute(&self.snapshot);
+        self.energy = self.snapshot.energies().iter().sum();
         range
     }
 
@@ -135,6 +160,9 @@ impl Receiver {
 pub struct ModeReceiver {
     bank: super::modes::ModeBank,
     receivers: Vec<Receiver>,
+    /// The captures' spectra and the transform's buffer, kept from ping to ping.
+    spectra: Vec<Vec<super::Complex>>,
+    padded: Vec<f64>,
 }
 
 /// What a [`ModeReceiver`] made of one ping.
@@ -158,17 +186,35 @@ impl ModeReceiver {
         let bank =
             super::modes::ModeBank::with_array(filters, centres, elements.to_vec(), config.sound_speed_m_s);
         let receivers = waveforms.iter().map(|w| Receiver::new(*w, elements, config.clone())).collect();
-        Self { bank, receivers }
+        Self { bank, receivers, spectra: Vec::new(), padded: Vec::new() }
     }
 
     /// Identifies the mode with the bank's search gated to `lags` (samples from the
     /// capture start: around the navigation filter's predicted range once it has
-    /// converged, the whole capture otherwise), then computes that mode's
-    /// pseudo-distributions.
+    /// converged, the whole capture otherwise) unless the whole capture's strongest
+    /// response is more than twice the gated one, then computes that mode's
+    /// pseudo-distributions; if they show no pulse, the strongest mode's instead.
     pub fn process(&mut self, captures: &[Vec<f64>], lags: std::ops::Range<usize>) -> ModePing {
-        let spectra = self.bank.spectra(captures);
-        let mode = self.bank.identify_within(&spectra, lags);
-        let range = self.receivers[mode].distributions(captures, &spectra);
+        self.bank.spectra_into(captures, &mut self.padded, &mut self.spectra);
+        let spectra = &self.spectra;
+        let all = self.bank.responses(spectra, 0..usize::MAX);
+        let strongest = super::matched_filter::argmax(&all);
+        let mut mode = strongest;
+        if lags.start > 0 || lags.end < self.receivers[0].config.capture_len {
+            // the gate is a prediction: a response outside it twice as strong as any
+            // inside wins (a new beacon, a filter converged on a reflection)
+            let gated = self.bank.responses(spectra, lags);
+            let best = super::matched_filter::argmax(&gated);
+            if gated[best] >= 0.5 * all[strongest] {
+                mode = best;
+            }
+        }
+        let mut range = self.receivers[mode].distributions(captures, spectra);
+        if !range.detected() && mode != strongest {
+            // the gated choice shows no pulse: the whole capture's strongest does
+            mode = strongest;
+            range = self.receivers[mode].distributions(captures, spectra);
+        }
         ModePing { mode, range }
     }
 

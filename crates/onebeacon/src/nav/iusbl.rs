@@ -183,6 +183,8 @@ pub struct IusblNavigator {
     /// Whether the vehicle surfaced since the last initialisation.
     surfaced: bool,
     pings: u64,
+    /// Pings in a row with no pulse detected (the mode gate is off after 3).
+    missed: u32,
 }
 
 impl IusblNavigator {
@@ -204,6 +206,7 @@ impl IusblNavigator {
             beacon: None,
             surfaced: false,
             pings: 0,
+            missed: 0,
             config,
         }
     }
@@ -274,7 +277,7 @@ impl IusblNavigator {
     fn mode_lags(&self) -> std::ops::Range<usize> {
         let (mean, cov) = self.filter.mean_covariance();
         let sigma = cov.trace().max(0.0).sqrt();
-        if sigma > self.config.gate_sigma_m || self.pings < 5 {
+        if sigma > self.config.gate_sigma_m || self.pings < 5 || self.missed >= 3 {
             return 0..usize::MAX;
         }
         let dz = self.config.beacon_depth_m - self.depth_m.unwrap_or(0.0);
@@ -290,8 +293,10 @@ impl IusblNavigator {
         let Some(rx) = self.receiver.as_mut() else { return Outcome::Skipped };
         let ping = rx.process(&c.samples, lags);
         if !ping.range.detected() {
+            self.missed = self.missed.saturating_add(1);
             return Outcome::Rejected(f64::NAN, f64::NAN); // no pulse heard: nothing to weigh
         }
+        self.missed = 0;
         self.confirmation.push(ping.mode);
         let t_tx = c.beacon.t_tx_s.unwrap_or(t);
         self.begin_ping(t, &c.beacon);
