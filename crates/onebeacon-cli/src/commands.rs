@@ -82,6 +82,13 @@ pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, message: usize,
         plot::autopilots(&staging.file("autopilots.png"), &vehicles, &title, &result.trajectory)
             .context("cannot draw autopilots.png")?;
     }
+    if let onebeacon_sim::Scenario::Fleet(f) = &s {
+        plot::fleet_tracks(&staging.file("tracks.png"), &vehicles, &title, &result.trajectory)
+            .context("cannot draw tracks.png")?;
+        let commands = onebeacon_sim::fleet::commands(f);
+        plot::fleet_modes(&staging.file("modes.png"), &vehicles, &title, &result.trajectory, &commands)
+            .context("cannot draw modes.png")?;
+    }
     if !result.guidance.is_empty() {
         let snapshot = result
             .guidance

@@ -15,6 +15,8 @@ pub enum Stream {
     Acoustic = 4,
     /// The water's current (its slow variation).
     Current = 5,
+    /// A moving beacon's own GPS (the fleet world's boat).
+    BeaconGps = 6,
 }
 
 /// SplitMix64 finaliser: a bijective mixing of 64 bits.

@@ -131,7 +131,7 @@ impl Default for Signal {
             water_depth_m: 5.3,
             surface_coef: -0.9,
             bottom_coef: 0.3,
-            snr_db_at_100m: 20.0,
+            snr_db_at_100m: 30.0,
             range_sigma_m: 0.3,
             angle_sigma_deg: 3.0,
             outlier_probability: 0.1,

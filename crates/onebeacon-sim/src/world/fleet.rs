@@ -102,7 +102,7 @@ impl FleetWorld {
             waveforms: rypkema_modes(),
             elements: pyramid_8cm(),
             sent: Vec::new(),
-            gps_rng: vehicle_rng(seed, run, usize::MAX >> 8, Stream::Acoustic),
+            gps_rng: crate::seed::rng(seed, run, Stream::BeaconGps),
             next_ping_s: 0.0,
             k: 0,
         }
