@@ -111,7 +111,8 @@ fn table(name: &str, seed: u64, wall_s: f64, st: &FleetStatistics) -> String {
     for e in st.tracks.iter().chain(&st.fleet) {
         let _ = writeln!(t, "  {:<32} {:>8.2} {:>8.2} {:>8.2} {:>9}", e.label, e.p68_m, e.p95_m, e.mean_m, e.samples);
     }
-    let _ = writeln!(t, "  {:<32} {PAPER_P68_M:>8.2} {PAPER_P95_M:>8.2}   (rypkema Table 3, real data)", "paper, all AUVs");
+    let _ =
+        writeln!(t, "  {:<32} {PAPER_P68_M:>8.2} {PAPER_P95_M:>8.2}   (rypkema Table 3, real data)", "paper, all AUVs");
     let _ = writeln!(
         t,
         "modes: every AUV confirmed every command in every run: {}; largest delay {:.1} s",
@@ -120,7 +121,8 @@ fn table(name: &str, seed: u64, wall_s: f64, st: &FleetStatistics) -> String {
     );
     for c in &st.confirmations {
         let delay = c.delay_s.map_or("never".to_string(), |d| format!("+{d:.1} s"));
-        let _ = writeln!(t, "  run 0: {:<10} mode {} commanded at {:>6.0} s: {delay}", c.vehicle, c.mode, c.commanded_s);
+        let _ =
+            writeln!(t, "  run 0: {:<10} mode {} commanded at {:>6.0} s: {delay}", c.vehicle, c.mode, c.commanded_s);
     }
     if let Some(sp) = &st.spacing {
         let _ = writeln!(

@@ -311,15 +311,9 @@ fn main() -> ExitCode {
         Command::Mc { scenario, runs, seed, threads, out, json } => {
             commands::mc(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), out, json)
         }
-        Command::Fleet { scenario, runs, seed, threads, snapshot_s, out, json } => fleet::fleet(
-            &scenario,
-            runs.map(|r| r as usize),
-            seed,
-            threads.map(usize::from),
-            snapshot_s,
-            out,
-            json,
-        ),
+        Command::Fleet { scenario, runs, seed, threads, snapshot_s, out, json } => {
+            fleet::fleet(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), snapshot_s, out, json)
+        }
         Command::Dsp { command: DspCommand::Simulate { config, out } } => dsp::simulate(config.as_deref(), &out),
         Command::Dsp { command: DspCommand::Process { wav, config, out, json } } => {
             dsp::process(&wav, config.as_deref(), out, json)

@@ -805,7 +805,9 @@ pub fn fleet_tracks(path: &Path, vehicles: &[String], title: &str, traj: &[StepR
         ))?;
         let rows = body.split_evenly((n, 2));
         for v in 0..n {
-            let pts: Vec<(Vector3<f64>, Vector3<f64>, Vector3<f64>, Option<usize>)> = traj
+            // (estimate, truth, beacon, confirmed mode)
+            type Point = (Vector3<f64>, Vector3<f64>, Vector3<f64>, Option<usize>);
+            let pts: Vec<Point> = traj
                 .iter()
                 .step_by(every)
                 .filter(|r| r.truth[v].pos.z > 0.5)
@@ -816,8 +818,10 @@ pub fn fleet_tracks(path: &Path, vehicles: &[String], title: &str, traj: &[StepR
                 .collect();
             for (panel, relative) in [(0usize, false), (1, true)] {
                 let area = &rows[2 * v + panel];
-                let xy = |p: &Vector3<f64>, b: &Vector3<f64>| if relative { (p.y - b.y, p.x - b.x) } else { (p.y, p.x) };
-                let mut all: Vec<(f64, f64)> = pts.iter().flat_map(|(e, t, b, _)| [xy(e, b), xy(t, b), xy(b, b)]).collect();
+                let xy =
+                    |p: &Vector3<f64>, b: &Vector3<f64>| if relative { (p.y - b.y, p.x - b.x) } else { (p.y, p.x) };
+                let mut all: Vec<(f64, f64)> =
+                    pts.iter().flat_map(|(e, t, b, _)| [xy(e, b), xy(t, b), xy(b, b)]).collect();
                 if !relative {
                     all.extend(pts.iter().map(|(_, _, b, _)| (b.y, b.x)));
                 }
@@ -825,7 +829,8 @@ pub fn fleet_tracks(path: &Path, vehicles: &[String], title: &str, traj: &[StepR
                 let (y0, y1) = span(all.iter().map(|p| p.1), 0.05);
                 let half = (x1 - x0).max(y1 - y0) / 2.0;
                 let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-                let caption = format!("{} {}", vehicles[v], if relative { "relative to the beacon" } else { "absolute" });
+                let caption =
+                    format!("{} {}", vehicles[v], if relative { "relative to the beacon" } else { "absolute" });
                 let mut chart =
                     chart(area, &caption, cx - half..cx + half, cy - half..cy + half, ("east (m)", "north (m)"))?;
                 line(&mut chart, pts.iter().map(|(_, t, b, _)| xy(t, b)), BLACK.stroke_width(1), Some("truth"))?;
@@ -852,7 +857,13 @@ pub fn fleet_tracks(path: &Path, vehicles: &[String], title: &str, traj: &[StepR
 
 /// The mode each AUV had confirmed against time, and the operator's commands (rypkema
 /// Fig. 12/14, middle row).
-pub fn fleet_modes(path: &Path, vehicles: &[String], title: &str, traj: &[StepRecord], commands: &[(f64, usize)]) -> Result<()> {
+pub fn fleet_modes(
+    path: &Path,
+    vehicles: &[String],
+    title: &str,
+    traj: &[StepRecord],
+    commands: &[(f64, usize)],
+) -> Result<()> {
     register_fonts();
     let t1 = traj.last().map_or(1.0, |r| r.t_s).max(1.0);
     both!(path, (1200, 500), |root| (|| -> Result<()> {
@@ -870,7 +881,8 @@ pub fn fleet_modes(path: &Path, vehicles: &[String], title: &str, traj: &[StepRe
         for (v, name) in vehicles.iter().enumerate() {
             let offset = 0.08 * (v as f64 + 1.0);
             let pts = traj.iter().map(|r| {
-                let m = r.pilots.iter().find(|p| p.vehicle == Some(v)).and_then(|p| p.mode).map_or(0.0, |m| m as f64 + 1.0);
+                let m =
+                    r.pilots.iter().find(|p| p.vehicle == Some(v)).and_then(|p| p.mode).map_or(0.0, |m| m as f64 + 1.0);
                 (r.t_s, m + offset)
             });
             line(&mut chart, pts, colour(v).stroke_width(2), Some(name))?;

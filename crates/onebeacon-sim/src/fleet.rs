@@ -129,9 +129,10 @@ fn spacing_errors(s: &Fleet, traj: &[StepRecord], out: &mut Vec<f64>) -> usize {
             .auvs
             .iter()
             .map(|a| {
-                a.modes.iter().find(|m| m.mode == mode && m.behaviour == BehaviourName::OffsetFollow).map(|m| {
-                    nalgebra::Vector2::new(m.offset_north_m, m.offset_east_m)
-                })
+                a.modes
+                    .iter()
+                    .find(|m| m.mode == mode && m.behaviour == BehaviourName::OffsetFollow)
+                    .map(|m| nalgebra::Vector2::new(m.offset_north_m, m.offset_east_m))
             })
             .collect();
         let Some(offsets) = offsets else { continue };

@@ -90,7 +90,8 @@ fn sprint_and_drift_respects_the_depth_ceiling() {
     assert!(shallowest >= 1.0 - p.rise_rate_m_s * DT - 1e-9, "{shallowest} m");
     let drifting = track.iter().filter(|t| t.2 == Phase::Drifting).count() as f64 / track.len() as f64;
     assert!(drifting > 0.3, "drifting {:.0} % of the time", 100.0 * drifting);
-    let farthest = track[1200..].iter().map(|(q, _, _)| (q.xy() - Vector2::new(20.0, -30.0)).norm()).fold(0.0, f64::max);
+    let farthest =
+        track[1200..].iter().map(|(q, _, _)| (q.xy() - Vector2::new(20.0, -30.0)).norm()).fold(0.0, f64::max);
     assert!(farthest < 15.0 + 10.0, "{farthest} m from the point");
 }
 
@@ -101,7 +102,9 @@ fn sprint_and_drift_respects_the_depth_ceiling() {
 #[test]
 fn a_short_mission_confirms_its_mode_and_navigates() {
     let text = scenario::builtin("rypkema-m1").unwrap().toml;
-    let text = text.replace("duration_s = 3600.0", "duration_s = 300.0").replace("model = \"channel\"", "model = \"abstract\"");
+    let text = text
+        .replace("duration_s = 3600.0", "duration_s = 300.0")
+        .replace("model = \"channel\"", "model = \"abstract\"");
     let s = scenario::parse(&text, "short").unwrap();
     let Scenario::Fleet(f) = &s else { panic!() };
     let out = simulate(&s, &Cell::Fleet, 1, 0, true);

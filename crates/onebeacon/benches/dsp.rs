@@ -3,13 +3,13 @@
 //! direction search and refinement (target: under 5 ms on one core).
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::Vector3;
 use onebeacon::dsp::beamform::{Cbf, DirectionGrid, Snapshot, SpdBf, direction, pyramid_8cm};
 use onebeacon::dsp::matched_filter::MatchedFilter;
 use onebeacon::dsp::modes::ModeBank;
+use onebeacon::dsp::receiver::ModeReceiver;
 use onebeacon::dsp::receiver::{Receiver, ReceiverConfig};
 use onebeacon::dsp::waveform::rypkema_modes;
-use nalgebra::Vector3;
-use onebeacon::dsp::receiver::ModeReceiver;
 use onebeacon::nav::{BeaconFix, Capture, IusblConfig, IusblNavigator, Kind, Measurement, Navigator};
 use std::hint::black_box;
 use std::sync::Arc;
@@ -45,12 +45,10 @@ fn bench(c: &mut Criterion) {
     // one second of one AUV with the signal in the loop (rypkema: about 500 ms on a
     // Raspberry Pi 3): 10 speed and attitude samples, the ping's receiver chain (mode
     // bank, PHAT range, SPD-BF tables) and the factored update of 500 particles
-    let mut nav = IusblNavigator::new(
-        IusblConfig::default(),
-        Some(ModeReceiver::new(&modes, &el, ReceiverConfig::default())),
-        1,
-    );
-    let capture = Arc::new(Capture { beacon: BeaconFix::fixed(0, Vector3::new(100.0, 60.0, 1.0)), samples: captures.clone() });
+    let mut nav =
+        IusblNavigator::new(IusblConfig::default(), Some(ModeReceiver::new(&modes, &el, ReceiverConfig::default())), 1);
+    let capture =
+        Arc::new(Capture { beacon: BeaconFix::fixed(0, Vector3::new(100.0, 60.0, 1.0)), samples: captures.clone() });
     let mut t = 0.0;
     c.bench_function("iusbl: one second of one AUV (receiver chain + 500-particle factored update)", |b| {
         b.iter(|| {

@@ -59,4 +59,42 @@ fn main() {
         black_box(rx.process(black_box(&captures)));
     });
     println!("RESULT dsp rust ping_range median_ms={median:.3} min_ms={min:.3} reps={reps}");
+    if std::env::var("STAGES").is_ok() {
+        let (m, _) = time(reps, || {
+            bank.spectra_into(&captures, &mut padded, &mut spectra);
+        });
+        println!("spectra {m:.3}");
+        let (m, _) = time(reps, || {
+            black_box(bank.identify(&spectra));
+        });
+        println!("identify {m:.3}");
+        let (m, _) = time(reps, || {
+            black_box(rx.distributions(&captures, &spectra));
+        });
+        println!("distributions {m:.3}");
+        let f = MatchedFilter::new(&modes[0].samples(fs), modes[0].band(), fs, 8000);
+        let mut w = Vec::new();
+        let mut e = Vec::new();
+        let (m, _) = time(reps, || {
+            for x in &spectra {
+                f.envelope_into(x, &mut w, &mut e);
+            }
+        });
+        println!("5 phat envelopes {m:.3}");
+        let envs: Vec<Vec<f64>> = spectra.iter().map(|x| f.envelope_of(x)).collect();
+        let (m, _) = time(reps, || {
+            black_box(onebeacon::dsp::matched_filter::estimate_range(&envs, 15, fs, 1500.0));
+        });
+        println!("estimate_range {m:.3}");
+        let snap = onebeacon::dsp::beamform::Snapshot::from_segment(&captures, 3100, 1024, modes[0].band(), fs);
+        let mut spd = onebeacon::dsp::beamform::SpdBf::new(&el, 1500.0, 0.25f64.to_radians());
+        let (m, _) = time(reps, || {
+            spd.compute(&snap);
+        });
+        println!("spd compute {m:.3}");
+        let (m, _) = time(reps, || {
+            black_box(rx.process_spectra(&captures, &spectra));
+        });
+        println!("process_spectra {m:.3}");
+    }
 }

@@ -82,12 +82,21 @@ enum State {
     None,
     /// Trackline: travelling along (+1) or against (-1) the line's heading, and whether
     /// steering back to it.
-    Track { forward: bool, centring: bool },
+    Track {
+        forward: bool,
+        centring: bool,
+    },
     /// Offset follow: drifting, or driving (closest approach so far, and whether first
     /// leaving the point to circle back at depth).
-    Follow { drifting: bool, closest_m: f64, leaving: bool },
+    Follow {
+        drifting: bool,
+        closest_m: f64,
+        leaving: bool,
+    },
     /// Return: reached the end.
-    Return { done: bool },
+    Return {
+        done: bool,
+    },
 }
 
 /// One vehicle's behaviours by mode, and the state of the active one.
@@ -112,7 +121,13 @@ impl Autonomy {
 
     /// The setpoint for this step from the confirmed `mode`, the vehicle's position
     /// relative to the beacon `rel` (NED, m), its depth and heading.
-    pub fn step(&mut self, mode: Option<usize>, rel: Vector2<f64>, depth_m: f64, heading_rad: f64) -> (Setpoint, Phase) {
+    pub fn step(
+        &mut self,
+        mode: Option<usize>,
+        rel: Vector2<f64>,
+        depth_m: f64,
+        heading_rad: f64,
+    ) -> (Setpoint, Phase) {
         if let Some(m) = mode.filter(|&m| self.modes.get(m).is_some_and(Option::is_some))
             && self.active != Some(m)
         {
@@ -121,7 +136,7 @@ impl Autonomy {
         }
         let s = self.settings;
         let drive = |heading: f64| Setpoint { heading_rad: heading, speed_m_s: s.speed_m_s, depth_m: s.depth_m };
-        let stop = Setpoint { heading_rad: heading_rad, speed_m_s: 0.0, depth_m: 0.0 };
+        let stop = Setpoint { heading_rad, speed_m_s: 0.0, depth_m: 0.0 };
         let Some(behaviour) = self.active.and_then(|m| self.modes[m]) else {
             return (drive(heading_rad), Phase::Waiting);
         };

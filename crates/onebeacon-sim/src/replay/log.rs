@@ -1637,8 +1637,10 @@ heading_clockwise = true
 "#;
         let files = [("compass.csv", "t,h\n1.0,0\n2.0,90\n3.0,-30\n"), ("odo.csv", "t,dx,dy,dh\n4.0,1.0,0.2,0.1\n")];
         let log = load("compass", body, &files).unwrap();
-        let ned: Vec<Kind> =
-            items(&log).iter().map(|i| measurement(&Item { t_s: i.t_s, input: i.input.clone().to_ned(log.frame) })).collect();
+        let ned: Vec<Kind> = items(&log)
+            .iter()
+            .map(|i| measurement(&Item { t_s: i.t_s, input: i.input.clone().to_ned(log.frame) }))
+            .collect();
         for (k, expected_deg) in ned.iter().zip([0.0, 90.0, -30.0]) {
             let Kind::Heading { heading_rad } = k else { panic!("{k:?}") };
             assert_abs_diff_eq!(*heading_rad, f64::to_radians(expected_deg), epsilon = 1e-12);
@@ -1740,7 +1742,8 @@ heading_clockwise = true
         assert_abs_diff_eq!(nu[0], 1.2, epsilon = 1e-12);
         assert_abs_diff_eq!(nu[1], -0.15, epsilon = 1e-12);
         assert_abs_diff_eq!(nu[5], -PI / 6.0, epsilon = 1e-12);
-        let Kind::BodyVelocity { nu } = measurement(&Item { t_s: 1.0, input: item.input.clone().to_ned(log.frame) }) else {
+        let Kind::BodyVelocity { nu } = measurement(&Item { t_s: 1.0, input: item.input.clone().to_ned(log.frame) })
+        else {
             panic!()
         };
         assert_abs_diff_eq!(nu[1], 0.15, epsilon = 1e-12);

@@ -1,9 +1,9 @@
 //! Range checks on a parsed scenario. The first violation is reported with its key.
 
 use super::estimator::{EstimatorKind, EstimatorSpec, Host, NOISE_KEYS, Sign};
+use super::fleet::{Fleet, FleetEstimator, MODES};
 use super::moving_beacon::Vehicle;
 use super::passive_usbl::{AsvVehicle, Auv, AuvVehicle};
-use super::fleet::{Fleet, FleetEstimator, MODES};
 use super::{FixedBeacon, MovingBeacon, PassiveUsbl, Scenario};
 use crate::replay::log::{COLUMN_KEYS, InitialFrom, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
 
@@ -186,7 +186,11 @@ fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
         }
     }
     if s.estimators.iter().enumerate().any(|(i, e)| s.estimators[..i].contains(e)) {
-        return Err(violation("estimators", s.estimators.iter().map(|e| e.label()).collect::<Vec<_>>(), "must all differ"));
+        return Err(violation(
+            "estimators",
+            s.estimators.iter().map(|e| e.label()).collect::<Vec<_>>(),
+            "must all differ",
+        ));
     }
     Ok(())
 }

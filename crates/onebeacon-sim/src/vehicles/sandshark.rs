@@ -125,10 +125,7 @@ pub struct SensorErrors {
 
 impl SensorErrors {
     pub fn draw<R: rand::Rng>(p: &SandSharkParams, rng: &mut R) -> Self {
-        Self {
-            heading_rad: gauss(rng, p.heading_error_deg.to_radians()),
-            speed_scale: gauss(rng, p.speed_scale_sigma),
-        }
+        Self { heading_rad: gauss(rng, p.heading_error_deg.to_radians()), speed_scale: gauss(rng, p.speed_scale_sigma) }
     }
 
     /// The heading error's Gauss-Markov step over `dt`.

@@ -227,7 +227,11 @@ impl FleetWorld {
                 let sa = sig.angle_sigma_deg.to_radians();
                 let (range_m, azimuth_rad, inclination_rad) = if rng.random_bool(sig.outlier_probability) {
                     let z: f64 = rng.random_range(-1.0..=1.0);
-                    (r + rng.random_range(0.0..=sig.outlier_max_m), rng.random_range(0.0..std::f64::consts::TAU), z.acos())
+                    (
+                        r + rng.random_range(0.0..=sig.outlier_max_m),
+                        rng.random_range(0.0..std::f64::consts::TAU),
+                        z.acos(),
+                    )
                 } else {
                     (
                         r + gauss(rng, sig.range_sigma_m),
@@ -289,7 +293,12 @@ impl World for FleetWorld {
         }
     }
 
-    fn advance(&mut self, k: usize, beliefs: &[&dyn Navigator], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot> {
+    fn advance(
+        &mut self,
+        k: usize,
+        beliefs: &[&dyn Navigator],
+        heard: &mut [Vec<Measurement>],
+    ) -> Option<GuidanceSnapshot> {
         self.k = k;
         let dt = self.dt();
         let t1 = self.t_s(k);
@@ -337,7 +346,8 @@ impl World for FleetWorld {
             let white = params.attitude_white_deg.to_radians();
             let sog = a.truth.speed_m_s * (1.0 + a.errors.speed_scale) * a.truth.pitch_rad.cos(); // eq. 1
             let speed = if a.truth.thrusting { (sog + gauss(rng, params.speed_white_m_s)).max(0.0) } else { 0.0 };
-            let heading = a.truth.heading_rad + a.errors.heading_rad + gauss(rng, params.heading_white_deg.to_radians());
+            let heading =
+                a.truth.heading_rad + a.errors.heading_rad + gauss(rng, params.heading_white_deg.to_radians());
             let h = &mut heard[v];
             h.push(Measurement::new(t1, Kind::Speed { speed_m_s: speed }));
             h.push(Measurement::new(

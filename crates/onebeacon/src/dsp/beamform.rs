@@ -77,7 +77,14 @@ impl SegmentTransform {
     }
 
     /// `snap` becomes the in-band spectra of the segment from `start` of every capture.
-    pub fn transform(&mut self, captures: &[Vec<f64>], start: usize, band_hz: (f64, f64), fs: f64, snap: &mut Snapshot) {
+    pub fn transform(
+        &mut self,
+        captures: &[Vec<f64>],
+        start: usize,
+        band_hz: (f64, f64),
+        fs: f64,
+        snap: &mut Snapshot,
+    ) {
         let n = self.n;
         let df = fs / n as f64;
         let lo = (band_hz.0 / df).ceil() as usize;
@@ -89,7 +96,9 @@ impl SegmentTransform {
             for (i, v) in self.segment.iter_mut().enumerate() {
                 *v = x.get(start + i).copied().unwrap_or(0.0);
             }
-            self.r2c.process_with_scratch(&mut self.segment, &mut self.out, &mut self.scratch).expect("sizes match the plan");
+            self.r2c
+                .process_with_scratch(&mut self.segment, &mut self.out, &mut self.scratch)
+                .expect("sizes match the plan");
             spectrum.clear();
             if hi >= lo {
                 spectrum.extend_from_slice(&self.out[lo..=hi]);
@@ -123,6 +132,20 @@ impl Cbf {
         }
         sum.iter().map(|c| c.norm_sqr()).sum()
     }
+}
+
+/// The dot product of two slices with four partial sums (the compiler keeps them in
+/// vector registers; one running sum would wait on each addition).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca.remainder().iter().zip(cb.remainder()).map(|(x, y)| x * y).sum();
+    for (x, y) in ca.zip(cb) {
+        for i in 0..4 {
+            acc[i] += x[i] * y[i];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 fn freq_step(f: &[f64]) -> f64 {
@@ -165,8 +188,10 @@ pub struct SpdBf {
     /// One steering table per distinct pair length, for the frequencies `freqs`.
     steering: Vec<Steering>,
     freqs: Vec<f64>,
-    /// conj(X_i) X_j of the pair being computed.
+    /// conj(X_i) X_j of the pair being computed, and its real and imaginary parts.
     cross: Vec<Complex>,
+    cross_re: Vec<f64>,
+    cross_im: Vec<f64>,
 }
 
 /// A direction's table positions in every pair: its grid cell and the weight of the
@@ -203,6 +228,8 @@ impl SpdBf {
             steering,
             freqs: Vec::new(),
             cross: Vec::new(),
+            cross_re: Vec::new(),
+            cross_im: Vec::new(),
         }
     }
 
@@ -264,15 +291,14 @@ impl SpdBf {
             let energy: f64 = xi.iter().chain(xj).map(|c| c.norm_sqr()).sum();
             self.cross.clear();
             self.cross.extend(xi.iter().zip(xj).map(|(a, b)| a.conj() * b));
-            let (cr, ci): (Vec<f64>, Vec<f64>) = self.cross.iter().map(|c| (c.re, c.im)).unzip();
+            self.cross_re.clear();
+            self.cross_re.extend(self.cross.iter().map(|c| c.re));
+            self.cross_im.clear();
+            self.cross_im.extend(self.cross.iter().map(|c| c.im));
             let st = &self.steering[p.steering];
-            for (g, out) in table.iter_mut().enumerate() {
-                let (wr, wi) = (&st.re[g * k..(g + 1) * k], &st.im[g * k..(g + 1) * k]);
-                let mut acc = 0.0;
-                for i in 0..k {
-                    acc += cr[i] * wr[i] - ci[i] * wi[i];
-                }
-                *out = energy + 2.0 * acc;
+            for ((out, wr), wi) in table.iter_mut().zip(st.re.chunks_exact(k.max(1))).zip(st.im.chunks_exact(k.max(1)))
+            {
+                *out = energy + 2.0 * (dot(&self.cross_re, wr) - dot(&self.cross_im, wi));
             }
         }
     }
@@ -378,7 +404,11 @@ impl DirectionGrid {
     /// [`DirectionGrid::search`] with the grid's powers given by index (`at(i)`: look
     /// direction i of [`DirectionGrid::directions`], from precomputed lookups, say) and
     /// `power` for the refinement.
-    pub fn search_indexed(&self, at: impl Fn(usize) -> f64, power: impl Fn(&Vector3<f64>) -> f64) -> (Vector3<f64>, f64) {
+    pub fn search_indexed(
+        &self,
+        at: impl Fn(usize) -> f64,
+        power: impl Fn(&Vector3<f64>) -> f64,
+    ) -> (Vector3<f64>, f64) {
         let mut best = (0.0, 0.0, f64::MIN);
         for (i, (az, inc, _)) in self.dirs.iter().enumerate() {
             let p = at(i);

@@ -60,7 +60,7 @@ impl MatchedFilter {
         let norm = spectrum[lo..hi].iter().map(|c| c.norm_sqr()).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
         let scale = if phat { 1.0 } else { 1.0 / norm };
         let template_conj = spectrum[lo..hi].iter().map(|c| c.conj() * scale).collect();
-        let decimation = (1..=n).rev().find(|d| n % d == 0 && n / d >= 2 * (hi - lo)).unwrap_or(1);
+        let decimation = (1..=n).rev().find(|d| n.is_multiple_of(*d) && n / d >= 2 * (hi - lo)).unwrap_or(1);
         let ifft_baseband = FftPlanner::<f64>::new().plan_fft_inverse(n / decimation);
         Self { capture_len, n, template_conj, lo, hi, phat, r2c, ifft, decimation, ifft_baseband }
     }
@@ -265,15 +265,20 @@ pub fn estimate_range(envelopes: &[Vec<f64>], gate: usize, fs: f64, c: f64) -> R
         (Some(lo), Some(hi)) => hi - lo <= gate,
         _ => false,
     };
+    // eq. 4: the sum over pairs i < j of e_i e_j is ((sum e)^2 - sum e^2) / 2
+    let mut sum = vec![0.0; len];
     let mut combined = vec![0.0; len];
+    for e in envelopes {
+        for ((s, q), v) in sum.iter_mut().zip(combined.iter_mut()).zip(&e[..len]) {
+            *s += v;
+            *q += v * v;
+        }
+    }
     if envelopes.len() == 1 {
         combined.copy_from_slice(&envelopes[0][..len]);
-    }
-    for i in 0..envelopes.len() {
-        for j in i + 1..envelopes.len() {
-            for (n, y) in combined.iter_mut().enumerate() {
-                *y += envelopes[i][n] * envelopes[j][n];
-            }
+    } else {
+        for (q, s) in combined.iter_mut().zip(&sum) {
+            *q = 0.5 * (s * s - *q);
         }
     }
     let energy = combined.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -320,8 +325,9 @@ mod tests {
             MatchedFilter::new(&chirp.samples(fs), chirp.band(), fs, 8000),
             MatchedFilter::classical(&chirp.samples(fs), chirp.band(), fs, 8000),
         ] {
-            let x: Vec<f64> =
-                (0..8000).map(|n| chirp.value((n as f64 - 3210.4) / fs) + 0.3 * ((n * 7919 % 13) as f64 - 6.0)).collect();
+            let x: Vec<f64> = (0..8000)
+                .map(|n| chirp.value((n as f64 - 3210.4) / fs) + 0.3 * ((n * 7919 % 13) as f64 - 6.0))
+                .collect();
             let spectrum = mf.spectrum(&x);
             let (full, base, d) = (mf.analytic_of(&spectrum), mf.baseband_of(&spectrum), mf.decimation());
             assert!(d > 4, "{d}");

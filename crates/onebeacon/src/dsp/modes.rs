@@ -17,8 +17,10 @@ pub struct ModeBank {
 /// template's centre frequency and the look directions tried.
 #[derive(Debug)]
 struct Coherent {
-    /// `steer[t][look][m]` = exp(+j 2 pi fc_t tau_m(look)), tau_m = -r_m . u / c.
-    steer: Vec<Vec<Vec<Complex>>>,
+    /// `steer[t][look * M + m]` = exp(+j 2 pi fc_t tau_m(look)), tau_m = -r_m . u / c
+    /// (M elements, each template's looks in one contiguous table).
+    steer: Vec<Vec<Complex>>,
+    elements: usize,
 }
 
 impl ModeBank {
@@ -46,18 +48,15 @@ impl ModeBank {
             .map(|fc| {
                 looks
                     .iter()
-                    .map(|u| {
-                        elements
-                            .iter()
-                            .map(|r| {
-                                Complex::from_polar(1.0, std::f64::consts::TAU * fc * (-r.dot(u) / sound_speed_m_s))
-                            })
-                            .collect()
+                    .flat_map(|u| {
+                        elements.iter().map(move |r| {
+                            Complex::from_polar(1.0, std::f64::consts::TAU * fc * (-r.dot(u) / sound_speed_m_s))
+                        })
                     })
                     .collect()
             })
             .collect();
-        Self { coherent: Some(Coherent { steer }), ..Self::new(filters) }
+        Self { coherent: Some(Coherent { steer, elements: elements.len() }), ..Self::new(filters) }
     }
 
     /// The spectra of the captures, shared by every filter of the bank (and by a
@@ -126,15 +125,19 @@ impl ModeBank {
 impl Coherent {
     /// The largest coherent power over the look directions at the 8 strongest local
     /// maxima of the incoherent sum within `lags`.
-    fn best_alignment(&self, outputs: &[Vec<Complex>], sum: &[f64], lags: Range<usize>, steer: &[Vec<Complex>]) -> f64 {
+    fn best_alignment(&self, outputs: &[Vec<Complex>], sum: &[f64], lags: Range<usize>, steer: &[Complex]) -> f64 {
         let inner = lags.start.max(1)..lags.end.min(sum.len().saturating_sub(1));
         let mut peaks: Vec<usize> = inner.filter(|&n| sum[n] >= sum[n - 1] && sum[n] > sum[n + 1]).collect();
         peaks.sort_by(|a, b| sum[*b].total_cmp(&sum[*a]));
         peaks.truncate(8);
         let mut best = 0.0f64;
+        let mut y = vec![Complex::new(0.0, 0.0); self.elements];
         for &n in &peaks {
-            for w in steer {
-                let s: Complex = outputs.iter().zip(w).map(|(y, w)| y[n] * w).sum();
+            for (v, o) in y.iter_mut().zip(outputs) {
+                *v = o[n];
+            }
+            for w in steer.chunks_exact(self.elements) {
+                let s: Complex = y.iter().zip(w).map(|(y, w)| y * w).sum();
                 best = best.max(s.norm_sqr());
             }
         }

@@ -183,8 +183,7 @@ impl ModeReceiver {
             .map(|m| MatchedFilter::classical(&m.samples(fs), m.band(), fs, config.capture_len))
             .collect();
         let centres = waveforms.iter().map(|m| (m.f0_hz + m.f1_hz) / 2.0).collect();
-        let bank =
-            super::modes::ModeBank::with_array(filters, centres, elements.to_vec(), config.sound_speed_m_s);
+        let bank = super::modes::ModeBank::with_array(filters, centres, elements.to_vec(), config.sound_speed_m_s);
         let receivers = waveforms.iter().map(|w| Receiver::new(*w, elements, config.clone())).collect();
         Self { bank, receivers, spectra: Vec::new(), padded: Vec::new() }
     }

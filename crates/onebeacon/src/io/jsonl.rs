@@ -52,7 +52,9 @@ pub fn item_json(item: &Item) -> Value {
                 Kind::ArrayFix { range_m, azimuth_rad, inclination_rad, mode, .. } => json!({
                     "range_m": range_m, "azimuth_rad": azimuth_rad, "inclination_rad": inclination_rad, "mode": mode}),
                 // raw hydrophone data is not streamed as JSON: its length only
-                Kind::Capture(c) => json!({"elements": c.samples.len(), "samples": c.samples.first().map_or(0, Vec::len)}),
+                Kind::Capture(c) => {
+                    json!({"elements": c.samples.len(), "samples": c.samples.first().map_or(0, Vec::len)})
+                }
             };
             v["t_s"] = json!(t);
             v["kind"] = json!(m.name());
@@ -357,7 +359,8 @@ mod tests {
             Kind::Bearing { station: b, station_heading_rad: 0.3, azimuth_rad: -1.2, elevation_rad: 0.6 },
             Kind::Report { heading_rad: 1.1, speed_m_s: 1.5, depth_m: 30.0 },
         ];
-        let mut items: Vec<Item> = kinds.iter().map(|k| Item { t_s: 2.5, input: Input::Measurement(k.clone()) }).collect();
+        let mut items: Vec<Item> =
+            kinds.iter().map(|k| Item { t_s: 2.5, input: Input::Measurement(k.clone()) }).collect();
         items.push(Item {
             t_s: 3.0,
             input: Input::BeaconPosition { beacon_id: 7, position: Vector3::new(1.0, 2.0, 0.5) },

@@ -271,7 +271,6 @@ impl IusblNavigator {
         self.pings += 1;
     }
 
-
     /// The search window of the mode bank, in lags: around the predicted range once
     /// converged, the whole capture before.
     fn mode_lags(&self) -> std::ops::Range<usize> {
@@ -485,10 +484,8 @@ mod tests {
             let heading = std::f64::consts::FRAC_PI_2;
             let _ = nav.process(&Measurement::new(t, Kind::Depth { depth_m: 2.5 }));
             let _ = nav.process(&Measurement::new(t, Kind::Speed { speed_m_s: 1.0 }));
-            let _ = nav.process(&Measurement::new(
-                t,
-                Kind::Attitude { roll_rad: 0.0, pitch_rad: 0.0, heading_rad: heading },
-            ));
+            let _ = nav
+                .process(&Measurement::new(t, Kind::Attitude { roll_rad: 0.0, pitch_rad: 0.0, heading_rad: heading }));
             let d = rotation(0.0, 0.0, heading).transpose() * (beacon - vehicle);
             let (az, incl) = crate::dsp::beamform::azimuth_inclination(&d);
             let noise = |s: f64, rng: &mut rand_pcg::Pcg64| crate::measure::gauss(rng, s);
