@@ -49,8 +49,8 @@ pub struct IusblConfig {
     pub floor: f64,
     /// The beam pattern (CBF-normalised SPD power, in [0, 1]) raised to this power as
     /// the direction weight: an 8 cm array's main lobe is tens of degrees wide where the
-    /// direction is known to a few degrees (ours: 40, about a 6 deg lobe; tuned on
-    /// rypkema-m1 seed 1).
+    /// direction is known to a few degrees (ours: 40, chosen, not tuned; the factored
+    /// filter's errors on rypkema-m1 hardly move between 10 and 100, see README).
     pub beam_exponent: f64,
     /// Noise of a [`Kind::ArrayFix`]'s range and direction as the filter weighs them
     /// (Gaussian in range, von Mises-Fisher in direction): m, rad (ours: 0.7 m, 7 deg,
