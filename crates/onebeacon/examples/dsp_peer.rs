@@ -8,7 +8,9 @@
 //! `ping_full`: 4-template mode identification (with the coherent alignment), PHAT
 //! range, SPD-BF tables at 0.25 deg, the 2 deg direction search and its refinement;
 //! `ping_range`: PHAT range and SPD-BF only. Prints RESULT lines like the script's:
-//! ms per ping, median and min over `reps` after one warm-up.
+//! ms per ping, median and min over `reps` after one warm-up. With `STAGES=1` it also
+//! prints each stage's median (spectra, mode identification, pseudo-distributions,
+//! PHAT envelopes, eq. 4, SPD-BF tables, everything but the mode search).
 
 use onebeacon::dsp::beamform::{direction, pyramid_8cm};
 use onebeacon::dsp::matched_filter::MatchedFilter;

@@ -194,9 +194,14 @@ pub struct SpdBf {
     cross_im: Vec<f64>,
 }
 
-/// A direction's table positions in every pair: its grid cell and the weight of the
-/// cell's upper end ([`SpdBf::lookups`]).
-pub type Lookup = Vec<(u32, f32)>;
+/// A set of directions' table positions in every pair ([`SpdBf::lookups`]), pair by
+/// pair: each direction's grid cell and the weight of the cell's upper end.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lookup {
+    directions: usize,
+    cell: Vec<u32>,
+    frac: Vec<f64>,
+}
 
 impl SpdBf {
     /// An SPD beamformer whose conical grid is no coarser than `resolution_rad` at
@@ -321,31 +326,34 @@ impl SpdBf {
 
     /// The table positions of every direction of `dirs` in every pair, to compute once
     /// for a fixed set of directions (a search grid) and read with
-    /// [`SpdBf::power_at`].
+    /// [`SpdBf::powers_at`].
     pub fn lookups(&self, dirs: &[Vector3<f64>]) -> Lookup {
         let scale = (self.n_cos - 1) as f64 / 2.0;
-        dirs.iter()
-            .flat_map(|u| {
-                self.pairs.iter().map(move |p| {
-                    let x = ((p.axis.dot(u) + 1.0) * scale).clamp(0.0, (self.n_cos - 1) as f64);
-                    let g = (x.floor() as usize).min(self.n_cos - 2);
-                    (g as u32, (x - g as f64) as f32)
-                })
-            })
-            .collect()
+        let mut l = Lookup { directions: dirs.len(), cell: Vec::new(), frac: Vec::new() };
+        for p in &self.pairs {
+            for u in dirs {
+                let x = ((p.axis.dot(u) + 1.0) * scale).clamp(0.0, (self.n_cos - 1) as f64);
+                let g = (x.floor() as usize).min(self.n_cos - 2);
+                l.cell.push(g as u32);
+                l.frac.push(x - g as f64);
+            }
+        }
+        l
     }
 
-    /// The power toward direction `d` of the set `lookups` was computed for.
-    pub fn power_at(&self, lookups: &Lookup, d: usize) -> f64 {
-        let n = self.pairs.len();
-        lookups[d * n..(d + 1) * n]
-            .iter()
-            .zip(&self.tables)
-            .map(|(&(g, f), t)| {
-                let (g, f) = (g as usize, f64::from(f));
-                t[g] * (1.0 - f) + t[g + 1] * f
-            })
-            .sum()
+    /// The power toward every direction `lookups` was computed for, into `out`: pair by
+    /// pair, each pair's table read for all directions in one pass.
+    pub fn powers_at(&self, lookups: &Lookup, out: &mut Vec<f64>) {
+        let n = lookups.directions;
+        out.clear();
+        out.resize(n, 0.0);
+        for (p, t) in self.tables.iter().enumerate() {
+            let (cells, fracs) = (&lookups.cell[p * n..(p + 1) * n], &lookups.frac[p * n..(p + 1) * n]);
+            for ((o, &g), &f) in out.iter_mut().zip(cells).zip(fracs) {
+                let g = g as usize;
+                *o += t[g] + (t[g + 1] - t[g]) * f;
+            }
+        }
     }
 
     /// The SPD power toward `u` evaluated exactly (no grid), for reference.
@@ -576,9 +584,10 @@ mod tests {
             }
         }
         let dirs = DirectionGrid::new(7f64.to_radians()).directions();
-        let lookups = spd.lookups(&dirs);
-        for (d, u) in dirs.iter().enumerate() {
-            assert_relative_eq!(spd.power_at(&lookups, d), spd.power(u), max_relative = 1e-6);
+        let mut powers = Vec::new();
+        spd.powers_at(&spd.lookups(&dirs), &mut powers);
+        for (p, u) in powers.iter().zip(&dirs) {
+            assert_relative_eq!(*p, spd.power(u), max_relative = 1e-12);
         }
     }
 

@@ -66,6 +66,7 @@ pub struct Receiver {
     segment: SegmentTransform,
     snapshot: Snapshot,
     grid_lookups: std::sync::OnceLock<Lookup>,
+    grid_powers: Vec<f64>,
 }
 
 impl Receiver {
@@ -88,6 +89,7 @@ impl Receiver {
             segment: SegmentTransform::new((pulse + pulse / 4).next_power_of_two()),
             snapshot: Snapshot { freqs_hz: Vec::new(), spectra: Vec::new() },
             grid_lookups: std::sync::OnceLock::new(),
+            grid_powers: Vec::new(),
         }
     }
 
@@ -103,7 +105,9 @@ impl Receiver {
         let range = self.distributions(captures, spectra);
         let spd = &self.spd;
         let lookups = self.grid_lookups.get_or_init(|| spd.lookups(&self.grid.directions()));
-        let (direction, _) = self.grid.search_indexed(|i| spd.power_at(lookups, i), |u| spd.power(u));
+        spd.powers_at(lookups, &mut self.grid_powers);
+        let powers = &self.grid_powers;
+        let (direction, _) = self.grid.search_indexed(|i| powers[i], |u| spd.power(u));
         let (azimuth, inclination) = azimuth_inclination(&direction);
         PingEstimate { range, direction, azimuth, inclination }
     }

@@ -470,6 +470,30 @@ mod tests {
         assert_relative_eq!(paper_angles(0.0, 0.0, 90f64.to_radians()).2, 0.0);
     }
 
+    /// A silent capture, one of NaNs and an absurd fix leave the filter as it was
+    /// (no pulse: nothing to weigh; not finite: skipped).
+    #[test]
+    fn bad_pings_leave_the_filter_alone() {
+        let rx = ModeReceiver::new(
+            &crate::dsp::waveform::rypkema_modes(),
+            &crate::dsp::beamform::pyramid_8cm(),
+            crate::dsp::receiver::ReceiverConfig::default(),
+        );
+        let mut nav = IusblNavigator::new(IusblConfig::default(), Some(rx), 2);
+        nav.process(&Measurement::new(0.0, Kind::Depth { depth_m: 2.5 }));
+        let before = nav.filter().particles().to_vec();
+        let beacon = super::super::BeaconFix::fixed(0, Vector3::new(10.0, 0.0, 1.0));
+        for value in [0.0, f64::NAN] {
+            let capture = super::super::Capture { beacon, samples: vec![vec![value; 8000]; 5] };
+            let out = nav.process(&Measurement::new(1.0, Kind::Capture(std::sync::Arc::new(capture))));
+            assert!(matches!(out, Outcome::Rejected(..)), "{out:?}");
+        }
+        let fix = Kind::ArrayFix { beacon, range_m: f64::NAN, azimuth_rad: 0.0, inclination_rad: 1.0, mode: 0 };
+        assert_eq!(nav.process(&Measurement::new(2.0, fix)), Outcome::Skipped);
+        assert_eq!(nav.filter().particles(), &before[..]);
+        assert!(nav.estimate().position_ned_m.iter().all(|v| v.is_finite()));
+    }
+
     /// Fixes from a beacon 40 m north-east of a vehicle driving east: the relative
     /// estimate converges to the truth and the modes are confirmed after three.
     #[test]
