@@ -333,10 +333,11 @@ impl IusblNavigator {
     }
 
     /// The vehicle's horizontal position relative to the beacon (eq. 17-18), and its
-    /// covariance.
+    /// covariance: the filter's, moved on by the displacement dead-reckoned since the
+    /// last ping (the particles move at pings only).
     fn relative(&self) -> (Vector2<f64>, Matrix2<f64>) {
         let (mean, cov) = self.filter.mean_covariance();
-        (-mean, cov)
+        (self.displacement_m - mean, cov)
     }
 }
 
@@ -418,7 +419,10 @@ impl Navigator for IusblNavigator {
                 .particles()
                 .iter()
                 .step_by(step)
-                .map(|p| Vector3::new(origin.x - p.x, origin.y - p.y, self.depth_m.unwrap_or(0.0)))
+                .map(|p| {
+                    let d = self.displacement_m;
+                    Vector3::new(origin.x + d.x - p.x, origin.y + d.y - p.y, self.depth_m.unwrap_or(0.0))
+                })
                 .collect(),
         )
     }
@@ -527,6 +531,16 @@ mod tests {
                 assert!((e.position_ned_m.xy() - vehicle.xy()).norm() < 3.0, "{k}: {} vs {vehicle}", e.position_ned_m);
             }
         }
+        // between pings the estimate moves on by dead reckoning: 1 m/s east for 1 s
+        let before = nav.estimate().position_ned_m;
+        for i in 1..=10 {
+            let t = 119.02 + 0.1 * i as f64;
+            nav.process(&Measurement::new(t, Kind::Speed { speed_m_s: 1.0 }));
+            let east = Kind::Attitude { roll_rad: 0.0, pitch_rad: 0.0, heading_rad: std::f64::consts::FRAC_PI_2 };
+            nav.process(&Measurement::new(t, east));
+        }
+        let moved = nav.estimate().position_ned_m - before;
+        assert!((moved.y - 1.0).abs() < 1e-9 && moved.x.abs() < 1e-9, "{moved}");
         assert_eq!(modes[1], None);
         assert_eq!(modes[2], Some(0));
         assert_eq!(modes[61], Some(0));
