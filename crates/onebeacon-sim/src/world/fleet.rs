@@ -174,7 +174,7 @@ impl FleetWorld {
 
     /// What AUV `v` hears of ping `p`, if anything.
     fn hear(&mut self, v: usize, p: &Sent, gps: Vector3<f64>) -> Option<Measurement> {
-        let sig = self.s.signal.clone();
+        let sig = &self.s.signal;
         let auv = &mut self.auvs[v];
         let at = auv.truth.position_ned_m;
         if at.z < SURFACE_M || auv.launch_s > p.t_tx {

@@ -188,8 +188,7 @@ pub struct SpdBf {
     /// One steering table per distinct pair length, for the frequencies `freqs`.
     steering: Vec<Steering>,
     freqs: Vec<f64>,
-    /// conj(X_i) X_j of the pair being computed, and its real and imaginary parts.
-    cross: Vec<Complex>,
+    /// The real and imaginary parts of conj(X_i) X_j of the pair being computed.
     cross_re: Vec<f64>,
     cross_im: Vec<f64>,
 }
@@ -232,7 +231,6 @@ impl SpdBf {
             n_cos,
             steering,
             freqs: Vec::new(),
-            cross: Vec::new(),
             cross_re: Vec::new(),
             cross_im: Vec::new(),
         }
@@ -294,12 +292,13 @@ impl SpdBf {
         for (p, table) in self.pairs.iter().zip(self.tables.iter_mut()) {
             let (xi, xj) = (&snap.spectra[p.i], &snap.spectra[p.j]);
             let energy: f64 = xi.iter().chain(xj).map(|c| c.norm_sqr()).sum();
-            self.cross.clear();
-            self.cross.extend(xi.iter().zip(xj).map(|(a, b)| a.conj() * b));
             self.cross_re.clear();
-            self.cross_re.extend(self.cross.iter().map(|c| c.re));
             self.cross_im.clear();
-            self.cross_im.extend(self.cross.iter().map(|c| c.im));
+            for (a, b) in xi.iter().zip(xj) {
+                let c = a.conj() * b;
+                self.cross_re.push(c.re);
+                self.cross_im.push(c.im);
+            }
             let st = &self.steering[p.steering];
             for ((out, wr), wi) in table.iter_mut().zip(st.re.chunks_exact(k.max(1))).zip(st.im.chunks_exact(k.max(1)))
             {

@@ -332,6 +332,12 @@ impl IusblNavigator {
         Outcome::Accepted(f64::NAN, f64::NAN)
     }
 
+    /// The beacon's position as its last ping reported it (the beacon-centred frame's
+    /// origin when unknown).
+    fn origin(&self) -> Vector3<f64> {
+        self.beacon.map(|(_, p)| p).filter(|p| p.iter().all(|v| v.is_finite())).unwrap_or_default()
+    }
+
     /// The vehicle's horizontal position relative to the beacon (eq. 17-18), and its
     /// covariance: the filter's, moved on by the displacement dead-reckoned since the
     /// last ping (the particles move at pings only).
@@ -393,7 +399,7 @@ impl Navigator for IusblNavigator {
 
     fn estimate(&self) -> Estimate {
         let (rel, cov) = self.relative();
-        let origin = self.beacon.map(|(_, p)| p).filter(|p| p.iter().all(|v| v.is_finite())).unwrap_or_default();
+        let origin = self.origin();
         let heading = self.attitude.back().map_or(0.0, |a| a.heading);
         let (roll, pitch) = self.attitude.back().map_or((0.0, 0.0), |a| (a.roll, a.pitch));
         Estimate {
@@ -412,7 +418,7 @@ impl Navigator for IusblNavigator {
     }
 
     fn position_sample(&self, m: usize) -> Option<Vec<Vector3<f64>>> {
-        let origin = self.beacon.map(|(_, p)| p).filter(|p| p.iter().all(|v| v.is_finite())).unwrap_or_default();
+        let origin = self.origin();
         let step = (self.filter.particles().len() / m.max(1)).max(1);
         Some(
             self.filter
