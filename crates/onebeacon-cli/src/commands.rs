@@ -122,6 +122,7 @@ pub fn mc(
     let s = scenario::load(name)?;
     let runs = runs.unwrap_or(s.runs());
     let seed = seed.unwrap_or(s.seed());
+    // an unwritable --out fails before the runs, not after
     let staging = out.as_deref().map(Staging::new).transpose()?;
 
     let total = (runs * s.cells().len()) as u64;
@@ -131,10 +132,22 @@ pub fn mc(
     let wall_s = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let json_text = report::mc_json(&s, &result, wall_s);
+    write_mc(&s, &result, wall_s, staging, json)
+}
+
+/// What `mc` and `mc merge` print (the table, or with `json` the JSON object) and write
+/// in `staging`'s directory (mc.json, mc_error.png).
+pub fn write_mc(
+    s: &onebeacon_sim::Scenario,
+    result: &onebeacon_sim::montecarlo::McResult,
+    wall_s: f64,
+    staging: Option<Staging>,
+    json: bool,
+) -> Result<()> {
+    let json_text = report::mc_json(s, result, wall_s);
     if let Some(staging) = staging {
         staging.write("mc.json", json_text.as_bytes())?;
-        plot::mc_errors(&staging.file("mc_error.png"), &s, &result).context("cannot draw mc_error.png")?;
+        plot::mc_errors(&staging.file("mc_error.png"), s, result).context("cannot draw mc_error.png")?;
         let files = staging.commit()?;
         if !json {
             for f in files {
@@ -145,7 +158,7 @@ pub fn mc(
     if json {
         outln!("{json_text}");
     } else {
-        out!("{}", report::mc_table(&s, &result, wall_s));
+        out!("{}", report::mc_table(s, result, wall_s));
     }
     Ok(())
 }

@@ -15,6 +15,7 @@ macro_rules! outln {
     }};
 }
 
+mod campaign;
 mod commands;
 mod dsp;
 mod fleet;
@@ -73,10 +74,16 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
-    /// Monte Carlo over the scenario's sweep: a table per estimator, or JSON.
+    /// Monte Carlo over the scenario's sweep: a table per estimator, or JSON. With
+    /// --shard I/N, one share of it (for many machines; `mc merge` combines the shares);
+    /// with --slurm N, a Slurm array job of N shards and the merge after them.
+    #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
     Mc {
+        #[command(subcommand)]
+        merge: Option<McCommand>,
         /// Built-in scenario name or path of a TOML file.
-        scenario: String,
+        #[arg(required = true)]
+        scenario: Option<String>,
         /// Runs per sweep cell (default: the scenario's `runs`).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
         runs: Option<u32>,
@@ -86,12 +93,33 @@ enum Command {
         /// Worker threads (default: one per core). Results do not depend on it.
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
         threads: Option<u16>,
-        /// Also write mc.json and plots to this directory.
+        /// Also write mc.json and plots to this directory; with --shard, where the
+        /// partial (partial-I-of-N.json) goes; with --slurm, where campaign.sh goes.
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
         /// Print one JSON object on stdout instead of the table.
-        #[arg(long)]
+        #[arg(long, conflicts_with_all = ["shard", "slurm"])]
         json: bool,
+        /// Compute share I of N of the (cell, run) pairs (pair j = cell x runs + run
+        /// goes to share j mod N) and write it as DIR/partial-I-of-N.json (needs --out).
+        #[arg(long, value_name = "I/N", requires = "out", conflicts_with = "slurm")]
+        shard: Option<onebeacon_sim::montecarlo::Shard>,
+        /// Write (with --out DIR) or print a Slurm submission script: an array job of N
+        /// shards (sbatch --array=0-(N-1)) and a merge job after them.
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        slurm: Option<u32>,
+        /// --slurm: the partition (sbatch --partition).
+        #[arg(long, requires = "slurm")]
+        partition: Option<String>,
+        /// --slurm: each job's time limit (sbatch --time, e.g. 02:00:00).
+        #[arg(long, requires = "slurm")]
+        time: Option<String>,
+        /// --slurm: the account to charge (sbatch --account).
+        #[arg(long, requires = "slurm")]
+        account: Option<String>,
+        /// --slurm: cores per shard (sbatch --cpus-per-task; the shard's --threads).
+        #[arg(long, requires = "slurm", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=1024))]
+        cpus_per_task: u16,
     },
     /// Recorded runs of a fleet scenario (rypkema-m1, rypkema-m6) with its mission
     /// statistics: the 2-norm error's 68 % and 95 % per AUV and estimator and for the
@@ -189,6 +217,24 @@ enum Command {
     Guidance {
         #[command(subcommand)]
         command: GuidanceCommand,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+enum McCommand {
+    /// Combine the partials of every shard of `mc --shard I/N` into what the unsharded
+    /// `mc` gives, bit for bit; refuses partials of different scenarios, seeds, runs or
+    /// versions, and missing or duplicate shares.
+    Merge {
+        /// Directories holding partial-*-of-*.json files, or partial files.
+        #[arg(required = true, value_name = "DIR|FILE")]
+        partials: Vec<PathBuf>,
+        /// Also write mc.json and plots to this directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Print one JSON object on stdout instead of the table.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -308,8 +354,36 @@ fn main() -> ExitCode {
         Command::Run { scenario, seed, run, ping, message, out } => {
             commands::run(&scenario, seed, run, ping, message, out)
         }
-        Command::Mc { scenario, runs, seed, threads, out, json } => {
-            commands::mc(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), out, json)
+        Command::Mc { merge: Some(McCommand::Merge { partials, out, json }), .. } => {
+            campaign::merge_partials(&partials, out, json)
+        }
+        Command::Mc {
+            merge: None,
+            scenario,
+            runs,
+            seed,
+            threads,
+            out,
+            json,
+            shard,
+            slurm,
+            partition,
+            time,
+            account,
+            cpus_per_task,
+        } => {
+            let scenario = scenario.expect("clap requires it without a subcommand");
+            let (runs, threads) = (runs.map(|r| r as usize), threads.map(usize::from));
+            match (shard, slurm) {
+                (Some(shard), _) => {
+                    campaign::shard(&scenario, runs, seed, threads, shard, &out.expect("clap requires it"))
+                }
+                (None, Some(n)) => {
+                    let slurm = campaign::Slurm { shards: n as usize, partition, time, cpus_per_task, account };
+                    campaign::slurm(&scenario, runs, seed, &slurm, out)
+                }
+                (None, None) => commands::mc(&scenario, runs, seed, threads, out, json),
+            }
         }
         Command::Fleet { scenario, runs, seed, threads, snapshot_s, out, json } => {
             fleet::fleet(&scenario, runs.map(|r| r as usize), seed, threads.map(usize::from), snapshot_s, out, json)

@@ -155,6 +155,88 @@ fn mc_out_writes_json_and_plot() {
     assert_eq!(v["cells"].as_array().unwrap().len(), 4);
 }
 
+#[test]
+fn sharded_mc_merges_into_the_unsharded_cells() {
+    let dir = scratch("shards");
+    let scenario = short_scenario(&dir);
+    let json = |out: Output| -> serde_json::Value {
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        serde_json::from_str(&text(&out.stdout)).unwrap()
+    };
+    let whole = json(run(&["mc", &scenario, "--runs", "5", "--seed", "4", "--json"]));
+    let parts = dir.join("parts");
+    for i in 0..3 {
+        let out = run(&[
+            "mc",
+            &scenario,
+            "--runs",
+            "5",
+            "--seed",
+            "4",
+            "--shard",
+            &format!("{i}/3"),
+            "--out",
+            parts.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+    }
+    let merged = json(run(&["mc", "merge", parts.to_str().unwrap(), "--json"]));
+    assert_eq!(merged["cells"], whole["cells"]);
+    assert_eq!(merged["scenario"], "short");
+    // the table, and a shard missing: one line, exit 2
+    let table = run(&["mc", "merge", parts.to_str().unwrap()]);
+    assert!(text(&table.stdout).contains("Mean positioning error"), "{}", text(&table.stdout));
+    let one = parts.join("partial-1-of-3.json");
+    let out = run(&["mc", "merge", one.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("missing shard(s) 0, 2 of 3"), "{err}");
+}
+
+#[test]
+fn slurm_script_has_the_array_and_the_merge_after_it() {
+    let dir = scratch("slurm");
+    let scenario = short_scenario(&dir);
+    let campaign = dir.join("campaign");
+    let out = run(&[
+        "mc",
+        &scenario,
+        "--runs",
+        "5",
+        "--slurm",
+        "4",
+        "--partition",
+        "long",
+        "--cpus-per-task",
+        "2",
+        "--out",
+        campaign.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let script = std::fs::read_to_string(campaign.join("campaign.sh")).unwrap();
+    for needle in [
+        "--array=0-3",
+        "--dependency=afterok:",
+        "--partition='long'",
+        "--cpus-per-task=2",
+        "--shard \"\\${SLURM_ARRAY_TASK_ID}/4\"",
+        "mc merge",
+    ] {
+        assert!(script.contains(needle), "{needle} not in\n{script}");
+    }
+    // the campaign's scenario is the canonical TOML of the one named
+    let copy = std::fs::read_to_string(campaign.join("scenario.toml")).unwrap();
+    assert!(copy.contains("name = \"short\""), "{copy}");
+    // bash can read it
+    let syntax = Command::new("bash").arg("-n").arg(campaign.join("campaign.sh")).output().unwrap();
+    assert!(syntax.status.success(), "{}", text(&syntax.stderr));
+    // more shards than (cell, run) pairs: refused
+    let out = run(&["mc", &scenario, "--runs", "2", "--slurm", "5"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("at most that many shards"), "{}", text(&out.stderr));
+}
+
 /// Each bad input: exit status 2, one line on stderr naming the problem, no panic, no
 /// output directory.
 #[test]

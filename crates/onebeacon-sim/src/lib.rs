@@ -9,6 +9,7 @@
 //! - [`run`]: one simulated run, a pure function of (scenario, sweep cell, seed, run);
 //! - [`metrics`]: per-run error statistics and their Monte Carlo aggregation;
 //! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count;
+//! - [`partial`]: one share of a sharded sweep as a file, and the merge of the shares;
 //! - [`replay`]: real logs (CSV files described by a TOML file) through the estimators.
 
 pub mod acoustics;
@@ -16,6 +17,7 @@ mod engine;
 pub mod fleet;
 pub mod metrics;
 pub mod montecarlo;
+pub mod partial;
 pub mod pcrb;
 pub mod replay;
 pub mod run;

@@ -29,6 +29,62 @@ pub struct RunMetrics {
     pub mean_error_second_half_m: f64,
 }
 
+impl RunMetrics {
+    /// Words in [`RunMetrics::to_words`].
+    pub const WORDS: usize = 11;
+
+    /// The fields as 64-bit words, floats as their bit patterns: exact, and able to
+    /// carry infinities (a shard's partial, [`crate::partial`]).
+    pub fn to_words(&self) -> [u64; Self::WORDS] {
+        // no `..`: a new field must be added here
+        let RunMetrics {
+            mean_error_m,
+            error_variance_m2,
+            mse_m2,
+            max_error_m,
+            final_error_m,
+            etd_max_pct,
+            etd_mean_pct,
+            nees_mean,
+            failed_updates,
+            mean_error_first_half_m,
+            mean_error_second_half_m,
+        } = *self;
+        let f = f64::to_bits;
+        [
+            f(mean_error_m),
+            f(error_variance_m2),
+            f(mse_m2),
+            f(max_error_m),
+            f(final_error_m),
+            f(etd_max_pct),
+            f(etd_mean_pct),
+            f(nees_mean),
+            failed_updates,
+            f(mean_error_first_half_m),
+            f(mean_error_second_half_m),
+        ]
+    }
+
+    /// The inverse of [`RunMetrics::to_words`]; `w` has [`RunMetrics::WORDS`] words.
+    pub fn from_words(w: &[u64]) -> RunMetrics {
+        let f = |i: usize| f64::from_bits(w[i]);
+        RunMetrics {
+            mean_error_m: f(0),
+            error_variance_m2: f(1),
+            mse_m2: f(2),
+            max_error_m: f(3),
+            final_error_m: f(4),
+            etd_max_pct: f(5),
+            etd_mean_pct: f(6),
+            nees_mean: f(7),
+            failed_updates: w[8],
+            mean_error_first_half_m: f(9),
+            mean_error_second_half_m: f(10),
+        }
+    }
+}
+
 /// Accumulates one estimator's errors step by step.
 #[derive(Debug, Clone, Default)]
 pub struct ErrorAccumulator {

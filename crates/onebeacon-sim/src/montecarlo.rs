@@ -3,6 +3,10 @@
 //! sequentially, so the output is bit-identical for any number of threads. Cells are
 //! done one after the other (their runs in parallel) so that only one cell's per-run
 //! data is held at a time.
+//!
+//! A sweep can also be cut into shares ([`Shard`]) run on different machines: each
+//! share's [`RunSummary`]s ([`monte_carlo_shard`]), gathered and [`aggregate`]d, give
+//! the same [`McResult`] bit for bit ([`crate::partial`] is their file).
 
 use crate::metrics::{CellSummary, RunMetrics, summarise};
 use crate::pcrb::{bearing_rmse_bound, horizontal_rmse_bound};
@@ -56,36 +60,173 @@ pub fn monte_carlo(
     threads: Option<usize>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<McResult, ThreadPoolError> {
-    let work = || scenario.cells().iter().map(|cell| run_cell(scenario, cell, runs, seed, progress)).collect();
-    let cells = match threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| ThreadPoolError { threads: n, message: e.to_string() })?
-            .install(work),
-        None => work(),
-    };
+    let cells = in_pool(threads, || {
+        scenario
+            .cells()
+            .iter()
+            .enumerate()
+            .map(|(c, cell)| {
+                let per_run: Vec<RunSummary> =
+                    (0..runs as u64).into_par_iter().map(|r| run_one(scenario, cell, c, seed, r, progress)).collect();
+                summarise_cell(scenario, cell, &per_run)
+            })
+            .collect()
+    })?;
     Ok(McResult { runs, seed, cells })
 }
 
-/// What the aggregation keeps of one run: its metrics and its acoustic information.
-type RunSummary = (Vec<RunMetrics>, Vec<(usize, usize, DMatrix<f64>)>);
+/// What the aggregation keeps of one run of one cell: its metrics (one per track) and
+/// its acoustic information (vehicle, step, matrix). A shard's partial result is a list
+/// of these.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    /// The cell's index in [`Scenario::cells`].
+    pub cell: usize,
+    pub run: u64,
+    pub metrics: Vec<RunMetrics>,
+    pub information: Vec<(usize, usize, DMatrix<f64>)>,
+}
 
-fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: &(dyn Fn() + Sync)) -> CellResult {
-    let per_run: Vec<RunSummary> = (0..runs as u64)
-        .into_par_iter()
-        .map(|r| {
-            let out = simulate(scenario, cell, seed, r, false);
-            progress();
-            (out.metrics, out.information)
-        })
-        .collect();
+/// Share `index` of `count` of a sweep's (cell, run) pairs: pair j = cell x runs + run
+/// belongs to the share j mod `count`, so that every share holds runs of every cell
+/// and the shares' costs stay alike when cells differ in cost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl Shard {
+    /// The whole sweep in one share.
+    pub const WHOLE: Shard = Shard { index: 0, count: 1 };
+
+    /// The (cell, run) pairs of this share, in (cell, run) order.
+    pub fn pairs(self, cells: usize, runs: usize) -> impl Iterator<Item = (usize, u64)> {
+        (0..cells * runs).skip(self.index).step_by(self.count.max(1)).map(move |j| (j / runs, (j % runs) as u64))
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    /// `I/N` with 0 <= I < N.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("`{s}`: expected I/N with 0 <= I < N (e.g. 0/4), N at most 100000");
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count): (usize, usize) =
+            (i.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+        if count == 0 || index >= count || count > 100_000 {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, ThreadPoolError> {
+    match threads {
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| ThreadPoolError { threads: n, message: e.to_string() })?
+            .install(work)),
+        None => Ok(work()),
+    }
+}
+
+/// Runs one share of the sweep ([`Shard`]) and returns its runs' summaries in (cell,
+/// run) order; [`aggregate`] turns the summaries of all shares into the [`McResult`]
+/// that [`monte_carlo`] gives, bit for bit. `progress` is called once per finished run.
+pub fn monte_carlo_shard(
+    scenario: &Scenario,
+    runs: usize,
+    seed: u64,
+    shard: Shard,
+    threads: Option<usize>,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<RunSummary>, ThreadPoolError> {
+    let cells = scenario.cells();
+    let pairs: Vec<(usize, u64)> = shard.pairs(cells.len(), runs).collect();
+    in_pool(threads, || {
+        pairs.into_par_iter().map(|(c, r)| run_one(scenario, &cells[c], c, seed, r, progress)).collect()
+    })
+}
+
+fn run_one(
+    scenario: &Scenario,
+    cell: &Cell,
+    index: usize,
+    seed: u64,
+    run: u64,
+    progress: &(dyn Fn() + Sync),
+) -> RunSummary {
+    let out = simulate(scenario, cell, seed, run, false);
+    progress();
+    RunSummary { cell: index, run, metrics: out.metrics, information: out.information }
+}
+
+/// Why summaries do not make a whole sweep.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum AggregateError {
+    #[error("run {run} of cell {cell} is missing")]
+    Missing { cell: usize, run: u64 },
+    #[error("run {run} of cell {cell} is given twice")]
+    Duplicate { cell: usize, run: u64 },
+    #[error("run {run} of cell {cell} is outside the sweep ({cells} cells x {runs} runs)")]
+    Outside { cell: usize, run: u64, cells: usize, runs: usize },
+    #[error("run {run} of cell {cell} has {got} tracks' metrics; the scenario has {tracks} tracks")]
+    Tracks { cell: usize, run: u64, got: usize, tracks: usize },
+}
+
+/// Aggregates the summaries of every (cell, run) pair of the sweep, in any order, into
+/// the result [`monte_carlo`] gives for (scenario, runs, seed).
+pub fn aggregate(
+    scenario: &Scenario,
+    runs: usize,
+    seed: u64,
+    summaries: Vec<RunSummary>,
+) -> Result<McResult, AggregateError> {
+    let cells = scenario.cells();
+    let tracks = scenario.tracks().len();
+    let mut slots: Vec<Option<RunSummary>> = vec![None; cells.len() * runs];
+    for s in summaries {
+        let (cell, run) = (s.cell, s.run);
+        if cell >= cells.len() || run >= runs as u64 {
+            return Err(AggregateError::Outside { cell, run, cells: cells.len(), runs });
+        }
+        if s.metrics.len() != tracks {
+            return Err(AggregateError::Tracks { cell, run, got: s.metrics.len(), tracks });
+        }
+        let slot = &mut slots[cell * runs + run as usize];
+        if slot.is_some() {
+            return Err(AggregateError::Duplicate { cell, run });
+        }
+        *slot = Some(s);
+    }
+    let mut slots = slots.into_iter();
+    let mut results = Vec::with_capacity(cells.len());
+    for (c, cell) in cells.iter().enumerate() {
+        let per_run: Vec<RunSummary> = (0..runs as u64)
+            .map(|run| slots.next().flatten().ok_or(AggregateError::Missing { cell: c, run }))
+            .collect::<Result<_, _>>()?;
+        results.push(summarise_cell(scenario, cell, &per_run));
+    }
+    Ok(McResult { runs, seed, cells: results })
+}
+
+/// The cell's result from its runs' summaries, in run order.
+fn summarise_cell(scenario: &Scenario, cell: &Cell, per_run: &[RunSummary]) -> CellResult {
+    let runs = per_run.len();
     let estimators = scenario
         .tracks()
         .into_iter()
         .enumerate()
         .map(|(e, track)| {
-            let metrics: Vec<_> = per_run.iter().map(|(m, _)| m[e]).collect();
+            let metrics: Vec<_> = per_run.iter().map(|s| s.metrics[e]).collect();
             (track, summarise(&metrics))
         })
         .collect();
@@ -93,8 +234,8 @@ fn run_cell(scenario: &Scenario, cell: &Cell, runs: usize, seed: u64, progress: 
     // with an acoustic measurement, not per step (memory follows the pings)
     let sum_information = |vehicles: usize| {
         let mut sum: Vec<BTreeMap<usize, DMatrix<f64>>> = vec![BTreeMap::new(); vehicles];
-        for (_, info) in &per_run {
-            for (v, k, m) in info {
+        for s in per_run {
+            for (v, k, m) in &s.information {
                 sum[*v].entry(*k).and_modify(|s| *s += m).or_insert_with(|| m.clone());
             }
         }

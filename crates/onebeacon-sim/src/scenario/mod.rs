@@ -233,6 +233,17 @@ impl Scenario {
             Scenario::Fleet(_) => Cell::Fleet,
         }
     }
+    /// The scenario as TOML, every key written out: [`parse`] gives it back equal,
+    /// whatever file or built-in it came from (what a shard's partial records).
+    pub fn to_toml(&self) -> String {
+        let text = match self {
+            Scenario::FixedBeacon(s) => toml::to_string(s),
+            Scenario::MovingBeacon(s) => toml::to_string(s),
+            Scenario::PassiveUsbl(s) => toml::to_string(s),
+            Scenario::Fleet(s) => toml::to_string(s),
+        };
+        text.expect("a parsed scenario is representable in TOML")
+    }
     /// The sweep cells of `mc`, in order.
     pub fn cells(&self) -> Vec<Cell> {
         match self {

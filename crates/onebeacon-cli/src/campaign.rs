@@ -1,0 +1,181 @@
+//! Campaigns on many machines: `mc --shard I/N` (one share of the sweep as a partial
+//! file), `mc merge` (the partials into the unsharded result) and `mc --slurm N` (a
+//! Slurm array job of the shards with a merge job after it).
+
+use crate::output::Staging;
+use crate::{BadInput, commands};
+use anyhow::{Context, Result};
+use onebeacon_sim::Scenario;
+use onebeacon_sim::montecarlo::{Shard, monte_carlo_shard};
+use onebeacon_sim::partial::{MergeError, Partial, merge, read_partials};
+use onebeacon_sim::scenario;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// `onebeacon mc SCENARIO --shard I/N --out DIR`: writes DIR/partial-I-of-N.json beside
+/// the other shards' files (never half-written: staged, then moved in).
+pub fn shard(
+    name: &str,
+    runs: Option<usize>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+    shard: Shard,
+    out: &Path,
+) -> Result<()> {
+    let s = scenario::load(name)?;
+    let runs = runs.unwrap_or(s.runs());
+    let seed = seed.unwrap_or(s.seed());
+    let staging = Staging::beside(out, &format!("partial-{}-of-{}", shard.index, shard.count))?;
+    let total = shard.pairs(s.cells().len(), runs).count() as u64;
+    let bar = crate::progress_bar(total, "runs", format!("mc {} shard {shard}", s.name()));
+    let start = Instant::now();
+    let summaries = monte_carlo_shard(&s, runs, seed, shard, threads, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let partial = Partial::new(&s, runs, seed, shard, start.elapsed().as_secs_f64(), &summaries);
+    staging.write(&partial.file_name(), partial.to_json().as_bytes())?;
+    for f in staging.move_files_to(out)? {
+        eprintln!("wrote {} ({total} of {} runs)", f.display(), runs * s.cells().len());
+    }
+    Ok(())
+}
+
+/// `onebeacon mc merge DIR|FILE... [--out DIR] [--json]`: what `mc` prints and writes,
+/// from the partials of every shard.
+pub fn merge_partials(paths: &[PathBuf], out: Option<PathBuf>, json: bool) -> Result<()> {
+    let bad = |e: MergeError| BadInput(e.to_string());
+    let merged = merge(read_partials(paths).map_err(bad)?).map_err(bad)?;
+    let staging = out.as_deref().map(Staging::new).transpose()?;
+    commands::write_mc(&merged.scenario, &merged.result, merged.wall_s, staging, json)
+}
+
+/// Slurm settings of `mc --slurm N`.
+pub struct Slurm {
+    pub shards: usize,
+    pub partition: Option<String>,
+    pub time: Option<String>,
+    pub cpus_per_task: u16,
+    pub account: Option<String>,
+}
+
+/// `onebeacon mc SCENARIO --slurm N [--partition P] [--time T] [--cpus-per-task C]
+/// [--account A] [--out DIR]`: with --out, DIR/campaign.sh (submit it with `bash`) and
+/// DIR/scenario.toml; without, campaign.sh on stdout for the user to adapt.
+pub fn slurm(name: &str, runs: Option<usize>, seed: Option<u64>, slurm: &Slurm, out: Option<PathBuf>) -> Result<()> {
+    let s = scenario::load(name)?;
+    let (runs, seed) = (runs.unwrap_or(s.runs()), seed.unwrap_or(s.seed()));
+    let pairs = runs * s.cells().len();
+    if slurm.shards > pairs {
+        return Err(BadInput(format!(
+            "--slurm {}: {} has {pairs} (cell, run) pairs ({} cells x {runs} runs); at most that many shards",
+            slurm.shards,
+            s.name(),
+            s.cells().len()
+        ))
+        .into());
+    }
+    let exe = std::env::current_exe().context("cannot find the onebeacon executable")?;
+    match out {
+        Some(dir) => {
+            let dir = absolute(&dir)?;
+            let staging = Staging::beside(&dir, "campaign")?;
+            let scenario_file = dir.join("scenario.toml");
+            staging.write("scenario.toml", s.to_toml().as_bytes())?;
+            let script = campaign_script(&s, &exe, &scenario_file.display().to_string(), runs, seed, slurm, &dir);
+            staging.write("campaign.sh", script.as_bytes())?;
+            let files = staging.move_files_to(&dir)?;
+            for f in &files {
+                eprintln!("wrote {}", f.display());
+            }
+            outln!("submit with: bash {}", dir.join("campaign.sh").display());
+        }
+        None => {
+            // a file is named by its absolute path: the jobs may start elsewhere
+            let source = if scenario::builtin(name).is_some() {
+                name.to_string()
+            } else {
+                absolute(Path::new(name))?.display().to_string()
+            };
+            let dir = absolute(&PathBuf::from("out").join(format!("{}-campaign", s.name())))?;
+            out!("{}", campaign_script(&s, &exe, &source, runs, seed, slurm, &dir));
+        }
+    }
+    Ok(())
+}
+
+fn absolute(p: &Path) -> Result<PathBuf> {
+    std::path::absolute(p).map_err(|e| BadInput(format!("{}: {e}", p.display())).into())
+}
+
+/// Single quotes for the shell.
+fn quote(s: &str) -> String {
+    format!("'{}'", s.replace('\'', r"'\''"))
+}
+
+/// The submission script: the array job of the shards, then the merge job after every
+/// shard succeeded (`afterok`).
+fn campaign_script(
+    s: &Scenario,
+    exe: &Path,
+    scenario: &str,
+    runs: usize,
+    seed: u64,
+    slurm: &Slurm,
+    dir: &Path,
+) -> String {
+    let n = slurm.shards;
+    let mut options = format!(" --cpus-per-task={}", slurm.cpus_per_task);
+    for (flag, value) in [("partition", &slurm.partition), ("time", &slurm.time), ("account", &slurm.account)] {
+        if let Some(v) = value {
+            options.push_str(&format!(" --{flag}={}", quote(v)));
+        }
+    }
+    let name = s.name();
+    let cells = s.cells().len();
+    format!(
+        r#"#!/usr/bin/env bash
+# onebeacon mc {name} on Slurm: {cells} cell(s) x {runs} runs (seed {seed}) cut into {n} shards,
+# an array job (sbatch --array=0-{last}) whose task I runs `mc --shard I/{n}`, and a merge
+# job that starts when every shard succeeded (afterok) and writes the unsharded result.
+# Written by `onebeacon mc --slurm`; adapt the sbatch options below to your cluster.
+# The executable and OUT must be on a file system that the compute nodes share.
+set -euo pipefail
+ONEBEACON=${{ONEBEACON:-{exe}}}
+SCENARIO={scenario}
+OUT=${{OUT:-{dir}}}
+SBATCH_OPTIONS=${{SBATCH_OPTIONS:-}}
+mkdir -p "$OUT/partials" "$OUT/logs"
+rm -f "$OUT"/partials/partial-*-of-{n}.json
+array=$(sbatch --parsable --job-name=onebeacon-{name} --array=0-{last}{options} $SBATCH_OPTIONS \
+  --output="$OUT/logs/shard-%a.out" <<EOF
+#!/usr/bin/env bash
+exec "$ONEBEACON" mc "$SCENARIO" --runs {runs} --seed {seed} --threads "\${{SLURM_CPUS_PER_TASK:-1}}" \
+  --shard "\${{SLURM_ARRAY_TASK_ID}}/{n}" --out "$OUT/partials"
+EOF
+)
+array=${{array%%;*}}
+merge=$(sbatch --parsable --job-name=onebeacon-{name}-merge --dependency=afterok:"$array"{options} $SBATCH_OPTIONS \
+  --output="$OUT/logs/merge.out" <<EOF
+#!/usr/bin/env bash
+exec "$ONEBEACON" mc merge "$OUT/partials" --out "$OUT/result" --json
+EOF
+)
+merge=${{merge%%;*}}
+echo "array job $array ({n} shards) and merge job $merge submitted; the result will be $OUT/result/mc.json"
+echo "$array $merge" > "$OUT/jobs"
+"#,
+        exe = quote(&exe.display().to_string()),
+        scenario = quote(scenario),
+        dir = quote(&dir.display().to_string()),
+        last = n - 1,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::quote;
+
+    #[test]
+    fn quoting_survives_single_quotes() {
+        assert_eq!(quote("a'b c"), r"'a'\''b c'");
+    }
+}

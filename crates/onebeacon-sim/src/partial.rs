@@ -1,0 +1,276 @@
+//! The partial result of one share of a sharded Monte Carlo ([`crate::montecarlo::Shard`]),
+//! as a JSON file, and the merge of the partials of every share into the result the
+//! unsharded sweep gives, bit for bit.
+//!
+//! A partial holds what the aggregation needs of each of its runs (metrics and acoustic
+//! information) with every float as its IEEE-754 bit pattern, so that nothing is
+//! rounded on the way (JSON numbers could not carry a diverged run's infinity either),
+//! and the scenario as canonical TOML ([`Scenario::to_toml`]), so that partials of the
+//! same scenario agree whether it was named as a built-in or as a file.
+
+use crate::metrics::RunMetrics;
+use crate::montecarlo::{AggregateError, McResult, RunSummary, Shard, aggregate};
+use crate::scenario::{Scenario, ScenarioError, parse};
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+/// The `format` field of a partial.
+pub const FORMAT: &str = "onebeacon-mc-partial/1";
+/// The version of onebeacon that writes and merges partials.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// One share's results: what `onebeacon mc --shard I/N` writes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Partial {
+    pub format: String,
+    pub version: String,
+    /// The scenario's name, for messages.
+    pub scenario: String,
+    /// The scenario, canonical TOML: what the partial's runs simulated.
+    pub scenario_toml: String,
+    pub runs: usize,
+    pub seed: u64,
+    pub shard: usize,
+    pub shards: usize,
+    /// Seconds the share took to compute, on its machine.
+    pub wall_s: f64,
+    pub results: Vec<Record>,
+}
+
+/// One run of one cell, floats as bit patterns.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    pub cell: usize,
+    pub run: u64,
+    /// Per track: [`RunMetrics::to_words`].
+    pub metrics: Vec<Vec<u64>>,
+    /// (vehicle, step, rows, the matrix's entries column by column).
+    pub information: Vec<(usize, usize, usize, Vec<u64>)>,
+}
+
+/// Why partials cannot be read or merged. Each message is one line naming the files.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    #[error("no partials given: name directories written by `mc --shard I/N --out DIR`, or partial files")]
+    Empty,
+    #[error("{path}: cannot read: {message}")]
+    Io { path: String, message: String },
+    #[error("{path}: no partial-*-of-*.json in this directory (written by `mc --shard I/N --out DIR`)")]
+    NoneInDir { path: String },
+    #[error("{path}: not an onebeacon mc partial: {message}")]
+    NotPartial { path: String, message: String },
+    #[error("{path}: the partial's scenario does not parse: {source}")]
+    Scenario { path: String, source: ScenarioError },
+    #[error(
+        "{path}: shard {shard} should hold {expected} (cell, run) pairs, it holds {got}: the file is incomplete or edited"
+    )]
+    Incomplete { path: String, shard: Shard, expected: usize, got: usize },
+    #[error(
+        "{first} and {second} differ in {what}: {a} against {b}; merge only the shares of one `mc --shard` campaign"
+    )]
+    Mismatch { first: String, second: String, what: &'static str, a: String, b: String },
+    #[error("{path} was written by onebeacon {theirs}; this is {ours}: merge with the version that ran the shards")]
+    Version { path: String, theirs: String, ours: String },
+    #[error("shard {shard} is given twice: {first} and {second}")]
+    Duplicate { shard: Shard, first: String, second: String },
+    #[error("missing shard(s) {missing} of {count} (have {have})")]
+    Missing { missing: String, count: usize, have: String },
+    #[error("{0}")]
+    Aggregate(#[from] AggregateError),
+}
+
+impl Partial {
+    /// The partial of `shard` from its summaries.
+    pub fn new(
+        scenario: &Scenario,
+        runs: usize,
+        seed: u64,
+        shard: Shard,
+        wall_s: f64,
+        summaries: &[RunSummary],
+    ) -> Partial {
+        let results = summaries
+            .iter()
+            .map(|s| Record {
+                cell: s.cell,
+                run: s.run,
+                metrics: s.metrics.iter().map(|m| m.to_words().to_vec()).collect(),
+                information: s
+                    .information
+                    .iter()
+                    .map(|(v, k, m)| (*v, *k, m.nrows(), m.iter().map(|x| x.to_bits()).collect()))
+                    .collect(),
+            })
+            .collect();
+        Partial {
+            format: FORMAT.to_string(),
+            version: VERSION.to_string(),
+            scenario: scenario.name().to_string(),
+            scenario_toml: scenario.to_toml(),
+            runs,
+            seed,
+            shard: shard.index,
+            shards: shard.count,
+            wall_s,
+            results,
+        }
+    }
+
+    /// The file name a partial is written under in its directory.
+    pub fn file_name(&self) -> String {
+        format!("partial-{}-of-{}.json", self.shard, self.shards)
+    }
+
+    /// The partial as JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).expect("serialisable")
+    }
+
+    /// Reads a partial from `text` (`path` names it in errors), with its shape checked.
+    pub fn from_json(text: &str, path: &str) -> Result<Partial, MergeError> {
+        let not = |message: String| MergeError::NotPartial { path: path.to_string(), message };
+        let head: serde_json::Value = serde_json::from_str(text).map_err(|e| not(e.to_string()))?;
+        match head.get("format").and_then(|f| f.as_str()) {
+            Some(FORMAT) => {}
+            Some(other) => return Err(not(format!("format `{other}`; this version reads `{FORMAT}`"))),
+            None => return Err(not("no `format` field".into())),
+        }
+        let p: Partial = serde_json::from_value(head).map_err(|e| not(e.to_string()))?;
+        if p.shards == 0 || p.shard >= p.shards {
+            return Err(not(format!("shard {}/{} is not I/N with I < N", p.shard, p.shards)));
+        }
+        for r in &p.results {
+            if r.metrics.iter().any(|m| m.len() != RunMetrics::WORDS)
+                || r.information.iter().any(|(_, _, n, e)| n * n != e.len())
+            {
+                return Err(not(format!("run {} of cell {} has malformed numbers", r.run, r.cell)));
+            }
+        }
+        Ok(p)
+    }
+
+    fn shard_of(&self) -> Shard {
+        Shard { index: self.shard, count: self.shards }
+    }
+
+    fn summaries(self) -> Vec<RunSummary> {
+        self.results
+            .into_iter()
+            .map(|r| RunSummary {
+                cell: r.cell,
+                run: r.run,
+                metrics: r.metrics.iter().map(|w| RunMetrics::from_words(w)).collect(),
+                information: r
+                    .information
+                    .into_iter()
+                    .map(|(v, k, n, e)| (v, k, DMatrix::from_iterator(n, n, e.into_iter().map(f64::from_bits))))
+                    .collect(),
+            })
+            .collect()
+    }
+}
+
+/// The merged sweep: the scenario the partials ran and its result.
+#[derive(Debug, Clone)]
+pub struct Merged {
+    pub scenario: Scenario,
+    pub result: McResult,
+    /// The shares' compute times added up, s.
+    pub wall_s: f64,
+}
+
+/// Merges partials (each with the path that names it in errors) into the result of the
+/// unsharded sweep. Refuses partials of different scenarios, seeds, runs, shard counts or
+/// versions, and missing or duplicate shares, with one line each.
+pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
+    let Some((first_path, first)) = partials.first() else { return Err(MergeError::Empty) };
+    let (first_path, first) = (first_path.clone(), first.clone());
+    let mut by_shard: Vec<Option<String>> = vec![None; first.shards];
+    for (path, p) in &partials {
+        if p.version != VERSION {
+            return Err(MergeError::Version { path: path.clone(), theirs: p.version.clone(), ours: VERSION.into() });
+        }
+        let mismatch = |what, a: String, b: String| MergeError::Mismatch {
+            first: first_path.clone(),
+            second: path.clone(),
+            what,
+            a,
+            b,
+        };
+        if p.scenario_toml != first.scenario_toml {
+            let (a, b) = (format!("`{}`", first.scenario), format!("`{}`", p.scenario));
+            let what = if a == b { "the scenario's keys (same name, edited in between)" } else { "scenario" };
+            return Err(mismatch(what, a, b));
+        }
+        if p.seed != first.seed {
+            return Err(mismatch("seed", first.seed.to_string(), p.seed.to_string()));
+        }
+        if p.runs != first.runs {
+            return Err(mismatch("runs per cell", first.runs.to_string(), p.runs.to_string()));
+        }
+        if p.shards != first.shards {
+            return Err(mismatch("shard count", first.shards.to_string(), p.shards.to_string()));
+        }
+        if let Some(earlier) = &by_shard[p.shard] {
+            return Err(MergeError::Duplicate { shard: p.shard_of(), first: earlier.clone(), second: path.clone() });
+        }
+        by_shard[p.shard] = Some(path.clone());
+    }
+    let missing: Vec<String> = (0..first.shards).filter(|&i| by_shard[i].is_none()).map(|i| i.to_string()).collect();
+    if !missing.is_empty() {
+        let have: Vec<String> = (0..first.shards).filter(|&i| by_shard[i].is_some()).map(|i| i.to_string()).collect();
+        return Err(MergeError::Missing { missing: missing.join(", "), count: first.shards, have: have.join(", ") });
+    }
+    let scenario = parse(&first.scenario_toml, &first.scenario)
+        .map_err(|source| MergeError::Scenario { path: first_path.clone(), source })?;
+    let cells = scenario.cells().len();
+    let mut summaries = Vec::with_capacity(cells * first.runs);
+    let mut wall_s = 0.0;
+    for (path, p) in partials {
+        let expected = p.shard_of().pairs(cells, p.runs).count();
+        if p.results.len() != expected {
+            return Err(MergeError::Incomplete { path, shard: p.shard_of(), expected, got: p.results.len() });
+        }
+        wall_s += p.wall_s;
+        summaries.extend(p.summaries());
+    }
+    let result = aggregate(&scenario, first.runs, first.seed, summaries)?;
+    Ok(Merged { scenario, result, wall_s })
+}
+
+/// Reads the partials of `paths`: each a partial file, or a directory whose
+/// `partial-*-of-*.json` files are all read (in name order).
+pub fn read_partials(paths: &[std::path::PathBuf]) -> Result<Vec<(String, Partial)>, MergeError> {
+    let io = |p: &std::path::Path, e: std::io::Error| MergeError::Io {
+        path: p.display().to_string(),
+        message: e.to_string(),
+    };
+    let mut files = Vec::new();
+    for path in paths {
+        if path.is_dir() {
+            let mut found: Vec<_> = std::fs::read_dir(path)
+                .map_err(|e| io(path, e))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+                    name.starts_with("partial-") && name.contains("-of-") && name.ends_with(".json")
+                })
+                .collect();
+            if found.is_empty() {
+                return Err(MergeError::NoneInDir { path: path.display().to_string() });
+            }
+            found.sort();
+            files.extend(found);
+        } else {
+            files.push(path.clone());
+        }
+    }
+    files
+        .into_iter()
+        .map(|f| {
+            let text = std::fs::read_to_string(&f).map_err(|e| io(&f, e))?;
+            let name = f.display().to_string();
+            Partial::from_json(&text, &name).map(|p| (name, p))
+        })
+        .collect()
+}
