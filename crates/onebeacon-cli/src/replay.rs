@@ -6,10 +6,8 @@ use crate::output::Staging;
 use crate::{plot, report};
 use anyhow::{Context, Result};
 use onebeacon::io::jsonl;
-use onebeacon::nav::session::{Limits, Session, Start};
-use onebeacon_sim::replay::log::{HeadingFrom, InitialFrom};
-use onebeacon_sim::replay::{Log, LogDescription, Replay, new_session, replay as run_replay};
-use serde_json::{Value, json};
+use onebeacon::nav::session::Session;
+use onebeacon_sim::replay::{Log, StreamSetup, replay as run_replay, stream_setup};
 use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -73,7 +71,7 @@ pub fn replay(
     trajectory.finish()?.flush().context("cannot write trajectory.csv")?;
     let wall_s = started.elapsed().as_secs_f64();
     let s = &r.session;
-    let summary = summary_json(&log, &used, &r, wall_s);
+    let summary = onebeacon_sim::json::replay_summary(&log, &used, &r, wall_s);
 
     staging.write("summary.json", serde_json::to_string_pretty(&summary)?.as_bytes())?;
     staging.write("rejected.csv", &rejected_csv(s)?)?;
@@ -125,58 +123,6 @@ pub fn replay(
     Ok(())
 }
 
-fn summary_json(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
-    let s = &r.session;
-    let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
-    let finals = s.final_estimates();
-    let estimators: Vec<Value> = s
-        .names
-        .iter()
-        .zip(&s.stats)
-        .zip(&finals)
-        .zip(s.beacon_offsets())
-        .map(|(((name, st), e), offsets)| {
-            let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m(), e.east_m(), 0.0));
-            let mut v = json!({
-                "name": name,
-                "rmse_m": num(st.rmse_m()),
-                "mean_error_m": num(st.mean_m()),
-                "final_error_m": if st.count > 0 { num(st.final_m) } else { Value::Null },
-                "max_error_m": if st.count > 0 { num(st.max_m) } else { Value::Null },
-                "rejected": st.rejected,
-                "failed_updates": st.failed,
-                "reinitialised": st.reinitialised,
-                "nees_mean": num(st.nees_mean()),
-                "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
-                "nis_mean": num(st.nis_mean()),
-                "nis_band": onebeacon_sim::metrics::nees_band(st.nis_count, 1).map(num),
-                "nis_within_95_pct": num(100.0 * st.nis_within_95_fraction()),
-                "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())},
-            });
-            for (k, x) in e.calibration() {
-                v[k] = num(x);
-            }
-            if !offsets.is_empty() {
-                let per_beacon =
-                    offsets.iter().map(|(b, o, sigma)| (b.to_string(), json!({"offset_m": o, "sigma_m": sigma})));
-                v["beacon_offsets"] = Value::Object(per_beacon.collect());
-            }
-            v
-        })
-        .collect();
-    json!({
-        "log": log.description.name,
-        "beacons": used,
-        "items": r.items,
-        "skipped_before_start": s.before_start,
-        "left_out": s.left_out,
-        "screened": s.screened,
-        "dropped_rows": r.dropped.iter().map(|(f, n)| (f.clone(), json!(n))).collect::<serde_json::Map<_, _>>(),
-        "wall_s": wall_s,
-        "estimators": estimators,
-    })
-}
-
 fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(["estimator", "t_s", "kind", "beacon", "value", "nis", "reason"])?;
@@ -197,33 +143,7 @@ fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
 /// `onebeacon stream CONFIG.toml`: JSON Lines on stdin, one JSON line per estimate on
 /// stdout, flushed after each; bad lines are reported on stderr and skipped.
 pub fn stream(config: &Path) -> Result<()> {
-    let d = LogDescription::load(config)?;
-    let base = config.parent().unwrap_or(Path::new("."));
-    let beacons = d.fixed_beacons(base)?;
-    let frame = onebeacon::geo::Frame::from(d.frame);
-    let init = &d.initial;
-    let start = match init.given_pose(frame) {
-        Some(pose) => Start::At { t0_s: None, pose },
-        None if init.from == InitialFrom::Ranges => {
-            return Err(BadInput(format!(
-                "{}: key `initial.from` = \"ranges\": needs a window of the log; a stream starts from the first ground_truth line or a given pose",
-                config.display()
-            ))
-            .into());
-        }
-        None if init.heading_from == HeadingFrom::Track => {
-            return Err(BadInput(format!(
-                "{}: key `initial.heading_from` = \"track\": needs the whole log; a stream starts from the first ground_truth line's heading (\"column\") or a given pose",
-                config.display()
-            ))
-            .into());
-        }
-        None => Start::FirstTruth,
-    };
-    let session = new_session(&d, start, None);
-    // the stream reports on the fly: the session keeps no rejection log
-    let limits = Limits { max_rejections: 0, ..*session.limits() };
-    let mut session = session.with_limits(limits);
+    let StreamSetup { mut session, beacons, frame } = stream_setup(config)?;
     jsonl::run(&mut session, &beacons, frame, std::io::stdin().lock(), std::io::stdout().lock(), |line, m| {
         eprintln!("stdin line {line}: {m}")
     })

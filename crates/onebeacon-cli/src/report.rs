@@ -2,24 +2,11 @@
 
 use anyhow::Result;
 use onebeacon_sim::Scenario;
+use onebeacon_sim::json;
 use onebeacon_sim::montecarlo::McResult;
 use onebeacon_sim::run::{RunOutput, StepRecord};
-use onebeacon_sim::scenario::{Cell, MovingBeaconCell, SweepValue};
-use serde_json::{Value, json};
+use onebeacon_sim::scenario::{Cell, MovingBeaconCell};
 use std::fmt::Write;
-
-/// JSON number, or null when not finite (JSON has no NaN or infinity).
-fn num(v: f64) -> Value {
-    if v.is_finite() { json!(v) } else { Value::Null }
-}
-
-fn sweep_json(cell: &Cell) -> Value {
-    let value = |v: SweepValue| match v {
-        SweepValue::Number(x) => num(x),
-        SweepValue::Text(t) => json!(t),
-    };
-    Value::Object(cell.values().into_iter().map(|(k, v)| (k.to_string(), value(v))).collect())
-}
 
 /// trajectory.csv: one row per step with the truth of every vehicle (`vehicles`; its
 /// columns prefixed with its name when there are several) and every track's estimate
@@ -97,38 +84,7 @@ impl<W: std::io::Write> TrajectoryWriter<W> {
 
 /// summary.json of one run.
 pub fn run_summary_json(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutput) -> String {
-    let estimators: Vec<Value> = s
-        .tracks()
-        .iter()
-        .zip(&out.metrics)
-        .map(|(track, m)| {
-            json!({
-                "vehicle": track.vehicle,
-                "estimator": track.estimator,
-                "mean_error_m": num(m.mean_error_m),
-                "error_variance_m2": num(m.error_variance_m2),
-                "rmse_m": num(m.mse_m2.sqrt()),
-                "max_error_m": num(m.max_error_m),
-                "final_error_m": num(m.final_error_m),
-                "etd_max_pct": num(m.etd_max_pct),
-                "etd_mean_pct": num(m.etd_mean_pct),
-                "nees_mean": num(m.nees_mean),
-                "failed_updates": m.failed_updates,
-            })
-        })
-        .collect();
-    let v = json!({
-        "scenario": s.name(),
-        "seed": seed,
-        "run": run,
-        "sweep": sweep_json(cell),
-        "duration_s": num(s.duration_s()),
-        "distance_m": num(out.distance_m[0]),
-        "vehicles": s.vehicle_names().iter().zip(&out.distance_m).map(|(name, d)| json!({"name": name, "distance_m": num(*d)})).collect::<Vec<_>>(),
-        "frames_decoded": out.frames_decoded,
-        "estimators": estimators,
-    });
-    serde_json::to_string_pretty(&v).expect("serialisable") + "\n"
+    serde_json::to_string_pretty(&json::run_summary(s, seed, run, cell, out)).expect("serialisable") + "\n"
 }
 
 /// The table printed by `run`.
@@ -163,37 +119,9 @@ pub fn run_table(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutput
     t
 }
 
-/// The `mc --json` object (contract: never rename or drop a field).
+/// The `mc --json` object ([`json::mc`]).
 pub fn mc_json(s: &Scenario, r: &McResult, wall_s: f64) -> String {
-    let cells: Vec<Value> = r
-        .cells
-        .iter()
-        .flat_map(|c| {
-            c.estimators.iter().map(move |(track, m)| {
-                json!({
-                    "sweep": sweep_json(&c.cell),
-                    "vehicle": track.vehicle,
-                    "estimator": track.estimator,
-                    "runs": m.runs,
-                    "mean_error_m": num(m.mean_error_m),
-                    "error_variance_m2": num(m.error_variance_m2),
-                    "rmse_m": num(m.rmse_m),
-                    "outliers": m.outliers,
-                    "etd_max_pct": num(m.etd_max_pct),
-                    "etd_mean_pct": num(m.etd_mean_pct),
-                    "nees_mean": num(m.nees_mean),
-                    "nees_band": [num(m.nees_band[0]), num(m.nees_band[1])],
-                    "nees_mean_all_runs": num(m.nees_mean_all_runs),
-                    "pcrb_rmse_m": c.pcrb(track.vehicle_index).map(num).unwrap_or(Value::Null),
-                    "mean_error_first_half_m": num(m.mean_error_first_half_m),
-                    "mean_error_second_half_m": num(m.mean_error_second_half_m),
-                    "failed_updates": m.failed_updates,
-                })
-            })
-        })
-        .collect();
-    let v = json!({ "scenario": s.name(), "runs": r.runs, "seed": r.seed, "cells": cells, "wall_s": wall_s });
-    serde_json::to_string(&v).expect("serialisable")
+    serde_json::to_string(&json::mc(s, r, wall_s)).expect("serialisable")
 }
 
 /// For moving-beacon sweeps, sousa's layout (Tables 4.1, 4.2): per guidance and

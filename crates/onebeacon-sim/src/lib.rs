@@ -10,11 +10,13 @@
 //! - [`metrics`]: per-run error statistics and their Monte Carlo aggregation;
 //! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count;
 //! - [`partial`]: one share of a sharded sweep as a file, and the merge of the shares;
+//! - [`json`]: the JSON forms of results, for the CLI and the Python package;
 //! - [`replay`]: real logs (CSV files described by a TOML file) through the estimators.
 
 pub mod acoustics;
 mod engine;
 pub mod fleet;
+pub mod json;
 pub mod metrics;
 pub mod montecarlo;
 pub mod partial;

@@ -2,6 +2,7 @@
 //! channel from a transducer to the elements of a receiving array; multichannel WAV
 //! recordings read a capture at a time.
 
+pub mod chain;
 pub mod channel;
 pub mod propagation;
 pub mod wav;

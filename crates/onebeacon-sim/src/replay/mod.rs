@@ -39,6 +39,44 @@ pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session,
     Ok(session.with_position_sigma(start.position_sigma_m))
 }
 
+/// What a live stream runs on: the session of a stream configuration (a log
+/// description; its sources are ignored), its fixed beacons and the frame of its lines.
+pub struct StreamSetup {
+    pub session: Session,
+    pub beacons: std::collections::BTreeMap<u32, Vector3<f64>>,
+    pub frame: onebeacon::geo::Frame,
+}
+
+/// The session `onebeacon stream CONFIG` (and the Python `Navigator`) runs: started at
+/// the configuration's given pose, or at the first ground-truth line; no rejection log
+/// (a stream reports each line as it comes).
+pub fn stream_setup(config: &std::path::Path) -> Result<StreamSetup, LogError> {
+    use log::{HeadingFrom, InitialFrom};
+    let d = LogDescription::load(config)?;
+    let base = config.parent().unwrap_or(std::path::Path::new("."));
+    let beacons = d.fixed_beacons(base)?;
+    let frame = onebeacon::geo::Frame::from(d.frame);
+    let init = &d.initial;
+    let refuse = |message: &str| Err(LogError::File { file: config.display().to_string(), message: message.into() });
+    let start = match init.given_pose(frame) {
+        Some(pose) => Start::At { t0_s: None, pose },
+        None if init.from == InitialFrom::Ranges => {
+            return refuse(
+                "key `initial.from` = \"ranges\": needs a window of the log; a stream starts from the first ground_truth line or a given pose",
+            );
+        }
+        None if init.heading_from == HeadingFrom::Track => {
+            return refuse(
+                "key `initial.heading_from` = \"track\": needs the whole log; a stream starts from the first ground_truth line's heading (\"column\") or a given pose",
+            );
+        }
+        None => Start::FirstTruth,
+    };
+    let session = new_session(&d, start, None);
+    let limits = onebeacon::nav::session::Limits { max_rejections: 0, ..*session.limits() };
+    Ok(StreamSetup { session: session.with_limits(limits), beacons, frame })
+}
+
 /// Runs every estimator of `log` over its stream, giving `record` one trajectory row
 /// per ground-truth pose (per measurement when the log has no ground truth) as it goes:
 /// nothing grows with the log's length but the bounded rejection log.

@@ -1,0 +1,146 @@
+//! The JSON forms of results that the CLI prints and writes and the Python package
+//! returns, built in one place so that both give the same fields and numbers:
+//! `mc --json` ([`mc`]), `run`'s summary.json ([`run_summary`]) and `replay`'s summary
+//! ([`replay_summary`]).
+
+use crate::Scenario;
+use crate::montecarlo::McResult;
+use crate::replay::{Log, Replay};
+use crate::run::RunOutput;
+use crate::scenario::{Cell, SweepValue};
+use serde_json::{Value, json};
+
+/// JSON number, or null when not finite (JSON has no NaN or infinity).
+pub fn num(v: f64) -> Value {
+    if v.is_finite() { json!(v) } else { Value::Null }
+}
+
+/// The swept keys of a cell and their values.
+pub fn sweep(cell: &Cell) -> Value {
+    let value = |v: SweepValue| match v {
+        SweepValue::Number(x) => num(x),
+        SweepValue::Text(t) => json!(t),
+    };
+    Value::Object(cell.values().into_iter().map(|(k, v)| (k.to_string(), value(v))).collect())
+}
+
+/// The `mc --json` object (contract: never rename or drop a field).
+pub fn mc(s: &Scenario, r: &McResult, wall_s: f64) -> Value {
+    let cells: Vec<Value> = r
+        .cells
+        .iter()
+        .flat_map(|c| {
+            c.estimators.iter().map(move |(track, m)| {
+                json!({
+                    "sweep": sweep(&c.cell),
+                    "vehicle": track.vehicle,
+                    "estimator": track.estimator,
+                    "runs": m.runs,
+                    "mean_error_m": num(m.mean_error_m),
+                    "error_variance_m2": num(m.error_variance_m2),
+                    "rmse_m": num(m.rmse_m),
+                    "outliers": m.outliers,
+                    "etd_max_pct": num(m.etd_max_pct),
+                    "etd_mean_pct": num(m.etd_mean_pct),
+                    "nees_mean": num(m.nees_mean),
+                    "nees_band": [num(m.nees_band[0]), num(m.nees_band[1])],
+                    "nees_mean_all_runs": num(m.nees_mean_all_runs),
+                    "pcrb_rmse_m": c.pcrb(track.vehicle_index).map(num).unwrap_or(Value::Null),
+                    "mean_error_first_half_m": num(m.mean_error_first_half_m),
+                    "mean_error_second_half_m": num(m.mean_error_second_half_m),
+                    "failed_updates": m.failed_updates,
+                })
+            })
+        })
+        .collect();
+    let v = json!({ "scenario": s.name(), "runs": r.runs, "seed": r.seed, "cells": cells, "wall_s": wall_s });
+    v
+}
+
+/// summary.json of one run.
+pub fn run_summary(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutput) -> Value {
+    let estimators: Vec<Value> = s
+        .tracks()
+        .iter()
+        .zip(&out.metrics)
+        .map(|(track, m)| {
+            json!({
+                "vehicle": track.vehicle,
+                "estimator": track.estimator,
+                "mean_error_m": num(m.mean_error_m),
+                "error_variance_m2": num(m.error_variance_m2),
+                "rmse_m": num(m.mse_m2.sqrt()),
+                "max_error_m": num(m.max_error_m),
+                "final_error_m": num(m.final_error_m),
+                "etd_max_pct": num(m.etd_max_pct),
+                "etd_mean_pct": num(m.etd_mean_pct),
+                "nees_mean": num(m.nees_mean),
+                "failed_updates": m.failed_updates,
+            })
+        })
+        .collect();
+    let v = json!({
+        "scenario": s.name(),
+        "seed": seed,
+        "run": run,
+        "sweep": sweep(cell),
+        "duration_s": num(s.duration_s()),
+        "distance_m": num(out.distance_m[0]),
+        "vehicles": s.vehicle_names().iter().zip(&out.distance_m).map(|(name, d)| json!({"name": name, "distance_m": num(*d)})).collect::<Vec<_>>(),
+        "frames_decoded": out.frames_decoded,
+        "estimators": estimators,
+    });
+    v
+}
+
+/// `replay --json`, the replay's summary.json.
+pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
+    let s = &r.session;
+    let finals = s.final_estimates();
+    let estimators: Vec<Value> = s
+        .names
+        .iter()
+        .zip(&s.stats)
+        .zip(&finals)
+        .zip(s.beacon_offsets())
+        .map(|(((name, st), e), offsets)| {
+            let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m(), e.east_m(), 0.0));
+            let mut v = json!({
+                "name": name,
+                "rmse_m": num(st.rmse_m()),
+                "mean_error_m": num(st.mean_m()),
+                "final_error_m": if st.count > 0 { num(st.final_m) } else { Value::Null },
+                "max_error_m": if st.count > 0 { num(st.max_m) } else { Value::Null },
+                "rejected": st.rejected,
+                "failed_updates": st.failed,
+                "reinitialised": st.reinitialised,
+                "nees_mean": num(st.nees_mean()),
+                "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
+                "nis_mean": num(st.nis_mean()),
+                "nis_band": crate::metrics::nees_band(st.nis_count, 1).map(num),
+                "nis_within_95_pct": num(100.0 * st.nis_within_95_fraction()),
+                "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())},
+            });
+            for (k, x) in e.calibration() {
+                v[k] = num(x);
+            }
+            if !offsets.is_empty() {
+                let per_beacon =
+                    offsets.iter().map(|(b, o, sigma)| (b.to_string(), json!({"offset_m": o, "sigma_m": sigma})));
+                v["beacon_offsets"] = Value::Object(per_beacon.collect());
+            }
+            v
+        })
+        .collect();
+    json!({
+        "log": log.description.name,
+        "beacons": used,
+        "items": r.items,
+        "skipped_before_start": s.before_start,
+        "left_out": s.left_out,
+        "screened": s.screened,
+        "dropped_rows": r.dropped.iter().map(|(f, n)| (f.clone(), json!(n))).collect::<serde_json::Map<_, _>>(),
+        "wall_s": wall_s,
+        "estimators": estimators,
+    })
+}
