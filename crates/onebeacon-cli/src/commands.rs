@@ -39,20 +39,7 @@ pub fn scenarios(show: Option<&str>) -> Result<()> {
 /// `onebeacon run SCENARIO [--seed N] [--run I] [--ping K] [--message M] [--out DIR]`
 pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, message: usize, out: Option<PathBuf>) -> Result<()> {
     let s = scenario::load(name)?;
-    // `run` records every step for its plots and CSV: refuse up front what would not fit
-    const MOST_BYTES: f64 = 4e9;
-    let bytes = onebeacon_sim::run::recorded_bytes(&s);
-    if bytes > MOST_BYTES {
-        return Err(BadInput(format!(
-            "{name}: `run` records every step: {} steps x {} estimators would hold about {:.1} GB; at most {:.0} GB \
-             (shorten mission.duration_s or lengthen mission.dt_s; `mc` records nothing)",
-            s.steps(),
-            s.tracks().len(),
-            bytes / 1e9,
-            MOST_BYTES / 1e9
-        ))
-        .into());
-    }
+    onebeacon_sim::run::check_recordable(&s).map_err(|e| BadInput(format!("{name}: {e}")))?;
     let seed = seed.unwrap_or(s.seed());
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name())));
     let staging = Staging::new(&dir)?;

@@ -14,16 +14,7 @@ use std::path::{Path, PathBuf};
 
 /// `--beacons` checked against the log's beacons.
 pub(crate) fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Option<BTreeSet<u32>>> {
-    let Some(ids) = ids else { return Ok(None) };
-    for id in &ids {
-        if !known.contains(id) {
-            let list: Vec<String> = known.iter().map(u32::to_string).collect();
-            return Err(
-                BadInput(format!("--beacons {id}: not a beacon of the log (beacons: {})", list.join(", "))).into()
-            );
-        }
-    }
-    Ok(Some(ids.into_iter().collect()))
+    onebeacon_sim::replay::beacon_filter(ids, known).map_err(|e| BadInput(format!("--beacons {e}")).into())
 }
 
 /// `onebeacon replay LOG.toml [--out DIR] [--beacons 0,5] [--json] [--print-stream]`

@@ -4,6 +4,7 @@ use anyhow::Result;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::json;
 use onebeacon_sim::montecarlo::McResult;
+use onebeacon_sim::run::trajectory;
 use onebeacon_sim::run::{RunOutput, StepRecord};
 use onebeacon_sim::scenario::{Cell, MovingBeaconCell};
 use std::fmt::Write;
@@ -22,57 +23,49 @@ pub fn trajectory_csv(vehicles: &[String], names: &[String], trajectory: &[StepR
 /// trajectory.csv written row by row as the steps come ([`trajectory_csv`]).
 pub struct TrajectoryWriter<W: std::io::Write> {
     w: csv::Writer<W>,
+    formats: Vec<Format>,
+}
+
+/// How a trajectory.csv column is written.
+enum Format {
+    Time,
+    Flag,
+    Degrees,
+    Speed,
+    Metres,
 }
 
 impl<W: std::io::Write> TrajectoryWriter<W> {
-    /// Writes the header.
+    /// Writes the header ([`trajectory::header`]).
     pub fn new(out: W, vehicles: &[String], names: &[String]) -> Result<Self> {
         let mut w = csv::Writer::from_writer(out);
-        let mut header = vec!["t_s".to_string()];
-        for v in vehicles {
-            let prefix = if vehicles.len() > 1 { format!("{v}_") } else { String::new() };
-            for col in ["truth_north_m", "truth_east_m", "truth_down_m", "truth_heading_deg", "truth_speed_m_s"] {
-                header.push(format!("{prefix}{col}"));
-            }
-        }
-        header.extend(["beacon_north_m", "beacon_east_m", "beacon_down_m", "frame"].map(String::from));
-        for name in names {
-            for col in [
-                "north_m",
-                "east_m",
-                "down_m",
-                "heading_deg",
-                "speed_m_s",
-                "sigma_north_m",
-                "sigma_east_m",
-                "error_m",
-                "nees",
-            ] {
-                header.push(format!("{name}_{col}"));
-            }
-        }
+        let header = trajectory::header(vehicles, names);
         w.write_record(&header)?;
-        Ok(Self { w })
+        // t_s to 0.01 s, headings to 0.001 deg, the frame flag as 0/1, the rest to 0.1 mm
+        // (a speed the estimator does not have left empty)
+        let formats = header
+            .iter()
+            .map(|h| match h.as_str() {
+                "t_s" => Format::Time,
+                "frame" => Format::Flag,
+                h if h.ends_with("_deg") => Format::Degrees,
+                h if h.ends_with("speed_m_s") => Format::Speed,
+                _ => Format::Metres,
+            })
+            .collect();
+        Ok(Self { w, formats })
     }
 
     /// Writes one step's row.
     pub fn write(&mut self, r: &StepRecord) -> Result<()> {
-        let f = |v: f64| format!("{v:.4}");
-        let mut row = vec![format!("{:.2}", r.t_s)];
-        for t in &r.truth {
-            row.extend([t.pos.x, t.pos.y, t.pos.z].map(f));
-            row.push(format!("{:.3}", onebeacon::geo::wrap_angle(t.heading).to_degrees()));
-            row.push(f(t.speed));
-        }
-        row.extend([r.beacon.x, r.beacon.y, r.beacon.z].map(f));
-        row.push(u8::from(r.frame).to_string());
-        for e in &r.estimates {
-            row.extend([e.pos.x, e.pos.y, e.pos.z].map(f));
-            row.push(format!("{:.3}", e.psi.to_degrees()));
-            row.push(e.speed.map(f).unwrap_or_default());
-            row.extend([e.sigma_pos.x, e.sigma_pos.y, e.error_m, e.nees].map(f));
-        }
-        self.w.write_record(&row)?;
+        let row = trajectory::values(r).into_iter().zip(&self.formats).map(|(v, f)| match f {
+            Format::Time => format!("{v:.2}"),
+            Format::Flag => format!("{v}"),
+            Format::Degrees => format!("{v:.3}"),
+            Format::Speed if v.is_nan() => String::new(),
+            Format::Speed | Format::Metres => format!("{v:.4}"),
+        });
+        self.w.write_record(row)?;
         Ok(())
     }
 

@@ -394,3 +394,84 @@ impl Observer for Recorder {
 }
 
 pub use crate::world::{TruthPath, initial_asv_position};
+
+/// Whether a recorded run of `s` fits in memory (at most 4 GB of step records): why
+/// not, naming the keys to change.
+pub fn check_recordable(s: &Scenario) -> Result<(), String> {
+    const MOST_BYTES: f64 = 4e9;
+    let bytes = recorded_bytes(s);
+    if bytes > MOST_BYTES {
+        return Err(format!(
+            "`run` records every step: {} steps x {} estimators would hold about {:.1} GB; at most {:.0} GB \
+             (shorten mission.duration_s or lengthen mission.dt_s; `mc` records nothing)",
+            s.steps(),
+            s.tracks().len(),
+            bytes / 1e9,
+            MOST_BYTES / 1e9
+        ));
+    }
+    Ok(())
+}
+
+/// The columns of a recorded trajectory, one row per step: what trajectory.csv holds and
+/// the Python package's `run` returns as arrays.
+pub mod trajectory {
+    use super::StepRecord;
+
+    /// The column names: time, every vehicle's truth (prefixed with its name when there
+    /// are several), the beacon, whether an acoustic measurement was heard, and every
+    /// track's estimate, standard deviations, error and NEES (prefixed with its label).
+    pub fn header(vehicles: &[String], names: &[String]) -> Vec<String> {
+        let mut header = vec!["t_s".to_string()];
+        for v in vehicles {
+            let prefix = if vehicles.len() > 1 { format!("{v}_") } else { String::new() };
+            for col in ["truth_north_m", "truth_east_m", "truth_down_m", "truth_heading_deg", "truth_speed_m_s"] {
+                header.push(format!("{prefix}{col}"));
+            }
+        }
+        header.extend(["beacon_north_m", "beacon_east_m", "beacon_down_m", "frame"].map(String::from));
+        for name in names {
+            for col in [
+                "north_m",
+                "east_m",
+                "down_m",
+                "heading_deg",
+                "speed_m_s",
+                "sigma_north_m",
+                "sigma_east_m",
+                "error_m",
+                "nees",
+            ] {
+                header.push(format!("{name}_{col}"));
+            }
+        }
+        header
+    }
+
+    /// One step's values in [`header`]'s order: headings in degrees in (-180, 180], the
+    /// frame flag 0 or 1, NaN for a speed the estimator does not have.
+    pub fn values(r: &StepRecord) -> Vec<f64> {
+        let mut row = vec![r.t_s];
+        for t in &r.truth {
+            row.extend([t.pos.x, t.pos.y, t.pos.z, onebeacon::geo::wrap_angle(t.heading).to_degrees(), t.speed]);
+        }
+        row.extend([r.beacon.x, r.beacon.y, r.beacon.z, f64::from(u8::from(r.frame))]);
+        for e in &r.estimates {
+            row.extend([e.pos.x, e.pos.y, e.pos.z, e.psi.to_degrees(), e.speed.unwrap_or(f64::NAN)]);
+            row.extend([e.sigma_pos.x, e.sigma_pos.y, e.error_m, e.nees]);
+        }
+        row
+    }
+
+    /// The whole trajectory by column, in [`header`]'s order.
+    pub fn columns(vehicles: &[String], names: &[String], records: &[StepRecord]) -> Vec<(String, Vec<f64>)> {
+        let header = header(vehicles, names);
+        let mut columns: Vec<Vec<f64>> = header.iter().map(|_| Vec::with_capacity(records.len())).collect();
+        for r in records {
+            for (c, v) in columns.iter_mut().zip(values(r)) {
+                c.push(v);
+            }
+        }
+        header.into_iter().zip(columns).collect()
+    }
+}

@@ -39,6 +39,17 @@ pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session,
     Ok(session.with_position_sigma(start.position_sigma_m))
 }
 
+/// Beacon ids asked for (all when `None`) checked against the log's: the set to use, or
+/// "ID: not a beacon of the log (beacons: ...)".
+pub fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Option<BTreeSet<u32>>, String> {
+    let Some(ids) = ids else { return Ok(None) };
+    if let Some(id) = ids.iter().find(|id| !known.contains(id)) {
+        let list: Vec<String> = known.iter().map(u32::to_string).collect();
+        return Err(format!("{id}: not a beacon of the log (beacons: {})", list.join(", ")));
+    }
+    Ok(Some(ids.into_iter().collect()))
+}
+
 /// What a live stream runs on: the session of a stream configuration (a log
 /// description; its sources are ignored), its fixed beacons and the frame of its lines.
 pub struct StreamSetup {

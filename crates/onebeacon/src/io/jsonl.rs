@@ -221,6 +221,103 @@ pub fn step_json(line: usize, step: &Step, names: &[String], frame: Frame) -> Va
     json!({"line": line, "t_s": step.t_s, "estimates": estimates})
 }
 
+/// What a stream keeps from line to line: the beacons whose positions it was given, the
+/// line count, and whether it said that it waits for its start.
+#[derive(Debug, Clone, Default)]
+pub struct Lines {
+    tracked: BTreeSet<u32>,
+    number: usize,
+    waiting_told: bool,
+}
+
+/// What [`Lines::push`] says of a line besides its output.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Note {
+    /// The line was skipped (not UTF-8, too long, not an item) or screened out by the
+    /// session: why.
+    Skipped(String),
+    /// The line was taken, and something is worth saying (before the start, an
+    /// estimator started again).
+    Info(String),
+}
+
+impl Lines {
+    /// The lines so far.
+    pub fn count(&self) -> usize {
+        self.number
+    }
+
+    /// One input line (without its end; `too_long` when the reader cut it), into
+    /// `session` (fixed beacons `fixed`, lines in `frame`): the output line ([`step_json`])
+    /// when the session gave an estimate. `note` gets the line's number and what there
+    /// is to say of it. Nothing a line holds stops the stream or poisons the session.
+    pub fn push(
+        &mut self,
+        session: &mut Session,
+        fixed: &BTreeMap<u32, Vector3<f64>>,
+        frame: Frame,
+        bytes: &[u8],
+        too_long: bool,
+        mut note: impl FnMut(usize, Note),
+    ) -> Option<Value> {
+        self.number += 1;
+        let number = self.number;
+        let mut skip = |m: String| {
+            note(number, Note::Skipped(m));
+            None
+        };
+        if too_long {
+            let max = session.limits().max_line_bytes;
+            return skip(format!("longer than {max} bytes (limits.max_line_bytes); skipped"));
+        }
+        let Ok(line) = std::str::from_utf8(bytes) else { return skip("not UTF-8 text; skipped".into()) };
+        if line.trim().is_empty() {
+            return None;
+        }
+        let item = match parse_item(line, fixed, &self.tracked) {
+            Ok(item) => item,
+            Err(e) => return skip(format!("{e}; skipped")),
+        };
+        match session.push(&item) {
+            Ok(step) => {
+                if let Input::BeaconPosition { beacon_id, .. } = item.input {
+                    self.tracked.insert(beacon_id);
+                }
+                let Some(step) = step else {
+                    if !std::mem::replace(&mut self.waiting_told, true) {
+                        note(number, Note::Info(format!("before the start: waiting for {}", session.waiting_for())));
+                    }
+                    return None;
+                };
+                for &i in &step.reinitialised {
+                    let name = &session.names[i];
+                    note(
+                        number,
+                        Note::Info(format!(
+                            "{name}: its state stopped being finite and positive definite; started again from its last sound estimate"
+                        )),
+                    );
+                }
+                Some(step_json(number, &step, &session.names, frame))
+            }
+            Err(screened) => skip(format!("{screened}; screened out")),
+        }
+    }
+
+    /// At the end of the input: `note` is told when the stream never reached its start.
+    pub fn finish(&self, session: &Session, mut note: impl FnMut(usize, Note)) {
+        if !session.started() {
+            note(
+                self.number,
+                Note::Info(format!(
+                    "the stream ended before the start ({}); no estimate was given",
+                    session.waiting_for()
+                )),
+            );
+        }
+    }
+}
+
 /// Reads JSON Lines items from `input` into `session` (fixed beacons `fixed`, lines in
 /// `frame`), writing one [`step_json`] line per item to `output`, flushed after each.
 /// Nothing a line holds stops the stream: a line that is not UTF-8, longer than
@@ -237,65 +334,22 @@ pub fn run(
     mut report: impl FnMut(usize, &str),
 ) -> std::io::Result<()> {
     let max_line = session.limits().max_line_bytes;
-    let mut tracked = BTreeSet::new();
+    let mut lines = Lines::default();
     let mut buf = Vec::new();
-    let (mut number, mut waiting_told) = (0, false);
+    let mut say = |line: usize, n: Note| match n {
+        Note::Skipped(m) | Note::Info(m) => report(line, &m),
+    };
     loop {
         let (read, too_long) = read_line(&mut input, &mut buf, max_line)?;
         if read == 0 {
             break;
         }
-        number += 1;
-        if too_long {
-            report(number, &format!("longer than {max_line} bytes (limits.max_line_bytes); skipped"));
-            continue;
-        }
-        let Ok(line) = std::str::from_utf8(&buf) else {
-            report(number, "not UTF-8 text; skipped");
-            continue;
-        };
-        if line.trim().is_empty() {
-            continue;
-        }
-        let item = match parse_item(line, fixed, &tracked) {
-            Ok(item) => item,
-            Err(e) => {
-                report(number, &format!("{e}; skipped"));
-                continue;
-            }
-        };
-        match session.push(&item) {
-            Ok(step) => {
-                if let Input::BeaconPosition { beacon_id, .. } = item.input {
-                    tracked.insert(beacon_id);
-                }
-                let Some(step) = step else {
-                    if !std::mem::replace(&mut waiting_told, true) {
-                        report(number, &format!("before the start: waiting for {}", session.waiting_for()));
-                    }
-                    continue;
-                };
-                for &i in &step.reinitialised {
-                    let name = &session.names[i];
-                    report(
-                        number,
-                        &format!(
-                            "{name}: its state stopped being finite and positive definite; started again from its last sound estimate"
-                        ),
-                    );
-                }
-                writeln!(output, "{}", step_json(number, &step, &session.names, frame))?;
-                output.flush()?;
-            }
-            Err(screened) => report(number, &format!("{screened}; screened out")),
+        if let Some(out) = lines.push(session, fixed, frame, &buf, too_long, &mut say) {
+            writeln!(output, "{out}")?;
+            output.flush()?;
         }
     }
-    if !session.started() {
-        report(
-            number,
-            &format!("the stream ended before the start ({}); no estimate was given", session.waiting_for()),
-        );
-    }
+    lines.finish(session, say);
     Ok(())
 }
 
