@@ -81,10 +81,11 @@ fn from_py(obj: &Bound<'_, PyAny>, at: &str) -> PyResult<Value> {
         }
         return Ok(Value::Object(map));
     }
-    if obj.is_instance_of::<PyInt>() || obj.hasattr("__index__")? && !obj.hasattr("__len__")? {
-        if let Ok(i) = obj.extract::<i64>() {
-            return Ok(Value::from(i));
-        }
+    // ints, numpy's among them (they have __index__), before floats
+    if (obj.is_instance_of::<PyInt>() || obj.hasattr("__index__")? && !obj.hasattr("__len__")?)
+        && let Ok(i) = obj.extract::<i64>()
+    {
+        return Ok(Value::from(i));
     }
     if let Ok(x) = obj.extract::<f64>() {
         return serde_json::Number::from_f64(x)
