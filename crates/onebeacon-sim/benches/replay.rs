@@ -3,10 +3,13 @@
 //! with calibration states and gating (target: under 50 ms); then with all 8 of
 //! plaza1.toml. The CSV files are read as the replay goes, so their parsing is part of
 //! it; `Log::load` (the description, the beacons, and each file's header and first row)
-//! is measured apart.
+//! is measured apart. Then one stream line through the session of plaza1.toml, as
+//! `onebeacon stream` and the Python `Navigator.feed` take it (JSON parse, the session's
+//! checks and every estimator's update, the output line): a range, an odometry item.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use onebeacon_sim::replay::{Log, LogError, replay};
+use onebeacon::io::jsonl::{Lines, item_json};
+use onebeacon_sim::replay::{Log, LogError, StreamSetup, replay, stream_setup};
 use std::hint::black_box;
 use std::path::PathBuf;
 
@@ -29,6 +32,35 @@ fn bench(c: &mut Criterion) {
         b.iter(|| black_box(replay(&full, None, drop_row).unwrap()))
     });
     c.bench_function("plaza1 load (TOML, beacons, CSV headers)", |b| b.iter(|| black_box(Log::load(&path).unwrap())));
+
+    // a started stream: plaza1's first 2000 items
+    let StreamSetup { mut session, beacons, frame } = stream_setup(&path).unwrap();
+    let mut lines = Lines::default();
+    let mut t0 = 0.0;
+    for item in full.items().unwrap().take(2000) {
+        let item = item.unwrap();
+        t0 = item.t_s;
+        lines.push(&mut session, &beacons, frame, item_json(&item).to_string().as_bytes(), false, |_, _| {});
+    }
+    assert!(session.started());
+    let names = session.names.len();
+    for (label, line) in [
+        ("range", r#"{"t_s":T,"kind":"range","beacon":1,"range_m":30.0}"#),
+        ("odometry", r#"{"t_s":T,"kind":"odometry","distance_m":0.01,"heading_change_rad":0.0}"#),
+    ] {
+        c.bench_function(&format!("stream line: {label}, {names} estimators (parse, update, output line)"), |b| {
+            b.iter_custom(|iters| {
+                let batch: Vec<String> =
+                    (0..iters).map(|k| line.replace('T', &format!("{}", t0 + 0.01 * (k + 1) as f64))).collect();
+                t0 += 0.01 * (iters + 1) as f64;
+                let start = std::time::Instant::now();
+                for l in &batch {
+                    black_box(lines.push(&mut session, &beacons, frame, l.as_bytes(), false, |_, _| {}));
+                }
+                start.elapsed()
+            })
+        });
+    }
 }
 
 criterion_group!(benches, bench);
