@@ -138,23 +138,13 @@ impl PyScenario {
     /// The built-in scenario `name` (see `onebeacon.scenarios()`).
     #[staticmethod]
     fn builtin(name: &str) -> PyResult<Self> {
-        let b = scenario::builtin(name).ok_or_else(|| {
-            input_error(scenario::ScenarioError::UnknownBuiltin {
-                name: name.to_string(),
-                available: BUILTINS.iter().map(|b| format!("`{}`", b.name)).collect::<Vec<_>>().join(", "),
-            })
-        })?;
-        scenario::parse(b.toml, &format!("built-in scenario `{}`", b.name)).map(Self::from).map_err(input_error)
+        scenario::load_builtin(name).map(Self::from).map_err(input_error)
     }
 
     /// The scenario of a TOML file.
     #[staticmethod]
     fn from_file(path: PathBuf) -> PyResult<Self> {
-        let name = path.display().to_string();
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            input_error(scenario::ScenarioError::Io { source_name: name.clone(), message: e.to_string() })
-        })?;
-        scenario::parse(&text, &name).map(Self::from).map_err(input_error)
+        scenario::load_file(&path).map(Self::from).map_err(input_error)
     }
 
     /// The scenario of TOML text; `source` names it in errors.

@@ -22,20 +22,33 @@ pub enum ScenarioError {
 
 /// Loads `name_or_path`: a built-in scenario name, or the path of a TOML file.
 pub fn load(name_or_path: &str) -> Result<Scenario, ScenarioError> {
-    if let Some(b) = builtin(name_or_path) {
-        return parse(b.toml, &format!("built-in scenario `{}`", b.name));
+    if builtin(name_or_path).is_some() {
+        return load_builtin(name_or_path);
     }
-    let path = Path::new(name_or_path);
     let looks_like_path = name_or_path.ends_with(".toml") || name_or_path.contains(['/', '\\']);
-    if !looks_like_path && !path.exists() {
-        return Err(ScenarioError::UnknownBuiltin {
-            name: name_or_path.to_string(),
-            available: super::BUILTINS.iter().map(|b| format!("`{}`", b.name)).collect::<Vec<_>>().join(", "),
-        });
+    if !looks_like_path && !Path::new(name_or_path).exists() {
+        return load_builtin(name_or_path);
     }
+    load_file(Path::new(name_or_path))
+}
+
+/// Loads the built-in scenario `name`.
+pub fn load_builtin(name: &str) -> Result<Scenario, ScenarioError> {
+    match builtin(name) {
+        Some(b) => parse(b.toml, &format!("built-in scenario `{}`", b.name)),
+        None => Err(ScenarioError::UnknownBuiltin {
+            name: name.to_string(),
+            available: super::BUILTINS.iter().map(|b| format!("`{}`", b.name)).collect::<Vec<_>>().join(", "),
+        }),
+    }
+}
+
+/// Loads the scenario of the TOML file at `path`.
+pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
+    let name = path.display().to_string();
     let text = std::fs::read_to_string(path)
-        .map_err(|e| ScenarioError::Io { source_name: name_or_path.to_string(), message: e.to_string() })?;
-    parse(&text, name_or_path)
+        .map_err(|e| ScenarioError::Io { source_name: name.clone(), message: e.to_string() })?;
+    parse(&text, &name)
 }
 
 /// Deserializes TOML into `T` with errors naming the source, line and key.

@@ -21,7 +21,7 @@ pub use builtin::{BUILTINS, Builtin, builtin};
 pub use estimator::{EstimatorKind, EstimatorSpec, Host};
 pub use fixed_beacon::{FixedBeacon, FixedBeaconCell};
 pub use fleet::Fleet;
-pub use load::{ScenarioError, load, parse};
+pub use load::{ScenarioError, load, load_builtin, load_file, parse};
 pub use moving_beacon::{MovingBeacon, MovingBeaconCell};
 pub use passive_usbl::{PassiveUsbl, PassiveUsblCell};
 
