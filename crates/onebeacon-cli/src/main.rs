@@ -90,8 +90,9 @@ enum Command {
         /// Base seed (default: the scenario's `seed`).
         #[arg(long)]
         seed: Option<u64>,
-        /// Worker threads (default: one per core). Results do not depend on it.
-        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+        /// Worker threads (default: one per core). Results do not depend on it. (With
+        /// --slurm, each shard's threads are its --cpus-per-task.)
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024), conflicts_with = "slurm")]
         threads: Option<u16>,
         /// Also write mc.json and plots to this directory; with --shard, where the
         /// partial (partial-I-of-N.json) goes; with --slurm, where campaign.sh goes.
