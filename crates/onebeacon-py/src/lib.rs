@@ -15,7 +15,7 @@ use onebeacon_sim::run::{StepRecord, check_recordable, simulate, trajectory};
 use onebeacon_sim::scenario::{self, BUILTINS, ping::PingConfig};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString, PyTuple};
 use serde_json::Value;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -81,21 +81,23 @@ fn from_py(obj: &Bound<'_, PyAny>, at: &str) -> PyResult<Value> {
         }
         return Ok(Value::Object(map));
     }
-    // ints, numpy's among them (they have __index__), before floats
-    if (obj.is_instance_of::<PyInt>() || obj.hasattr("__index__")? && !obj.hasattr("__len__")?)
-        && let Ok(i) = obj.extract::<i64>()
-    {
+    // sequences (lists, tuples, numpy arrays of any length, one included) before
+    // numbers: a one-element array also converts to a float
+    if let Ok(len) = obj.len() {
+        let mut values = Vec::with_capacity(len);
+        for (i, x) in obj.try_iter()?.enumerate() {
+            values.push(from_py(&x?, &format!("{at}[{i}]"))?);
+        }
+        return Ok(Value::Array(values));
+    }
+    // ints (numpy's too, through __index__) before floats, which do not convert to i64
+    if let Ok(i) = obj.extract::<i64>() {
         return Ok(Value::from(i));
     }
     if let Ok(x) = obj.extract::<f64>() {
         return serde_json::Number::from_f64(x)
             .map(Value::Number)
             .ok_or_else(|| input_error(format!("{at} = {x}: not a finite number")));
-    }
-    if let Ok(items) = obj.try_iter() {
-        let values: PyResult<Vec<Value>> =
-            items.enumerate().map(|(i, x)| from_py(&x?, &format!("{at}[{i}]"))).collect();
-        return Ok(Value::Array(values?));
     }
     Err(input_error(format!(
         "{at}: {} is not a TOML value (dict, list, str, bool, int, float)",

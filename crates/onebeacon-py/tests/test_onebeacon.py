@@ -74,6 +74,9 @@ def test_scenario_dict_round_trip():
     # numpy values are taken as the numbers they hold
     d = dict(SHORT, mission={"duration_s": np.float64(120.0)}, sweep={"t_com_s": np.array([3.0, 9.0])})
     assert onebeacon.Scenario.from_dict(d) == short
+    one = dict(SHORT, seed=np.int64(4), sweep={"t_com_s": np.array([9.0])})
+    assert onebeacon.Scenario.from_dict(one).cells == [{"t_com_s": 9.0}]
+    assert onebeacon.Scenario.from_dict(one).seed == 4
 
 
 def test_scenario_from_a_name_a_path_or_a_dict_is_the_same(tmp_path):
