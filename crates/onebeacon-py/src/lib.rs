@@ -351,7 +351,7 @@ fn run<'py>(
     check_recordable(&s).map_err(|e| input_error(format!("{}: {e}", s.name())))?;
     let seed = seed.unwrap_or(s.seed());
     let cell = s.base_cell();
-    let out = with_progress(py, 1, None, |_| simulate(&s, &cell, seed, run, true))?;
+    let out = py.detach(|| simulate(&s, &cell, seed, run, true));
     let columns = trajectory_dict(py, &s.vehicle_names(), &s.track_labels(), &out.trajectory)?;
     let summary = to_py(py, &onebeacon_sim::json::run_summary(&s, seed, run, &cell, &out))?;
     PyTuple::new(py, [columns.into_any(), summary])
@@ -406,14 +406,14 @@ fn replay<'py>(
     let filter = beacon_filter(beacons, &known).map_err(|e| input_error(format!("beacons {e}")))?;
     let used: Vec<u32> = filter.clone().map_or_else(|| known.iter().copied().collect(), |f| f.into_iter().collect());
     let started = std::time::Instant::now();
-    let (records, r) = with_progress(py, 1, None, |_| {
+    let (records, r) = py.detach(|| {
         let mut records = Vec::new();
         let r = run_replay::<onebeacon_sim::replay::LogError>(&l, filter, |rec| {
             records.push(rec);
             Ok(())
         });
         (records, r)
-    })?;
+    });
     let r = r.map_err(input_error)?;
     let summary = onebeacon_sim::json::replay_summary(&l, &used, &r, started.elapsed().as_secs_f64());
     let columns = trajectory_dict(py, &["auv".to_string()], &r.session.names, &records)?;
@@ -555,8 +555,7 @@ fn dsp_process<'py>(
     }
     let captures: Vec<Vec<f64>> = view.rows().into_iter().map(|r| r.to_vec()).collect();
     let len = view.ncols();
-    let found = with_progress(py, 1, None, |_| Chain::new(c, len).map(|mut chain| chain.process(&captures)))?
-        .map_err(input_error)?;
+    let found = py.detach(|| Chain::new(c, len).map(|mut chain| chain.process(&captures))).map_err(input_error)?;
     to_py(py, &found.result)
 }
 

@@ -184,7 +184,6 @@ pub struct Merged {
 /// versions, and missing or duplicate shares, with one line each.
 pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
     let Some((first_path, first)) = partials.first() else { return Err(MergeError::Empty) };
-    let (first_path, first) = (first_path.clone(), first.clone());
     let mut by_shard: Vec<Option<String>> = vec![None; first.shards];
     for (path, p) in &partials {
         if p.version != VERSION {
@@ -223,8 +222,9 @@ pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
     }
     let scenario = parse(&first.scenario_toml, &first.scenario)
         .map_err(|source| MergeError::Scenario { path: first_path.clone(), source })?;
+    let (runs, seed) = (first.runs, first.seed);
     let cells = scenario.cells().len();
-    let mut summaries = Vec::with_capacity(cells * first.runs);
+    let mut summaries = Vec::with_capacity(cells * runs);
     let mut wall_s = 0.0;
     for (path, p) in partials {
         let expected = p.shard_of().pairs(cells, p.runs).count();
@@ -234,7 +234,7 @@ pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
         wall_s += p.wall_s;
         summaries.extend(p.summaries());
     }
-    let result = aggregate(&scenario, first.runs, first.seed, summaries)?;
+    let result = aggregate(&scenario, runs, seed, summaries)?;
     Ok(Merged { scenario, result, wall_s })
 }
 
