@@ -25,15 +25,18 @@ pub fn shard(
     let s = scenario::load(name)?;
     let runs = runs.unwrap_or(s.runs());
     let seed = seed.unwrap_or(s.seed());
-    let staging = Staging::beside(out, &format!("partial-{}-of-{}", shard.index, shard.count))?;
-    let total = shard.pairs(s.cells().len(), runs).count() as u64;
+    check_shard_count(&s, runs, &format!("--shard {shard}"), shard.count)?;
+    crate::check_memory(name, &s, onebeacon_sim::budget::concurrent_runs(threads, runs), 0)?;
+    let file = format!("partial-{}-of-{}.json", shard.index, shard.count);
+    let staging = Staging::beside(out, &[&file])?;
+    let total = shard.len(s.cells().len() * runs) as u64;
     let bar = crate::progress_bar(total, "runs", format!("mc {} shard {shard}", s.name()));
     let start = Instant::now();
     let summaries = monte_carlo_shard(&s, runs, seed, shard, threads, &|| bar.inc(1))?;
     bar.finish_and_clear();
     let partial = Partial::new(&s, runs, seed, shard, start.elapsed().as_secs_f64(), &summaries);
     staging.write(&partial.file_name(), partial.to_json().as_bytes())?;
-    for f in staging.move_files_to(out)? {
+    for f in staging.move_files_to()? {
         eprintln!("wrote {} ({total} of {} runs)", f.display(), runs * s.cells().len());
     }
     Ok(())
@@ -43,7 +46,7 @@ pub fn shard(
 /// from the partials of every shard.
 pub fn merge_partials(paths: &[PathBuf], out: Option<PathBuf>, json: bool) -> Result<()> {
     let bad = |e: MergeError| BadInput(e.to_string());
-    let merged = merge(read_partials(paths).map_err(bad)?).map_err(bad)?;
+    let merged = merge(read_partials(paths, &crate::budget()).map_err(bad)?).map_err(bad)?;
     let staging = out.as_deref().map(Staging::new).transpose()?;
     commands::write_mc(&merged.scenario, &merged.result, merged.wall_s, staging, json)
 }
@@ -63,26 +66,18 @@ pub struct Slurm {
 pub fn slurm(name: &str, runs: Option<usize>, seed: Option<u64>, slurm: &Slurm, out: Option<PathBuf>) -> Result<()> {
     let s = scenario::load(name)?;
     let (runs, seed) = (runs.unwrap_or(s.runs()), seed.unwrap_or(s.seed()));
-    let pairs = runs * s.cells().len();
-    if slurm.shards > pairs {
-        return Err(BadInput(format!(
-            "--slurm {}: {} has {pairs} (cell, run) pairs ({} cells x {runs} runs); at most that many shards",
-            slurm.shards,
-            s.name(),
-            s.cells().len()
-        ))
-        .into());
-    }
+    check_shard_count(&s, runs, &format!("--slurm {}", slurm.shards), slurm.shards)?;
     let exe = std::env::current_exe().context("cannot find the onebeacon executable")?;
     match out {
         Some(dir) => {
             let dir = absolute(&dir)?;
-            let staging = Staging::beside(&dir, "campaign")?;
+            let staging = Staging::beside(&dir, &["campaign.sh", "scenario.toml"])?;
             let scenario_file = dir.join("scenario.toml");
-            staging.write("scenario.toml", s.to_toml().as_bytes())?;
+            let toml = format!("# the scenario of the campaign written by `onebeacon mc --slurm`\n{}", s.to_toml());
+            staging.write("scenario.toml", toml.as_bytes())?;
             let script = campaign_script(&s, &exe, &scenario_file.display().to_string(), runs, seed, slurm, &dir);
             staging.write("campaign.sh", script.as_bytes())?;
-            let files = staging.move_files_to(&dir)?;
+            let files = staging.move_files_to()?;
             for f in &files {
                 eprintln!("wrote {}", f.display());
             }
@@ -98,6 +93,21 @@ pub fn slurm(name: &str, runs: Option<usize>, seed: Option<u64>, slurm: &Slurm, 
             let dir = absolute(&PathBuf::from("out").join(format!("{}-campaign", s.name())))?;
             out!("{}", campaign_script(&s, &exe, &source, runs, seed, slurm, &dir));
         }
+    }
+    Ok(())
+}
+
+/// Bad input where `shards` (given as `flag`) exceed the sweep's (cell, run) pairs: a
+/// share would be empty.
+fn check_shard_count(s: &Scenario, runs: usize, flag: &str, shards: usize) -> Result<()> {
+    let pairs = runs * s.cells().len();
+    if shards > pairs {
+        return Err(BadInput(format!(
+            "{flag}: {} has {pairs} (cell, run) pairs ({} cells x {runs} runs); at most that many shards",
+            s.name(),
+            s.cells().len()
+        ))
+        .into());
     }
     Ok(())
 }
@@ -138,30 +148,25 @@ fn campaign_script(
 # job that starts when every shard succeeded (afterok) and writes the unsharded result.
 # Written by `onebeacon mc --slurm`; adapt the sbatch options below to your cluster.
 # The executable and OUT must be on a file system that the compute nodes share.
+# The job scripts name every path through printf %q: a path is never run as code.
 set -euo pipefail
 ONEBEACON=${{ONEBEACON:-{exe}}}
 SCENARIO={scenario}
 OUT=${{OUT:-{dir}}}
 SBATCH_OPTIONS=${{SBATCH_OPTIONS:-}}
-mkdir -p "$OUT/partials" "$OUT/logs"
-rm -f "$OUT"/partials/partial-*-of-{n}.json
+mkdir -p -- "$OUT/partials" "$OUT/logs"
+shard_job=$(printf '#!/usr/bin/env bash\nexec %q mc %q --runs {runs} --seed {seed} --threads "${{SLURM_CPUS_PER_TASK:-1}}" --shard "${{SLURM_ARRAY_TASK_ID}}/{n}" --out %q\n' \
+  "$ONEBEACON" "$SCENARIO" "$OUT/partials")
+merge_job=$(printf '#!/usr/bin/env bash\nexec %q mc merge %q/partial-*-of-{n}.json --out %q --json\n' \
+  "$ONEBEACON" "$OUT/partials" "$OUT/result")
 array=$(sbatch --parsable --job-name=onebeacon-{name} --array=0-{last}{options} $SBATCH_OPTIONS \
-  --output="$OUT/logs/shard-%a.out" <<EOF
-#!/usr/bin/env bash
-exec "$ONEBEACON" mc "$SCENARIO" --runs {runs} --seed {seed} --threads "\${{SLURM_CPUS_PER_TASK:-1}}" \
-  --shard "\${{SLURM_ARRAY_TASK_ID}}/{n}" --out "$OUT/partials"
-EOF
-)
+  --output="$OUT/logs/shard-%a.out" <<<"$shard_job")
 array=${{array%%;*}}
 merge=$(sbatch --parsable --job-name=onebeacon-{name}-merge --dependency=afterok:"$array"{options} $SBATCH_OPTIONS \
-  --output="$OUT/logs/merge.out" <<EOF
-#!/usr/bin/env bash
-exec "$ONEBEACON" mc merge "$OUT/partials" --out "$OUT/result" --json
-EOF
-)
+  --output="$OUT/logs/merge.out" <<<"$merge_job")
 merge=${{merge%%;*}}
 echo "array job $array ({n} shards) and merge job $merge submitted; the result will be $OUT/result/mc.json"
-echo "$array $merge" > "$OUT/jobs"
+printf '%s %s\n' "$array" "$merge" > "$OUT/jobs"
 "#,
         exe = quote(&exe.display().to_string()),
         scenario = quote(scenario),

@@ -39,7 +39,7 @@ pub fn scenarios(show: Option<&str>) -> Result<()> {
 /// `onebeacon run SCENARIO [--seed N] [--run I] [--ping K] [--message M] [--out DIR]`
 pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, message: usize, out: Option<PathBuf>) -> Result<()> {
     let s = scenario::load(name)?;
-    onebeacon_sim::run::check_recordable(&s).map_err(|e| BadInput(format!("{name}: {e}")))?;
+    crate::check_memory(name, &s, 1, 1)?;
     let seed = seed.unwrap_or(s.seed());
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name())));
     let staging = Staging::new(&dir)?;
@@ -109,6 +109,7 @@ pub fn mc(
     let s = scenario::load(name)?;
     let runs = runs.unwrap_or(s.runs());
     let seed = seed.unwrap_or(s.seed());
+    crate::check_memory(name, &s, onebeacon_sim::budget::concurrent_runs(threads, runs), 0)?;
     // an unwritable --out fails before the runs, not after
     let staging = out.as_deref().map(Staging::new).transpose()?;
 

@@ -49,8 +49,8 @@ pub fn simulate(config: Option<&str>, out: &Path) -> Result<()> {
     let dir =
         out.parent().filter(|p| !p.as_os_str().is_empty()).map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
     let wav_name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "ping.wav".into());
-    let staging = Staging::beside(&dir, &wav_name)?;
     let json_name = Path::new(&wav_name).with_extension("json").to_string_lossy().into_owned();
+    let staging = Staging::beside(&dir, &[&wav_name, &json_name])?;
     let spec = hound::WavSpec {
         channels: elements.len() as u16,
         sample_rate: c.capture.fs_hz.round() as u32,
@@ -65,7 +65,7 @@ pub fn simulate(config: Option<&str>, out: &Path) -> Result<()> {
     }
     w.finalize()?;
     staging.write(&json_name, (serde_json::to_string_pretty(&truth)? + "\n").as_bytes())?;
-    let moved = staging.move_files_to(&dir)?;
+    let moved = staging.move_files_to()?;
     for f in moved {
         outln!("wrote {}", f.display());
     }

@@ -45,6 +45,7 @@ pub fn fleet(
     }
     let runs = runs.unwrap_or(s.runs());
     let seed = seed.unwrap_or(s.seed());
+    crate::check_memory(name, &s, onebeacon_sim::budget::concurrent_runs(threads, runs), runs)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-fleet", s.name())));
     let staging = Staging::new(&dir)?;
     let bar = crate::progress_bar(runs as u64, "runs", format!("fleet {}", s.name()));

@@ -41,6 +41,30 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The memory budget, GiB: a configuration whose estimated working set is larger is
+    /// refused before any work (default: $ONEBEACON_MEMORY_GIB, else half this
+    /// machine's memory).
+    #[arg(long, global = true, value_name = "GiB", value_parser = positive_f64)]
+    memory_gib: Option<f64>,
+}
+
+/// The memory budget of this invocation ([`onebeacon_sim::budget`]).
+static BUDGET: std::sync::OnceLock<onebeacon_sim::budget::Budget> = std::sync::OnceLock::new();
+
+/// Refuses (as bad input) `s` with `concurrent` runs at once, `recorded` of them keeping
+/// every step, where it would not fit in the memory budget.
+pub(crate) fn check_memory(
+    name: &str,
+    s: &onebeacon_sim::Scenario,
+    concurrent: usize,
+    recorded: usize,
+) -> anyhow::Result<()> {
+    budget().check_scenario(s, concurrent, recorded).map_err(|e| BadInput(format!("{name}: {e}")).into())
+}
+
+/// The memory budget of this invocation.
+pub(crate) fn budget() -> onebeacon_sim::budget::Budget {
+    *BUDGET.get().expect("set in main")
 }
 
 #[derive(Debug, Subcommand)]
@@ -350,6 +374,15 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    match onebeacon_sim::budget::Budget::resolve(cli.memory_gib) {
+        Ok(b) => {
+            let _ = BUDGET.set(b);
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    }
     let result = match cli.command {
         Command::Scenarios { show } => commands::scenarios(show.as_deref()),
         Command::Run { scenario, seed, run, ping, message, out } => {

@@ -70,7 +70,18 @@ fn span(values: impl Iterator<Item = f64>, margin: f64) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// A white canvas with a titled, labelled chart of the given ranges.
+/// The largest magnitude an axis reaches, m or s: beyond it (a diverged filter's 1e308,
+/// an overflow) plotters' tick search does not end; what lies beyond is clipped.
+const AXIS_LIMIT: f64 = 1e12;
+
+/// An axis range that can be drawn: finite, within [`AXIS_LIMIT`], never empty.
+fn drawable(r: Range<f64>) -> Range<f64> {
+    let clamp = |v: f64| if v.is_nan() { 0.0 } else { v.clamp(-AXIS_LIMIT, AXIS_LIMIT) };
+    let (lo, hi) = (clamp(r.start), clamp(r.end));
+    if hi > lo { lo..hi } else { lo..lo + 1.0 }
+}
+
+/// A white canvas with a titled, labelled chart of the given ranges (made drawable).
 fn chart<'a, DB: DrawingBackend + 'a>(
     root: &Area<DB>,
     caption: &str,
@@ -87,7 +98,7 @@ where
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .build_cartesian_2d(x, y)?;
+        .build_cartesian_2d(drawable(x), drawable(y))?;
     chart.configure_mesh().x_desc(labels.0).y_desc(labels.1).label_style((FONT, 16)).draw()?;
     Ok(chart)
 }
@@ -188,7 +199,7 @@ fn colour_bar<DB: DrawingBackend>(area: &Area<DB>, lo: f64, hi: f64, label: &str
 where
     DB::ErrorType: 'static,
 {
-    let (lo, hi) = if hi > lo { (lo, hi) } else { (lo, lo + 1.0) };
+    let Range { start: lo, end: hi } = drawable(lo..hi);
     let mut bar = ChartBuilder::on(area)
         .margin_top(60)
         .margin_bottom(60)

@@ -45,6 +45,7 @@ pub fn replay(
         filter.as_ref().map(|f| format!("-beacons-{}", f.iter().map(u32::to_string).collect::<Vec<_>>().join("-")));
     let name = &log.description.name;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-replay{}", suffix.unwrap_or_default())));
+    crate::budget().check_replay(&log, false).map_err(|e| BadInput(e.to_string()))?;
     let staging = Staging::new(&dir)?;
 
     let started = std::time::Instant::now();
@@ -74,14 +75,17 @@ pub fn replay(
     plot::error_vs_time(&staging.file("error.png"), &s.names, &title, plotted.records())
         .context("cannot draw error.png")?;
     let files = staging.commit()?;
+    for w in r.warnings(log.has_truth()) {
+        eprintln!("warning: {w}");
+    }
 
     if as_json {
         outln!("{summary}");
         return Ok(());
     }
     outln!("{title}: {} measurements, replayed in {:.1} ms", r.items, wall_s * 1e3);
-    for (file, n) in r.dropped.iter().filter(|(_, n)| *n > 0) {
-        outln!("{file}: {n} rows out of time order dropped (time_order = \"drop\")");
+    for d in r.dropped.iter().filter(|d| d.dropped > 0) {
+        outln!("{}: {} rows out of time order dropped (time_order = \"drop\")", d.file, d.dropped);
     }
     // (header, summary key, decimals)
     const COLUMNS: [(&str, &str, usize); 12] = [

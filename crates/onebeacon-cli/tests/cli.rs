@@ -220,7 +220,7 @@ fn slurm_script_has_the_array_and_the_merge_after_it() {
         "--dependency=afterok:",
         "--partition='long'",
         "--cpus-per-task=2",
-        "--shard \"\\${SLURM_ARRAY_TASK_ID}/4\"",
+        "--shard \"${SLURM_ARRAY_TASK_ID}/4\"",
         "mc merge",
     ] {
         assert!(script.contains(needle), "{needle} not in\n{script}");
@@ -235,6 +235,81 @@ fn slurm_script_has_the_array_and_the_merge_after_it() {
     let out = run(&["mc", &scenario, "--runs", "2", "--slurm", "5"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("at most that many shards"), "{}", text(&out.stderr));
+}
+
+/// A stand-in `sbatch`: saves the job script it reads and runs it at once (each array
+/// task in turn, `SLURM_ARRAY_TASK_ID` set), printing a job id.
+const STUB_SBATCH: &str = r#"#!/usr/bin/env bash
+set -euo pipefail
+array=""
+for a in "$@"; do case "$a" in --array=*) array=${a#--array=0-} ;; esac; done
+n=$(ls "$STUB_JOBS" | wc -l)
+script="$STUB_JOBS/job-$n.sh"
+cat > "$script"
+if [ -n "$array" ]; then
+  for i in $(seq 0 "$array"); do SLURM_ARRAY_TASK_ID=$i bash "$script" >> "$STUB_JOBS/log" 2>&1; done
+else
+  bash "$script" >> "$STUB_JOBS/log" 2>&1
+fi
+echo "$((100 + n))"
+"#;
+
+/// Paths with `$(...)`, backticks, `$VAR`, quotes, spaces and newlines in --out, in the
+/// scenario's path and in OUT reach the jobs as the paths they are: nothing in them
+/// runs, the shards land where they were sent, and the merge equals the unsharded mc.
+#[cfg(unix)]
+#[test]
+fn slurm_jobs_never_run_their_paths() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("slurm-quoting");
+    let hostile = "x $(touch PWNED) `touch PWNED2` $HOME \"dq\" 'sq' ;touch PWNED3\nline";
+    let scenario_dir = dir.join(format!("s {hostile}"));
+    std::fs::create_dir_all(&scenario_dir).unwrap();
+    let scenario = short_scenario(&scenario_dir);
+    let stub = dir.join("stub");
+    let jobs = dir.join("jobs");
+    std::fs::create_dir_all(&stub).unwrap();
+    std::fs::create_dir_all(&jobs).unwrap();
+    std::fs::write(stub.join("sbatch"), STUB_SBATCH).unwrap();
+    std::fs::set_permissions(stub.join("sbatch"), std::fs::Permissions::from_mode(0o755)).unwrap();
+    let whole = run(&["mc", &scenario, "--runs", "3", "--json"]);
+    assert!(whole.status.success(), "{}", text(&whole.stderr));
+    let whole: serde_json::Value = serde_json::from_str(&text(&whole.stdout)).unwrap();
+    let path = format!("{}:{}", stub.display(), std::env::var("PATH").unwrap_or_default());
+    // once with --out, once with OUT overriding it at submission
+    for (i, env_out) in [(0, None), (1, Some(dir.join(format!("env {hostile}"))))] {
+        let campaign = dir.join(format!("c{i} {hostile}"));
+        let out = run(&["mc", &scenario, "--runs", "3", "--slurm", "3", "--out", campaign.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let mut submit = Command::new("bash");
+        submit.arg(campaign.join("campaign.sh")).current_dir(&dir).env("PATH", &path).env("STUB_JOBS", &jobs);
+        if let Some(o) = &env_out {
+            submit.env("OUT", o);
+        }
+        let o = submit.output().unwrap();
+        let log = std::fs::read_to_string(jobs.join("log")).unwrap_or_default();
+        assert!(o.status.success(), "{}{}", text(&o.stderr), log);
+        let target = env_out.unwrap_or(campaign);
+        for shard in 0..3 {
+            assert!(target.join(format!("partials/partial-{shard}-of-3.json")).is_file(), "{log}");
+        }
+        let merged: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(target.join("result/mc.json")).unwrap()).unwrap();
+        assert_eq!(merged["cells"], whole["cells"]);
+    }
+    let mut seen = Vec::new();
+    let mut stack = vec![dir.clone()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().map(Result::unwrap) {
+            seen.push(e.file_name().to_string_lossy().into_owned());
+            if e.file_type().unwrap().is_dir() {
+                stack.push(e.path());
+            }
+        }
+    }
+    assert!(seen.iter().all(|n| !n.starts_with("PWNED")), "a path ran as code: {seen:?}");
+    let home = std::env::var("HOME").unwrap_or_default();
+    assert!(!Path::new(&home).join("partials").exists() || home.is_empty());
 }
 
 /// Each bad input: exit status 2, one line on stderr naming the problem, no panic, no
@@ -260,10 +335,52 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
     let escape = write("escape.toml", "name = \"../../x\"\n");
     let huge = write("huge.toml", "name = \"huge\"\n[mission]\nduration_s = 25000000\n");
     let estimator = write("est.toml", "name = \"e\"\n[[estimators]]\nkind = \"rosb\"\nnis_gate = 3.0\n");
+    let builtin = |name: &str| text(&run(&["scenarios", "--show", name]).stdout);
+    let particles = write(
+        "particles.toml",
+        &builtin("hoff2024")
+            .replace("particles = 500000 ", "particles = 50000000 ")
+            .replace("duration_s = 3600 ", "duration_s = 60 "),
+    );
+    let long_step = write("step.toml", "name = \"d\"\n[mission]\nduration_s = 60\ndt_s = 100\n");
+    let crawl = write("crawl.toml", "name = \"c\"\n[mission]\nspeed_m_s = 1e-300\n");
+    let deep = write("deep.toml", &builtin("rypkema-m1").replacen("depth_m = 2.5", "depth_m = 1e9", 1));
+    let wide = write("wide.toml", "name = \"w\"\n[[estimators]]\nkind = \"rosb\"\n");
+    let partial = dir.join("p");
+    let o = run(&["mc", &wide, "--runs", "2", "--shard", "0/1", "--out", partial.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let good = std::fs::read_to_string(partial.join("partial-0-of-1.json")).unwrap();
+    let shards = write("partial-0-of-1000000000.json", &good.replace("\"shards\":1,", "\"shards\":1000000000,"));
+    let runs = write("partial-runs.json", &good.replace("\"runs\":2,", "\"runs\":1000000000,"));
+    let plaza1 = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/plaza/plaza1.toml");
+    let plaza1 = plaza1.to_str().unwrap();
     let out_dir = dir.join("should-not-exist");
     let out = out_dir.to_str().unwrap();
 
     let cases: Vec<(Vec<&str>, &[&str])> = vec![
+        // tuning what weighs no measurement
+        (
+            vec!["tune", plaza1, "--estimators", "dead-reckoning", "--out", out],
+            &["dead-reckoning", "weighs 0 innovation(s)", "nothing to fit"],
+        ),
+        // memory: refused up front, not aborted
+        (
+            vec!["mc", &particles, "--runs", "2", "--threads", "2", "--memory-gib", "12", "--out", out],
+            &["particles.toml", "16.9 GB", "memory budget is 12.9 GB", "particles", "--memory-gib"],
+        ),
+        (vec!["run", &particles, "--memory-gib", "4", "--out", out], &["particles.toml", "memory budget is 4.3 GB"]),
+        (vec!["mc", "garin2024", "--memory-gib", "0"], &["--memory-gib", "> 0"]),
+        (vec!["mc", &long_step, "--out", out], &["step.toml", "mission.dt_s", "duration"]),
+        (vec!["mc", &crawl, "--out", out], &["crawl.toml", "mission.speed_m_s", "1e8 steps"]),
+        (vec!["fleet", &deep, "--out", out], &["deep.toml", "auvs[0].depth_m", "signal.water_depth_m"]),
+        (
+            vec!["mc", "garin2024", "--runs", "2", "--shard", "12/13", "--out", out],
+            &["--shard 12/13", "12 (cell, run)"],
+        ),
+        // merge: counts checked before use, only regular files read
+        (vec!["mc", "merge", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
+        (vec!["mc", "merge", &shards, "--out", out], &["partial-0-of-1000000000.json", "shards 1000000000"]),
+        (vec!["mc", "merge", &runs, "--out", out], &["partial-runs.json", "should hold 1000000000"]),
         (vec!["run", "garin2025", "--out", out], &["garin2025", "garin2024"]),
         (vec!["mc", &missing, "--out", out], &["nope.toml", "cannot read"]),
         (vec!["mc", &malformed, "--out", out], &["malformed.toml", "line 2"]),
@@ -636,24 +753,122 @@ fn full_stdout_is_an_error_not_a_panic() {
     }
 }
 
-/// An existing output directory is replaced whole: no stale file of an older run stays,
+/// The names in `dir`, sorted.
+fn names_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
+}
+
+/// An earlier onebeacon output is replaced whole: no stale file of an older run stays,
 /// and no staging directory is left beside it.
 #[test]
-fn out_replaces_an_existing_directory_whole() {
+fn out_replaces_an_earlier_output_whole() {
     let dir = scratch("replace");
     let scenario = short_scenario(&dir);
     let out = dir.join("o");
-    std::fs::create_dir_all(&out).unwrap();
-    std::fs::write(out.join("stale.txt"), "from an older run").unwrap();
+    let o = run(&["mc", &scenario, "--runs", "2", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(out.join("mc.json").is_file());
     let o = run(&["run", &scenario, "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let mut names: Vec<String> =
-        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    names.sort();
-    assert_eq!(names, ["error.png", "error.svg", "summary.json", "top_view.png", "top_view.svg", "trajectory.csv"]);
-    let beside: Vec<String> =
-        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    assert!(beside.iter().all(|n| !n.contains("partial")), "{beside:?}");
+    assert_eq!(
+        names_in(&out),
+        [
+            ".onebeacon-output",
+            "error.png",
+            "error.svg",
+            "summary.json",
+            "top_view.png",
+            "top_view.svg",
+            "trajectory.csv"
+        ]
+    );
+    assert!(names_in(&dir).iter().all(|n| !n.contains("partial")), "{:?}", names_in(&dir));
+}
+
+/// `--out` never removes what onebeacon did not write: a directory holding other files
+/// (a log's own directory, a thesis), the working directory or one that holds it, and
+/// a symbolic link are refused before any work, with one line and exit status 2, and
+/// every file stays as it was.
+#[test]
+fn out_never_takes_what_onebeacon_did_not_write() {
+    let dir = scratch("foreign");
+    let scenario = short_scenario(&dir);
+    let refused = |args: &[&str], cwd: &Path, needle: &str| {
+        let o = bin().args(args).current_dir(cwd).output().unwrap();
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    };
+    // the user's own directory
+    let thesis = dir.join("u");
+    std::fs::create_dir_all(&thesis).unwrap();
+    std::fs::write(thesis.join("thesis.tex"), "my thesis").unwrap();
+    refused(&["run", &scenario, "--out", thesis.to_str().unwrap()], &dir, "thesis.tex");
+    assert_eq!(names_in(&thesis), ["thesis.tex"]);
+    // a log replayed into its own directory
+    let plaza = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/plaza");
+    let dl = dir.join("dl");
+    std::fs::create_dir_all(&dl).unwrap();
+    for e in std::fs::read_dir(&plaza).unwrap().map(Result::unwrap) {
+        std::fs::copy(e.path(), dl.join(e.file_name())).unwrap();
+    }
+    let before = names_in(&dl);
+    refused(&["replay", dl.join("plaza1.toml").to_str().unwrap(), "--out", dl.to_str().unwrap()], &dir, "not empty");
+    assert_eq!(names_in(&dl), before);
+    // an earlier output with a file of the user's added
+    let out = dir.join("o");
+    assert!(run(&["run", &scenario, "--out", out.to_str().unwrap()]).status.success());
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    refused(&["run", &scenario, "--out", out.to_str().unwrap()], &dir, "notes.txt");
+    assert_eq!(std::fs::read_to_string(out.join("notes.txt")).unwrap(), "mine");
+    // the working directory, and a parent of it, even when they are outputs
+    std::fs::remove_file(out.join("notes.txt")).unwrap();
+    refused(&["run", &scenario, "--out", "."], &out, "working directory");
+    let inner = out.join("..").join("u");
+    refused(&["mc", &scenario, "--runs", "1", "--out", ".."], &inner, "working directory");
+    assert_eq!(names_in(&thesis), ["thesis.tex"]);
+    // a symbolic link
+    #[cfg(unix)]
+    {
+        let link = dir.join("link");
+        std::os::unix::fs::symlink(&thesis, &link).unwrap();
+        refused(&["run", &scenario, "--out", link.to_str().unwrap()], &dir, "symbolic link");
+        assert_eq!(names_in(&thesis), ["thesis.tex"]);
+    }
+    // a file beside others: `dsp simulate` does not overwrite a recording of the user's
+    let wav = thesis.join("rec.wav");
+    std::fs::write(&wav, "RIFF of the user's").unwrap();
+    refused(&["dsp", "simulate", "--out", wav.to_str().unwrap()], &dir, "not written by onebeacon");
+    assert_eq!(std::fs::read_to_string(&wav).unwrap(), "RIFF of the user's");
+    // nothing was staged anywhere
+    assert!(names_in(&dir).iter().all(|n| !n.contains("partial")), "{:?}", names_in(&dir));
+}
+
+/// A staging directory that a killed run left (its process gone) is removed by the next
+/// run that writes beside it; one of a live process is not.
+#[cfg(unix)]
+#[test]
+fn a_killed_runs_staging_directory_is_cleaned_later() {
+    let dir = scratch("stale");
+    let scenario = short_scenario(&dir);
+    let mut dead = Command::new("true").spawn().unwrap();
+    let dead_pid = dead.id();
+    dead.wait().unwrap();
+    let stale = dir.join(format!(".o.partial-{dead_pid}"));
+    std::fs::create_dir_all(&stale).unwrap();
+    std::fs::write(stale.join(".onebeacon-output"), "onebeacon 0.1.0 output\n").unwrap();
+    std::fs::write(stale.join("trajectory.csv"), "half").unwrap();
+    let live = dir.join(format!(".o.partial-{}", std::process::id()));
+    std::fs::create_dir_all(&live).unwrap();
+    std::fs::write(live.join(".onebeacon-output"), "onebeacon 0.1.0 output\n").unwrap();
+    let o = run(&["run", &scenario, "--out", dir.join("o").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(!stale.exists(), "the dead run's staging directory is removed");
+    assert!(live.exists(), "a live process's staging directory stays");
 }
 
 /// A signal while `--out` is being computed removes the staging directory and leaves
@@ -664,8 +879,10 @@ fn a_signal_leaves_no_partial_output() {
     for (signal, name) in [(libc::SIGINT, "int"), (libc::SIGTERM, "term")] {
         let dir = scratch(&format!("signal-{name}"));
         let out = dir.join("res");
-        std::fs::create_dir_all(&out).unwrap();
-        std::fs::write(out.join("keep.txt"), "old run").unwrap();
+        let scenario = short_scenario(&dir);
+        let first = run(&["mc", &scenario, "--runs", "1", "--out", out.to_str().unwrap()]);
+        assert!(first.status.success(), "{}", text(&first.stderr));
+        let old = std::fs::read(out.join("mc.json")).unwrap();
         let child = bin()
             .args(["mc", "garin2024", "--runs", "2000", "--out", out.to_str().unwrap()])
             .stdout(std::process::Stdio::null())
@@ -683,7 +900,7 @@ fn a_signal_leaves_no_partial_output() {
         let o = child.wait_with_output().unwrap();
         assert_eq!(o.status.code(), Some(128 + signal), "{name}: {}", text(&o.stderr));
         assert!(!partial.exists(), "{name}: the staging directory is removed");
-        assert_eq!(std::fs::read_to_string(out.join("keep.txt")).unwrap(), "old run");
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "{name}: nothing else beside the output");
+        assert_eq!(std::fs::read(out.join("mc.json")).unwrap(), old, "{name}: the earlier output is as it was");
+        assert_eq!(names_in(&dir), ["res", "short.toml"], "{name}: nothing else beside the output");
     }
 }

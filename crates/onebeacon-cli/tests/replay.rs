@@ -387,4 +387,40 @@ lon = "lon"
         }
     }
     eprintln!("plaza1 metric against clock times and latitudes: largest difference {worst:.2e} m");
+
+    // a row that is no place on Earth is refused with its file, line and column, exit 2
+    let truth = std::fs::read_to_string(dir.join("truth.csv")).unwrap();
+    let mut lines: Vec<String> = truth.lines().map(String::from).collect();
+    let good = lines[40].clone();
+    for bad in ["95.0", "1e9"] {
+        let mut cells: Vec<&str> = good.split(',').collect();
+        let column = if bad == "95.0" { 1 } else { 2 };
+        cells[column] = bad;
+        lines[40] = cells.join(",");
+        std::fs::write(dir.join("truth.csv"), lines.join("\n") + "\n").unwrap();
+        let o = run(&["replay", &log.display().to_string(), "--out", &dir.join("bad").display().to_string()]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains("truth.csv line 41") && err.contains("no place on Earth"), "{bad}: {err}");
+        assert!(!dir.join("bad").exists());
+    }
+
+    // a ground truth whose rows run backwards, dropped out of time order but one: the
+    // scores of a handful of rows are flagged, on stderr and in the summary
+    let mut backwards: Vec<&str> = truth.lines().skip(1).collect();
+    backwards.reverse();
+    std::fs::write(dir.join("truth.csv"), format!("time,lat,lon,yaw\n{}\n", backwards.join("\n"))).unwrap();
+    let dropping = std::fs::read_to_string(&log)
+        .unwrap()
+        .replace("file = \"truth.csv\"\n", "file = \"truth.csv\"\ntime_order = \"drop\"\n");
+    std::fs::write(&log, dropping).unwrap();
+    let o = run(&["replay", &log.display().to_string(), "--json", "--out", &dir.join("drop").display().to_string()]);
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("truth.csv") && err.contains("rows dropped out of time order"), "{err}");
+    assert!(err.contains("fewer than 30"), "{err}");
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let warnings = v["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1 + v["estimators"].as_array().unwrap().len(), "{warnings:?}");
 }

@@ -19,13 +19,14 @@ use std::path::PathBuf;
 pub type Target = fn(&[u8]);
 
 /// The targets by name, as `fuzz/fuzz_targets/` and the corpus directories name them.
-pub const TARGETS: [(&str, Target); 6] = [
+pub const TARGETS: [(&str, Target); 7] = [
     ("scenario", scenario),
     ("log_description", log_description),
     ("log_csv", log_csv),
     ("stream", stream),
     ("wav", wav),
     ("ping_config", ping_config),
+    ("partial", partial),
 ];
 
 /// Longest scenario the target simulates (steps x vehicles): longer ones are only
@@ -198,4 +199,19 @@ pub fn ping_config(data: &[u8]) {
         simulate_ping(&c.signal(), &c.source(), &c.receiver(), &c.attitude(), &elements, &c.channel(), &mut noise);
     assert!(caps.iter().flatten().all(|v| v.is_finite()), "a sample is not a number");
     assert!(caps.iter().flatten().any(|v| *v != 0.0), "a silent capture");
+}
+
+/// An `mc --shard` partial file: read and, when it reads, merged on its own (a one-share
+/// campaign, or a share of one whose other shares are missing). Every count in it is
+/// the file's word: the merge must check each before it allocates by it, and a merged
+/// result holds only the runs the file gave.
+pub fn partial(data: &[u8]) {
+    use onebeacon_sim::partial::{Partial, merge};
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(p) = Partial::from_json(text, "fuzz") else { return };
+    let records = p.results.len();
+    if let Ok(merged) = merge(vec![("fuzz".into(), p)]) {
+        let runs: usize = merged.result.cells.len() * merged.result.runs;
+        assert_eq!(runs, records, "a merged campaign of {runs} runs from {records} records");
+    }
 }

@@ -9,9 +9,11 @@ use onebeacon::io::jsonl::{Lines, Note};
 use onebeacon::nav::session::Session;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::acoustics::chain::Chain;
+use onebeacon_sim::budget::{Budget, concurrent_runs};
+use onebeacon_sim::montecarlo::Progress;
 use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::replay::{Log, StreamSetup, beacon_filter, replay as run_replay, stream_setup};
-use onebeacon_sim::run::{StepRecord, check_recordable, simulate, trajectory};
+use onebeacon_sim::run::{StepRecord, simulate, trajectory};
 use onebeacon_sim::scenario::{self, BUILTINS, ping::PingConfig};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -60,9 +62,20 @@ fn to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
     })
 }
 
+/// How deep dicts and lists may nest in what Python gives (a scenario is 4 deep).
+const MAX_DEPTH: usize = 64;
+
 /// Python to JSON (dicts with str keys, lists and tuples, str, bool, int, finite float,
 /// None; numpy scalars and arrays too); `at` names the place in errors.
 fn from_py(obj: &Bound<'_, PyAny>, at: &str) -> PyResult<Value> {
+    from_py_at(obj, at, 0)
+}
+
+fn from_py_at(obj: &Bound<'_, PyAny>, at: &str, depth: usize) -> PyResult<Value> {
+    if depth > MAX_DEPTH {
+        let at: String = at.chars().take(80).collect();
+        return Err(input_error(format!("{at}...: nested more than {MAX_DEPTH} deep; no onebeacon input nests so")));
+    }
     if obj.is_none() {
         return Ok(Value::Null);
     }
@@ -77,7 +90,7 @@ fn from_py(obj: &Bound<'_, PyAny>, at: &str) -> PyResult<Value> {
         for (k, v) in d.iter() {
             let key: String = k.extract().map_err(|_| input_error(format!("{at}: key {k}: keys must be strings")))?;
             let here = if at.is_empty() { key.clone() } else { format!("{at}.{key}") };
-            map.insert(key, from_py(&v, &here)?);
+            map.insert(key, from_py_at(&v, &here, depth + 1)?);
         }
         return Ok(Value::Object(map));
     }
@@ -86,7 +99,7 @@ fn from_py(obj: &Bound<'_, PyAny>, at: &str) -> PyResult<Value> {
     if let Ok(len) = obj.len() {
         let mut values = Vec::with_capacity(len);
         for (i, x) in obj.try_iter()?.enumerate() {
-            values.push(from_py(&x?, &format!("{at}[{i}]"))?);
+            values.push(from_py_at(&x?, &format!("{at}[{i}]"), depth + 1)?);
         }
         return Ok(Value::Array(values));
     }
@@ -286,54 +299,85 @@ fn trajectory_dict<'py>(
     Ok(d)
 }
 
-/// Runs `work` (given the per-run tick) with the GIL released, on its own thread, while
-/// this thread calls `progress(done, total)` (with the GIL) as runs finish. An exception
+/// The progress of a sweep run for Python: runs counted, and a stop that Ctrl-C sets.
+struct Ticks {
+    done: AtomicUsize,
+    stop: std::sync::atomic::AtomicBool,
+}
+
+impl Progress for Ticks {
+    fn tick(&self) {
+        self.done.fetch_add(1, Ordering::Relaxed);
+    }
+    fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+}
+
+/// Runs `work` with the GIL released, on its own thread, while this thread calls
+/// `progress(done, total)` (with the GIL) as runs finish and checks for signals every
+/// 0.1 s. Ctrl-C (or any signal handler's exception) stops the sweep: the runs under way
+/// finish, no other starts, and the exception (KeyboardInterrupt) is raised. An exception
 /// the callback raises is raised once the work is done.
 fn with_progress<T: Send>(
     py: Python<'_>,
     total: usize,
     progress: Option<Py<PyAny>>,
-    work: impl FnOnce(&(dyn Fn() + Sync)) -> T + Send,
+    work: impl FnOnce(&dyn Progress) -> T + Send,
 ) -> PyResult<T> {
-    let done = AtomicUsize::new(0);
-    let done = &done;
-    let (result, raised) = py.detach(|| {
+    let ticks = Ticks { done: AtomicUsize::new(0), stop: false.into() };
+    let ticks = &ticks;
+    let (result, raised, interrupted) = py.detach(|| {
         std::thread::scope(|scope| {
             let (tx, rx) = std::sync::mpsc::channel::<()>();
             let worker = scope.spawn(move || {
-                let r = work(&|| {
-                    done.fetch_add(1, Ordering::Relaxed);
-                });
+                let r = work(ticks);
                 let _ = tx.send(());
                 r
             });
             let mut raised: Option<PyErr> = None;
+            let mut interrupted: Option<PyErr> = None;
             let mut told = usize::MAX;
             loop {
                 let finished = !matches!(
                     rx.recv_timeout(Duration::from_millis(100)),
                     Err(std::sync::mpsc::RecvTimeoutError::Timeout)
                 );
-                if let (Some(callback), None) = (&progress, &raised) {
-                    let now = done.load(Ordering::Relaxed);
-                    if now != told {
-                        told = now;
-                        if let Err(e) = Python::attach(|py| callback.call1(py, (now, total)).map(drop)) {
-                            raised = Some(e);
+                Python::attach(|py| {
+                    if interrupted.is_none()
+                        && let Err(e) = py.check_signals()
+                    {
+                        ticks.stop.store(true, Ordering::Relaxed);
+                        interrupted = Some(e);
+                    }
+                    if let (Some(callback), None, None) = (&progress, &raised, &interrupted) {
+                        let now = ticks.done.load(Ordering::Relaxed);
+                        if now != told {
+                            told = now;
+                            if let Err(e) = callback.call1(py, (now, total)) {
+                                raised = Some(e);
+                            }
                         }
                     }
-                }
+                });
                 if finished {
                     break;
                 }
             }
-            (worker.join(), raised)
+            (worker.join(), raised, interrupted)
         })
     });
-    if let Some(e) = raised {
+    if let Some(e) = interrupted.or(raised) {
         return Err(e);
     }
     result.map_err(|_| PyRuntimeError::new_err("the computation panicked (a bug: please report it with the scenario)"))
+}
+
+/// The memory budget ([`onebeacon_sim::budget`]: $ONEBEACON_MEMORY_GIB, else half this
+/// machine's memory) checked for `s` with `concurrent` runs at once, `recorded` of them
+/// kept whole.
+fn check_memory(s: &Scenario, concurrent: usize, recorded: usize) -> PyResult<()> {
+    Budget::resolve(None).and_then(|b| b.check_scenario(s, concurrent, recorded)).map_err(input_error)
 }
 
 /// One recorded run of a scenario (`onebeacon run`): `(trajectory, summary)`, the
@@ -348,7 +392,7 @@ fn run<'py>(
     run: u64,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let s = scenario_of(scenario)?;
-    check_recordable(&s).map_err(|e| input_error(format!("{}: {e}", s.name())))?;
+    check_memory(&s, 1, 1)?;
     let seed = seed.unwrap_or(s.seed());
     let cell = s.base_cell();
     let out = py.detach(|| simulate(&s, &cell, seed, run, true));
@@ -379,6 +423,7 @@ fn mc<'py>(
         return Err(input_error(format!("threads = {}: must be 1 to 1024", threads.unwrap_or(0))));
     }
     let seed = seed.unwrap_or(s.seed());
+    check_memory(&s, concurrent_runs(threads, runs), 0)?;
     let total = runs * s.cells().len();
     let result = with_progress(py, total, progress, |tick| monte_carlo(&s, runs, seed, threads, tick))?
         .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
@@ -405,6 +450,8 @@ fn replay<'py>(
     let known = l.beacon_ids();
     let filter = beacon_filter(beacons, &known).map_err(|e| input_error(format!("beacons {e}")))?;
     let used: Vec<u32> = filter.clone().map_or_else(|| known.iter().copied().collect(), |f| f.into_iter().collect());
+    let budget = Budget::resolve(None).map_err(input_error)?;
+    budget.check_replay(&l, true).map_err(input_error)?;
     let started = std::time::Instant::now();
     let (records, r) = py.detach(|| {
         let mut records = Vec::new();
@@ -416,6 +463,9 @@ fn replay<'py>(
     });
     let r = r.map_err(input_error)?;
     let summary = onebeacon_sim::json::replay_summary(&l, &used, &r, started.elapsed().as_secs_f64());
+    for w in r.warnings(l.has_truth()) {
+        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &std::ffi::CString::new(w)?, 1)?;
+    }
     let columns = trajectory_dict(py, &["auv".to_string()], &r.session.names, &records)?;
     PyTuple::new(py, [columns.into_any(), to_py(py, &summary)?])
 }
@@ -548,6 +598,15 @@ fn dsp_process<'py>(
         return Err(input_error(format!(
             "samples has {} rows; the configuration's array has {elements} elements (one row per element)",
             view.nrows()
+        )));
+    }
+    if view.ncols() > c.capture.samples {
+        return Err(input_error(format!(
+            "samples has {} columns; one capture holds at most capture.samples = {} (the configuration's): cut a \
+             longer recording into captures and process each (as `onebeacon dsp process` does), or set \
+             capture.samples (at most 10000000)",
+            view.ncols(),
+            c.capture.samples
         )));
     }
     if view.iter().any(|x| !x.is_finite()) {

@@ -296,3 +296,73 @@ def test_dsp_process_on_arrays_equals_the_cli(cli, tmp_path):
         onebeacon.dsp.process(samples, -1.0)
     with pytest.raises(onebeacon.InputError, match="pulse"):
         onebeacon.dsp.process(samples[:, :10], fs)
+
+
+# --- hostile and careless input ------------------------------------------------------
+
+
+def nested(depth, make):
+    inner = make()
+    for _ in range(depth):
+        inner = make(inner)
+    return inner
+
+
+def test_deep_nesting_raises_instead_of_crashing():
+    deep_dict = nested(20000, lambda x=None: {} if x is None else {"x": x})
+    deep_list = nested(20000, lambda x=None: [] if x is None else [x])
+    with pytest.raises(onebeacon.InputError, match="nested more than"):
+        onebeacon.Scenario.from_dict(deep_dict)
+    with pytest.raises(onebeacon.InputError, match="nested more than"):
+        onebeacon.mc(dict(SHORT, sweep={"t_com_s": deep_list}), runs=1)
+    nav = onebeacon.Navigator(PLAZA)
+    with pytest.raises(onebeacon.InputError, match="nested more than"):
+        nav.feed({"t": 0.0, "kind": "odometry", "extra": deep_dict})
+    # a scenario's real depth passes
+    assert onebeacon.Scenario.from_dict(SHORT).name == "short"
+
+
+def test_a_list_where_a_table_belongs_raises():
+    for bad in (dict(SHORT, mission=[1.0, 2.0]), dict(SHORT, comms=[])):
+        with pytest.raises(onebeacon.InputError, match="must be a table"):
+            onebeacon.Scenario.from_dict(bad)
+    with pytest.raises(onebeacon.InputError, match="path of a TOML file or a dict"):
+        onebeacon.dsp.process(np.zeros((5, 100)), 37500.0, config=[1, 2])
+
+
+def test_memory_budget_refuses_before_any_work(monkeypatch):
+    monkeypatch.setenv("ONEBEACON_MEMORY_GIB", "0.01")
+    for call in (lambda: onebeacon.mc(SHORT, runs=2), lambda: onebeacon.run(SHORT), lambda: onebeacon.replay(PLAZA)):
+        with pytest.raises(onebeacon.InputError, match="memory budget is 0.0 GB"):
+            call()
+    monkeypatch.setenv("ONEBEACON_MEMORY_GIB", "lots")
+    with pytest.raises(onebeacon.InputError, match="ONEBEACON_MEMORY_GIB"):
+        onebeacon.mc(SHORT, runs=1)
+
+
+def test_ctrl_c_stops_mc_and_raises_keyboard_interrupt():
+    import _thread
+
+    long = dict(SHORT, mission={"duration_s": 1500.0})
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        onebeacon.mc(long, runs=100000, threads=1)
+    elapsed = time.perf_counter() - start
+    # 100000 runs of 25 min each take hours; stopped, only the run under way finishes
+    assert elapsed < 5.0, elapsed
+
+
+def test_dsp_process_takes_real_numbers_only_and_one_capture(cli, tmp_path):
+    wav = tmp_path / "ping.wav"
+    cli("dsp", "simulate", "--out", wav)
+    samples, fs = read_float_wav(wav)
+    for bad in (samples.astype(np.complex128), samples.astype(object), samples.astype(str)):
+        with pytest.raises(onebeacon.InputError, match="dtype"):
+            onebeacon.dsp.process(bad, fs)
+    longer = np.concatenate([samples, np.zeros((samples.shape[0], 1))], axis=1)
+    with pytest.raises(onebeacon.InputError, match="capture.samples"):
+        onebeacon.dsp.process(longer, fs)
+    with pytest.raises(onebeacon.InputError, match="dimensions"):
+        onebeacon.dsp.process(samples[np.newaxis], fs)

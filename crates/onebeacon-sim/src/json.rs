@@ -139,7 +139,8 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
         "skipped_before_start": s.before_start,
         "left_out": s.left_out,
         "screened": s.screened,
-        "dropped_rows": r.dropped.iter().map(|(f, n)| (f.clone(), json!(n))).collect::<serde_json::Map<_, _>>(),
+        "dropped_rows": r.dropped.iter().map(|d| (d.file.clone(), json!(d.dropped))).collect::<serde_json::Map<_, _>>(),
+        "warnings": r.warnings(log.has_truth()),
         "wall_s": wall_s,
         "estimators": estimators,
     })

@@ -14,6 +14,7 @@
 //! - [`replay`]: real logs (CSV files described by a TOML file) through the estimators.
 
 pub mod acoustics;
+pub mod budget;
 mod engine;
 pub mod fleet;
 pub mod json;

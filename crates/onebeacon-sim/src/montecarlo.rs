@@ -42,12 +42,31 @@ pub struct McResult {
     pub cells: Vec<CellResult>,
 }
 
-/// Failure to set up the worker threads.
+/// Why a sweep gave no result.
 #[derive(Debug, thiserror::Error)]
-#[error("cannot start {threads} worker threads: {message}")]
-pub struct ThreadPoolError {
-    pub threads: usize,
-    pub message: String,
+pub enum SweepError {
+    #[error("cannot start {threads} worker threads: {message}")]
+    ThreadPool { threads: usize, message: String },
+    /// [`Progress::stopped`] said so: the runs under way finished, no other started.
+    #[error("stopped before the sweep was done")]
+    Stopped,
+}
+
+/// What a sweep tells as it goes, and whether it must stop. Any `Fn() + Sync` closure
+/// is one that ticks and never stops.
+pub trait Progress: Sync {
+    /// A run finished (called from any worker thread).
+    fn tick(&self);
+    /// Whether to start no more runs (asked before each).
+    fn stopped(&self) -> bool {
+        false
+    }
+}
+
+impl<F: Fn() + Sync> Progress for F {
+    fn tick(&self) {
+        self()
+    }
 }
 
 /// Runs the sweep of `scenario` with `runs` runs per cell from base seed `seed`, on
@@ -58,20 +77,20 @@ pub fn monte_carlo(
     runs: usize,
     seed: u64,
     threads: Option<usize>,
-    progress: &(dyn Fn() + Sync),
-) -> Result<McResult, ThreadPoolError> {
+    progress: &dyn Progress,
+) -> Result<McResult, SweepError> {
     let cells = in_pool(threads, || {
         scenario
             .cells()
             .iter()
             .enumerate()
             .map(|(c, cell)| {
-                let per_run: Vec<RunSummary> =
+                let per_run: Option<Vec<RunSummary>> =
                     (0..runs as u64).into_par_iter().map(|r| run_one(scenario, cell, c, seed, r, progress)).collect();
-                summarise_cell(scenario, cell, &per_run)
+                Ok(summarise_cell(scenario, cell, &per_run.ok_or(SweepError::Stopped)?))
             })
-            .collect()
-    })?;
+            .collect::<Result<Vec<_>, SweepError>>()
+    })??;
     Ok(McResult { runs, seed, cells })
 }
 
@@ -104,6 +123,12 @@ impl Shard {
     pub fn pairs(self, cells: usize, runs: usize) -> impl Iterator<Item = (usize, u64)> {
         (0..cells * runs).skip(self.index).step_by(self.count.max(1)).map(move |j| (j / runs, (j % runs) as u64))
     }
+
+    /// How many pairs this share of `pairs` holds: the indices below `pairs` that are
+    /// `index` mod `count`, counted without visiting them.
+    pub fn len(self, pairs: usize) -> usize {
+        if self.index >= pairs { 0 } else { (pairs - self.index - 1) / self.count.max(1) + 1 }
+    }
 }
 
 impl std::fmt::Display for Shard {
@@ -127,12 +152,12 @@ impl std::str::FromStr for Shard {
     }
 }
 
-fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, ThreadPoolError> {
+fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, SweepError> {
     match threads {
         Some(n) => Ok(rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
-            .map_err(|e| ThreadPoolError { threads: n, message: e.to_string() })?
+            .map_err(|e| SweepError::ThreadPool { threads: n, message: e.to_string() })?
             .install(work)),
         None => Ok(work()),
     }
@@ -147,13 +172,14 @@ pub fn monte_carlo_shard(
     seed: u64,
     shard: Shard,
     threads: Option<usize>,
-    progress: &(dyn Fn() + Sync),
-) -> Result<Vec<RunSummary>, ThreadPoolError> {
+    progress: &dyn Progress,
+) -> Result<Vec<RunSummary>, SweepError> {
     let cells = scenario.cells();
     let pairs: Vec<(usize, u64)> = shard.pairs(cells.len(), runs).collect();
     in_pool(threads, || {
-        pairs.into_par_iter().map(|(c, r)| run_one(scenario, &cells[c], c, seed, r, progress)).collect()
-    })
+        pairs.into_par_iter().map(|(c, r)| run_one(scenario, &cells[c], c, seed, r, progress)).collect::<Option<_>>()
+    })?
+    .ok_or(SweepError::Stopped)
 }
 
 fn run_one(
@@ -162,11 +188,14 @@ fn run_one(
     index: usize,
     seed: u64,
     run: u64,
-    progress: &(dyn Fn() + Sync),
-) -> RunSummary {
+    progress: &dyn Progress,
+) -> Option<RunSummary> {
+    if progress.stopped() {
+        return None;
+    }
     let out = simulate(scenario, cell, seed, run, false);
-    progress();
-    RunSummary { cell: index, run, metrics: out.metrics, information: out.information }
+    progress.tick();
+    Some(RunSummary { cell: index, run, metrics: out.metrics, information: out.information })
 }
 
 /// Why summaries do not make a whole sweep.
@@ -180,6 +209,21 @@ pub enum AggregateError {
     Outside { cell: usize, run: u64, cells: usize, runs: usize },
     #[error("run {run} of cell {cell} has {got} tracks' metrics; the scenario has {tracks} tracks")]
     Tracks { cell: usize, run: u64, got: usize, tracks: usize },
+    #[error(
+        "run {run} of cell {cell} has an information matrix of vehicle {vehicle}, {rows} x {rows}; the cell has \
+         {vehicles} vehicle(s) with {dim} x {dim} matrices"
+    )]
+    Information { cell: usize, run: u64, vehicle: usize, rows: usize, vehicles: usize, dim: usize },
+}
+
+/// How many vehicles a run of `cell` reports acoustic information for, and the size of
+/// its matrices (none where the scenario has no bound to compute).
+fn information_shape(scenario: &Scenario, cell: &Cell) -> (usize, usize) {
+    match (scenario, cell) {
+        (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => (s.vehicles(c).len(), 6),
+        (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(_)) => (s.auvs().len(), onebeacon::models::hoff::DIM),
+        _ => (0, 0),
+    }
 }
 
 /// Aggregates the summaries of every (cell, run) pair of the sweep, in any order, into
@@ -192,6 +236,7 @@ pub fn aggregate(
 ) -> Result<McResult, AggregateError> {
     let cells = scenario.cells();
     let tracks = scenario.tracks().len();
+    let shapes: Vec<_> = cells.iter().map(|c| information_shape(scenario, c)).collect();
     let mut slots: Vec<Option<RunSummary>> = vec![None; cells.len() * runs];
     for s in summaries {
         let (cell, run) = (s.cell, s.run);
@@ -200,6 +245,11 @@ pub fn aggregate(
         }
         if s.metrics.len() != tracks {
             return Err(AggregateError::Tracks { cell, run, got: s.metrics.len(), tracks });
+        }
+        let (vehicles, dim) = shapes[cell];
+        if let Some((vehicle, _, m)) = s.information.iter().find(|(v, _, m)| *v >= vehicles || m.shape() != (dim, dim))
+        {
+            return Err(AggregateError::Information { cell, run, vehicle: *vehicle, rows: m.nrows(), vehicles, dim });
         }
         let slot = &mut slots[cell * runs + run as usize];
         if slot.is_some() {
@@ -279,6 +329,19 @@ mod tests {
         assert_eq!(one, two);
         assert_eq!(one, three);
         assert_eq!(one.cells.len(), 2);
+    }
+
+    /// The closed form against counting the pairs one by one.
+    #[test]
+    fn a_shares_length_is_its_pairs_counted() {
+        for (cells, runs) in [(1, 1), (3, 5), (4, 7), (2, 1)] {
+            for count in 1..=cells * runs + 2 {
+                for index in 0..count {
+                    let shard = Shard { index, count };
+                    assert_eq!(shard.len(cells * runs), shard.pairs(cells, runs).count(), "{shard} of {cells}x{runs}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -13,6 +13,7 @@ use crate::montecarlo::{AggregateError, McResult, RunSummary, Shard, aggregate};
 use crate::scenario::{Scenario, ScenarioError, parse};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// The `format` field of a partial.
 pub const FORMAT: &str = "onebeacon-mc-partial/1";
@@ -75,9 +76,20 @@ pub enum MergeError {
     Duplicate { shard: Shard, first: String, second: String },
     #[error("missing shard(s) {missing} of {count} (have {have})")]
     Missing { missing: String, count: usize, have: String },
+    #[error(
+        "{path}: {what} {value} does not fit the campaign ({cells} cell(s) x {runs} runs = {pairs} (cell, run) pairs): \
+         the file is corrupt or edited"
+    )]
+    Count { path: String, what: &'static str, value: usize, cells: usize, runs: usize, pairs: String },
     #[error("{0}")]
     Aggregate(#[from] AggregateError),
+    #[error("{0}")]
+    Budget(#[from] crate::budget::BudgetError),
 }
+
+/// Bytes that reading and merging a partial holds per byte of its file, at most (the
+/// parsed JSON and the typed records side by side).
+const BYTES_PER_FILE_BYTE: f64 = 8.0;
 
 impl Partial {
     /// The partial of `shard` from its summaries.
@@ -141,7 +153,7 @@ impl Partial {
         }
         for r in &p.results {
             if r.metrics.iter().any(|m| m.len() != RunMetrics::WORDS)
-                || r.information.iter().any(|(_, _, n, e)| n * n != e.len())
+                || r.information.iter().any(|(_, _, n, e)| n.checked_mul(*n) != Some(e.len()))
             {
                 return Err(not(format!("run {} of cell {} has malformed numbers", r.run, r.cell)));
             }
@@ -181,10 +193,31 @@ pub struct Merged {
 
 /// Merges partials (each with the path that names it in errors) into the result of the
 /// unsharded sweep. Refuses partials of different scenarios, seeds, runs, shard counts or
-/// versions, and missing or duplicate shares, with one line each.
+/// versions, counts that do not fit the campaign, and missing or duplicate shares, with
+/// one line each; every count is checked before anything is allocated by it.
 pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
     let Some((first_path, first)) = partials.first() else { return Err(MergeError::Empty) };
-    let mut by_shard: Vec<Option<String>> = vec![None; first.shards];
+    let scenario = parse(&first.scenario_toml, &first.scenario)
+        .map_err(|source| MergeError::Scenario { path: first_path.clone(), source })?;
+    let (runs, seed, shards) = (first.runs, first.seed, first.shards);
+    let cells = scenario.cells().len();
+    let count = |what, value| MergeError::Count {
+        path: first_path.clone(),
+        what,
+        value,
+        cells,
+        runs,
+        pairs: cells.checked_mul(runs).map_or("too many".into(), |p| p.to_string()),
+    };
+    // nothing is allocated by `pairs` before every share is found to hold its pairs
+    let pairs = match cells.checked_mul(runs) {
+        Some(p) if runs > 0 => p,
+        _ => return Err(count("runs", runs)),
+    };
+    if shards > pairs {
+        return Err(count("shards", shards));
+    }
+    let mut by_shard: BTreeMap<usize, String> = BTreeMap::new();
     for (path, p) in &partials {
         if p.version != VERSION {
             return Err(MergeError::Version { path: path.clone(), theirs: p.version.clone(), ours: VERSION.into() });
@@ -201,36 +234,41 @@ pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
             let what = if a == b { "the scenario's keys (same name, edited in between)" } else { "scenario" };
             return Err(mismatch(what, a, b));
         }
-        if p.seed != first.seed {
-            return Err(mismatch("seed", first.seed.to_string(), p.seed.to_string()));
+        if p.seed != seed {
+            return Err(mismatch("seed", seed.to_string(), p.seed.to_string()));
         }
-        if p.runs != first.runs {
-            return Err(mismatch("runs per cell", first.runs.to_string(), p.runs.to_string()));
+        if p.runs != runs {
+            return Err(mismatch("runs per cell", runs.to_string(), p.runs.to_string()));
         }
-        if p.shards != first.shards {
-            return Err(mismatch("shard count", first.shards.to_string(), p.shards.to_string()));
+        if p.shards != shards {
+            return Err(mismatch("shard count", shards.to_string(), p.shards.to_string()));
         }
-        if let Some(earlier) = &by_shard[p.shard] {
-            return Err(MergeError::Duplicate { shard: p.shard_of(), first: earlier.clone(), second: path.clone() });
-        }
-        by_shard[p.shard] = Some(path.clone());
-    }
-    let missing: Vec<String> = (0..first.shards).filter(|&i| by_shard[i].is_none()).map(|i| i.to_string()).collect();
-    if !missing.is_empty() {
-        let have: Vec<String> = (0..first.shards).filter(|&i| by_shard[i].is_some()).map(|i| i.to_string()).collect();
-        return Err(MergeError::Missing { missing: missing.join(", "), count: first.shards, have: have.join(", ") });
-    }
-    let scenario = parse(&first.scenario_toml, &first.scenario)
-        .map_err(|source| MergeError::Scenario { path: first_path.clone(), source })?;
-    let (runs, seed) = (first.runs, first.seed);
-    let cells = scenario.cells().len();
-    let mut summaries = Vec::with_capacity(cells * runs);
-    let mut wall_s = 0.0;
-    for (path, p) in partials {
-        let expected = p.shard_of().pairs(cells, p.runs).count();
+        let expected = p.shard_of().len(pairs);
         if p.results.len() != expected {
-            return Err(MergeError::Incomplete { path, shard: p.shard_of(), expected, got: p.results.len() });
+            return Err(MergeError::Incomplete {
+                path: path.clone(),
+                shard: p.shard_of(),
+                expected,
+                got: p.results.len(),
+            });
         }
+        if let Some(earlier) = by_shard.insert(p.shard, path.clone()) {
+            return Err(MergeError::Duplicate { shard: p.shard_of(), first: earlier, second: path.clone() });
+        }
+    }
+    if by_shard.len() < shards {
+        const SHOWN: usize = 10;
+        let mut missing: Vec<String> =
+            (0..shards).filter(|i| !by_shard.contains_key(i)).take(SHOWN).map(|i| i.to_string()).collect();
+        if shards - by_shard.len() > SHOWN {
+            missing.push(format!("and {} more", shards - by_shard.len() - SHOWN));
+        }
+        let have: Vec<String> = by_shard.keys().take(SHOWN).map(|i| i.to_string()).collect();
+        return Err(MergeError::Missing { missing: missing.join(", "), count: shards, have: have.join(", ") });
+    }
+    let mut summaries = Vec::with_capacity(pairs);
+    let mut wall_s = 0.0;
+    for (_, p) in partials {
         wall_s += p.wall_s;
         summaries.extend(p.summaries());
     }
@@ -239,8 +277,12 @@ pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
 }
 
 /// Reads the partials of `paths`: each a partial file, or a directory whose
-/// `partial-*-of-*.json` files are all read (in name order).
-pub fn read_partials(paths: &[std::path::PathBuf]) -> Result<Vec<(String, Partial)>, MergeError> {
+/// `partial-*-of-*.json` files are all read (in name order). Only regular files are
+/// read, and only while their sizes fit in `budget`.
+pub fn read_partials(
+    paths: &[std::path::PathBuf],
+    budget: &crate::budget::Budget,
+) -> Result<Vec<(String, Partial)>, MergeError> {
     let io = |p: &std::path::Path, e: std::io::Error| MergeError::Io {
         path: p.display().to_string(),
         message: e.to_string(),
@@ -265,10 +307,30 @@ pub fn read_partials(paths: &[std::path::PathBuf]) -> Result<Vec<(String, Partia
             files.push(path.clone());
         }
     }
+    let mut total = 0u64;
+    for f in &files {
+        let meta = std::fs::metadata(f).map_err(|e| io(f, e))?;
+        if !meta.is_file() {
+            return Err(MergeError::NotPartial {
+                path: f.display().to_string(),
+                message: "not a regular file (a partial is a file written by `mc --shard`)".into(),
+            });
+        }
+        total += meta.len();
+    }
+    let need = total as f64 * BYTES_PER_FILE_BYTE;
+    let detail = format!("{} partial file(s) of {:.2} GB x {BYTES_PER_FILE_BYTE}", files.len(), total as f64 / 1e9);
+    budget.check("merging the partials", need, &detail, "the partials given")?;
     files
         .into_iter()
         .map(|f| {
-            let text = std::fs::read_to_string(&f).map_err(|e| io(&f, e))?;
+            let len = std::fs::metadata(&f).map_err(|e| io(&f, e))?.len();
+            let mut text = String::new();
+            std::io::Read::read_to_string(
+                &mut std::io::Read::take(std::fs::File::open(&f).map_err(|e| io(&f, e))?, len),
+                &mut text,
+            )
+            .map_err(|e| io(&f, e))?;
             let name = f.display().to_string();
             Partial::from_json(&text, &name).map(|p| (name, p))
         })

@@ -395,24 +395,6 @@ impl Observer for Recorder {
 
 pub use crate::world::{TruthPath, initial_asv_position};
 
-/// Whether a recorded run of `s` fits in memory (at most 4 GB of step records): why
-/// not, naming the keys to change.
-pub fn check_recordable(s: &Scenario) -> Result<(), String> {
-    const MOST_BYTES: f64 = 4e9;
-    let bytes = recorded_bytes(s);
-    if bytes > MOST_BYTES {
-        return Err(format!(
-            "`run` records every step: {} steps x {} estimators would hold about {:.1} GB; at most {:.0} GB \
-             (shorten mission.duration_s or lengthen mission.dt_s; `mc` records nothing)",
-            s.steps(),
-            s.tracks().len(),
-            bytes / 1e9,
-            MOST_BYTES / 1e9
-        ));
-    }
-    Ok(())
-}
-
 /// The columns of a recorded trajectory, one row per step: what trajectory.csv holds and
 /// the Python package's `run` returns as arrays.
 pub mod trajectory {

@@ -155,3 +155,42 @@ fn merge_refuses_what_is_not_one_campaign() {
     assert!(matches!(Partial::from_json("{\"a\": 1}", "x"), Err(MergeError::NotPartial { .. })));
     assert!(matches!(Partial::from_json("[", "x"), Err(MergeError::NotPartial { .. })));
 }
+
+/// Counts from a corrupt or hostile file are checked before anything is allocated by
+/// them: one error each, no abort, no panic.
+#[test]
+fn merge_checks_counts_before_using_them() {
+    let s = short("sousa");
+    let good = partials(&s, 2, 1, 2);
+    let err = |p: Vec<(String, Partial)>| merge(p).unwrap_err();
+    let with = |edit: &dyn Fn(&mut Partial)| {
+        let mut p = good.clone();
+        for (_, q) in &mut p {
+            edit(q);
+        }
+        p
+    };
+    for shards in [1_000_000_000, 1 << 62, usize::MAX] {
+        let e = err(with(&|p| p.shards = shards));
+        assert!(matches!(e, MergeError::Count { what: "shards", .. }), "{shards}: {e}");
+    }
+    for runs in [1_000_000_000, usize::MAX, 0] {
+        let e = err(with(&|p| p.runs = runs));
+        assert!(matches!(e, MergeError::Count { .. } | MergeError::Incomplete { .. }), "{runs}: {e}");
+    }
+    let vehicles = s.vehicle_names().len();
+    let info = |v: usize, n: usize| {
+        with(&|p: &mut Partial| {
+            if let Some(r) = p.results.first_mut() {
+                r.information.push((v, 1, n, vec![0; n * n]));
+            }
+        })
+    };
+    assert!(matches!(err(info(vehicles, 6)), MergeError::Aggregate(_)), "a vehicle out of range");
+    assert!(matches!(err(info(0, 5)), MergeError::Aggregate(_)), "a 5 x 5 matrix where 6 x 6 belong");
+    assert!(merge(info(0, 6)).is_ok(), "a well-formed extra entry is merged");
+    // a matrix whose side squared overflows is not a partial
+    let mut p = good[0].1.clone();
+    p.results[0].information.push((0, 1, 1 << 33, vec![0; 4]));
+    assert!(Partial::from_json(&p.to_json(), "x").is_err());
+}

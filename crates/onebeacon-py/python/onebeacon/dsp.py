@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from ._native import dsp_process as _process
+from ._native import InputError, dsp_process as _process
 
 
 def process(
@@ -27,6 +27,13 @@ def process(
     nothing was detected.
     """
     a = np.asarray(samples)
+    if a.dtype.kind not in "biuf":
+        raise InputError(
+            f"samples has dtype {a.dtype}; a real number type is allowed (bool, int, uint, float): "
+            "take the real part or the magnitude of complex samples yourself"
+        )
+    if a.ndim not in (1, 2):
+        raise InputError(f"samples has {a.ndim} dimensions; 1 (one element) or 2 (one row per element) are allowed")
     if a.ndim == 1:
         a = a[np.newaxis, :]
     return _process(np.ascontiguousarray(a, dtype=np.float64), float(fs), config)

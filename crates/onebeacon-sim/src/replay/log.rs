@@ -197,13 +197,29 @@ pub(crate) struct Geodetic {
 }
 
 impl Geodetic {
-    /// (x, y) in the log's frame of a point at (lat, lon) radians, on the ellipsoid.
-    fn local(&self, lat_rad: f64, lon_rad: f64) -> (f64, f64) {
+    /// (x, y) in the log's frame of a point at (lat, lon) radians, on the ellipsoid; why
+    /// not where the point is no place on Earth ([`check_latlon`]).
+    fn local(&self, lat_rad: f64, lon_rad: f64) -> Result<(f64, f64), String> {
+        check_latlon(lat_rad, lon_rad)?;
         let (n, e, _) =
             map_3d::geodetic2ned(lat_rad, lon_rad, 0.0, self.lat0_rad, self.lon0_rad, 0.0, map_3d::Ellipsoid::WGS84);
         let (x, y, _) = self.frame.from_ned(&Vector3::new(n, e, 0.0));
-        (x, y)
+        Ok((x, y))
     }
+}
+
+/// A latitude in [-90, 90] and a longitude in [-180, 360] degrees (as `[origin]`), given
+/// in radians: why not, in one line.
+fn check_latlon(lat_rad: f64, lon_rad: f64) -> Result<(), String> {
+    const SLACK: f64 = 1e-9;
+    let (lat, lon) = (lat_rad.to_degrees(), lon_rad.to_degrees());
+    if (-90.0 - SLACK..=90.0 + SLACK).contains(&lat) && (-180.0 - SLACK..=360.0 + SLACK).contains(&lon) {
+        return Ok(());
+    }
+    Err(format!(
+        "latitude {lat} deg, longitude {lon} deg is no place on Earth: a latitude in [-90, 90] and a longitude in \
+         [-180, 360] degrees are allowed (check `latlon_unit`)"
+    ))
 }
 
 /// One CSV file: its kind, the time column and the column of each quantity.
@@ -496,6 +512,19 @@ pub struct Log {
     base: PathBuf,
 }
 
+impl Log {
+    /// The bytes of the log's CSV files (those that can be read; the replay names the
+    /// others).
+    pub fn source_bytes(&self) -> u64 {
+        self.description
+            .sources
+            .iter()
+            .filter_map(|s| std::fs::metadata(self.base.join(&s.file)).ok())
+            .map(|m| m.len())
+            .sum()
+    }
+}
+
 impl LogDescription {
     /// Reads and checks a log description (the CSV files are not read).
     pub fn load(path: &Path) -> Result<Self, LogError> {
@@ -528,7 +557,9 @@ impl LogDescription {
             let mut table = Table::open(base, file)?;
             let (lat, lon) = (table.index(lat)?, table.index(lon)?);
             let Some(row) = table.next_row()? else { return Ok(None) };
-            Ok(Some((row.number(lat)? * unit.radians(), row.number(lon)? * unit.radians())))
+            let (lat_rad, lon_rad) = (row.number(lat)? * unit.radians(), row.number(lon)? * unit.radians());
+            check_latlon(lat_rad, lon_rad).map_err(|m| row.error(lat, m))?;
+            Ok(Some((lat_rad, lon_rad)))
         };
         if let Some(t) = self.beacons.as_ref().filter(|_| first.is_none())
             && let (Some(lat), Some(lon)) = (&t.lat, &t.lon)
@@ -575,7 +606,7 @@ impl LogDescription {
                     (Some((x, y)), _, _) => (row.number(x)? * scale, row.number(y)? * scale),
                     (None, Some((lat, lon)), Some(geo)) => {
                         let unit = t.latlon_unit.radians();
-                        geo.local(row.number(lat)? * unit, row.number(lon)? * unit)
+                        geo.local(row.number(lat)? * unit, row.number(lon)? * unit).map_err(|m| row.error(lat, m))?
                     }
                     _ => unreachable!("validated: x and y, or lat and lon"),
                 };
@@ -588,7 +619,9 @@ impl LogDescription {
         for b in &self.beacon_list {
             let (x, y) = match (b.x_m.zip(b.y_m), b.lat_deg.zip(b.lon_deg), geo) {
                 (Some(xy), _, _) => xy,
-                (None, Some((lat, lon)), Some(geo)) => geo.local(lat * deg, lon * deg),
+                (None, Some((lat, lon)), Some(geo)) => geo.local(lat * deg, lon * deg).map_err(|message| {
+                    LogError::File { file: "[[beacon]]".into(), message: format!("beacon {}: {message}", b.id) }
+                })?,
                 _ => unreachable!("validated: x_m and y_m, or lat_deg and lon_deg"),
             };
             if out.insert(b.id, Vector3::new(x, y, b.z_m)).is_some() {
@@ -825,12 +858,14 @@ pub struct Items<'a> {
 }
 
 impl Items<'_> {
-    /// The rows dropped so far by sources with `time_order = "drop"`: (file, count).
-    pub fn dropped(&self) -> Vec<(String, usize)> {
+    /// The rows dropped and kept so far by sources with `time_order = "drop"`.
+    pub fn dropped(&self) -> Vec<Dropped> {
         self.rows
             .iter()
             .filter_map(|r| match r {
-                Rows::Streamed(rows) if rows.order == TimeOrder::Drop => Some((rows.table.file.clone(), rows.dropped)),
+                Rows::Streamed(rows) if rows.order == TimeOrder::Drop => {
+                    Some(Dropped { file: rows.table.file.clone(), dropped: rows.dropped, kept: rows.kept_rows })
+                }
                 _ => None,
             })
             .collect()
@@ -991,7 +1026,24 @@ struct SourceRows<'a> {
     ahead: Option<RowItems>,
     kept: Option<f64>,
     dropped: usize,
+    kept_rows: usize,
     error: Option<LogError>,
+}
+
+/// The rows of a `time_order = "drop"` source: dropped out of time order, and kept.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Dropped {
+    pub file: String,
+    pub dropped: usize,
+    pub kept: usize,
+}
+
+impl Dropped {
+    /// Whether the source lost more rows than it kept: its time column is suspect, and
+    /// so is a score made of what is left.
+    pub fn most(&self) -> bool {
+        self.dropped > self.kept
+    }
 }
 
 /// The one or two items of a row.
@@ -1096,6 +1148,7 @@ impl<'a> SourceRows<'a> {
             ahead: None,
             kept: None,
             dropped: 0,
+            kept_rows: 0,
             error: None,
         })
     }
@@ -1141,6 +1194,7 @@ impl<'a> SourceRows<'a> {
                 continue;
             }
             self.kept = Some(t);
+            self.kept_rows += 1;
             return Ok(Some(row));
         }
     }
@@ -1170,7 +1224,7 @@ impl<'a> SourceRows<'a> {
             (Some((&x, &y)), _) => Ok::<_, LogError>((row.number(x)? * len, row.number(y)? * len)),
             (None, Some(geo)) => {
                 let unit = s.latlon_unit.radians();
-                Ok(geo.local(num("lat")? * unit, num("lon")? * unit))
+                geo.local(num("lat")? * unit, num("lon")? * unit).map_err(|m| row.error(cols["lat"], m))
             }
             (None, None) => unreachable!("validated: x and y, or lat and lon (which make the origin)"),
         };
@@ -1566,7 +1620,7 @@ depth = "d"
             .collect();
         assert_eq!(speeds, [1.0, 2.0, 4.0, 6.0, 7.0]);
         assert_eq!(stream.dropped().len(), 1);
-        assert_eq!(stream.dropped()[0].1, 2);
+        assert_eq!(stream.dropped()[0].dropped, 2);
     }
 
     /// Latitude and longitude on WGS-84 about `[origin]`, against the closed-form radii of

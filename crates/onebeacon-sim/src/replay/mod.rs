@@ -6,7 +6,7 @@
 pub mod log;
 pub mod tune;
 
-pub use log::{Log, LogDescription, LogError};
+pub use log::{Dropped, Log, LogDescription, LogError};
 
 use onebeacon::nav::session::{Input, Session, Start, Step};
 
@@ -20,8 +20,43 @@ use std::collections::BTreeSet;
 pub struct Replay {
     pub session: Session,
     pub items: usize,
-    /// Rows dropped by sources with `time_order = "drop"`: (file, count).
-    pub dropped: Vec<(String, usize)>,
+    /// Rows dropped and kept by sources with `time_order = "drop"`.
+    pub dropped: Vec<Dropped>,
+}
+
+/// Fewer ground-truth rows than this make a score that says little (a NEES band of a
+/// handful of rows holds almost anything): the replay flags it.
+pub const MIN_SCORED_ROWS: usize = 30;
+
+impl Replay {
+    /// What makes the replay's scores suspect, one line each: a source that dropped more
+    /// rows than it kept, an estimator scored on fewer than [`MIN_SCORED_ROWS`] rows.
+    pub fn warnings(&self, has_truth: bool) -> Vec<String> {
+        let mut w: Vec<String> = self
+            .dropped
+            .iter()
+            .filter(|d| d.most())
+            .map(|d| {
+                format!(
+                    "{}: {} of {} rows dropped out of time order (time_order = \"drop\"): check its time column",
+                    d.file,
+                    d.dropped,
+                    d.dropped + d.kept
+                )
+            })
+            .collect();
+        if has_truth {
+            for (name, st) in self.session.names.iter().zip(&self.session.stats) {
+                if st.count < MIN_SCORED_ROWS {
+                    w.push(format!(
+                        "{name}: scored on {} ground-truth row(s), fewer than {MIN_SCORED_ROWS}: its statistics say little",
+                        st.count
+                    ));
+                }
+            }
+        }
+        w
+    }
 }
 
 /// A session of the description's estimators, starting at `start`, restricted to

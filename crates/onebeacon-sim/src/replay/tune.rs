@@ -67,6 +67,10 @@ pub struct Tuned {
     pub evaluations: usize,
 }
 
+/// The fewest innovations a tuned key needs: fewer and the likelihood's optimum is
+/// whatever fits those few corrections.
+pub const MIN_INNOVATIONS_PER_KEY: usize = 10;
+
 /// The smallest step of the search, as a factor on a value: it stops at 2 %.
 const FINEST_STEP: f64 = 1.02;
 
@@ -127,6 +131,22 @@ pub fn tune(
         Ok((each.iter().map(|e| e.0).sum(), each[0].1))
     };
     let (nll_before, before) = evaluate(&start)?;
+    // a likelihood of fewer innovations than a handful per key fits noise, not the log
+    let needed = MIN_INNOVATIONS_PER_KEY * keys.len();
+    if before.nis_count < needed {
+        return Err(LogError::File {
+            file: log.description.name.clone(),
+            message: format!(
+                "estimator `{}` weighs {} innovation(s) on this log{}; tuning {} key(s) needs at least {needed} \
+                 ({MIN_INNOVATIONS_PER_KEY} per key): tune fewer keys, on a longer log, or an estimator that uses \
+                 ranges or Doppler",
+                spec.name(),
+                before.nis_count,
+                if before.nis_count == 0 { " (it uses no measurement: nothing to fit)" } else { "" },
+                keys.len()
+            ),
+        });
+    }
     let (mut x, mut best, mut evaluations) = (start.clone(), nll_before, beacon_sets.len());
     let mut step = 2f64.ln();
     while step >= FINEST_STEP.ln() {

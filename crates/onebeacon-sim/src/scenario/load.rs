@@ -83,9 +83,10 @@ pub(crate) fn invalid(source_name: &str, v: validate::Violation) -> ScenarioErro
 
 /// Parses and validates scenario TOML; `source_name` names it in errors.
 pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
-    // the world's kind decides the schema; a bad `kind` is reported by the default one
-    let kind =
-        toml::from_str::<toml::Table>(text).ok().and_then(|t| t.get("kind").and_then(|k| k.as_str().map(String::from)));
+    // the world's kind decides the schema; a bad `kind` is reported by the default one,
+    // and text that is no TOML (an integer beyond 64 bits too) as what it is
+    let table: toml::Table = deserialize(text, source_name)?;
+    let kind = table.get("kind").and_then(|k| k.as_str().map(String::from));
     let scenario = if kind.as_deref() == Some("moving_beacon") {
         Scenario::MovingBeacon(deserialize::<MovingBeacon>(text, source_name)?)
     } else if kind.as_deref() == Some("passive_usbl") {
@@ -95,8 +96,43 @@ pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
     } else {
         Scenario::FixedBeacon(deserialize::<FixedBeacon>(text, source_name)?)
     };
+    let canonical: toml::Table = toml::from_str(&scenario.to_toml()).expect("canonical TOML parses");
+    tables_where_tables_belong(&table, &canonical, "").map_err(|v| invalid(source_name, v))?;
     validate::validate(&scenario).map_err(|v| invalid(source_name, v))?;
     Ok(scenario)
+}
+
+/// Refuses an array where the schema has a table (`canonical`: what was read, written
+/// back with every key): serde builds a struct from an array by position, so
+/// `mission = [1, 2]` would silently set the mission's first two keys.
+pub(crate) fn tables_where_tables_belong(
+    input: &toml::Table,
+    canonical: &toml::Table,
+    at: &str,
+) -> Result<(), validate::Violation> {
+    use toml::Value::{Array, Table};
+    for (k, v) in input {
+        let key = if at.is_empty() { k.clone() } else { format!("{at}.{k}") };
+        match (v, canonical.get(k)) {
+            (Array(_), Some(Table(_))) => {
+                return Err(validate::Violation {
+                    key,
+                    value: "an array".into(),
+                    allowed: "must be a table (a [section] or { key = value, ... }), not an array".into(),
+                });
+            }
+            (Table(t), Some(Table(c))) => tables_where_tables_belong(t, c, &key)?,
+            (Array(a), Some(Array(c))) => {
+                for (i, (x, y)) in a.iter().zip(c).enumerate() {
+                    if let (Table(x), Table(y)) = (x, y) {
+                        tables_where_tables_belong(x, y, &format!("{key}[{i}]"))?;
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -135,6 +171,18 @@ mod tests {
 
         let e = err("name = \"x\"\nruns = 0\n");
         assert!(e.contains("`runs`") && e.contains("from 1 to"), "{e}");
+
+        // a number TOML cannot hold is named as such, not as another kind's unknown key
+        let e = err(
+            "kind = \"passive_usbl\"\nname = \"x\"\n[[estimators]]\nkind = \"pf\"\nparticles = 18446744073709551615\n[asv]\n",
+        );
+        assert!(e.contains("line 5") && !e.contains("unknown field"), "{e}");
+
+        // an array where a table belongs is not read by position
+        for text in ["name = \"x\"\nmission = [1.0, 2.0]\n", "name = \"x\"\ncomms = []\n"] {
+            let e = err(text);
+            assert!(e.contains("must be a table"), "{text}: {e}");
+        }
 
         let e = err("name = \"x\"\n[sweep]\nt_com_s = [3.0, 0.0]\n");
         assert!(e.contains("sweep.t_com_s[1]"), "{e}");

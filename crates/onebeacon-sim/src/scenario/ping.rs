@@ -3,7 +3,7 @@
 //! key is optional; the defaults are rypkema's receiver (5-element pyramid with 8 cm
 //! edges, 8000 samples at 37.5 kS/s, mode-1 chirp) 120 m from the beacon.
 
-use super::load::{ScenarioError, deserialize, invalid};
+use super::load::{ScenarioError, deserialize, invalid, tables_where_tables_belong};
 use super::validate::{Rule, Violation, check, check_count, check_fields};
 use crate::acoustics::channel::{Boundaries, Channel};
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -200,6 +200,11 @@ impl PingConfig {
 
     pub fn parse(text: &str, source_name: &str) -> Result<Self, ScenarioError> {
         let c: Self = deserialize(text, source_name)?;
+        let (input, canonical): (toml::Table, toml::Table) = (
+            deserialize(text, source_name)?,
+            toml::from_str(&toml::to_string(&c).expect("a ping configuration is TOML")).expect("and parses back"),
+        );
+        tables_where_tables_belong(&input, &canonical, "").map_err(|v| invalid(source_name, v))?;
         c.validate().map_err(|v| invalid(source_name, v))?;
         Ok(c)
     }
@@ -224,6 +229,7 @@ impl PingConfig {
                     check(&format!("array.elements_m[{i}][{j}]"), *v, Rule::Finite)?;
                 }
             }
+            check_array_geometry(&self.array.elements_m)?;
         }
         check_fields!("geometry", self.geometry, {
             source_north_m: Finite,
@@ -384,6 +390,24 @@ impl PingConfig {
     }
 }
 
+/// Elements that can tell a direction: no two at one point (closer than 1 mm).
+fn check_array_geometry(elements: &[[f64; 3]]) -> Result<(), Violation> {
+    const CLOSE_M: f64 = 1e-3;
+    let p: Vec<Vector3<f64>> = elements.iter().map(|e| Vector3::from(*e)).collect();
+    for i in 0..p.len() {
+        if let Some(j) = (0..i).find(|&j| (p[i] - p[j]).norm() < CLOSE_M) {
+            return Err(Violation {
+                key: format!("array.elements_m[{i}]"),
+                value: format!("{:?}", elements[i]),
+                allowed: format!(
+                    "must be at least 1 mm from element {j}: elements at one point cannot tell a direction"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -409,6 +433,8 @@ mod tests {
             ("[water]\nbottom_coef = -3\n", "water.bottom_coef"),
             ("[geometry]\nsource_north_m = 5000\n", "must arrive within the capture window"),
             ("[clock]\noffset_s = -1\n", "must arrive within the capture window"),
+            ("[array]\nkind = \"custom\"\nelements_m = [[0.1, 0, 0], [0.1, 0, 0], [0.1, 0, 0]]\n", "elements_m[1]"),
+            ("[array]\nkind = \"custom\"\nelements_m = [[0, 0, 0], [0.05, 0, 0], [0.0501, 0, 0.0002]]\n", "element 1"),
         ] {
             let e = PingConfig::parse(text, "ping.toml").unwrap_err().to_string();
             assert!(e.contains(key), "{text}: {e}");

@@ -77,7 +77,7 @@ fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
     if s.mission.dt_s > s.mission.ping_period_s {
         return Err(violation("mission.dt_s", s.mission.dt_s, "must be at most mission.ping_period_s"));
     }
-    check_steps(s.mission.duration_s, s.mission.dt_s)?;
+    check_steps(s.mission.duration_s, s.mission.dt_s, "mission.duration_s")?;
     check_fields!("signal", s.signal, {
         sound_speed_m_s: Positive,
         water_depth_m: Positive,
@@ -157,6 +157,14 @@ fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
         ] {
             check(&at(k), v, rule)?;
         }
+        let water = s.signal.water_depth_m;
+        if a.depth_m >= water {
+            return Err(violation(
+                at("depth_m"),
+                a.depth_m,
+                format!("must be above the bed: less than signal.water_depth_m = {water} m"),
+            ));
+        }
         for (j, m) in a.modes.iter().enumerate() {
             let at = |k: &str| format!("auvs[{i}].modes[{j}].{k}");
             if !(1..=MODES).contains(&m.mode) {
@@ -172,6 +180,13 @@ fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
                     return Err(violation(at(key), "missing", format!("is needed by a {:?} behaviour", m.behaviour)));
                 };
                 check(&at(key), v, if *key == "heading_deg" { Rule::Finite } else { Rule::Positive })?;
+            }
+            if let Some(c) = m.ceiling_m.filter(|c| *c >= water) {
+                return Err(violation(
+                    at("ceiling_m"),
+                    c,
+                    format!("must be above the bed: less than signal.water_depth_m = {water} m"),
+                ));
             }
         }
     }
@@ -195,13 +210,25 @@ fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
     Ok(())
 }
 
-fn check_steps(duration_s: f64, dt_s: f64) -> Result<(), Violation> {
-    let steps = duration_s / dt_s;
-    if steps > 1e8 {
+/// A run of `duration_s` (which the key `duration_key` sets) in steps of `dt_s`: at
+/// least one step, at most 1e8.
+fn check_steps(duration_s: f64, dt_s: f64, duration_key: &str) -> Result<(), Violation> {
+    if dt_s > duration_s {
         return Err(Violation {
             key: "mission.dt_s".into(),
             value: format!("{dt_s:?}"),
-            allowed: format!("gives {steps:.0} steps; at most 1e8 steps per run"),
+            allowed: format!("must not exceed the mission's duration, {duration_s:.6} s (set by {duration_key})"),
+        });
+    }
+    let steps = duration_s / dt_s;
+    if steps > 1e8 {
+        return Err(Violation {
+            key: duration_key.into(),
+            value: format!("{duration_s:.4e} s of mission"),
+            allowed: format!(
+                "gives {steps:.4e} steps of mission.dt_s = {dt_s:?} s; at most 1e8 steps per run: shorten the \
+                 mission or raise mission.dt_s"
+            ),
         });
     }
     Ok(())
@@ -489,7 +516,7 @@ fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
     for (j, &d) in s.sweep.depth_m.iter().flatten().enumerate() {
         check(&format!("sweep.depth_m[{j}]"), d, NonNegative)?;
     }
-    check_steps(s.mission.duration_s, s.mission.dt_s)
+    check_steps(s.mission.duration_s, s.mission.dt_s, "mission.duration_s")
 }
 
 /// One AUV's table of a passive_usbl scenario (`prefix`: its key).
@@ -533,7 +560,7 @@ fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
             allowed: format!("must be at most mission.message_period_s ({})", s.mission.message_period_s),
         });
     }
-    check_steps(s.mission.duration_s, s.mission.dt_s)?;
+    check_steps(s.mission.duration_s, s.mission.dt_s, "mission.duration_s")?;
     check_auv("auv", &s.auv)?;
     check_count("other_auvs (count)", s.other_auvs.len(), 0, 31)?;
     for (k, a) in s.other_auvs.iter().enumerate() {
@@ -683,7 +710,9 @@ fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
     }
 
     // the run must be of a workable size
-    check_steps(s.duration_s(), m.dt_s)
+    let duration_key =
+        if m.duration_s.is_some() { "mission.duration_s" } else { "mission.speed_m_s (the path's length / speed_m_s)" };
+    check_steps(s.duration_s(), m.dt_s, duration_key)
 }
 
 /// A log description: each source's column keys, the estimators, the start.

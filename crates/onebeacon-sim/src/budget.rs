@@ -1,0 +1,226 @@
+//! The memory budget: one check, made before any allocation that scales with the input,
+//! by every command and by the Python package alike (`run`, `mc`, `fleet`, `replay`,
+//! `mc merge`).
+//!
+//! A configuration is refused up front, with the keys to change, where the estimate of
+//! the bytes it would hold exceeds the budget: by default half of this machine's
+//! physical memory (8 GiB where it cannot be read); `--memory-gib` or the environment
+//! variable `ONEBEACON_MEMORY_GIB` sets it. The estimates are upper bounds of the
+//! working sets measured (`scripts/` and docs/outputs.md): a particle filter of `n`
+//! particles of `d` states holds two copies of its states (the spare one for
+//! resampling) and five per-particle vectors (log-weights, increments, normalised
+//! weights, cumulative weights, ancestors).
+
+use crate::replay::Log;
+use crate::run::{Estimate, StepRecord, TruthRecord, recorded_bytes};
+use crate::scenario::{EstimatorKind, EstimatorSpec, Scenario};
+
+/// The environment variable that sets the budget, GiB.
+pub const ENV: &str = "ONEBEACON_MEMORY_GIB";
+
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+/// What a run holds besides its filters (scenario, worlds, buffers), bytes.
+const BASE_BYTES: f64 = 64e6;
+
+/// Why a configuration is refused: one line, naming the keys to change.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BudgetError {
+    #[error(
+        "{what} would hold about {need:.1} GB ({detail}); the memory budget is {budget:.1} GB ({origin}): \
+         lower {keys}, or raise the budget with --memory-gib or {ENV}"
+    )]
+    Over { what: String, need: f64, detail: String, budget: f64, origin: &'static str, keys: String },
+    #[error("{from} = `{value}`: the memory budget must be a number of GiB > 0")]
+    Invalid { from: &'static str, value: String },
+}
+
+/// A number of bytes that a command may hold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Budget {
+    bytes: f64,
+    source: &'static str,
+}
+
+impl Budget {
+    /// The budget `gib` (a flag's value), else `ONEBEACON_MEMORY_GIB`, else half this
+    /// machine's physical memory.
+    pub fn resolve(gib: Option<f64>) -> Result<Budget, BudgetError> {
+        let valid = |v: f64| v.is_finite() && v > 0.0;
+        if let Some(g) = gib {
+            return if valid(g) {
+                Ok(Budget { bytes: g * GIB, source: "--memory-gib" })
+            } else {
+                Err(BudgetError::Invalid { from: "--memory-gib", value: g.to_string() })
+            };
+        }
+        if let Ok(text) = std::env::var(ENV) {
+            return match text.trim().parse::<f64>() {
+                Ok(g) if valid(g) => Ok(Budget { bytes: g * GIB, source: ENV }),
+                _ => Err(BudgetError::Invalid { from: ENV, value: text }),
+            };
+        }
+        Ok(match physical_memory_bytes() {
+            Some(b) => Budget { bytes: b / 2.0, source: "half this machine's memory" },
+            None => Budget { bytes: 8.0 * GIB, source: "8 GiB: this machine's memory is unknown" },
+        })
+    }
+
+    /// The budget in bytes.
+    pub fn bytes(&self) -> f64 {
+        self.bytes
+    }
+
+    /// Refuses `need` bytes above the budget: `what` needs them (`detail` says how they
+    /// add up), `keys` are what to lower.
+    pub fn check(&self, what: &str, need: f64, detail: &str, keys: &str) -> Result<(), BudgetError> {
+        if need <= self.bytes {
+            return Ok(());
+        }
+        Err(BudgetError::Over {
+            what: what.to_string(),
+            need: need / 1e9,
+            detail: detail.to_string(),
+            budget: self.bytes / 1e9,
+            origin: self.source,
+            keys: keys.to_string(),
+        })
+    }
+
+    /// Refuses simulating `s` with `concurrent` runs at once, `recorded` of them
+    /// keeping every step (`run`: 1, `fleet`: all), where it would not fit.
+    pub fn check_scenario(&self, s: &Scenario, concurrent: usize, recorded: usize) -> Result<(), BudgetError> {
+        let per_run = run_bytes(s);
+        let record = recorded_bytes(s) * recorded as f64;
+        let need = per_run * concurrent.max(1) as f64 + record;
+        let mut detail = format!("{:.2} GB a run x {} at once", per_run / 1e9, concurrent.max(1));
+        if recorded > 0 {
+            detail.push_str(&format!(
+                " + {:.2} GB of recorded steps ({recorded} run(s) x {} steps x {} estimators)",
+                record / 1e9,
+                s.steps(),
+                s.tracks().len()
+            ));
+        }
+        let mut keys: Vec<&str> = match s {
+            Scenario::PassiveUsbl(_) => vec!["the estimators' `particles`", "guidance.planner_particles"],
+            Scenario::Fleet(_) => vec!["navigation.particles"],
+            _ => vec![],
+        };
+        if concurrent > 1 {
+            keys.push("--threads");
+        }
+        if recorded > 0 {
+            keys.push("mission.duration_s (or raise mission.dt_s)");
+        }
+        if recorded > 1 {
+            keys.push("--runs");
+        }
+        let keys = keys.join(", ");
+        let what = format!("{} ({})", s.name(), if recorded > 0 { "recorded runs" } else { "the runs" });
+        self.check(&what, need, &detail, &keys)
+    }
+}
+
+impl Budget {
+    /// Refuses replaying `log` where it would not fit: its estimators, the rows the plots
+    /// keep (20 000 at most) and, with `keep_records` (the Python package returns every
+    /// row), one trajectory row per CSV row of at least [`MIN_ROW_BYTES`].
+    pub fn check_replay(&self, log: &Log, keep_records: bool) -> Result<(), BudgetError> {
+        let estimators = log.description.estimators.len();
+        let row = (size_of::<StepRecord>() + size_of::<TruthRecord>() + estimators * size_of::<Estimate>()) as f64;
+        let source = log.source_bytes();
+        let rows = if keep_records { source as f64 / MIN_ROW_BYTES } else { PLOTTED_ROWS };
+        let need = BASE_BYTES + estimators as f64 * 1e5 + rows * row;
+        let detail = format!("{estimators} estimators, {rows:.0} rows of {row:.0} bytes kept");
+        let keys = if keep_records { "the log's length (cut it), [[estimators]]" } else { "[[estimators]]" };
+        self.check(&format!("replaying {}", log.description.name), need, &detail, keys)
+    }
+}
+
+/// The fewest bytes a CSV row takes (a time, one value, separators): what bounds the
+/// rows of a log from its files' sizes.
+pub const MIN_ROW_BYTES: f64 = 16.0;
+/// The rows a replay keeps for its plots, at most.
+const PLOTTED_ROWS: f64 = 20_000.0;
+
+/// How many runs a sweep holds at once on `threads` worker threads (default: rayon's,
+/// one per core): the runs of one cell go in parallel, the cells one after the other.
+pub fn concurrent_runs(threads: Option<usize>, runs: usize) -> usize {
+    threads.unwrap_or_else(rayon::current_num_threads).min(runs).max(1)
+}
+
+/// Physical memory, bytes (Linux: MemTotal of /proc/meminfo).
+fn physical_memory_bytes() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
+}
+
+/// The bytes of a particle filter of `n` particles of `d` states (module doc).
+pub fn particle_filter_bytes(n: usize, d: usize) -> f64 {
+    n as f64 * (2.0 * d as f64 + 5.0) * 8.0
+}
+
+/// The working set of one run of `s`, bytes: its filters (one per estimator and
+/// vehicle) and the planner's subsamples, without the recorded steps.
+pub fn run_bytes(s: &Scenario) -> f64 {
+    let specs = |e: &[EstimatorSpec], vehicles: usize| -> f64 {
+        let one: f64 = e
+            .iter()
+            .map(|e| match e.kind {
+                EstimatorKind::Particle => particle_filter_bytes(e.particle_settings().0, onebeacon::models::hoff::DIM),
+                _ => 1e5,
+            })
+            .sum();
+        one * vehicles as f64
+    };
+    BASE_BYTES
+        + match s {
+            Scenario::FixedBeacon(f) => specs(&f.estimators, 1),
+            Scenario::MovingBeacon(m) => specs(&m.estimators, s.vehicle_names().len()),
+            // the planner scores a subsample of 3-d positions per AUV and candidate
+            Scenario::PassiveUsbl(p) => {
+                specs(&p.estimators, p.auvs().len()) + 4.0 * 24.0 * p.guidance.planner_particles as f64
+            }
+            // the factored filter: a handful of f64 per particle and factor
+            Scenario::Fleet(f) => {
+                f.auvs.len() as f64 * f.estimators.len() as f64 * particle_filter_bytes(f.navigation.particles, 4)
+            }
+        }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{builtin, parse};
+
+    fn hoff(particles: usize) -> Scenario {
+        let text = builtin("hoff2024").unwrap().toml.replace("particles = 500000", &format!("particles = {particles}"));
+        parse(&text, "hoff2024").unwrap()
+    }
+
+    /// The particle filter dominates: 5e7 particles of 8 states are 5e7 x 21 x 8 bytes.
+    #[test]
+    fn a_particle_filter_of_5e7_is_8_4_gb() {
+        assert_eq!(particle_filter_bytes(50_000_000, 8), 8.4e9);
+        let one = run_bytes(&hoff(50_000_000));
+        assert!((8.4e9..8.6e9).contains(&one), "{one}");
+    }
+
+    #[test]
+    fn over_the_budget_is_refused_with_the_keys_to_lower() {
+        let b = Budget { bytes: 12.0 * GIB, source: "test" };
+        let e = b.check_scenario(&hoff(50_000_000), 2, 0).unwrap_err().to_string();
+        assert!(e.contains("hoff2024") && e.contains("particles") && e.contains("--memory-gib"), "{e}");
+        assert!(b.check_scenario(&hoff(500_000), 2, 0).is_ok());
+        assert!(b.check_scenario(&hoff(50_000_000), 1, 0).is_ok());
+    }
+
+    #[test]
+    fn a_flag_overrides_and_must_be_positive() {
+        assert_eq!(Budget::resolve(Some(2.0)).unwrap().bytes(), 2.0 * GIB);
+        assert!(Budget::resolve(Some(0.0)).is_err());
+        assert!(Budget::resolve(Some(f64::NAN)).is_err());
+    }
+}
