@@ -848,6 +848,38 @@ fn out_never_takes_what_onebeacon_did_not_write() {
     assert!(names_in(&dir).iter().all(|n| !n.contains("partial")), "{:?}", names_in(&dir));
 }
 
+/// A filter started with an absurd uncertainty (1e308 m) is drawn, clipped, instead of
+/// hanging in the plotter's tick search (it once did, forever).
+#[test]
+fn absurd_values_are_plotted_not_hung() {
+    let dir = scratch("absurd");
+    let sousa = text(&run(&["scenarios", "--show", "sousa"]).stdout)
+        .replace("position_sigma_m = 1.0 ", "position_sigma_m = 1e308 ")
+        .replace("duration_s = 7200", "duration_s = 30");
+    assert!(sousa.contains("position_sigma_m = 1e308"));
+    let p = dir.join("absurd.toml");
+    std::fs::write(&p, sousa).unwrap();
+    let mut child = bin()
+        .args(["run", p.to_str().unwrap(), "--out", dir.join("o").to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if started.elapsed().as_secs() > 60 {
+            let _ = child.kill();
+            panic!("run did not end in 60 s (a 30 s mission takes well under 1 s)");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert!(status.success());
+    assert!(std::fs::read(dir.join("o/error.png")).unwrap().starts_with(b"\x89PNG"));
+}
+
 /// A staging directory that a killed run left (its process gone) is removed by the next
 /// run that writes beside it; one of a live process is not.
 #[cfg(unix)]
