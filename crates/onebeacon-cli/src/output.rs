@@ -114,8 +114,8 @@ fn why_not_replaceable(target: &Path) -> Option<String> {
         let first = found[0].to_string_lossy();
         return Some(format!(
             "is not empty (it holds `{first}`{}) and is not an onebeacon output (no {MARKER}); onebeacon replaces \
-             only its own output directories: name a new or empty directory (an output of onebeacon before 0.1.0's \
-             marker has none: delete it yourself)",
+             only its own output directories: name a new or empty directory (an output written before onebeacon \
+             marked its outputs has none: delete such a one yourself)",
             if found.len() > 1 { format!(" and {} more", found.len() - 1) } else { String::new() }
         ));
     };
