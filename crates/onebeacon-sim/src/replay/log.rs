@@ -1041,7 +1041,7 @@ pub struct Dropped {
 impl Dropped {
     /// Whether the source lost more rows than it kept: its time column is suspect, and
     /// so is a score made of what is left.
-    pub fn most(&self) -> bool {
+    pub fn lost_most(&self) -> bool {
         self.dropped > self.kept
     }
 }

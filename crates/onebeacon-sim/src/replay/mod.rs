@@ -35,7 +35,7 @@ impl Replay {
         let mut w: Vec<String> = self
             .dropped
             .iter()
-            .filter(|d| d.most())
+            .filter(|d| d.lost_most())
             .map(|d| {
                 format!(
                     "{}: {} of {} rows dropped out of time order (time_order = \"drop\"): check its time column",
