@@ -174,17 +174,32 @@ fn alive(pid: u32) -> bool {
     }
 }
 
-/// Removes the staging directories `.{name}.partial-PID[.old]` in `parent` that a killed
-/// run left (its PID no longer alive) and that hold our marker (or nothing).
+/// This machine's name: a PID means something only on the machine that ran it (shards
+/// of a campaign write one shared directory from many nodes).
+fn host() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname").map(|h| h.trim().to_string()).unwrap_or_default()
+}
+
+/// The first line of a staging directory's marker: onebeacon, and the machine.
+fn staging_header() -> String {
+    format!("onebeacon {} staging on host `{}`\n", env!("CARGO_PKG_VERSION"), host())
+}
+
+/// Removes the staging directories `.{name}.partial-PID` in `parent` that a killed run
+/// of this machine left (its marker names this host; PID no longer alive), and the
+/// earlier output `.{name}.partial-PID.old` that such a run had set aside (our marker).
 fn remove_stale_staging(parent: &Path, name: &str) {
     let prefix = format!(".{name}.partial-");
     let Ok(found) = entries(parent) else { return };
+    let here = staging_header();
     for entry in found {
         let entry = entry.to_string_lossy();
         let Some(rest) = entry.strip_prefix(&prefix) else { continue };
-        let Ok(pid) = rest.strip_suffix(".old").unwrap_or(rest).parse::<u32>() else { continue };
+        let (rest, old) = rest.strip_suffix(".old").map_or((rest, false), |r| (r, true));
+        let Ok(pid) = rest.parse::<u32>() else { continue };
         let path = parent.join(&*entry);
-        let ours = marker_names(&path).is_some() || entries(&path).is_ok_and(|e| e.is_empty());
+        let marker = std::fs::read_to_string(path.join(MARKER)).unwrap_or_default();
+        let ours = if old { marker_names(&path).is_some() } else { marker.starts_with(&here) };
         if pid != std::process::id() && !alive(pid) && ours && path.is_dir() {
             let _ = std::fs::remove_dir_all(&path);
         }
@@ -225,14 +240,15 @@ impl Staging {
         Self::staged_in(dir, names.first().copied().unwrap_or("out"), dir)
     }
 
-    /// Creates `parent/.{name}.partial-PID` (with our marker, so that a later run may
-    /// remove it if this one is killed) after removing what killed runs left there.
+    /// Creates `parent/.{name}.partial-PID` (with a marker naming this host, so that a
+    /// later run here may remove it if this one is killed) after removing what killed
+    /// runs left there.
     fn staged_in(parent: &Path, name: &str, target: &Path) -> Result<Self> {
         remove_stale_staging(parent, name);
         let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&staging);
         std::fs::create_dir(&staging)
-            .and_then(|()| std::fs::write(staging.join(MARKER), marker_text(&[])))
+            .and_then(|()| std::fs::write(staging.join(MARKER), staging_header()))
             .map_err(|e| BadInput(format!("cannot write in {}: {e}", parent.display())))?;
         staged().push(staging.clone());
         Ok(Self { target: target.to_path_buf(), staging, committed: false })

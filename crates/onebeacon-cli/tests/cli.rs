@@ -883,26 +883,37 @@ fn absurd_values_are_plotted_not_hung() {
     assert!(std::fs::read(dir.join("o/error.png")).unwrap().starts_with(b"\x89PNG"));
 }
 
-/// A staging directory that a killed run left (its process gone) is removed by the next
-/// run that writes beside it; one of a live process is not.
+/// A staging directory that a killed run left (SIGKILL: no handler runs) is removed by
+/// the next run that writes beside it; one of a live process is not.
 #[cfg(unix)]
 #[test]
 fn a_killed_runs_staging_directory_is_cleaned_later() {
     let dir = scratch("stale");
     let scenario = short_scenario(&dir);
-    let mut dead = Command::new("true").spawn().unwrap();
-    let dead_pid = dead.id();
-    dead.wait().unwrap();
-    let stale = dir.join(format!(".o.partial-{dead_pid}"));
-    std::fs::create_dir_all(&stale).unwrap();
-    std::fs::write(stale.join(".onebeacon-output"), "onebeacon 0.1.0 output\n").unwrap();
-    std::fs::write(stale.join("trajectory.csv"), "half").unwrap();
+    let out = dir.join("o");
+    let child = bin()
+        .args(["mc", "garin2024", "--runs", "2000", "--out", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let stale = dir.join(format!(".o.partial-{}", child.id()));
+    let waited = std::time::Instant::now();
+    while !stale.join(".onebeacon-output").exists() {
+        assert!(waited.elapsed().as_secs() < 60, "no staging directory appeared");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // SAFETY: kill(2) on our own child's pid
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGKILL) }, 0);
+    child.wait_with_output().unwrap();
+    assert!(stale.exists(), "SIGKILL leaves the staging directory");
+    // a live process's staging directory, as its run writes it
     let live = dir.join(format!(".o.partial-{}", std::process::id()));
     std::fs::create_dir_all(&live).unwrap();
-    std::fs::write(live.join(".onebeacon-output"), "onebeacon 0.1.0 output\n").unwrap();
-    let o = run(&["run", &scenario, "--out", dir.join("o").to_str().unwrap()]);
+    std::fs::copy(stale.join(".onebeacon-output"), live.join(".onebeacon-output")).unwrap();
+    let o = run(&["run", &scenario, "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    assert!(!stale.exists(), "the dead run's staging directory is removed");
+    assert!(!stale.exists(), "the killed run's staging directory is removed");
     assert!(live.exists(), "a live process's staging directory stays");
 }
 
