@@ -883,6 +883,26 @@ fn absurd_values_are_plotted_not_hung() {
     assert!(std::fs::read(dir.join("o/error.png")).unwrap().starts_with(b"\x89PNG"));
 }
 
+/// A long `mc garin2024 --out out` (stderr piped), once its staging directory
+/// `.NAME.partial-PID` beside `out` holds its marker: the child and that directory.
+#[cfg(unix)]
+fn long_mc_staged(out: &Path) -> (std::process::Child, PathBuf) {
+    let child = bin()
+        .args(["mc", "garin2024", "--runs", "2000", "--out", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let name = out.file_name().unwrap().to_string_lossy();
+    let staging = out.with_file_name(format!(".{name}.partial-{}", child.id()));
+    let waited = std::time::Instant::now();
+    while !staging.join(".onebeacon-output").exists() {
+        assert!(waited.elapsed().as_secs() < 60, "no staging directory appeared");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    (child, staging)
+}
+
 /// A staging directory that a killed run left (SIGKILL: no handler runs) is removed by
 /// the next run that writes beside it; one of a live process is not.
 #[cfg(unix)]
@@ -891,18 +911,7 @@ fn a_killed_runs_staging_directory_is_cleaned_later() {
     let dir = scratch("stale");
     let scenario = short_scenario(&dir);
     let out = dir.join("o");
-    let child = bin()
-        .args(["mc", "garin2024", "--runs", "2000", "--out", out.to_str().unwrap()])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let stale = dir.join(format!(".o.partial-{}", child.id()));
-    let waited = std::time::Instant::now();
-    while !stale.join(".onebeacon-output").exists() {
-        assert!(waited.elapsed().as_secs() < 60, "no staging directory appeared");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    let (child, stale) = long_mc_staged(&out);
     // SAFETY: kill(2) on our own child's pid
     assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGKILL) }, 0);
     child.wait_with_output().unwrap();
@@ -929,18 +938,7 @@ fn a_signal_leaves_no_partial_output() {
         let first = run(&["mc", &scenario, "--runs", "1", "--out", out.to_str().unwrap()]);
         assert!(first.status.success(), "{}", text(&first.stderr));
         let old = std::fs::read(out.join("mc.json")).unwrap();
-        let child = bin()
-            .args(["mc", "garin2024", "--runs", "2000", "--out", out.to_str().unwrap()])
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        let partial = dir.join(format!(".res.partial-{}", child.id()));
-        let waited = std::time::Instant::now();
-        while !partial.exists() {
-            assert!(waited.elapsed().as_secs() < 60, "no staging directory appeared");
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
+        let (child, partial) = long_mc_staged(&out);
         // SAFETY: kill(2) on our own child's pid
         assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
         let o = child.wait_with_output().unwrap();

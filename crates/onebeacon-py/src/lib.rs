@@ -34,6 +34,11 @@ fn input_error(e: impl std::fmt::Display) -> PyErr {
     InputError::new_err(e.to_string())
 }
 
+/// `message` as a Python `UserWarning` (a stream's notes, a replay's warnings).
+fn user_warning(py: Python<'_>, message: String) -> PyResult<()> {
+    PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &std::ffi::CString::new(message)?, 1)
+}
+
 /// JSON to Python: null None, numbers int or float as JSON has them, objects dicts.
 fn to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
     Ok(match v {
@@ -464,7 +469,7 @@ fn replay<'py>(
     let r = r.map_err(input_error)?;
     let summary = onebeacon_sim::json::replay_summary(&l, &used, &r, started.elapsed().as_secs_f64());
     for w in r.warnings(l.has_truth()) {
-        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &std::ffi::CString::new(w)?, 1)?;
+        user_warning(py, w)?;
     }
     let columns = trajectory_dict(py, &["auv".to_string()], &r.session.names, &records)?;
     PyTuple::new(py, [columns.into_any(), to_py(py, &summary)?])
@@ -520,7 +525,7 @@ impl PyNavigator {
             Note::Info(m) => infos.push(m),
         });
         for m in infos {
-            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &std::ffi::CString::new(m)?, 1)?;
+            user_warning(py, m)?;
         }
         if let Some(m) = skipped {
             return Err(input_error(m));

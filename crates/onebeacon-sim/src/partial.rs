@@ -201,16 +201,17 @@ pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
         .map_err(|source| MergeError::Scenario { path: first_path.clone(), source })?;
     let (runs, seed, shards) = (first.runs, first.seed, first.shards);
     let cells = scenario.cells().len();
+    let product = cells.checked_mul(runs);
     let count = |what, value| MergeError::Count {
         path: first_path.clone(),
         what,
         value,
         cells,
         runs,
-        pairs: cells.checked_mul(runs).map_or("too many".into(), |p| p.to_string()),
+        pairs: product.map_or("too many".into(), |p| p.to_string()),
     };
     // nothing is allocated by `pairs` before every share is found to hold its pairs
-    let pairs = match cells.checked_mul(runs) {
+    let pairs = match product {
         Some(p) if runs > 0 => p,
         _ => return Err(count("runs", runs)),
     };
@@ -307,30 +308,32 @@ pub fn read_partials(
             files.push(path.clone());
         }
     }
-    let mut total = 0u64;
-    for f in &files {
-        let meta = std::fs::metadata(f).map_err(|e| io(f, e))?;
-        if !meta.is_file() {
-            return Err(MergeError::NotPartial {
-                path: f.display().to_string(),
-                message: "not a regular file (a partial is a file written by `mc --shard`)".into(),
-            });
-        }
-        total += meta.len();
-    }
+    // each file's length, read once: the budget is checked on them, and no file is read
+    // past its length (one that grows meanwhile, a device)
+    let lengths = files
+        .iter()
+        .map(|f| {
+            let meta = std::fs::metadata(f).map_err(|e| io(f, e))?;
+            if !meta.is_file() {
+                return Err(MergeError::NotPartial {
+                    path: f.display().to_string(),
+                    message: "not a regular file (a partial is a file written by `mc --shard`)".into(),
+                });
+            }
+            Ok(meta.len())
+        })
+        .collect::<Result<Vec<u64>, _>>()?;
+    let total: u64 = lengths.iter().sum();
     let need = total as f64 * BYTES_PER_FILE_BYTE;
     let detail = format!("{} partial file(s) of {:.2} GB x {BYTES_PER_FILE_BYTE}", files.len(), total as f64 / 1e9);
     budget.check("merging the partials", need, &detail, "the partials given")?;
     files
         .into_iter()
-        .map(|f| {
-            let len = std::fs::metadata(&f).map_err(|e| io(&f, e))?.len();
+        .zip(lengths)
+        .map(|(f, len)| {
+            use std::io::Read;
             let mut text = String::new();
-            std::io::Read::read_to_string(
-                &mut std::io::Read::take(std::fs::File::open(&f).map_err(|e| io(&f, e))?, len),
-                &mut text,
-            )
-            .map_err(|e| io(&f, e))?;
+            std::fs::File::open(&f).and_then(|file| file.take(len).read_to_string(&mut text)).map_err(|e| io(&f, e))?;
             let name = f.display().to_string();
             Partial::from_json(&text, &name).map(|p| (name, p))
         })

@@ -2,6 +2,8 @@
 //! stream. Every error is one line naming the file, the line, the column or key and
 //! what was expected.
 
+use super::geodesy::{Geodetic, check_latlon};
+pub use super::geodesy::{LatLonUnit, Origin};
 use crate::scenario::EstimatorSpec;
 use crate::scenario::load::deserialize;
 use nalgebra::Vector3;
@@ -155,71 +157,6 @@ pub enum TimeOrder {
     /// Drop the rows out of order, counted in the replay's summary: a row behind the
     /// last row kept, or a row ahead of both its neighbours (a glitched time stamp).
     Drop,
-}
-
-/// How latitudes and longitudes are written (`latlon_unit`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum LatLonUnit {
-    #[default]
-    Deg,
-    /// Integers of 1e-7 degree (degrees times 1e7), as many GNSS receivers write them.
-    Deg1e7,
-    Rad,
-}
-
-impl LatLonUnit {
-    fn radians(self) -> f64 {
-        match self {
-            LatLonUnit::Deg => std::f64::consts::PI / 180.0,
-            LatLonUnit::Deg1e7 => std::f64::consts::PI / 180.0 * 1e-7,
-            LatLonUnit::Rad => 1.0,
-        }
-    }
-}
-
-/// The point about which latitudes and longitudes become local north and east
-/// (`[origin]`); without it, the log's first latitude and longitude.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Origin {
-    pub lat_deg: f64,
-    pub lon_deg: f64,
-}
-
-/// Latitude and longitude to the log's local frame: north and east on the plane tangent
-/// to the WGS-84 ellipsoid at the origin (through ECEF, `map_3d`), in the log's frame.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Geodetic {
-    lat0_rad: f64,
-    lon0_rad: f64,
-    frame: Frame,
-}
-
-impl Geodetic {
-    /// (x, y) in the log's frame of a point at (lat, lon) radians, on the ellipsoid; why
-    /// not where the point is no place on Earth ([`check_latlon`]).
-    fn local(&self, lat_rad: f64, lon_rad: f64) -> Result<(f64, f64), String> {
-        check_latlon(lat_rad, lon_rad)?;
-        let (n, e, _) =
-            map_3d::geodetic2ned(lat_rad, lon_rad, 0.0, self.lat0_rad, self.lon0_rad, 0.0, map_3d::Ellipsoid::WGS84);
-        let (x, y, _) = self.frame.from_ned(&Vector3::new(n, e, 0.0));
-        Ok((x, y))
-    }
-}
-
-/// A latitude in [-90, 90] and a longitude in [-180, 360] degrees (as `[origin]`), given
-/// in radians: why not, in one line.
-fn check_latlon(lat_rad: f64, lon_rad: f64) -> Result<(), String> {
-    const SLACK: f64 = 1e-9;
-    let (lat, lon) = (lat_rad.to_degrees(), lon_rad.to_degrees());
-    if (-90.0 - SLACK..=90.0 + SLACK).contains(&lat) && (-180.0 - SLACK..=360.0 + SLACK).contains(&lon) {
-        return Ok(());
-    }
-    Err(format!(
-        "latitude {lat} deg, longitude {lon} deg is no place on Earth: a latitude in [-90, 90] and a longitude in \
-         [-180, 360] degrees are allowed (check `latlon_unit`)"
-    ))
 }
 
 /// One CSV file: its kind, the time column and the column of each quantity.
@@ -578,7 +515,7 @@ impl LogDescription {
             }
         }
         let frame = Frame::from(self.frame);
-        Ok(first.map(|(lat0_rad, lon0_rad)| Geodetic { lat0_rad, lon0_rad, frame }))
+        Ok(first.map(|(lat0_rad, lon0_rad)| Geodetic::new(lat0_rad, lon0_rad, frame)))
     }
 
     /// Fixed beacons (the log's frame): the `[beacons]` file and the inline `[[beacon]]`

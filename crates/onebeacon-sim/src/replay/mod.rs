@@ -3,6 +3,7 @@
 //! time-ordered stream, as `onebeacon stream` does live; [`replay`] does a whole log
 //! and keeps what the outputs need.
 
+pub(crate) mod geodesy;
 pub mod log;
 pub mod tune;
 

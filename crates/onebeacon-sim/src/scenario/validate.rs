@@ -783,7 +783,7 @@ fn check_time(i: usize, s: &Source) -> Result<(), Violation> {
 pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
     check_file_name("name", &d.name)?;
     if let Some(o) = &d.origin
-        && (!(-90.0..=90.0).contains(&o.lat_deg) || !(-180.0..=360.0).contains(&o.lon_deg))
+        && !crate::replay::geodesy::on_earth(o.lat_deg, o.lon_deg)
     {
         return Err(Violation {
             key: "origin".into(),
