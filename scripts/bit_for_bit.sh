@@ -10,6 +10,7 @@ OLD=$(realpath "$1"); NEW=$(realpath "$2"); REPO=$(cd "$(dirname "$0")/.." && pw
 mkdir -p "$3"; cd "$3"
 $NEW scenarios --show hoff2024 | sed 's/^duration_s = 3600 .*/duration_s = 300/' > hoff300.toml
 $NEW scenarios --show hoff2024-pair | sed 's/^duration_s = 3600 .*/duration_s = 300/' > hoffpair300.toml
+$NEW scenarios --show hoff2024-kinematic | sed 's/^duration_s = 3600 .*/duration_s = 300/' > hoffkin300.toml
 cmp_json() { python3 -c "
 import json,sys
 def strip(v):
@@ -28,13 +29,18 @@ run_case sousa mc sousa --runs 2 --json
 run_case sousa-pair mc sousa-pair --runs 2 --json
 run_case hoff2024-300s mc hoff300.toml --runs 1 --json
 run_case hoff2024-pair-300s mc hoffpair300.toml --runs 1 --json
+run_case hoff2024-kinematic-300s mc hoffkin300.toml --runs 1 --json
 for c in "rypkema-m1 fleet rypkema-m1 --runs 2" "plaza1 replay $REPO/data/plaza/plaza1.toml" \
   "plaza2 replay $REPO/data/plaza/plaza2.toml"; do
   set -- $c; n=$1; shift
   $OLD "$@" --json --out old-out-$n > old-$n.json 2>/dev/null; $NEW "$@" --json --out new-out-$n > new-$n.json 2>/dev/null
   echo "$n ($*): $(cmp_json old-$n.json new-$n.json)"
 done
-for s in garin2024 sousa; do
+$NEW replay "$REPO/data/plaza/plaza1.toml" --print-stream > plaza1.jsonl
+$OLD stream "$REPO/data/plaza/plaza1.toml" < plaza1.jsonl > old-stream.jsonl 2>/dev/null
+$NEW stream "$REPO/data/plaza/plaza1.toml" < plaza1.jsonl > new-stream.jsonl 2>/dev/null
+echo "stream plaza1 ($(wc -l < new-stream.jsonl) lines): $(cmp -s old-stream.jsonl new-stream.jsonl && echo identical || echo DIFFERENT)"
+for s in garin2024 sousa hoff2024-kinematic; do
   $OLD run $s --out old-run-$s > /dev/null 2>&1; $NEW run $s --out new-run-$s > /dev/null 2>&1
   echo "run $s trajectory.csv: $(cmp -s old-run-$s/trajectory.csv new-run-$s/trajectory.csv && echo identical || echo DIFFERENT)"
 done

@@ -1,16 +1,18 @@
 //! The simulation engine: one loop for every world.
 //!
-//! A [`World`] moves the truth of its vehicles and beacons one step and says which
-//! measurements each underwater vehicle received during it. The engine feeds them, in
-//! order, to every estimator ([`Track`]) of that vehicle through the
+//! Each step: every [`Helm`] (a vehicle's controller from the onboard crate) decides on
+//! what its vehicle knows of itself and on the beliefs of the vehicles it serves; the
+//! [`World`] moves the truth of its vehicles and beacons one step under those commands
+//! and says which measurements each underwater vehicle received during it; the engine
+//! feeds them, in order, to every estimator ([`Track`]) of that vehicle through the
 //! [`Navigator`] interface alone. Then it shows the step to the [`Observer`]s: error
 //! statistics, recording, guidance snapshots, information for the bound. A world holds
-//! no estimator or scoring code, an observer no world code, so a new estimator runs in
-//! every world and a new world scores every estimator.
+//! no estimator, controller or scoring code, an observer no world code, so a new
+//! estimator runs in every world and a new world scores every estimator.
 
-use crate::run::{GuidanceSnapshot, PilotRecord};
 use nalgebra::{Vector3, Vector6};
 use onebeacon::nav::{Estimate, Measurement, Navigator, Outcome};
+use onebeacon::vehicle::{Command, Controller, GuidanceSnapshot, Situation};
 
 /// The truth of one underwater vehicle at one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,6 +23,40 @@ pub(crate) struct VehicleTruth {
     pub speed_m_s: f64,
     /// Distance travelled since the start, m.
     pub distance_m: f64,
+}
+
+/// What a dynamic vehicle's autopilots were commanded at the end of one step, and
+/// what the vehicle did: heading (rad), surge speed (m/s), depth (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PilotRecord {
+    /// The underwater vehicle's index, or None for the beacon's surface vehicle.
+    pub vehicle: Option<usize>,
+    pub command: crate::vehicles::autopilot::Command,
+    pub heading_rad: f64,
+    pub speed_m_s: f64,
+    pub depth_m: f64,
+    /// A fleet AUV's confirmed command mode (index into the bank) and what its autonomy
+    /// does (None elsewhere).
+    pub mode: Option<usize>,
+    pub phase: Option<onebeacon::vehicle::Phase>,
+}
+
+impl PilotRecord {
+    pub(crate) fn of(
+        vehicle: Option<usize>,
+        command: crate::vehicles::autopilot::Command,
+        body: &crate::vehicles::rigid_body::BodyState,
+    ) -> Self {
+        Self {
+            vehicle,
+            command,
+            heading_rad: body.euler().2,
+            speed_m_s: body.nu[0],
+            depth_m: body.position_ned_m.z,
+            mode: None,
+            phase: None,
+        }
+    }
 }
 
 /// A world: its truth, its beacons, and the acoustic channel that decides who hears
@@ -39,18 +75,23 @@ pub(crate) trait World {
     /// Appends what the dynamic vehicles' autopilots were last commanded, and what the
     /// vehicles do now (none in a world of kinematic vehicles).
     fn pilots(&self, _out: &mut Vec<PilotRecord>) {}
-    /// Moves from step `k - 1` to `k` and appends to `heard[v]` what was measured of
-    /// vehicle `v` during the step, in the order its estimators must process it.
-    /// `beliefs[v]` is vehicle `v`'s first estimator as it stands after step `k - 1`:
-    /// what a beacon vehicle that guides itself on the vehicle knows of it (its
-    /// estimate, and a particle filter's particles). Returns the guidance decision
-    /// taken in the step, if any.
-    fn advance(
-        &mut self,
-        k: usize,
-        beliefs: &[&dyn Navigator],
-        heard: &mut [Vec<Measurement>],
-    ) -> Option<GuidanceSnapshot>;
+    /// What the vehicle of helm `h` knows of itself at the start of the move from step
+    /// `k - 1` to `k` when its controller decides now (its clock, a surface vehicle's
+    /// GPS and compass); None: it keeps its last command. A world of no helm has none.
+    fn situation(&mut self, _k: usize, _h: usize) -> Option<Situation> {
+        None
+    }
+    /// Moves from step `k - 1` to `k` under each helm's last command (None before its
+    /// first) and appends to `heard[v]` what was measured of vehicle `v` during the step,
+    /// in the order its estimators must process it.
+    fn advance(&mut self, k: usize, commands: &[Option<Command>], heard: &mut [Vec<Measurement>]);
+}
+
+/// A vehicle's controller, and the vehicles whose first estimator it reads (its own,
+/// or those a surface vehicle serves).
+pub(crate) struct Helm {
+    pub controller: Box<dyn Controller>,
+    pub serves: Vec<usize>,
 }
 
 /// One estimator on one vehicle.
@@ -84,8 +125,14 @@ pub(crate) trait Observer {
     fn inspect(&mut self, _k: usize, _tracks: &[Track]) {}
 }
 
-/// Runs `world` from its start to its last step with `tracks`, shown to `observers`.
-pub(crate) fn run(world: &mut dyn World, tracks: &mut [Track], observers: &mut [&mut dyn Observer]) {
+/// Runs `world` from its start to its last step with `tracks` and `helms`, shown to
+/// `observers`.
+pub(crate) fn run(
+    world: &mut dyn World,
+    tracks: &mut [Track],
+    helms: &mut [Helm],
+    observers: &mut [&mut dyn Observer],
+) {
     let vehicles = world.vehicles();
     let vehicle_of: Vec<usize> = tracks.iter().map(|t| t.vehicle).collect();
     // the track each vehicle reports from: its first
@@ -96,6 +143,7 @@ pub(crate) fn run(world: &mut dyn World, tracks: &mut [Track], observers: &mut [
     let mut truth: Vec<VehicleTruth> = (0..vehicles).map(|v| world.truth(v)).collect();
     let mut estimates: Vec<Estimate> = tracks.iter().map(|t| t.navigator.estimate()).collect();
     let mut pilots = Vec::new();
+    let mut commands = vec![None; helms.len()];
     let mut k = 0;
     loop {
         observers.iter_mut().for_each(|o| o.inspect(k, tracks));
@@ -117,10 +165,16 @@ pub(crate) fn run(world: &mut dyn World, tracks: &mut [Track], observers: &mut [
         }
         k += 1;
         heard.iter_mut().for_each(Vec::clear);
-        let beliefs: Vec<&dyn Navigator> = reporter.iter().map(|&i| &*tracks[i].navigator).collect();
-        if let Some(g) = world.advance(k, &beliefs, &mut heard) {
-            observers.iter_mut().for_each(|o| o.guidance(&g));
+        for (h, helm) in helms.iter_mut().enumerate() {
+            let Some(situation) = world.situation(k, h) else { continue };
+            let beliefs: Vec<&dyn Navigator> = helm.serves.iter().map(|&v| &*tracks[reporter[v]].navigator).collect();
+            let decided = helm.controller.decide(&situation, &beliefs).expect("a world gives its helms what they read");
+            commands[h] = Some(decided.command);
+            if let Some(g) = decided.snapshot {
+                observers.iter_mut().for_each(|o| o.guidance(&g));
+            }
         }
+        world.advance(k, &commands, &mut heard);
         for (i, t) in tracks.iter_mut().enumerate() {
             for m in &heard[t.vehicle] {
                 let outcome = t.navigator.process(m);

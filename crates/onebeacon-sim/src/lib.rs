@@ -3,9 +3,12 @@
 //! - [`vehicles`]: truth dynamics, paths and their controllers;
 //! - [`sensors`]: what the vehicle's sensors and modem report, with their errors;
 //! - [`acoustics`]: pings propagating between moving ends;
+//! - [`chain`]: the receiver chain on recorded captures, as a ping configuration sets it;
 //! - [`pcrb`]: the posterior Cramer-Rao bound of the range-only moving-beacon case;
 //! - [`scenario`]: the TOML scenario schema, its validation and the built-in scenarios;
 //! - [`engine`](crate::engine): the one simulation loop, its worlds and its observers;
+//! - `helms`: each scenario's onboard controllers (the vehicles' decisions are the
+//!   onboard crate's [`onebeacon::vehicle`]; the worlds move the truth under them);
 //! - [`run`]: one simulated run, a pure function of (scenario, sweep cell, seed, run);
 //! - [`metrics`]: per-run error statistics and their Monte Carlo aggregation;
 //! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count;
@@ -15,8 +18,10 @@
 
 pub mod acoustics;
 pub mod budget;
+pub mod chain;
 mod engine;
 pub mod fleet;
+mod helms;
 pub mod json;
 pub mod metrics;
 pub mod montecarlo;

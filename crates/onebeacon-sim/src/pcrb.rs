@@ -69,7 +69,7 @@ pub fn horizontal_rmse_bound(
     let mut sum = c[(0, 0)] + c[(1, 1)];
     let steps = s.steps();
     for k in 1..=steps {
-        let model = noise.process_model(body_velocity(v, v.path, (k - 1) as f64 * dt + dt / 2.0));
+        let model = noise.process_model(body_velocity(&v.body_path(), (k - 1) as f64 * dt + dt / 2.0));
         let f = model.jacobian(truth.state(), dt);
         let q = model.noise_covariance(truth.state(), dt);
         truth.step();

@@ -3,7 +3,8 @@
 //! paired comparison), scored and recorded by observers. A pure function of (scenario,
 //! cell, seed, run index).
 
-use crate::engine::{self, Observer, Step, Track, VehicleTruth, World};
+use crate::engine::{self, Helm, Observer, Step, Track, VehicleTruth, World};
+use crate::helms;
 use crate::metrics::{ErrorAccumulator, RunMetrics};
 use crate::scenario::{Cell, Scenario};
 use crate::world::{
@@ -12,7 +13,6 @@ use crate::world::{
 };
 use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::filter::consistency::nees;
-use onebeacon::guidance::FimPlanner;
 use onebeacon::nav::Outcome;
 
 /// One estimator's estimate at one step.
@@ -69,39 +69,7 @@ impl TruthRecord {
     }
 }
 
-/// What a dynamic vehicle's autopilots were commanded at the end of one step, and
-/// what the vehicle did: heading (rad), surge speed (m/s), depth (m).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PilotRecord {
-    /// The underwater vehicle's index, or None for the beacon's surface vehicle.
-    pub vehicle: Option<usize>,
-    pub command: crate::vehicles::autopilot::Command,
-    pub heading_rad: f64,
-    pub speed_m_s: f64,
-    pub depth_m: f64,
-    /// A fleet AUV's confirmed command mode (index into the bank) and what its autonomy
-    /// does (None elsewhere).
-    pub mode: Option<usize>,
-    pub phase: Option<onebeacon::autonomy::Phase>,
-}
-
-impl PilotRecord {
-    pub(crate) fn of(
-        vehicle: Option<usize>,
-        command: crate::vehicles::autopilot::Command,
-        body: &crate::vehicles::rigid_body::BodyState,
-    ) -> Self {
-        Self {
-            vehicle,
-            command,
-            heading_rad: body.euler().2,
-            speed_m_s: body.nu[0],
-            depth_m: body.position_ned_m.z,
-            mode: None,
-            phase: None,
-        }
-    }
-}
+pub use crate::engine::PilotRecord;
 
 /// Truth and all estimates at one step.
 #[derive(Debug, Clone, PartialEq)]
@@ -119,45 +87,8 @@ pub struct StepRecord {
     pub pilots: Vec<PilotRecord>,
 }
 
-/// What a beacon vehicle's guidance knew and chose at one decision (recorded runs).
-#[derive(Debug, Clone, PartialEq)]
-pub enum GuidanceSnapshot {
-    /// A ranging beacon's Fisher-information guidance (sousa).
-    Fim(FimSnapshot),
-    /// A listening USBL's spread-of-bearings planner (hoff2024).
-    Bearing(BearingSnapshot),
-}
-
-/// The decision of the bearing planner (hoff2024 eq. 10-12) when it chose a waypoint:
-/// every candidate of the half-annulus with its score.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BearingSnapshot {
-    pub t_s: f64,
-    /// The AUV the decision served.
-    pub vehicle: usize,
-    /// The ASV's position, the belief's mean shifted by the lead (NED).
-    pub asv: Vector2<f64>,
-    pub belief_mean: Vector3<f64>,
-    pub candidates: Vec<(Vector2<f64>, f64)>,
-    pub waypoint: Vector2<f64>,
-}
-
-/// What the beacon vehicle's FIM guidance knew and chose at one ping, so that its
-/// metric can be mapped over the reaching set (sousa Fig. 3.5, 3.7).
-#[derive(Debug, Clone, PartialEq)]
-pub struct FimSnapshot {
-    pub t_s: f64,
-    /// The planner whose metric is mapped (approach A for the baselines).
-    pub planner: FimPlanner,
-    /// The beacon's position estimate at this ping, the centre of its reaching set.
-    pub previous: Vector2<f64>,
-    pub reach_m: f64,
-    /// The vehicle's estimate now and predicted at the next ping.
-    pub target: Vector3<f64>,
-    pub target_next: Vector3<f64>,
-    /// The waypoint the guidance chose.
-    pub waypoint: Vector2<f64>,
-}
+// the guidance decisions are the onboard controllers' records
+pub use onebeacon::vehicle::{BearingSnapshot, FimSnapshot, GuidanceSnapshot};
 
 /// The outcome of one run.
 #[derive(Debug, Clone, PartialEq)]
@@ -226,28 +157,31 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
         (Scenario::FixedBeacon(s), Cell::FixedBeacon(c)) => {
             let mut world = FixedBeaconWorld::new(s, c, seed, run);
             let mut tracks = world.tracks(s, seed, run);
-            drive(&mut world, &mut tracks, None, recorder)
+            drive(&mut world, &mut tracks, &mut [], None, recorder)
         }
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
-            let mut world = MovingBeaconWorld::new(s, c, seed, run);
+            let asv0 = helms::initial_asv_position(s, c);
+            let mut world = MovingBeaconWorld::new(s, c, asv0, seed, run);
             let mut tracks = world.tracks(s, seed, run);
+            let mut helms = helms::moving_beacon(s, c, asv0);
             let mut info = Information::new(range_information(s.sensor_noise()));
-            let mut out = drive(&mut world, &mut tracks, Some(&mut info), recorder);
+            let mut out = drive(&mut world, &mut tracks, &mut helms, Some(&mut info), recorder);
             out.information = info.into_inner();
             out
         }
         (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(c)) => {
-            let mut world = PassiveUsblWorld::new(s, c, seed, run);
+            let mut world = PassiveUsblWorld::new(s, seed, run);
             let mut tracks = world.tracks(s, seed, run);
+            let mut helms = helms::passive_usbl(s, c, world.asv_start());
             let mut info = Information::new(bearing_information(s.tracker_noise()));
-            let mut out = drive(&mut world, &mut tracks, Some(&mut info), recorder);
+            let mut out = drive(&mut world, &mut tracks, &mut helms, Some(&mut info), recorder);
             out.information = info.into_inner();
             out
         }
         (Scenario::Fleet(s), Cell::Fleet) => {
             let mut world = FleetWorld::new(s, seed, run);
             let mut tracks = world.tracks(s, seed, run);
-            drive(&mut world, &mut tracks, None, recorder)
+            drive(&mut world, &mut tracks, &mut helms::fleet(s), None, recorder)
         }
         _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),
     }
@@ -257,6 +191,7 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
 fn drive(
     world: &mut dyn World,
     tracks: &mut [Track],
+    helms: &mut [Helm],
     extra: Option<&mut dyn Observer>,
     mut recorder: Recorder,
 ) -> RunOutput {
@@ -266,7 +201,7 @@ fn drive(
         if let Some(extra) = extra {
             observers.push(extra);
         }
-        engine::run(world, tracks, &mut observers);
+        engine::run(world, tracks, helms, &mut observers);
     }
     RunOutput {
         metrics: scoring.acc.iter().zip(&scoring.vehicle_of).map(|(a, &v)| a.finish(scoring.distance_m[v])).collect(),
@@ -393,7 +328,8 @@ impl Observer for Recorder {
     }
 }
 
-pub use crate::world::{TruthPath, initial_asv_position};
+pub use crate::helms::initial_asv_position;
+pub use crate::world::TruthPath;
 
 /// The columns of a recorded trajectory, one row per step: what trajectory.csv holds and
 /// the Python package's `run` returns as arrays.

@@ -28,7 +28,7 @@ fn mix(mut z: u64) -> u64 {
 }
 
 /// A zero-mean Gaussian draw of standard deviation `sigma` (the models' own draw).
-pub use onebeacon::measure::gauss;
+pub use onebeacon::filter::gauss;
 
 /// The generator of stream `stream` of run `run` under base seed `seed`.
 pub fn rng(seed: u64, run: u64, stream: Stream) -> Pcg64Mcg {

@@ -3,7 +3,6 @@
 //! is drawn from the measurement model the filters use ([`ScalarModel::noise`]), built
 //! with the world's noise.
 
-use crate::scenario::fixed_beacon::Sensors;
 use crate::seed::{Stream, gauss, rng};
 use crate::vehicles::TruthState;
 use nalgebra::Vector2;
@@ -13,11 +12,61 @@ use onebeacon::models::unicycle::{State, idx};
 use onebeacon::nav::{BeaconFix, Kind};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
+use serde::{Deserialize, Serialize};
 
 /// The truth in the unicycle state layout [x, y, psi, v, Omega, a] the models read (the
 /// commanded rates do not enter any measurement model's noise).
 fn state(truth: &TruthState) -> State {
     State::from([truth.pos.x, truth.pos.y, truth.psi, truth.v, 0.0, 0.0])
+}
+
+/// Sensor errors of the simulated vehicle (standard deviations).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Sensors {
+    /// OWTT range noise, m.
+    pub range_noise_m: f64,
+    /// Doppler radial speed noise, m/s.
+    pub doppler_noise_m_s: f64,
+    /// AHRS heading white noise, deg.
+    pub heading_noise_deg: f64,
+    /// Standard deviation of the heading bias at the start, deg.
+    pub heading_bias_deg: f64,
+    /// Standard deviation of the heading bias drift rate, deg/h (constant in a run).
+    pub heading_bias_drift_deg_per_h: f64,
+    /// Gyro (yaw rate) white noise, rad/s.
+    pub gyro_noise_rad_s: f64,
+    /// Accelerometer (forward) white noise, m/s^2.
+    pub accel_noise_m_s2: f64,
+}
+
+impl Default for Sensors {
+    fn default() -> Self {
+        Self {
+            range_noise_m: 3.464,
+            doppler_noise_m_s: 0.447,
+            heading_noise_deg: 2.0,
+            heading_bias_deg: 0.0,
+            heading_bias_drift_deg_per_h: 5.0,
+            gyro_noise_rad_s: 0.05,
+            accel_noise_m_s2: 0.05,
+        }
+    }
+}
+
+impl Sensors {
+    /// All errors zero: a noise-free world.
+    pub fn noise_free() -> Self {
+        Self {
+            range_noise_m: 0.0,
+            doppler_noise_m_s: 0.0,
+            heading_noise_deg: 0.0,
+            heading_bias_deg: 0.0,
+            heading_bias_drift_deg_per_h: 0.0,
+            gyro_noise_rad_s: 0.0,
+            accel_noise_m_s2: 0.0,
+        }
+    }
 }
 
 /// The sensor suite of one run.

@@ -3,8 +3,9 @@
 //! `onebeacon fleet rypkema-m1` and `rypkema-m6`).
 
 use nalgebra::{Vector2, Vector3};
-use onebeacon::autonomy::{Autonomy, AutonomySettings, Behaviour, Phase};
 use onebeacon::geo::wrap_angle;
+use onebeacon::vehicle::Phase;
+use onebeacon::vehicle::autonomy::{Autonomy, AutonomySettings, Behaviour};
 use onebeacon_sim::Scenario;
 use onebeacon_sim::fleet::statistics;
 use onebeacon_sim::run::simulate;

@@ -8,7 +8,8 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::{SVector, Vector3};
 use onebeacon::filter::particle::{ParticleFilter, ParticleSettings, Resampler};
 use onebeacon::measure::Usbl;
-use onebeacon::models::hoff::{DIM, HoffProcess, InsReport, UsblBearing};
+use onebeacon::measure::hoff::{InsReport, UsblBearing};
+use onebeacon::models::hoff::{DIM, HoffProcess};
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {

@@ -2,7 +2,6 @@
 //!
 //! What runs on a vehicle lives here, with lean dependencies (nalgebra, thiserror):
 //!
-//! - [`autonomy`]: beacon-relative behaviours selected by command modes (rypkema);
 //! - [`geo`]: NED frame conventions and angle wrapping;
 //! - [`dsp`]: receiver signal processing: matched filter, beamforming, modes;
 //! - [`models`]: process models used by the estimators;
@@ -11,12 +10,13 @@
 //! - [`guidance`]: where a beacon vehicle should go next (Fisher information);
 //! - [`nav`]: the navigator interface, measurement events, the papers' navigators and
 //!   the onboard [`nav::session`] that a vehicle's computer runs;
+//! - [`vehicle`]: the vehicle's own decisions: controllers that turn the navigators'
+//!   beliefs into commands (hoff's planner, sousa's FIM guidance, rypkema's behaviours);
 //! - [`io`]: the JSON Lines codec of the session (feature `stream`, adds serde_json).
 //!
 //! Conventions: NED frame (x north, y east, z down), SI units, radians, heading from
 //! north toward east. Equation numbers in comments refer to the source papers.
 
-pub mod autonomy;
 pub mod dsp;
 pub mod filter;
 pub mod geo;
@@ -26,3 +26,4 @@ pub mod measure;
 pub mod models;
 pub mod nav;
 pub mod optim;
+pub mod vehicle;

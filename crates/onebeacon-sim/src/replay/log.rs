@@ -474,7 +474,7 @@ impl LogDescription {
     /// Parses and checks the text of a log description; `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, LogError> {
         let mut d: LogDescription = deserialize(text, name)?;
-        crate::scenario::validate::validate_log(&d)
+        super::validate::validate_log(&d)
             .map_err(|v| LogError::Description(crate::scenario::load::invalid(name, v)))?;
         for e in &mut d.estimators {
             for (key, v) in &d.noise {

@@ -6,6 +6,7 @@
 pub(crate) mod geodesy;
 pub mod log;
 pub mod tune;
+pub(crate) mod validate;
 
 pub use log::{Dropped, Log, LogDescription, LogError};
 

@@ -133,54 +133,7 @@ impl Default for Comms {
     }
 }
 
-/// Sensor errors of the simulated vehicle (standard deviations).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Sensors {
-    /// OWTT range noise, m.
-    pub range_noise_m: f64,
-    /// Doppler radial speed noise, m/s.
-    pub doppler_noise_m_s: f64,
-    /// AHRS heading white noise, deg.
-    pub heading_noise_deg: f64,
-    /// Standard deviation of the heading bias at the start, deg.
-    pub heading_bias_deg: f64,
-    /// Standard deviation of the heading bias drift rate, deg/h (constant in a run).
-    pub heading_bias_drift_deg_per_h: f64,
-    /// Gyro (yaw rate) white noise, rad/s.
-    pub gyro_noise_rad_s: f64,
-    /// Accelerometer (forward) white noise, m/s^2.
-    pub accel_noise_m_s2: f64,
-}
-
-impl Default for Sensors {
-    fn default() -> Self {
-        Self {
-            range_noise_m: 3.464,
-            doppler_noise_m_s: 0.447,
-            heading_noise_deg: 2.0,
-            heading_bias_deg: 0.0,
-            heading_bias_drift_deg_per_h: 5.0,
-            gyro_noise_rad_s: 0.05,
-            accel_noise_m_s2: 0.05,
-        }
-    }
-}
-
-impl Sensors {
-    /// All errors zero: a noise-free world.
-    pub fn noise_free() -> Self {
-        Self {
-            range_noise_m: 0.0,
-            doppler_noise_m_s: 0.0,
-            heading_noise_deg: 0.0,
-            heading_bias_deg: 0.0,
-            heading_bias_drift_deg_per_h: 0.0,
-            gyro_noise_rad_s: 0.0,
-            accel_noise_m_s2: 0.0,
-        }
-    }
-}
+pub use crate::sensors::Sensors;
 
 /// Initial uncertainty: the filters start at the truth plus an error drawn with these
 /// standard deviations (the same draw for every estimator), with the matching

@@ -248,7 +248,7 @@ fn default_depth() -> f64 {
     2.5
 }
 
-/// The behaviours of `onebeacon::autonomy`.
+/// The behaviours of `onebeacon::vehicle::autonomy`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BehaviourName {
@@ -285,8 +285,8 @@ pub struct ModeBehaviour {
 
 impl ModeBehaviour {
     /// The behaviour, its required keys checked by validation.
-    pub fn behaviour(&self) -> onebeacon::autonomy::Behaviour {
-        use onebeacon::autonomy::Behaviour as B;
+    pub fn behaviour(&self) -> onebeacon::vehicle::autonomy::Behaviour {
+        use onebeacon::vehicle::autonomy::Behaviour as B;
         let at = nalgebra::Vector2::new(self.offset_north_m, self.offset_east_m);
         let heading = self.heading_deg.unwrap_or(0.0).to_radians();
         let length = self.length_m.unwrap_or(0.0);

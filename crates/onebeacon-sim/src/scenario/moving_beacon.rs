@@ -4,6 +4,7 @@
 //! sound between moving ends. Unknown keys are errors.
 
 use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
+use crate::vehicles::rov::BodyPath;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -62,26 +63,7 @@ impl Default for Mission {
     }
 }
 
-/// The underwater vehicle's path, defined by its body velocities (sousa 4.1.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum PathKind {
-    Stationary,
-    Lawnmower,
-    Circular,
-    Spiral,
-}
-
-impl PathKind {
-    pub fn label(self) -> &'static str {
-        match self {
-            PathKind::Stationary => "stationary",
-            PathKind::Lawnmower => "lawnmower",
-            PathKind::Circular => "circular",
-            PathKind::Spiral => "spiral",
-        }
-    }
-}
+pub use crate::vehicles::rov::PathKind;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -104,6 +86,20 @@ pub struct Vehicle {
     /// Lawnmower leg length and spacing (diameter of the turns), m.
     pub leg_length_m: f64,
     pub leg_spacing_m: f64,
+}
+
+impl Vehicle {
+    /// The body velocities of its path, for the truth.
+    pub fn body_path(&self) -> BodyPath {
+        BodyPath {
+            kind: self.path,
+            speed_m_s: self.speed_m_s,
+            circle_radius_m: self.circle_radius_m,
+            spiral_descent_m_s: self.spiral_descent_m_s,
+            leg_length_m: self.leg_length_m,
+            leg_spacing_m: self.leg_spacing_m,
+        }
+    }
 }
 
 impl Default for Vehicle {

@@ -7,8 +7,8 @@
 
 use crate::seed::gauss;
 use nalgebra::{Matrix3, Vector3};
-use onebeacon::autonomy::Setpoint;
 use onebeacon::geo::wrap_angle;
+use onebeacon::vehicle::Setpoint;
 use serde::{Deserialize, Serialize};
 
 /// The vehicle's response and its sensors' errors (`[sandshark]` of a fleet scenario).

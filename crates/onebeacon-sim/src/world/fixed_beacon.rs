@@ -2,14 +2,14 @@
 //! feedback-linearising controller, a fixed beacon, communication frames every T_com.
 
 use crate::engine::{Track, VehicleTruth, World};
-use crate::run::GuidanceSnapshot;
 use crate::scenario::{FixedBeacon, FixedBeaconCell, Host};
 use crate::seed::{Stream, gauss, rng};
 use crate::sensors::SensorSuite;
 use crate::vehicles::{Path, TruthState, feedback_linearising_control};
 use nalgebra::{SVector, Vector2, Vector3, Vector6};
 use onebeacon::models::unicycle::{Cov, State};
-use onebeacon::nav::{Measurement, Navigator, SingleBeaconNavigator};
+use onebeacon::nav::{Measurement, SingleBeaconNavigator};
+use onebeacon::vehicle::Command;
 
 pub(crate) struct FixedBeaconWorld {
     dt: f64,
@@ -117,7 +117,7 @@ impl World for FixedBeaconWorld {
         Vector3::new(self.beacon.x, self.beacon.y, 0.0)
     }
 
-    fn advance(&mut self, k: usize, _: &[&dyn Navigator], heard: &mut [Vec<Measurement>]) -> Option<GuidanceSnapshot> {
+    fn advance(&mut self, k: usize, _: &[Option<Command>], heard: &mut [Vec<Measurement>]) {
         let t = self.t_s(k);
         // truth moves under the command of the previous step (eq. 3-4), then a new
         // command is computed from the reference (eq. 2)
@@ -136,7 +136,6 @@ impl World for FixedBeaconWorld {
             }
         }
         heard[0].push(Measurement::new(t, sample));
-        None
     }
 }
 

@@ -1,20 +1,18 @@
 //! The fleet world (rypkema): SandShark-like AUVs, a beacon towed by a boat along a
 //! scripted track (and one fixed at the dock), the operator's schedule of command
-//! modes. Each AUV's first estimator (the iUSBL navigator) tells its autonomy the
-//! confirmed mode and where the vehicle is relative to the beacon; the autonomy's
-//! setpoint moves the vehicle. Every `ping_period_s` the transmitting beacon sends its
+//! modes. Each AUV's onboard controller ([`onebeacon::vehicle::behaviours`]) reads the
+//! confirmed mode and where the vehicle is relative to the beacon from its first
+//! estimator (the iUSBL navigator); its setpoint moves the vehicle. Every `ping_period_s` the transmitting beacon sends its
 //! mode's chirp: through the channel simulation to each AUV's array (the captures go to
 //! the navigators' receiver chains), or drawn as range, direction and mode (abstract).
 
 use crate::acoustics::channel::{Boundaries, Channel, simulate_ping};
-use crate::engine::{Track, VehicleTruth, World};
-use crate::run::{GuidanceSnapshot, PilotRecord};
+use crate::engine::{PilotRecord, Track, VehicleTruth, World};
 use crate::scenario::fleet::{Fleet, FleetEstimator, SignalModel, Transmitter};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::autopilot::Command;
 use crate::vehicles::sandshark::{SandShark, SensorErrors};
 use nalgebra::Vector3;
-use onebeacon::autonomy::{Autonomy, AutonomySettings, Phase, Setpoint};
 use onebeacon::dsp::beamform::{azimuth_inclination, pyramid_8cm};
 use onebeacon::dsp::receiver::{ModeReceiver, ReceiverConfig};
 use onebeacon::dsp::waveform::{Lfm, rypkema_modes};
@@ -24,6 +22,7 @@ use onebeacon::nav::{
     Aiding, BeaconFix, Capture, IusblConfig, IusblNavigator, Kind, Measurement, Navigator, PlanarConfig,
     PlanarNavigator,
 };
+use onebeacon::vehicle::{Command as VehicleCommand, Phase, Setpoint, Situation};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 use std::sync::Arc;
@@ -33,10 +32,9 @@ const WINDOW_S: f64 = 8000.0 / 37_500.0;
 /// Shallower than this an AUV hears nothing (its array is out of the water), m.
 const SURFACE_M: f64 = 0.3;
 
-/// One AUV: truth, autonomy, sensor errors and random streams.
+/// One AUV: truth, its last command, sensor errors and random streams.
 struct Auv {
     truth: SandShark,
-    autonomy: Autonomy,
     errors: SensorErrors,
     launch_s: f64,
     distance_m: f64,
@@ -76,15 +74,9 @@ impl FleetWorld {
             .enumerate()
             .map(|(v, a)| {
                 let mut imu_rng = vehicle_rng(seed, run, v, Stream::Imu);
-                let settings = AutonomySettings { speed_m_s: a.speed_m_s, depth_m: a.depth_m, ..Default::default() };
-                let mut modes = vec![None; crate::scenario::fleet::MODES];
-                for m in &a.modes {
-                    modes[m.mode - 1] = Some(m.behaviour());
-                }
                 let heading = a.start_heading_deg.to_radians();
                 Auv {
                     truth: SandShark::new(Vector3::new(a.start_north_m, a.start_east_m, 0.0), heading),
-                    autonomy: Autonomy::new(settings, modes),
                     errors: SensorErrors::draw(&s.sandshark, &mut imu_rng),
                     launch_s: a.launch_s,
                     distance_m: 0.0,
@@ -293,12 +285,13 @@ impl World for FleetWorld {
         }
     }
 
-    fn advance(
-        &mut self,
-        k: usize,
-        beliefs: &[&dyn Navigator],
-        heard: &mut [Vec<Measurement>],
-    ) -> Option<GuidanceSnapshot> {
+    /// An AUV in the water decides every step, on its navigators alone.
+    fn situation(&mut self, k: usize, h: usize) -> Option<Situation> {
+        let t1 = self.t_s(k);
+        (t1 >= self.auvs[h].launch_s).then_some(Situation { t_s: t1, fix: None })
+    }
+
+    fn advance(&mut self, k: usize, commands: &[Option<VehicleCommand>], heard: &mut [Vec<Measurement>]) {
         self.k = k;
         let dt = self.dt();
         let t1 = self.t_s(k);
@@ -333,13 +326,10 @@ impl World for FleetWorld {
             if t1 < a.launch_s {
                 continue; // not in the water yet
             }
-            let belief = beliefs[v];
-            a.mode = belief.command_mode();
-            let rel = belief.beacon_relative_ned_m().unwrap_or_default();
-            let e = belief.estimate();
-            let (setpoint, phase) = a.autonomy.step(a.mode, rel.xy(), rel.z, e.heading_rad());
-            (a.setpoint, a.phase) = (setpoint, phase);
-            a.truth.step(&params, &setpoint, dt);
+            if let Some(Some(VehicleCommand::Setpoint { setpoint, mode, phase })) = commands.get(v) {
+                (a.setpoint, a.mode, a.phase) = (*setpoint, *mode, *phase);
+            }
+            a.truth.step(&params, &a.setpoint, dt);
             a.distance_m += a.truth.speed_m_s * dt;
             a.errors.advance(&params, dt, &mut a.imu_rng);
             let rng = &mut a.imu_rng;
@@ -361,6 +351,5 @@ impl World for FleetWorld {
             let depth = a.truth.position_ned_m.z + gauss(rng, params.depth_white_m);
             h.push(Measurement::new(t1, Kind::Depth { depth_m: depth }));
         }
-        None
     }
 }

@@ -8,8 +8,8 @@ mod passive_usbl;
 
 pub(crate) use fixed_beacon::FixedBeaconWorld;
 pub(crate) use fleet::FleetWorld;
+pub use moving_beacon::TruthPath;
 pub(crate) use moving_beacon::{MovingBeaconWorld, range_information};
-pub use moving_beacon::{TruthPath, initial_asv_position};
 pub(crate) use passive_usbl::{PassiveUsblWorld, bearing_information};
 
 use crate::engine::{Observer, Step, VehicleTruth};

@@ -1,12 +1,11 @@
 //! The moving-beacon world (sousa): underwater vehicles follow their paths by body
 //! velocities; the ASV carries the beacon, pings every period and moves, between pings,
-//! to the waypoint its guidance chose at the last ping for the first vehicle; each ping
-//! reaches each vehicle when the wavefront meets it.
+//! to the waypoint its onboard controller ([`onebeacon::vehicle::fim`]) chose at the
+//! last ping; each ping reaches each vehicle when the wavefront meets it.
 
 use crate::acoustics::Ping;
-use crate::engine::{Track, VehicleTruth, World};
-use crate::run::{FimSnapshot, GuidanceSnapshot, PilotRecord};
-use crate::scenario::moving_beacon::{GuidanceKind, Vehicle};
+use crate::engine::{PilotRecord, Track, VehicleTruth, World};
+use crate::scenario::moving_beacon::Vehicle;
 use crate::scenario::passive_usbl::AsvVehicle;
 use crate::scenario::{Host, MovingBeacon, MovingBeaconCell};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
@@ -15,10 +14,10 @@ use crate::vehicles::autopilot::{Command, MAX_STEP_S, step_over};
 use crate::vehicles::otter::OtterPilot;
 use crate::vehicles::rov::{body_velocity, rk4_step};
 use nalgebra::{DMatrix, SVector, Vector2, Vector3};
-use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, ReachingSet, best_standoff};
 use onebeacon::measure::ScalarModel;
 use onebeacon::models::kinematic6dof::{BodyVelocity, Cov, State, idx};
-use onebeacon::nav::{BeaconFix, Estimate, Kind, Measurement, Navigator, Range6DofNavigator, SensorNoise};
+use onebeacon::nav::{BeaconFix, Kind, Measurement, Range6DofNavigator, SensorNoise};
+use onebeacon::vehicle::{Command as VehicleCommand, OwnFix, Situation};
 use rand_pcg::Pcg64Mcg;
 
 /// The true state of vehicle `v` (path and depth set), step after step: RK4 on its
@@ -46,20 +45,10 @@ impl TruthPath {
 
     /// Moves to the next step.
     pub fn step(&mut self) {
-        let v = &self.vehicle;
-        self.eta = rk4_step(&self.eta, self.k as f64 * self.dt, self.dt, |t| body_velocity(v, v.path, t));
+        let path = self.vehicle.body_path();
+        self.eta = rk4_step(&self.eta, self.k as f64 * self.dt, self.dt, |t| body_velocity(&path, t));
         self.k += 1;
     }
-}
-
-/// The ASV's start: the best standoff for the vehicle's start depth and the ASV's reach
-/// (sousa Fig. 4.7), in the direction `asv.start_bearing_deg` from the vehicle.
-pub fn initial_asv_position(s: &MovingBeacon, cell: &MovingBeaconCell) -> Vector2<f64> {
-    let reach = s.asv.max_speed_m_s * s.acoustics.ping_period_s;
-    let grid = PolarGrid { radial: 20, angular: 36, refinements: 10 };
-    let d = best_standoff((cell.depth_m - s.asv.transducer_depth_m).max(0.0), reach, grid).distance_m;
-    let b = s.asv.start_bearing_deg.to_radians();
-    Vector2::new(s.vehicle.start_north_m, s.vehicle.start_east_m) + Vector2::new(b.cos(), b.sin()) * d
 }
 
 /// The ping on its way with what the vehicles will be told of its origin.
@@ -86,12 +75,12 @@ struct Underwater {
 
 pub(crate) struct MovingBeaconWorld<'a> {
     s: &'a MovingBeacon,
-    guidance_kind: GuidanceKind,
     noise: SensorNoise,
     vehicles: Vec<Underwater>,
     lim: AsvLimits,
-    asv0: Vector2<f64>,
     asv: AsvState,
+    /// The ASV's surge speed over the last step.
+    asv_speed: f64,
     /// The Otter's dynamics and autopilots when the ASV is one (`asv.vehicle`), and its
     /// last command.
     otter: Option<OtterPilot>,
@@ -107,7 +96,8 @@ pub(crate) struct MovingBeaconWorld<'a> {
 }
 
 impl<'a> MovingBeaconWorld<'a> {
-    pub(crate) fn new(s: &'a MovingBeacon, cell: &MovingBeaconCell, seed: u64, run: u64) -> Self {
+    /// The world of `cell` with the ASV starting at `asv0`.
+    pub(crate) fn new(s: &'a MovingBeacon, cell: &MovingBeaconCell, asv0: Vector2<f64>, seed: u64, run: u64) -> Self {
         let vehicles: Vec<Underwater> = s
             .vehicles(cell)
             .into_iter()
@@ -122,20 +112,18 @@ impl<'a> MovingBeaconWorld<'a> {
                 distance_m: 0.0,
             })
             .collect();
-        let asv0 = initial_asv_position(s, cell);
         let start = vehicles[0].truth.state();
         let toward_vehicle = Vector2::new(start[idx::N], start[idx::E]) - asv0;
         Self {
             s,
-            guidance_kind: cell.guidance,
             noise: s.sensor_noise(),
             vehicles,
             lim: AsvLimits {
                 max_speed_m_s: s.asv.max_speed_m_s,
                 max_turn_rate_rad_s: s.asv.max_turn_rate_deg_s.to_radians(),
             },
-            asv0,
             asv: AsvState { pos: asv0, psi: toward_vehicle.y.atan2(toward_vehicle.x) },
+            asv_speed: 0.0,
             otter: (s.asv.vehicle == AsvVehicle::Otter)
                 .then(|| OtterPilot::on_surface(asv0, toward_vehicle.y.atan2(toward_vehicle.x))),
             asv_command: None,
@@ -173,58 +161,6 @@ impl<'a> MovingBeaconWorld<'a> {
         }
         tracks
     }
-
-    fn planner(&self, metric: Metric) -> FimPlanner {
-        let g = &self.s.guidance;
-        FimPlanner {
-            metric,
-            grid: PolarGrid { radial: g.grid_radial, angular: g.grid_angular, refinements: 12 },
-            range_var_m2: self.s.acoustics.range_noise_m.powi(2),
-            beacon_depth_m: self.s.asv.transducer_depth_m,
-        }
-    }
-
-    /// The ASV pings, then picks where to be at the next ping (sousa 3.3) from what the
-    /// first vehicle reports.
-    fn ping(&mut self, t0: f64, report: &Estimate) -> FimSnapshot {
-        let s = self.s;
-        let (period, z_tx) = (s.acoustics.ping_period_s, s.asv.transducer_depth_m);
-        let reach = s.asv.max_speed_m_s * period;
-        let gps = Vector3::new(
-            self.asv.pos.x + gauss(&mut self.acoustic_rng, s.asv.gps_noise_m),
-            self.asv.pos.y + gauss(&mut self.acoustic_rng, s.asv.gps_noise_m),
-            z_tx,
-        ); // eq. 4.3
-        self.in_flight.push(InFlight {
-            ping: Ping { t_tx: t0, origin: self.beacon_ned_m() },
-            gps,
-            heard: vec![false; self.vehicles.len()],
-        });
-        let target = report.position_ned_m;
-        let lin = self.vehicles[0].nu_meas.fixed_rows::<3>(0).into_owned();
-        let target_next = target + report.body_to_ned() * lin * period;
-        let here = gps.xy();
-        // the baselines' snapshots map approach A's metric
-        let metric = if self.guidance_kind == GuidanceKind::ApproachB { Metric::ApproachB } else { Metric::ApproachA };
-        let planner = self.planner(metric);
-        self.waypoint = match self.guidance_kind {
-            GuidanceKind::ApproachA | GuidanceKind::ApproachB => {
-                planner
-                    .next_waypoint(&ReachingSet { center: here, radius: reach }, here, &target, &target_next)
-                    .waypoint
-            }
-            GuidanceKind::Static => self.asv0,
-            GuidanceKind::Circle => {
-                let r = s.guidance.circle_radius_m;
-                let rel = here - target.xy();
-                let angle = rel.y.atan2(rel.x) + (reach / r).min(std::f64::consts::FRAC_PI_2);
-                target.xy() + Vector2::new(angle.cos(), angle.sin()) * r
-            }
-        };
-        self.arrive_at = t0 + period;
-        self.next_ping += period;
-        FimSnapshot { t_s: t0, planner, previous: here, reach_m: reach, target, target_next, waypoint: self.waypoint }
-    }
 }
 
 impl World for MovingBeaconWorld<'_> {
@@ -245,7 +181,7 @@ impl World for MovingBeaconWorld<'_> {
         let t = self.t_s(self.k);
         VehicleTruth {
             eta: *u.truth.state(),
-            speed_m_s: body_velocity(&u.spec, u.spec.path, t).fixed_rows::<3>(0).norm(),
+            speed_m_s: body_velocity(&u.spec.body_path(), t).fixed_rows::<3>(0).norm(),
             distance_m: u.distance_m,
         }
     }
@@ -260,18 +196,37 @@ impl World for MovingBeaconWorld<'_> {
         }
     }
 
-    fn advance(
-        &mut self,
-        k: usize,
-        beliefs: &[&dyn Navigator],
-        heard: &mut [Vec<Measurement>],
-    ) -> Option<GuidanceSnapshot> {
+    /// At a ping the ASV sends it, and knows where it sent it from by its GPS (eq. 4.3):
+    /// its controller decides then. Between pings it keeps its waypoint.
+    fn situation(&mut self, k: usize, _h: usize) -> Option<Situation> {
+        let t0 = self.t_s(k - 1);
+        if t0 + 1e-9 < self.next_ping {
+            return None;
+        }
+        let s = self.s;
+        let gps = Vector3::new(
+            self.asv.pos.x + gauss(&mut self.acoustic_rng, s.asv.gps_noise_m),
+            self.asv.pos.y + gauss(&mut self.acoustic_rng, s.asv.gps_noise_m),
+            s.asv.transducer_depth_m,
+        ); // eq. 4.3
+        self.in_flight.push(InFlight {
+            ping: Ping { t_tx: t0, origin: self.beacon_ned_m() },
+            gps,
+            heard: vec![false; self.vehicles.len()],
+        });
+        self.next_ping += s.acoustics.ping_period_s;
+        let fix = OwnFix { position_m: gps.xy(), heading_rad: self.asv.psi, speed_m_s: self.asv_speed };
+        Some(Situation { t_s: t0, fix: Some(fix) })
+    }
+
+    fn advance(&mut self, k: usize, commands: &[Option<VehicleCommand>], heard: &mut [Vec<Measurement>]) {
         self.k = k;
         let (t0, t1) = (self.t_s(k - 1), self.t_s(k));
         let dt = self.s.mission.dt_s;
         let c = self.s.acoustics.sound_speed_m_s;
-        let snapshot =
-            (t0 + 1e-9 >= self.next_ping).then(|| GuidanceSnapshot::Fim(self.ping(t0, &beliefs[0].estimate())));
+        if let Some(Some(VehicleCommand::Waypoint { waypoint, arrive_s })) = commands.first() {
+            (self.waypoint, self.arrive_at) = (*waypoint, *arrive_s);
+        }
         let (u, r) = self.asv.command(self.waypoint, self.arrive_at - t0, &self.lim);
         if let Some(otter) = &mut self.otter {
             // the same speed, and the course to the waypoint, as the autopilots' commands
@@ -281,8 +236,10 @@ impl World for MovingBeaconWorld<'_> {
             step_over(otter, &command, &Vector3::zeros(), dt, MAX_STEP_S);
             self.asv_command = Some(command);
             self.asv = AsvState { pos: otter.state.position_ned_m.xy(), psi: otter.state.euler().2 };
+            self.asv_speed = otter.state.nu[0];
         } else {
             self.asv = self.asv.step(u, r, dt);
+            self.asv_speed = u;
         }
 
         let noise = self.noise;
@@ -290,7 +247,7 @@ impl World for MovingBeaconWorld<'_> {
             // the vehicle's body velocities over the step, as measured: drawn from the
             // process model the navigators use
             veh.nu_meas = noise
-                .process_model(body_velocity(&veh.spec, veh.spec.path, t0 + dt / 2.0))
+                .process_model(body_velocity(&veh.spec.body_path(), t0 + dt / 2.0))
                 .sample_input(&mut veh.velocity_rng);
             let p0 = veh.truth.state().fixed_rows::<3>(0).into_owned();
             veh.truth.step();
@@ -333,7 +290,6 @@ impl World for MovingBeaconWorld<'_> {
             ));
         }
         self.in_flight.retain(|f| f.heard.iter().any(|h| !h));
-        snapshot
     }
 }
 

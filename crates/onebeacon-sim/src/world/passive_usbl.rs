@@ -1,31 +1,28 @@
 //! The passive-USBL world (hoff2024): AUVs on circles send a message every period with
 //! their INS heading, speed and depth; a surface vehicle (ASV) hears each message on
 //! its USBL (azimuth and elevation, eq. 1-3) and moves, between messages, along the
-//! legs its guidance plans on what the first estimator of the AUVs believes (eq.
-//! 10-16, 24-26). One engine step is one message period; the ASV is integrated within
+//! path its onboard controller commands ([`onebeacon::vehicle::bearing`], eq. 10-16),
+//! timed along it (eq. 24-26). One engine step is one message period; the ASV is integrated within
 //! it at `mission.dt_s`. Each vehicle is kinematic (an AUV on its circle in closed form,
 //! a unicycle ASV) or dynamic (REMUS 100 following its circle by ILOS, the Otter its
 //! legs, both under their autopilots by RK4 at 0.05 s or finer, in the water's current).
 //! Messages travel instantly (at 40 m the 27 ms of flight move the ASV 6 cm).
 
-use crate::engine::{Track, VehicleTruth, World};
-use crate::run::{BearingSnapshot, GuidanceSnapshot, PilotRecord};
-use crate::scenario::passive_usbl::{AsvVehicle, Auv, AuvVehicle, Current, GuidanceKind};
-use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
+use crate::engine::{PilotRecord, Track, VehicleTruth, World};
+use crate::scenario::passive_usbl::{AsvVehicle, Auv, AuvVehicle, Current};
+use crate::scenario::{EstimatorKind, PassiveUsbl};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::autopilot::{Command, MAX_STEP_S, Piloted, step_over};
 use crate::vehicles::ilos::{self, CircleFollower, Ilos};
 use crate::vehicles::otter::OtterPilot;
 use crate::vehicles::remus100::{Remus100, Remus100Pilot};
-use nalgebra::{DMatrix, Matrix2, SMatrix, SVector, Vector2, Vector3};
+use nalgebra::{DMatrix, SMatrix, SVector, Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
-use onebeacon::guidance::bearing::{BearingPlanner, Belief, SpreadMetric, leg_done, leg_target};
 use onebeacon::measure::{ScalarModel, Usbl, UsblAngle};
 use onebeacon::models::hoff::{DIM, idx};
-use onebeacon::nav::{
-    BeaconFix, Estimate, GaussianTracker, Kind, Measurement, Navigator, ParticleTracker, TrackerNoise,
-};
+use onebeacon::nav::{BeaconFix, GaussianTracker, Kind, Measurement, Navigator, ParticleTracker, TrackerNoise};
+use onebeacon::vehicle::{Command as VehicleCommand, OwnFix, Situation};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::FRAC_PI_2;
@@ -209,16 +206,8 @@ impl Circle {
     }
 }
 
-/// The leg the ASV follows: from the previous waypoint to the current (eq. 13-16).
-#[derive(Debug, Clone, Copy)]
-struct Leg {
-    from: Vector2<f64>,
-    to: Vector2<f64>,
-}
-
 pub(crate) struct PassiveUsblWorld<'a> {
     s: &'a PassiveUsbl,
-    guidance: GuidanceKind,
     auvs: Vec<AuvTruth>,
     lim: AsvLimits,
     asv0: Vector2<f64>,
@@ -230,16 +219,15 @@ pub(crate) struct PassiveUsblWorld<'a> {
     /// Line-of-sight steering on the legs, with its integral across them.
     asv_ilos: Ilos,
     water: Water,
-    /// The ASV's speed at the end of the last step (for the side of the half-annulus).
+    /// The ASV's speed at the end of the last step.
     asv_speed: f64,
-    leg: Option<Leg>,
     /// GPS and compass errors of the ASV.
     station_rng: Pcg64Mcg,
     k: usize,
 }
 
 impl<'a> PassiveUsblWorld<'a> {
-    pub(crate) fn new(s: &'a PassiveUsbl, cell: &PassiveUsblCell, seed: u64, run: u64) -> Self {
+    pub(crate) fn new(s: &'a PassiveUsbl, seed: u64, run: u64) -> Self {
         let auvs: Vec<AuvTruth> = s
             .auvs()
             .into_iter()
@@ -254,7 +242,6 @@ impl<'a> PassiveUsblWorld<'a> {
         let to_auv = start - asv0;
         Self {
             s,
-            guidance: cell.guidance,
             auvs,
             lim: AsvLimits {
                 max_speed_m_s: s.asv.max_speed_m_s,
@@ -267,10 +254,14 @@ impl<'a> PassiveUsblWorld<'a> {
             asv_ilos: Ilos::new(s.asv.lookahead_m, s.asv.ilos_integral_gain),
             water: Water::new(s.current.clone(), vehicle_rng(seed, run, 0, Stream::Current)),
             asv_speed: 0.0,
-            leg: None,
             station_rng: vehicle_rng(seed, run, 0, Stream::Heading),
             k: 0,
         }
+    }
+
+    /// Where the ASV starts.
+    pub(crate) fn asv_start(&self) -> Vector2<f64> {
+        self.asv0
     }
 
     /// The true state of eq. 4 of AUV `v`, as a function of time.
@@ -318,111 +309,6 @@ impl<'a> PassiveUsblWorld<'a> {
             }
         }
         tracks
-    }
-
-    fn planner(&self) -> BearingPlanner {
-        let g = &self.s.guidance;
-        BearingPlanner {
-            metric: if self.guidance == GuidanceKind::MaxEigenvalue {
-                SpreadMetric::MaxEigenvalue
-            } else {
-                SpreadMetric::Determinant
-            },
-            r1_m: g.r1_m,
-            r2_m: g.r2_m,
-            radii: g.radii,
-            angles: g.angles,
-            // the planner knows the USBL as the first estimator assumes it
-            sigma_usbl_rad_per_m: self.s.estimators[0]
-                .tracker_config(self.s.tracker_noise())
-                .noise
-                .usbl_sigma_rad_per_m,
-        }
-    }
-
-    /// The next waypoint of the planners (eq. 10-12): on the half-annulus of the AUV
-    /// whose estimate is the least certain (det of its horizontal covariance), scored
-    /// on its belief. With one AUV, the paper's planner.
-    fn plan(&self, t_s: f64, beliefs: &[&dyn Navigator]) -> BearingSnapshot {
-        let estimates: Vec<Estimate> = beliefs.iter().map(|b| b.estimate()).collect();
-        let worst = (0..estimates.len())
-            .max_by(|&a, &b| {
-                estimates[a].horizontal_cov_m2.determinant().total_cmp(&estimates[b].horizontal_cov_m2.determinant())
-            })
-            .unwrap_or(0);
-        let g = &self.s.guidance;
-        let e = &estimates[worst];
-        let positions = beliefs[worst]
-            .position_sample(g.planner_particles)
-            .unwrap_or_else(|| gaussian_sample(e, g.planner_particles));
-        let weights = vec![1.0 / positions.len() as f64; positions.len()];
-        // the velocity over ground of the estimated heading, pitch and speed
-        let velocity = e.body_to_ned() * Vector3::new(e.speed_m_s.unwrap_or(0.0), 0.0, 0.0);
-        let belief = Belief {
-            positions: &positions,
-            weights: &weights,
-            velocity_m_s: velocity.xy(),
-            lead_s: g.lead_periods * self.s.mission.message_period_s,
-        };
-        let asv_velocity = Vector2::new(self.asv.psi.cos(), self.asv.psi.sin()) * self.asv_speed.max(0.1);
-        let planner = self.planner();
-        let decision = planner.decide(&belief, self.asv.pos, asv_velocity);
-        BearingSnapshot {
-            t_s,
-            vehicle: worst,
-            asv: self.asv.pos,
-            belief_mean: belief.shifted_mean(),
-            candidates: decision.candidates,
-            waypoint: decision.waypoint,
-        }
-    }
-
-    /// Where the ASV is to go in this period: the straight path from p_a to p_t (eq. 24),
-    /// and a guidance decision when one was taken.
-    fn path(&mut self, t_s: f64, beliefs: &[&dyn Navigator]) -> (Vector2<f64>, Vector2<f64>, Option<BearingSnapshot>) {
-        let s = self.s;
-        let (u_nom, period) = (s.asv.nominal_speed_m_s, s.mission.message_period_s);
-        let here = self.asv.pos;
-        // the baselines steer toward a point, at most u_nom x period away this period
-        let toward = |target: Vector2<f64>| {
-            let d = target - here;
-            let reach = u_nom * period;
-            (here, if d.norm() > reach { here + d / d.norm() * reach } else { target })
-        };
-        match self.guidance {
-            GuidanceKind::Determinant | GuidanceKind::MaxEigenvalue => {
-                let mut snapshot = None;
-                let need = self.leg.is_none_or(|l| leg_done(l.from, l.to, here, u_nom, period)); // eq. 16
-                if need {
-                    let plan = self.plan(t_s, beliefs);
-                    let from = self.leg.map_or(here, |l| l.to);
-                    self.leg = Some(Leg { from, to: plan.waypoint });
-                    snapshot = Some(plan);
-                }
-                let leg = self.leg.expect("planned above");
-                let (p_a, p_t) = leg_target(leg.from, leg.to, here, u_nom, period); // eq. 13-15
-                // a leg shorter than one period ends at its waypoint
-                let p_t = if (p_t - p_a).norm() > (leg.to - p_a).norm() { leg.to } else { p_t };
-                (p_a, p_t, snapshot)
-            }
-            GuidanceKind::Static => (here, self.asv0, None),
-            GuidanceKind::Circle => {
-                let e = beliefs[0].estimate();
-                let centre = e.position_ned_m.xy();
-                let r = s.guidance.circle_radius_m;
-                let rel = here - centre;
-                let angle = rel.y.atan2(rel.x) + (u_nom * period / r).min(FRAC_PI_2);
-                let (p_a, p_t) = toward(centre + Vector2::new(angle.cos(), angle.sin()) * r);
-                (p_a, p_t, None)
-            }
-            GuidanceKind::Offset => {
-                let e = beliefs[0].estimate();
-                let h = e.heading_rad();
-                let target = e.position_ned_m.xy() - Vector2::new(h.cos(), h.sin()) * s.guidance.offset_m;
-                let (p_a, p_t) = toward(target);
-                (p_a, p_t, None)
-            }
-        }
     }
 
     /// Moves the ASV over one period along the path from `p_a` to `p_t`, timed by
@@ -473,25 +359,6 @@ impl<'a> PassiveUsblWorld<'a> {
     }
 }
 
-/// `m` points standing for a Gaussian estimate's horizontal belief at its depth (a
-/// planner's fallback when the first estimator is not a particle filter): a
-/// deterministic grid of normal quantiles through the Cholesky factor.
-fn gaussian_sample(e: &Estimate, m: usize) -> Vec<Vector3<f64>> {
-    let side = (m as f64).sqrt().ceil().max(2.0) as usize;
-    let l = e.horizontal_cov_m2.cholesky().map_or(Matrix2::zeros(), |c| c.l());
-    let q = |i: usize| {
-        statrs::function::erf::erf_inv(2.0 * (i as f64 + 0.5) / side as f64 - 1.0) * std::f64::consts::SQRT_2
-    };
-    let mut out = Vec::with_capacity(side * side);
-    for i in 0..side {
-        for j in 0..side {
-            let d = l * Vector2::new(q(i), q(j));
-            out.push(e.position_ned_m + Vector3::new(d.x, d.y, 0.0));
-        }
-    }
-    out
-}
-
 impl World for PassiveUsblWorld<'_> {
     fn vehicles(&self) -> usize {
         self.auvs.len()
@@ -520,14 +387,19 @@ impl World for PassiveUsblWorld<'_> {
         Vector3::new(self.asv.pos.x, self.asv.pos.y, self.s.usbl.transducer_depth_m)
     }
 
-    fn advance(
-        &mut self,
-        k: usize,
-        beliefs: &[&dyn Navigator],
-        heard: &mut [Vec<Measurement>],
-    ) -> Option<GuidanceSnapshot> {
+    /// The ASV knows its position, heading and speed exactly (its GPS and compass errors
+    /// are drawn on what it reports with the bearings).
+    fn situation(&mut self, k: usize, _h: usize) -> Option<Situation> {
+        let fix = OwnFix { position_m: self.asv.pos, heading_rad: self.asv.psi, speed_m_s: self.asv_speed };
+        Some(Situation { t_s: self.t_s(k - 1), fix: Some(fix) })
+    }
+
+    fn advance(&mut self, k: usize, commands: &[Option<VehicleCommand>], heard: &mut [Vec<Measurement>]) {
         let t0 = self.t_s(k - 1);
-        let (p_a, p_t, snapshot) = self.path(t0, beliefs);
+        let (p_a, p_t) = match commands.first() {
+            Some(Some(VehicleCommand::Path { from, to })) => (*from, *to),
+            _ => (self.asv.pos, self.asv.pos),
+        };
         self.follow(p_a, p_t);
         self.k = k;
         let t1 = self.t_s(k);
@@ -575,7 +447,6 @@ impl World for PassiveUsblWorld<'_> {
                 },
             ));
         }
-        snapshot.map(GuidanceSnapshot::Bearing)
     }
 }
 
@@ -609,7 +480,7 @@ mod tests {
     fn an_otter_follows_the_legs() {
         let mut s = scenario();
         s.asv.vehicle = AsvVehicle::Otter;
-        let mut w = PassiveUsblWorld::new(&s, &s.base_cell(), 1, 0);
+        let mut w = PassiveUsblWorld::new(&s, 1, 0);
         let period = s.mission.message_period_s;
         w.otter = Some(OtterPilot::on_surface(Vector2::new(0.0, 10.0), 0.0));
         w.asv = AsvState { pos: Vector2::new(0.0, 10.0), psi: 0.0 };
@@ -637,7 +508,7 @@ mod tests {
             s.current.toward_deg = 90.0;
             s.auv.ilos_integral_gain = kappa;
             s.estimators = vec![EstimatorSpec::new(EstimatorKind::DeadReckoning)];
-            s.guidance.kind = GuidanceKind::Static;
+            s.guidance.kind = crate::scenario::passive_usbl::GuidanceKind::Static;
             let cell = Cell::PassiveUsbl(s.base_cell());
             let out = simulate(&Scenario::PassiveUsbl(s), &cell, 1, 0, true);
             let start = out.trajectory[0].beacon;
@@ -702,7 +573,7 @@ mod tests {
             s.asv.ilos_integral_gain = kappa;
             s.current.speed_m_s = 0.3;
             s.current.toward_deg = 90.0;
-            let mut w = PassiveUsblWorld::new(&s, &s.base_cell(), 1, 0);
+            let mut w = PassiveUsblWorld::new(&s, 1, 0);
             w.otter = Some(OtterPilot::on_surface(Vector2::zeros(), 0.0));
             w.asv = AsvState { pos: Vector2::zeros(), psi: 0.0 };
             follow_legs(&mut w, Vector2::new(2.0 * s.mission.message_period_s, 0.0), 150).1
@@ -743,7 +614,7 @@ mod tests {
     #[test]
     fn follows_legs_timed_by_eq_24_to_26() {
         let s = builtin_scenario("hoff2024-kinematic");
-        let mut w = PassiveUsblWorld::new(&s, &s.base_cell(), 1, 0);
+        let mut w = PassiveUsblWorld::new(&s, 1, 0);
         let period = s.mission.message_period_s;
         w.asv = AsvState { pos: Vector2::new(0.0, 0.0), psi: 0.0 };
         let step = Vector2::new(2.0 * period, 0.0);

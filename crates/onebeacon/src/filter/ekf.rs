@@ -66,7 +66,7 @@ pub trait MeasurementModel<const N: usize, const M: usize> {
     /// measures, so the filter's R and the world's noise are one number.
     fn sample<R: rand::Rng + ?Sized>(&self, x: &SVector<f64, N>, rng: &mut R) -> SVector<f64, M> {
         let l = self.covariance(x).cholesky().map_or_else(SMatrix::zeros, |c| c.l());
-        let n = SVector::<f64, M>::from_fn(|_, _| crate::measure::gauss(rng, 1.0));
+        let n = SVector::<f64, M>::from_fn(|_, _| super::gauss(rng, 1.0));
         self.predict(x) + l * n
     }
 }

@@ -18,6 +18,13 @@ pub use ekf::{Ekf, FilterError, Gated, MeasurementModel, ProcessModel};
 pub use ukf::{Ukf, UkfParams};
 
 use nalgebra::{SMatrix, SVector};
+use rand::{Rng, RngExt};
+
+/// A zero-mean Gaussian draw of standard deviation `sigma` (every noise draw of the
+/// models and of the simulated world).
+pub fn gauss<R: Rng + ?Sized>(rng: &mut R, sigma: f64) -> f64 {
+    sigma * rng.sample::<f64, _>(rand_distr::StandardNormal)
+}
 
 /// A filter whose belief is a mean and a covariance (EKF, UKF).
 pub trait GaussianFilter<const N: usize> {

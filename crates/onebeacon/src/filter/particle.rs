@@ -635,7 +635,8 @@ mod tests {
     /// hoff2024's model over 3 chunks and a part, resampling or not.
     #[test]
     fn fused_resampling_and_prediction_equal_the_two_steps() {
-        use crate::models::hoff::{DIM, HoffProcess, InsReport};
+        use crate::measure::hoff::InsReport;
+        use crate::models::hoff::{DIM, HoffProcess};
         let mean = SVector::<f64, DIM>::from([100.0, 50.0, 30.0, 0.0, 0.3, 1.5, 0.0, 0.002]);
         let sigma = SVector::<f64, DIM>::from([10.0, 10.0, 2.0, 0.05, 0.2, 0.3, 0.001, 0.003]);
         let report = InsReport {

@@ -8,9 +8,11 @@
 //! yaw rate and acceleration when a communication frame arrives.
 //!
 //! States put the NED position first; the Doppler model also reads the heading and
-//! forward speed of [`crate::models::unicycle`].
+//! forward speed of [`crate::models::unicycle`]; [`hoff`] holds the particle likelihoods
+//! of [`crate::models::hoff`].
 
 pub mod doppler;
+pub mod hoff;
 pub mod range;
 pub mod state;
 pub mod usbl;
@@ -20,9 +22,9 @@ pub use range::{Range2d, Range3d, SlantRange};
 pub use state::StateComponent;
 pub use usbl::{Usbl, UsblAngle, UsblModel};
 
-use crate::filter::MeasurementModel;
+use crate::filter::{MeasurementModel, gauss};
 use nalgebra::{SMatrix, SVector};
-use rand::{Rng, RngExt};
+use rand::Rng;
 
 /// One scalar measurement z = h(x) + v.
 pub trait ScalarModel<const N: usize> {
@@ -50,12 +52,6 @@ pub trait ScalarModel<const N: usize> {
     {
         self.predict(x) + self.noise(x, rng)
     }
-}
-
-/// A zero-mean Gaussian draw of standard deviation `sigma` (every noise draw of the
-/// models and of the simulated world).
-pub fn gauss<R: Rng + ?Sized>(rng: &mut R, sigma: f64) -> f64 {
-    sigma * rng.sample::<f64, _>(rand_distr::StandardNormal)
 }
 
 /// A reference to a scalar model is that model (so `[&dyn ScalarModel<N>; M]` stacks

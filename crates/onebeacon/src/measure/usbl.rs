@@ -168,7 +168,7 @@ mod tests {
         let (a0, e0, _) = nominal.angles(&p);
         let (mut sa, mut se) = (0.0, 0.0);
         for _ in 0..n {
-            let g = |rng: &mut rand_pcg::Pcg64Mcg, s: f64| crate::measure::gauss(rng, s);
+            let g = |rng: &mut rand_pcg::Pcg64Mcg, s: f64| crate::filter::gauss(rng, s);
             let station = Usbl::exact(
                 Vector3::new(g(&mut rng, 1.0), g(&mut rng, 1.0), 0.0),
                 0.3 + g(&mut rng, 2f64.to_radians()),

@@ -93,7 +93,7 @@ impl Kinematic6Dof {
     /// The input as the vehicle's sensors measure it: `nu` plus a draw of their noise
     /// (u, v, w, then p, q, r).
     pub fn sample_input<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> BodyVelocity {
-        let mut draw = |sigma: f64| crate::measure::gauss(rng, sigma);
+        let mut draw = |sigma: f64| crate::filter::gauss(rng, sigma);
         let (v, w) = (self.velocity_sigma_m_s, self.rate_sigma_rad_s);
         self.nu + SVector::from([draw(v), draw(v), draw(v), draw(w), draw(w), draw(w)])
     }

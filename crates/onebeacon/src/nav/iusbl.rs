@@ -522,7 +522,7 @@ mod tests {
                 .process(&Measurement::new(t, Kind::Attitude { roll_rad: 0.0, pitch_rad: 0.0, heading_rad: heading }));
             let d = rotation(0.0, 0.0, heading).transpose() * (beacon - vehicle);
             let (az, incl) = crate::dsp::beamform::azimuth_inclination(&d);
-            let noise = |s: f64, rng: &mut rand_pcg::Pcg64| crate::measure::gauss(rng, s);
+            let noise = |s: f64, rng: &mut rand_pcg::Pcg64| crate::filter::gauss(rng, s);
             let fix = Kind::ArrayFix {
                 beacon: super::super::BeaconFix::fixed(0, beacon),
                 range_m: d.norm() + noise(0.3, &mut rng),

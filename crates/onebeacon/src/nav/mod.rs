@@ -209,6 +209,11 @@ pub trait Navigator: Send {
     fn beacon_relative_ned_m(&self) -> Option<Vector3<f64>> {
         None
     }
+    /// The body-frame linear velocity (u, v, w) the navigator last dead-reckoned on, m/s,
+    /// for a beacon vehicle predicting where the vehicle will be; None if it has none.
+    fn body_velocity_m_s(&self) -> Option<Vector3<f64>> {
+        None
+    }
     /// The command mode the beacon's pings confirmed last (rypkema sec. 4.2), if any.
     fn command_mode(&self) -> Option<usize> {
         None

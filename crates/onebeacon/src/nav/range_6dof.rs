@@ -103,6 +103,10 @@ fn update<const M: usize, H: MeasurementModel<DIM, M>>(
 }
 
 impl Navigator for Range6DofNavigator {
+    fn body_velocity_m_s(&self) -> Option<nalgebra::Vector3<f64>> {
+        Some(self.nu.fixed_rows::<3>(0).into_owned())
+    }
+
     fn process(&mut self, m: &Measurement) -> Outcome {
         match m.kind {
             Kind::BodyVelocity { nu } => {

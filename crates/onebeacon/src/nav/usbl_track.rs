@@ -8,8 +8,9 @@
 use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, gated_update};
 use crate::filter::particle::{ParticleFilter, ParticleSettings};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
+use crate::measure::hoff::{InsReport, UsblBearing};
 use crate::measure::{StateComponent, Usbl, UsblAngle};
-use crate::models::hoff::{DIM, HoffProcess, InsReport, UsblBearing, idx};
+use crate::models::hoff::{DIM, HoffProcess, idx};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use std::cell::OnceCell;
 
@@ -275,9 +276,9 @@ mod tests {
                 elevation_rad: el,
             };
             let report = Kind::Report {
-                heading_rad: 0.7 + crate::measure::gauss(&mut rng, 0.3),
-                speed_m_s: crate::measure::gauss(&mut rng, 0.2f64).abs(),
-                depth_m: p.z + crate::measure::gauss(&mut rng, 0.3),
+                heading_rad: 0.7 + crate::filter::gauss(&mut rng, 0.3),
+                speed_m_s: crate::filter::gauss(&mut rng, 0.2f64).abs(),
+                depth_m: p.z + crate::filter::gauss(&mut rng, 0.3),
             };
             for nav in [&mut pf as &mut dyn Navigator, &mut ekf] {
                 nav.process(&Measurement::new(t, report.clone()));

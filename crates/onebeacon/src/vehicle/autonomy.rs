@@ -11,14 +11,7 @@
 use crate::geo::wrap_angle;
 use nalgebra::Vector2;
 
-/// What the autonomy asks of the vehicle's autopilots.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Setpoint {
-    pub heading_rad: f64,
-    /// Speed over ground, m/s; 0: propeller off.
-    pub speed_m_s: f64,
-    pub depth_m: f64,
-}
+use super::{Phase, Setpoint};
 
 /// One beacon-relative behaviour. Positions are offsets from the beacon, NED, m;
 /// headings from north toward east, rad.
@@ -41,19 +34,6 @@ pub enum Behaviour {
     Return { end_m: Vector2<f64>, heading_rad: f64, length_m: f64 },
     /// Stop and float up.
     Abort,
-}
-
-/// What the vehicle is doing, for records and pictures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Phase {
-    /// No mode confirmed yet: holding heading at depth.
-    Waiting,
-    /// Driving (to a point, along a line, around a circle).
-    Driving,
-    /// Propeller off at an offset-follow point.
-    Drifting,
-    /// Propeller off for good: a return's end or an abort.
-    Surfacing,
 }
 
 /// Settings common to every behaviour of a vehicle.
