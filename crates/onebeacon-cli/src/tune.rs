@@ -5,7 +5,7 @@
 use crate::BadInput;
 use crate::output::Staging;
 use anyhow::Result;
-use onebeacon::nav::session::ErrorStats;
+use onebeacon::nav::evaluation::ErrorStats;
 use onebeacon_sim::replay::Log;
 use onebeacon_sim::replay::tune::{DEFAULT_KEYS, TUNABLE, Tuned, tune as fit};
 use serde_json::{Value, json};

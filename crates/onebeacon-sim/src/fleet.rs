@@ -5,6 +5,7 @@
 
 use crate::run::{RunOutput, StepRecord};
 use crate::scenario::fleet::{BehaviourName, Fleet};
+use onebeacon::nav::evaluation::quantile;
 use serde::Serialize;
 
 /// Errors of one (vehicle, estimator) or one estimator pooled over the fleet.
@@ -63,16 +64,6 @@ pub struct FleetStatistics {
     pub max_delay_s: f64,
     pub spacing: Option<Spacing>,
     pub coverage: Option<Coverage>,
-}
-
-/// The q-quantile of sorted values (linear between order statistics).
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let x = q * (sorted.len() - 1) as f64;
-    let (i, f) = (x.floor() as usize, x - x.floor());
-    sorted[i] * (1.0 - f) + sorted[(i + 1).min(sorted.len() - 1)] * f
 }
 
 fn percentiles(label: String, mut e: Vec<f64>) -> ErrorPercentiles {
@@ -254,18 +245,5 @@ pub fn statistics(s: &Fleet, runs: &[RunOutput]) -> FleetStatistics {
         max_delay_s: max_delay,
         spacing,
         coverage: runs.first().and_then(|o| coverage(s, &o.trajectory)),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn quantiles_interpolate_order_statistics() {
-        let v: Vec<f64> = (0..=100).map(f64::from).collect();
-        assert_eq!(quantile(&v, 0.68), 68.0);
-        assert_eq!(quantile(&v, 0.95), 95.0);
-        assert_eq!(quantile(&[1.0, 3.0], 0.5), 2.0);
     }
 }

@@ -117,7 +117,7 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
                 "nees_mean": num(st.nees_mean()),
                 "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
                 "nis_mean": num(st.nis_mean()),
-                "nis_band": crate::metrics::nees_band(st.nis_count, 1).map(num),
+                "nis_band": onebeacon::nav::evaluation::chi_square_band(st.nis_count, 1).map(num),
                 "nis_within_95_pct": num(100.0 * st.nis_within_95_fraction()),
                 "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())},
             });

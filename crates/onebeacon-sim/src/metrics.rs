@@ -1,8 +1,8 @@
 //! Error statistics of one run and their aggregation over Monte Carlo runs
 //! (garin2024 section 4.1: mean error, its variance, outliers, %etd).
 
+use onebeacon::nav::evaluation::{ErrorStats, chi_square_band, quantile};
 use serde::Serialize;
-use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 /// Statistics of one estimator over one run.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -85,80 +85,34 @@ impl RunMetrics {
     }
 }
 
-/// Accumulates one estimator's errors step by step.
-#[derive(Debug, Clone, Default)]
-pub struct ErrorAccumulator {
-    /// Steps pushed before this one count in the first half.
-    half: u64,
-    first_half_sum: f64,
-    n: u64,
-    sum: f64,
-    sum2: f64,
-    max: f64,
-    last: f64,
-    nees_sum: f64,
-    nees_n: u64,
-    failed_updates: u64,
-    diverged: bool,
-}
-
-impl ErrorAccumulator {
-    /// An accumulator for a run of `steps` steps.
-    pub fn new(steps: usize) -> Self {
-        Self { half: (steps / 2) as u64, ..Self::default() }
-    }
-
-    /// Adds the error of one step and its position NEES (None if P was not positive
-    /// definite).
-    pub fn push(&mut self, error_m: f64, nees: Option<f64>) {
-        if !error_m.is_finite() {
-            self.diverged = true;
-            return;
-        }
-        if self.n < self.half {
-            self.first_half_sum += error_m;
-        }
-        self.n += 1;
-        self.sum += error_m;
-        self.sum2 += error_m * error_m;
-        self.max = self.max.max(error_m);
-        self.last = error_m;
-        if let Some(v) = nees.filter(|v| v.is_finite()) {
-            self.nees_sum += v;
-            self.nees_n += 1;
-        }
-    }
-
-    /// Counts `outcome` if it is a failed update.
-    pub fn count_failure(&mut self, outcome: &onebeacon::nav::Outcome) {
-        self.failed_updates += u64::from(matches!(outcome, onebeacon::nav::Outcome::Failed(_)));
-    }
-
-    /// The run's statistics; `distance_m` is the distance travelled in the run.
-    pub fn finish(&self, distance_m: f64) -> RunMetrics {
-        let n = self.n.max(1) as f64;
-        let mean = self.sum / n;
-        let mse = self.sum2 / n;
+impl RunMetrics {
+    /// The run's statistics from its errors, scored every step with half
+    /// ([`ErrorStats::with_half`]) the steps; `distance_m` is the distance travelled in
+    /// the run.
+    pub fn of(st: &ErrorStats, distance_m: f64) -> RunMetrics {
+        let n = st.count.max(1) as f64;
+        let mean = st.sum_m / n;
+        let mse = st.sum_sq_m2 / n;
         // %etd is undefined for a vehicle that does not move
         let pct = if distance_m > 1e-6 { 100.0 / distance_m } else { f64::NAN };
-        let bad = self.diverged || self.n == 0;
-        let first = self.half.min(self.n);
-        let second = self.n - first;
+        let bad = st.diverged || st.count == 0;
+        let first = st.half.min(st.count);
+        let second = st.count - first;
         RunMetrics {
             mean_error_m: if bad { f64::INFINITY } else { mean },
             error_variance_m2: if bad { f64::INFINITY } else { (mse - mean * mean).max(0.0) },
             mse_m2: if bad { f64::INFINITY } else { mse },
-            max_error_m: if bad { f64::INFINITY } else { self.max },
-            final_error_m: if bad { f64::INFINITY } else { self.last },
-            etd_max_pct: if bad { f64::INFINITY } else { self.max * pct },
+            max_error_m: if bad { f64::INFINITY } else { st.max_m },
+            final_error_m: if bad { f64::INFINITY } else { st.final_m },
+            etd_max_pct: if bad { f64::INFINITY } else { st.max_m * pct },
             etd_mean_pct: if bad { f64::INFINITY } else { mean * pct },
-            nees_mean: if self.nees_n == 0 { f64::NAN } else { self.nees_sum / self.nees_n as f64 },
-            failed_updates: self.failed_updates,
-            mean_error_first_half_m: if bad || first == 0 { f64::INFINITY } else { self.first_half_sum / first as f64 },
+            nees_mean: if st.nees_count == 0 { f64::NAN } else { st.nees_mean() },
+            failed_updates: st.failed as u64,
+            mean_error_first_half_m: if bad || first == 0 { f64::INFINITY } else { st.first_half_sum_m / first as f64 },
             mean_error_second_half_m: if bad || second == 0 {
                 f64::INFINITY
             } else {
-                (self.sum - self.first_half_sum) / second as f64
+                (st.sum_m - st.first_half_sum_m) / second as f64
             },
         }
     }
@@ -195,27 +149,6 @@ pub struct CellSummary {
     pub mean_error_second_half_m: f64,
 }
 
-/// Quantile by linear interpolation between order statistics (type 7); `sorted` must
-/// be sorted ascending and non-empty.
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    let h = (sorted.len() - 1) as f64 * q;
-    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
-    if lo == hi || !sorted[hi].is_finite() {
-        sorted[lo]
-    } else {
-        sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
-    }
-}
-
-/// 95 % band for the average of `runs` independent chi-square(`dof`) variables.
-pub fn nees_band(runs: usize, dof: usize) -> [f64; 2] {
-    let n = (runs * dof) as f64;
-    match ChiSquared::new(n) {
-        Ok(chi) => [chi.inverse_cdf(0.025) / runs as f64, chi.inverse_cdf(0.975) / runs as f64],
-        Err(_) => [f64::NAN, f64::NAN],
-    }
-}
-
 /// Aggregates runs (in run order) into a cell summary.
 pub fn summarise(runs: &[RunMetrics]) -> CellSummary {
     assert!(!runs.is_empty(), "a cell has at least one run");
@@ -243,7 +176,7 @@ pub fn summarise(runs: &[RunMetrics]) -> CellSummary {
         etd_max_pct: avg(&|r| r.etd_max_pct),
         etd_mean_pct: avg(&|r| r.etd_mean_pct),
         nees_mean: avg(&|r| r.nees_mean),
-        nees_band: nees_band(inliers.len(), 2),
+        nees_band: chi_square_band(inliers.len(), 2),
         nees_mean_all_runs: nees_all,
         failed_updates: runs.iter().map(|r| r.failed_updates).sum(),
         mean_error_first_half_m: avg(&|r| r.mean_error_first_half_m),
@@ -257,10 +190,10 @@ mod tests {
     use approx::assert_relative_eq;
 
     fn run(mean: f64) -> RunMetrics {
-        let mut a = ErrorAccumulator::new(2);
+        let mut a = ErrorStats::with_half(1);
         a.push(mean - 1.0, Some(1.0));
         a.push(mean + 1.0, Some(3.0));
-        a.finish(1000.0)
+        RunMetrics::of(&a, 1000.0)
     }
 
     #[test]
@@ -275,9 +208,9 @@ mod tests {
         assert_eq!(m.final_error_m, 6.0);
         assert_relative_eq!(m.mean_error_first_half_m, 4.0);
         assert_relative_eq!(m.mean_error_second_half_m, 6.0);
-        let mut still = ErrorAccumulator::new(2);
+        let mut still = ErrorStats::with_half(1);
         still.push(1.0, None);
-        assert!(still.finish(0.0).etd_mean_pct.is_nan());
+        assert!(RunMetrics::of(&still, 0.0).etd_mean_pct.is_nan());
     }
 
     #[test]
@@ -289,23 +222,13 @@ mod tests {
         assert_eq!(s.outliers, 1);
         assert_relative_eq!(s.mean_error_m, 6.0); // mean of 2..=10
         assert_relative_eq!(s.nees_mean, 2.0);
-        assert_eq!(s.nees_band, nees_band(9, 2));
+        assert_eq!(s.nees_band, chi_square_band(9, 2));
         // a diverged run is an outlier; NEES over all runs sees it
-        let mut acc = ErrorAccumulator::new(2);
+        let mut acc = ErrorStats::with_half(1);
         acc.push(f64::NAN, None);
-        runs.push(acc.finish(1000.0));
+        runs.push(RunMetrics::of(&acc, 1000.0));
         let s = summarise(&runs);
         assert_eq!(s.outliers, 2);
         assert!(s.nees_mean.is_finite() && s.nees_mean_all_runs.is_infinite());
-    }
-
-    #[test]
-    fn nees_band_matches_chi_square_quantiles() {
-        // N x ANEES ~ chi2(N n) (Bar-Shalom et al. 2001, 5.4): N = 50, n = 2: [1.48, 2.59];
-        // N = 100, n = 2: [1.63, 2.41]
-        let b = nees_band(50, 2);
-        assert!((b[0] - 1.48).abs() < 0.01 && (b[1] - 2.59).abs() < 0.01, "{b:?}");
-        let b = nees_band(100, 2);
-        assert!((b[0] - 1.63).abs() < 0.01 && (b[1] - 2.41).abs() < 0.01, "{b:?}");
     }
 }

@@ -5,15 +5,15 @@
 
 use crate::engine::{self, Helm, Observer, Step, Track, VehicleTruth, World};
 use crate::helms;
-use crate::metrics::{ErrorAccumulator, RunMetrics};
+use crate::metrics::RunMetrics;
 use crate::scenario::{Cell, Scenario};
 use crate::world::{
     FixedBeaconWorld, FleetWorld, Information, MovingBeaconWorld, PassiveUsblWorld, bearing_information,
     range_information,
 };
 use nalgebra::{DMatrix, Vector2, Vector3};
-use onebeacon::filter::consistency::nees;
 use onebeacon::nav::Outcome;
+use onebeacon::nav::evaluation::{ErrorStats, horizontal_error};
 
 /// One estimator's estimate at one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -204,7 +204,12 @@ fn drive(
         engine::run(world, tracks, helms, &mut observers);
     }
     RunOutput {
-        metrics: scoring.acc.iter().zip(&scoring.vehicle_of).map(|(a, &v)| a.finish(scoring.distance_m[v])).collect(),
+        metrics: scoring
+            .acc
+            .iter()
+            .zip(&scoring.vehicle_of)
+            .map(|(a, &v)| RunMetrics::of(a, scoring.distance_m[v]))
+            .collect(),
         trajectory: recorder.trajectory,
         distance_m: scoring.distance_m,
         frames_decoded: scoring.heard,
@@ -214,17 +219,10 @@ fn drive(
     }
 }
 
-/// The horizontal error of estimate `e` of truth `t`, and its NEES (None if the
-/// covariance is not positive definite).
-fn score(e: &onebeacon::nav::Estimate, t: &VehicleTruth) -> (f64, Option<f64>) {
-    let err = (e.position_ned_m - t.eta.fixed_rows::<3>(0)).xy();
-    (err.norm(), nees(&err, &e.horizontal_cov_m2))
-}
-
 /// Error statistics of every track, failed updates, acoustic measurements heard, and
 /// each vehicle's distance travelled so far.
 struct Scoring {
-    acc: Vec<ErrorAccumulator>,
+    acc: Vec<ErrorStats>,
     /// The vehicle of each track.
     vehicle_of: Vec<usize>,
     distance_m: Vec<f64>,
@@ -233,7 +231,8 @@ struct Scoring {
 
 impl Scoring {
     fn new(vehicle_of: Vec<usize>, steps: usize) -> Self {
-        let acc = vec![ErrorAccumulator::new(steps + 1); vehicle_of.len()];
+        // steps + 1 errors scored, the first half of them apart
+        let acc = vec![ErrorStats::with_half(steps.div_ceil(2)); vehicle_of.len()];
         Self { acc, vehicle_of, distance_m: Vec::new(), heard: 0 }
     }
 }
@@ -241,7 +240,7 @@ impl Scoring {
 impl Observer for Scoring {
     fn step(&mut self, s: &Step<'_>) {
         for ((a, e), &v) in self.acc.iter_mut().zip(s.estimates).zip(&self.vehicle_of) {
-            let (error_m, nees) = score(e, &s.truth[v]);
+            let (error_m, nees) = horizontal_error(e, s.truth[v].eta[0], s.truth[v].eta[1]);
             a.push(error_m, nees);
         }
         self.heard += s.heard.iter().flatten().filter(|m| m.kind.beacon().is_some()).count() as u64;
@@ -250,7 +249,7 @@ impl Observer for Scoring {
     }
 
     fn outcome(&mut self, track: usize, outcome: &Outcome) {
-        self.acc[track].count_failure(outcome);
+        self.acc[track].push_outcome(outcome, true);
     }
 }
 
@@ -307,7 +306,7 @@ impl Observer for Recorder {
             .iter()
             .zip(s.vehicle_of)
             .map(|(e, &v)| {
-                let (error_m, nees) = score(e, &s.truth[v]);
+                let (error_m, nees) = horizontal_error(e, s.truth[v].eta[0], s.truth[v].eta[1]);
                 Estimate::new(v, e, error_m, nees)
             })
             .collect();

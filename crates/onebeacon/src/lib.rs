@@ -26,4 +26,5 @@ pub mod measure;
 pub mod models;
 pub mod nav;
 pub mod optim;
+mod par;
 pub mod vehicle;

@@ -3,12 +3,17 @@
 //! time-ordered stream, as `onebeacon stream` does live; [`replay`] does a whole log
 //! and keeps what the outputs need.
 
+mod csv;
 pub(crate) mod geodesy;
 pub mod log;
+mod merge;
+mod rows;
+mod schema;
 pub mod tune;
 pub(crate) mod validate;
 
-pub use log::{Dropped, Log, LogDescription, LogError};
+pub use log::{Log, LogDescription, LogError};
+pub use rows::Dropped;
 
 use onebeacon::nav::session::{Input, Session, Start, Step};
 

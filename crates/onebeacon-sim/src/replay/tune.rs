@@ -6,7 +6,7 @@
 
 use super::{Log, LogError, replay};
 use crate::scenario::EstimatorSpec;
-use onebeacon::nav::session::ErrorStats;
+use onebeacon::nav::evaluation::ErrorStats;
 use rayon::prelude::*;
 use std::collections::BTreeSet;
 

@@ -5,14 +5,14 @@
 //! stratified, residual) when the effective sample size falls below a threshold, and
 //! optional roughening.
 //!
-//! Work is split into chunks of [`CHUNK`] particles run in parallel (rayon); each chunk
+//! Work is split into chunks of [`CHUNK`] particles run in parallel ([`crate::par`]); each chunk
 //! draws from its own random stream, derived from (seed, step, chunk), and sums are
 //! reduced in chunk order, so a result does not depend on the thread count.
 
+use crate::par::*;
 use nalgebra::{SMatrix, SVector};
 use rand::RngExt;
 use rand_pcg::Pcg64;
-use rayon::prelude::*;
 
 /// Particles per chunk: the unit of parallel work and of random streams.
 pub const CHUNK: usize = 8192;
@@ -278,7 +278,8 @@ impl<const D: usize> ParticleFilter<D> {
     fn normalised(&self) -> &[f64] {
         self.normalised.get_or_init(|| {
             // the maximum is exact in any order; the sum is taken in chunk order
-            let max = self.log_w.par_iter().copied().reduce(|| f64::NEG_INFINITY, f64::max);
+            let log_w = &self.log_w;
+            let max = crate::par::max_over(log_w.len(), CHUNK, |i| log_w[i]);
             let mut w = self.weight_buffer.0.take();
             w.resize(self.len(), 0.0);
             let partial: Vec<f64> = w
@@ -458,7 +459,7 @@ fn chunk_views(x: &mut [Vec<f64>]) -> Vec<Vec<&mut [f64]>> {
 /// Adds `likelihood`'s log-likelihood of every particle of `x` to `log_w`, chunk by
 /// chunk in parallel; the largest of the results, NaN if any is NaN.
 fn add_log_likelihood(x: &[Vec<f64>], log_w: &mut [f64], likelihood: &impl ParticleLikelihood) -> f64 {
-    log_w
+    let maxima: Vec<f64> = log_w
         .par_chunks_mut(CHUNK)
         .enumerate()
         .map(|(c, lw)| {
@@ -468,14 +469,15 @@ fn add_log_likelihood(x: &[Vec<f64>], log_w: &mut [f64], likelihood: &impl Parti
             let (max, nan) = lw.iter().fold((f64::NEG_INFINITY, false), |(m, nan), v| (m.max(*v), nan | v.is_nan()));
             if nan { f64::NAN } else { max }
         })
-        .reduce(|| f64::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) })
+        .collect();
+    maxima.into_iter().fold(f64::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) })
 }
 
 /// The effective sample size of log-weights `log_w + lambda inc`, summed by chunks in
 /// order.
 fn ess_tempered(log_w: &[f64], inc: &[f64], lambda: f64) -> f64 {
     let at = |i: usize| log_w[i] + lambda * inc[i];
-    let max = (0..log_w.len()).into_par_iter().map(at).reduce(|| f64::NEG_INFINITY, f64::max);
+    let max = crate::par::max_over(log_w.len(), CHUNK, at);
     let partial: Vec<(f64, f64)> = (0..log_w.len().div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
@@ -794,6 +796,7 @@ mod tests {
     }
 
     /// The same seed gives the same particles whatever the thread count.
+    #[cfg(feature = "parallel")]
     #[test]
     fn results_do_not_depend_on_the_thread_count() {
         struct Jitter;

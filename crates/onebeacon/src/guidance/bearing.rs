@@ -4,8 +4,8 @@
 //! straight-line waypoint following of eq. 13-16.
 
 use crate::measure::Usbl;
+use crate::par::*;
 use nalgebra::{Matrix2, Vector2, Vector3};
-use rayon::prelude::*;
 
 /// How a candidate's spread of predicted measurements is scored (eq. 10).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

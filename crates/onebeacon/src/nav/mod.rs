@@ -4,8 +4,10 @@
 //! Every navigator implements [`Navigator`]: `process` one event, read the
 //! [`Estimate`]. Each is written once against [`crate::filter::GaussianFilter`], so it
 //! runs with the EKF or the UKF ([`crate::filter::FilterKind`]). The simulator, the log
-//! replay and the live stream drive them through this interface alone.
+//! replay and the live stream drive them through this interface alone, and score them
+//! with one [`evaluation`].
 
+pub mod evaluation;
 pub mod event;
 pub mod fix;
 pub mod iusbl;

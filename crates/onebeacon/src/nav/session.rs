@@ -4,13 +4,13 @@
 //! measurements, beacon positions, ground truth, in the source's frame.
 
 use crate::filter::FilterKind;
-use crate::filter::consistency::nees;
 use crate::geo::Frame;
+use crate::nav::evaluation::{ErrorStats, horizontal_error};
 use crate::nav::planar::STATES_WITH_OFFSETS;
 use crate::nav::{
     BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, PlanarConfig, PlanarNavigator, TrackingNavigator,
 };
-use nalgebra::{Vector2, Vector3};
+use nalgebra::Vector3;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// A ground-truth pose (heading when the log has one). Items hold SI values in the
@@ -314,93 +314,6 @@ pub struct Screened {
     pub reason: String,
 }
 
-/// Error statistics of one estimator against the ground truth.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct ErrorStats {
-    pub count: usize,
-    pub sum_m: f64,
-    pub sum_sq_m2: f64,
-    pub max_m: f64,
-    pub final_m: f64,
-    pub rejected: usize,
-    pub failed: usize,
-    /// Times the estimator's state or covariance stopped being finite and positive
-    /// definite and it was started again from its last sound estimate.
-    pub reinitialised: usize,
-    /// Position NEES (2 dof): sum and count of the finite ones, and how many were within
-    /// the 95 % chi-square quantile.
-    pub nees_sum: f64,
-    pub nees_count: usize,
-    pub nees_within_95: usize,
-    /// NIS (1 dof) of every scalar correction the estimator weighed, accepted or gated
-    /// out: sum, count, and how many were within the 95 % chi-square quantile.
-    pub nis_sum: f64,
-    pub nis_count: usize,
-    pub nis_within_95: usize,
-    /// Sum of ln det S of the same corrections: with the NIS, their Gaussian likelihood.
-    pub ln_det_s_sum: f64,
-}
-
-/// The 95 % quantile of chi-square with 2 degrees of freedom, -2 ln 0.05.
-pub const NEES_95_2DOF: f64 = 5.991464547107982;
-
-/// The 95 % quantile of chi-square with 1 degree of freedom, 1.96^2.
-pub const NIS_95_1DOF: f64 = 3.841458820694124;
-
-impl ErrorStats {
-    pub fn rmse_m(&self) -> f64 {
-        (self.sum_sq_m2 / self.count as f64).sqrt()
-    }
-    pub fn mean_m(&self) -> f64 {
-        self.sum_m / self.count as f64
-    }
-    /// Mean position NEES: 2 for a consistent filter, more for an overconfident one.
-    pub fn nees_mean(&self) -> f64 {
-        self.nees_sum / self.nees_count as f64
-    }
-    /// Fraction of the NEES values within the 95 % quantile (0.95 when consistent).
-    pub fn nees_within_95_fraction(&self) -> f64 {
-        self.nees_within_95 as f64 / self.nees_count as f64
-    }
-
-    /// Mean NIS: 1 for a consistent filter (its innovations as large as it expects).
-    pub fn nis_mean(&self) -> f64 {
-        self.nis_sum / self.nis_count as f64
-    }
-    /// Fraction of the NIS values within the 95 % quantile (0.95 when consistent).
-    pub fn nis_within_95_fraction(&self) -> f64 {
-        self.nis_within_95 as f64 / self.nis_count as f64
-    }
-
-    /// The negative log-likelihood of the corrections weighed, sum of (ln det(2 pi S) +
-    /// NIS) / 2 over them (the innovations' Gaussian density, what `tune` minimises).
-    pub fn neg_log_likelihood(&self) -> f64 {
-        0.5 * (self.ln_det_s_sum + self.nis_count as f64 * std::f64::consts::TAU.ln() + self.nis_sum)
-    }
-
-    fn push_nis(&mut self, nis: f64, det_s: f64) {
-        if nis.is_finite() && det_s > 0.0 && det_s.is_finite() {
-            self.nis_sum += nis;
-            self.nis_count += 1;
-            self.nis_within_95 += usize::from(nis <= NIS_95_1DOF);
-            self.ln_det_s_sum += det_s.ln();
-        }
-    }
-
-    fn push(&mut self, err: f64, nees: f64) {
-        self.count += 1;
-        self.sum_m += err;
-        self.sum_sq_m2 += err * err;
-        self.max_m = self.max_m.max(err);
-        self.final_m = err;
-        if nees.is_finite() {
-            self.nees_sum += nees;
-            self.nees_count += 1;
-            self.nees_within_95 += usize::from(nees <= NEES_95_2DOF);
-        }
-    }
-}
-
 /// What one item did: each estimator's outcome (none for beacon positions and truth)
 /// and estimate, and when the item is a ground-truth pose each estimator's horizontal
 /// error (m) and its NEES.
@@ -434,12 +347,6 @@ fn sound(e: &Estimate) -> bool {
         && p.iter().all(|v| v.is_finite())
         && p[(0, 0)] > 0.0
         && p.determinant() > 0.0
-}
-
-/// Horizontal error and its NEES against `truth` (NaN when the covariance is singular).
-fn error_and_nees(e: &Estimate, truth: &TruthPose) -> (f64, f64) {
-    let d = Vector2::new(e.north_m() - truth.north_m, e.east_m() - truth.east_m);
-    (d.norm(), nees(&d, &e.horizontal_cov_m2).unwrap_or(f64::NAN))
 }
 
 /// One estimator of a session: the planar navigator, or the constant-velocity tracker
@@ -686,15 +593,11 @@ impl Session {
                     let m = Measurement::new(t, kind.clone());
                     for (i, nav) in self.navs.iter_mut().enumerate() {
                         let out = nav.navigator().process(&m);
-                        self.stats[i].failed += usize::from(matches!(out, Outcome::Failed(_)));
-                        if let Outcome::Accepted(nis, det_s) | Outcome::Rejected(nis, det_s) = out {
-                            self.stats[i].push_nis(nis, det_s);
-                        }
+                        self.stats[i].push_outcome(&out, true);
                         outcomes[i] = Some(out);
                     }
                     for (i, out) in outcomes.iter().enumerate() {
                         if let Some(Outcome::Rejected(nis, _)) = *out {
-                            self.stats[i].rejected += 1;
                             self.log_rejection(Rejection {
                                 estimator: Some(i),
                                 t_s: t,
@@ -729,9 +632,9 @@ impl Session {
                 .iter()
                 .zip(self.stats.iter_mut())
                 .map(|(e, s)| {
-                    let (err, nees) = error_and_nees(e, &p);
+                    let (err, nees) = horizontal_error(e, p.north_m, p.east_m);
                     s.push(err, nees);
-                    (err, nees)
+                    (err, nees.unwrap_or(f64::NAN))
                 })
                 .collect()
         });
@@ -899,20 +802,5 @@ mod tests {
             .collect();
         assert!(turns > 1e3, "beyond the old 1000 rad bound");
         approx::assert_abs_diff_eq!(finals[0].position_ned_m, finals[1].position_ned_m, epsilon = 1e-9);
-    }
-
-    #[test]
-    fn nees_quantile_and_statistics() {
-        // chi-square(2) is exponential with mean 2: its 95 % quantile is -2 ln 0.05
-        approx::assert_relative_eq!(NEES_95_2DOF, -2.0 * 0.05f64.ln(), max_relative = 1e-12);
-        let mut s = ErrorStats::default();
-        for (err, nees) in [(1.0, 1.0), (3.0, 9.0), (2.0, f64::NAN), (2.0, 2.0)] {
-            s.push(err, nees);
-        }
-        assert_eq!((s.count, s.nees_count, s.nees_within_95), (4, 3, 2));
-        approx::assert_relative_eq!(s.nees_mean(), 4.0);
-        approx::assert_relative_eq!(s.nees_within_95_fraction(), 2.0 / 3.0);
-        approx::assert_relative_eq!(s.rmse_m(), (18.0f64 / 4.0).sqrt());
-        assert_eq!((s.max_m, s.final_m), (3.0, 2.0));
     }
 }

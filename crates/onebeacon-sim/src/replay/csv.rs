@@ -1,0 +1,108 @@
+//! CSV files read row by row with their header, with a bound on the length of a line.
+
+use super::log::*;
+use std::path::Path;
+
+/// A CSV file being read, with its header.
+pub(super) struct Table {
+    pub(super) file: String,
+    header: Vec<String>,
+    reader: csv::Reader<LineLimited<std::fs::File>>,
+    record: csv::StringRecord,
+}
+
+/// Longest CSV line read, bytes: a file that is not a CSV (a device, a binary) is
+/// refused with an error instead of filling the memory.
+pub(super) const MAX_CSV_LINE_BYTES: usize = 1 << 20;
+
+/// A reader that fails on a line longer than [`MAX_CSV_LINE_BYTES`].
+pub(super) struct LineLimited<R> {
+    inner: R,
+    line: usize,
+}
+
+impl<R: std::io::Read> std::io::Read for LineLimited<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for &b in &buf[..n] {
+            self.line = if b == b'\n' { 0 } else { self.line + 1 };
+            if self.line > MAX_CSV_LINE_BYTES {
+                return Err(std::io::Error::other(format!(
+                    "a line longer than {MAX_CSV_LINE_BYTES} bytes: not a CSV file"
+                )));
+            }
+        }
+        Ok(n)
+    }
+}
+
+/// One row of a [`Table`].
+pub(super) struct Row<'a> {
+    pub(super) table: &'a Table,
+    line: u64,
+}
+
+impl Table {
+    pub(super) fn open(base: &Path, file: &Path) -> Result<Self, LogError> {
+        let path = base.join(file);
+        let name = path.display().to_string();
+        let f = std::fs::File::open(&path)
+            .map_err(|e| LogError::File { file: name.clone(), message: format!("cannot open: {e}") })?;
+        let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(LineLimited { inner: f, line: 0 });
+        let header = reader
+            .headers()
+            .map_err(|e| LogError::File { file: name.clone(), message: format!("cannot read the header: {e}") })?
+            .iter()
+            .map(String::from)
+            .collect();
+        Ok(Self { file: name, header, reader, record: csv::StringRecord::new() })
+    }
+
+    pub(super) fn index(&self, column: &str) -> Result<usize, LogError> {
+        self.header.iter().position(|h| h == column).ok_or_else(|| LogError::File {
+            file: self.file.clone(),
+            message: format!("no column `{column}` (columns: {})", self.header.join(", ")),
+        })
+    }
+
+    pub(super) fn next_row(&mut self) -> Result<Option<Row<'_>>, LogError> {
+        match self.reader.read_record(&mut self.record) {
+            Ok(false) => Ok(None),
+            Ok(true) => {
+                let line = self.record.position().map_or(0, |p| p.line());
+                Ok(Some(Row { table: self, line }))
+            }
+            Err(e) => Err(LogError::File { file: self.file.clone(), message: format!("malformed CSV: {e}") }),
+        }
+    }
+}
+
+impl Row<'_> {
+    pub(super) fn error(&self, column: usize, message: String) -> LogError {
+        LogError::Cell {
+            file: self.table.file.clone(),
+            line: self.line,
+            column: self.table.header[column].clone(),
+            message,
+        }
+    }
+
+    pub(super) fn cell(&self, column: usize) -> &str {
+        self.table.record.get(column).unwrap_or("")
+    }
+
+    pub(super) fn number(&self, column: usize) -> Result<f64, LogError> {
+        let cell = self.cell(column);
+        match cell.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(self.error(column, format!("`{cell}` is not finite; a finite number is expected"))),
+            Err(_) => Err(self.error(column, format!("`{cell}` is not a number"))),
+        }
+    }
+
+    pub(super) fn beacon_id(&self, column: usize) -> Result<u32, LogError> {
+        let cell = self.cell(column);
+        cell.parse::<u32>()
+            .map_err(|_| self.error(column, format!("`{cell}` is not a beacon id (a non-negative integer)")))
+    }
+}

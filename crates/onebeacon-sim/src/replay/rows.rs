@@ -1,0 +1,280 @@
+//! One source's rows into stream items: its clock (time cells to seconds), units and
+//! frame to SI and the log's frame, and the rows dropped out of time order.
+
+use super::csv::*;
+use super::geodesy::Geodetic;
+use super::log::*;
+use nalgebra::Vector3;
+use onebeacon::geo::Frame;
+use onebeacon::nav::Kind;
+use onebeacon::nav::session::{Input, Item, TruthPose, resolve_beacon};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// One source read row by row into stream items (the log's frame, SI units).
+pub(super) struct SourceRows<'a> {
+    source: &'a Source,
+    pub(super) table: Table,
+    time: usize,
+    cols: BTreeMap<&'static str, usize>,
+    beacons: &'a BTreeMap<u32, Vector3<f64>>,
+    tracked: &'a BTreeSet<u32>,
+    geodetic: Option<Geodetic>,
+    clock: Clock,
+    pub(super) order: TimeOrder,
+    /// +1, or -1 when the file's headings turn against the log frame's sense.
+    sense: f64,
+    /// The time of the row above.
+    previous: Option<f64>,
+    /// The second item of a `speed_heading` row.
+    pending: Option<Item>,
+    /// `time_order = "drop"`: the row read ahead, the time of the last row kept, the rows
+    /// dropped, and an error met while reading ahead (given after the row in hand).
+    ahead: Option<RowItems>,
+    kept: Option<f64>,
+    pub(super) dropped: usize,
+    pub(super) kept_rows: usize,
+    error: Option<LogError>,
+}
+
+/// The rows of a `time_order = "drop"` source: dropped out of time order, and kept.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Dropped {
+    pub file: String,
+    pub dropped: usize,
+    pub kept: usize,
+}
+
+impl Dropped {
+    /// Whether the source lost more rows than it kept: its time column is suspect, and
+    /// so is a score made of what is left.
+    pub fn lost_most(&self) -> bool {
+        self.dropped > self.kept
+    }
+}
+
+/// The one or two items of a row.
+type RowItems = (Item, Option<Item>);
+
+/// How a source's time cells become seconds.
+pub(super) enum Clock {
+    Number(f64),
+    /// A strftime pattern for a date and time (with an offset when `zoned`).
+    DateTime {
+        format: String,
+        zoned: bool,
+    },
+    /// A strftime pattern for a time of day, the day of the first row (UNIX seconds),
+    /// and the days passed since (a time of day 12 h before the one above is the next
+    /// day's).
+    TimeOfDay {
+        format: String,
+        day_s: f64,
+        days: f64,
+        last_s: Option<f64>,
+    },
+}
+
+impl Clock {
+    fn new(s: &Source) -> Self {
+        match (&s.time_format, &s.date) {
+            (None, _) => Clock::Number(s.time_unit.seconds()),
+            (Some(format), None) => {
+                let zoned = ["%z", "%:z", "%::z", "%:::z", "%#z"].iter().any(|z| format.contains(z));
+                Clock::DateTime { format: format.clone(), zoned }
+            }
+            (Some(format), Some(date)) => {
+                let day = chrono::NaiveDate::parse_from_str(date, "%Y-%m-%d").expect("validated: date is YYYY-MM-DD");
+                let day_s = day.and_time(chrono::NaiveTime::MIN).and_utc().timestamp() as f64;
+                Clock::TimeOfDay { format: format.clone(), day_s, days: 0.0, last_s: None }
+            }
+        }
+    }
+
+    /// The time of a cell, seconds; an error message when it cannot be read.
+    fn read(&mut self, cell: &str) -> Result<f64, String> {
+        let unix =
+            |t: chrono::DateTime<chrono::Utc>| t.timestamp() as f64 + f64::from(t.timestamp_subsec_nanos()) * 1e-9;
+        let explain = |format: &str, e: chrono::ParseError| {
+            let hint = if e.kind() == chrono::format::ParseErrorKind::NotEnough {
+                " (a time of day needs the source's `date` key)"
+            } else {
+                ""
+            };
+            format!("`{cell}` does not match time_format `{format}`: {e}{hint}")
+        };
+        match self {
+            Clock::Number(unit) => match cell.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v * *unit),
+                Ok(_) => Err(format!("`{cell}` is not finite; a finite number is expected")),
+                Err(_) => Err(format!("`{cell}` is not a number (set time_format for times written as text)")),
+            },
+            Clock::DateTime { format, zoned: false } => chrono::NaiveDateTime::parse_from_str(cell, format)
+                .map(|t| unix(t.and_utc()))
+                .map_err(|e| explain(format, e)),
+            Clock::DateTime { format, zoned: true } => {
+                chrono::DateTime::parse_from_str(cell, format).map(|t| unix(t.to_utc())).map_err(|e| explain(format, e))
+            }
+            Clock::TimeOfDay { format, day_s, days, last_s } => {
+                let t = chrono::NaiveTime::parse_from_str(cell, format).map_err(|e| explain(format, e))?;
+                use chrono::Timelike;
+                let s = f64::from(t.num_seconds_from_midnight()) + f64::from(t.nanosecond()) * 1e-9;
+                if last_s.is_some_and(|last| s < last - 43_200.0) {
+                    *days += 1.0;
+                }
+                *last_s = Some(s);
+                Ok(*day_s + *days * 86_400.0 + s)
+            }
+        }
+    }
+}
+
+impl<'a> SourceRows<'a> {
+    pub(super) fn open(log: &'a Log, source: &'a Source) -> Result<Self, LogError> {
+        let table = Table::open(&log.base, &source.file)?;
+        let time = table.index(&source.time)?;
+        let cols = COLUMN_KEYS
+            .iter()
+            .filter_map(|k| source.column(k).map(|c| table.index(c).map(|c| (*k, c))))
+            .collect::<Result<_, _>>()?;
+        let frame_clockwise = log.frame == Frame::Ned;
+        let sense = if source.heading_clockwise.is_some_and(|c| c != frame_clockwise) { -1.0 } else { 1.0 };
+        Ok(Self {
+            source,
+            table,
+            time,
+            cols,
+            beacons: &log.beacons,
+            tracked: &log.tracked,
+            geodetic: log.geodetic,
+            clock: Clock::new(source),
+            order: source.time_order(),
+            sense,
+            previous: None,
+            pending: None,
+            ahead: None,
+            kept: None,
+            dropped: 0,
+            kept_rows: 0,
+            error: None,
+        })
+    }
+
+    /// The next item, None at the end of the file.
+    pub(super) fn next_item(&mut self) -> Result<Option<Item>, LogError> {
+        if let Some(item) = self.pending.take() {
+            return Ok(Some(item));
+        }
+        let row = if self.order == TimeOrder::Drop { self.next_in_order()? } else { self.read_row()? };
+        Ok(row.map(|(item, second)| {
+            self.pending = second;
+            item
+        }))
+    }
+
+    /// `time_order = "drop"`: the next row in time order, with one row read ahead so that
+    /// a time stamp glitched forward drops its row, not every row after it.
+    fn next_in_order(&mut self) -> Result<Option<RowItems>, LogError> {
+        loop {
+            if let Some(e) = self.error.take() {
+                return Err(e);
+            }
+            let row = match self.ahead.take() {
+                Some(row) => row,
+                None => match self.read_row()? {
+                    Some(row) => row,
+                    None => return Ok(None),
+                },
+            };
+            let t = row.0.t_s;
+            if self.kept.is_some_and(|k| t < k) {
+                self.dropped += 1; // behind the last row kept
+                continue;
+            }
+            match self.read_row() {
+                Ok(next) => self.ahead = next,
+                Err(e) => self.error = Some(e),
+            }
+            let next_t = self.ahead.as_ref().map(|(next, _)| next.t_s);
+            if next_t.is_some_and(|n| n < t && self.kept.is_none_or(|k| n >= k)) {
+                self.dropped += 1; // ahead of both neighbours
+                continue;
+            }
+            self.kept = Some(t);
+            self.kept_rows += 1;
+            return Ok(Some(row));
+        }
+    }
+
+    /// The next row's items, None at the end of the file.
+    fn read_row(&mut self) -> Result<Option<RowItems>, LogError> {
+        let (s, cols, time) = (self.source, &self.cols, self.time);
+        let (beacons, tracked, geodetic, sense) = (self.beacons, self.tracked, self.geodetic, self.sense);
+        let previous = self.previous;
+        let Some(row) = self.table.next_row()? else { return Ok(None) };
+        let t = self.clock.read(row.cell(time)).map_err(|m| row.error(time, m))? + s.time_offset_s;
+        if let Some(p) = previous.filter(|p| t < *p && self.order == TimeOrder::Refuse) {
+            return Err(row.error(
+                time,
+                format!("time {t} is before {p} on the row above; rows must be in time order (or set time_order = \"sort\" or \"drop\" on this source)"),
+            ));
+        }
+        let (len, ang) = (s.length_unit.metres(), s.angle_unit.radians());
+        let num = |k: &str| row.number(cols[k]);
+        let heading = |k: &str| Ok::<_, LogError>(sense * num(k)? * ang + s.heading_offset_deg.to_radians());
+        let turn = |k: &str| Ok::<_, LogError>(sense * num(k)? * ang);
+        let beacon = || {
+            let id = row.beacon_id(cols["beacon"])?;
+            resolve_beacon(id, beacons, tracked).map_err(|m| row.error(cols["beacon"], m))
+        };
+        let position = || match (cols.get("x").zip(cols.get("y")), geodetic) {
+            (Some((&x, &y)), _) => Ok::<_, LogError>((row.number(x)? * len, row.number(y)? * len)),
+            (None, Some(geo)) => {
+                let unit = s.latlon_unit.radians();
+                geo.local(num("lat")? * unit, num("lon")? * unit).map_err(|m| row.error(cols["lat"], m))
+            }
+            (None, None) => unreachable!("validated: x and y, or lat and lon (which make the origin)"),
+        };
+        let measurement = |m: Kind| Item { t_s: t, input: Input::Measurement(m) };
+        let mut second = None;
+        let item = match s.kind {
+            SourceKind::Odometry => measurement(Kind::Odometry {
+                distance_m: num("distance")? * len,
+                heading_change_rad: turn("heading_change")?,
+            }),
+            SourceKind::BodyOdometry => measurement(Kind::BodyOdometry {
+                forward_m: num("forward")? * len,
+                lateral_m: sense * num("lateral")? * len,
+                heading_change_rad: turn("heading_change")?,
+            }),
+            SourceKind::BodyVelocity => {
+                let r = cols.contains_key("yaw_rate").then(|| turn("yaw_rate")).transpose()?.unwrap_or(0.0);
+                let (u, v) = (num("forward_speed")? * len, sense * num("lateral_speed")? * len);
+                measurement(Kind::BodyVelocity { nu: [u, v, 0.0, 0.0, 0.0, r] })
+            }
+            SourceKind::Speed => measurement(Kind::Speed { speed_m_s: num("speed")? * len }),
+            SourceKind::Heading => measurement(Kind::Heading { heading_rad: heading("heading")? }),
+            SourceKind::SpeedHeading => {
+                second = Some(measurement(Kind::Heading { heading_rad: heading("heading")? }));
+                measurement(Kind::Speed { speed_m_s: num("speed")? * len })
+            }
+            SourceKind::Depth => measurement(Kind::Depth { depth_m: num("depth")? * len }),
+            SourceKind::Range => measurement(Kind::Range { beacon: beacon()?, range_m: num("range")? * len }),
+            SourceKind::Doppler => {
+                measurement(Kind::Doppler { beacon: beacon()?, radial_speed_m_s: num("radial_speed")? * len })
+            }
+            SourceKind::BeaconTrack => {
+                let beacon_id = row.beacon_id(cols["beacon"])?;
+                let z = cols.get("z").map_or(Ok(0.0), |&c| row.number(c))? * len;
+                let (x, y) = position()?;
+                Item { t_s: t, input: Input::BeaconPosition { beacon_id, position: Vector3::new(x, y, z) } }
+            }
+            SourceKind::GroundTruth => {
+                let heading_rad = cols.contains_key("heading").then(|| heading("heading")).transpose()?;
+                let (north_m, east_m) = position()?;
+                Item { t_s: t, input: Input::Truth(TruthPose { north_m, east_m, heading_rad }) }
+            }
+        };
+        self.previous = Some(t);
+        Ok(Some((item, second)))
+    }
+}

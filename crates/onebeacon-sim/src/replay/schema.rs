@@ -1,0 +1,409 @@
+//! The log description's schema: the TOML keys of a log (its sources and their columns,
+//! units, clocks, beacons, start and limits), deserialised and documented.
+
+pub use super::geodesy::{LatLonUnit, Origin};
+use crate::scenario::EstimatorSpec;
+use onebeacon::geo::Frame;
+use onebeacon::nav::session::Limits;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// The frame of the log's x, y, z and headings (`frame` key).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrameKey {
+    #[default]
+    Ned,
+    Enu,
+}
+
+impl From<FrameKey> for Frame {
+    fn from(f: FrameKey) -> Self {
+        match f {
+            FrameKey::Ned => Frame::Ned,
+            FrameKey::Enu => Frame::Enu,
+        }
+    }
+}
+
+/// What a CSV source holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SourceKind {
+    Odometry,
+    BodyOdometry,
+    /// Body-frame speeds (a DVL): forward, lateral, optional yaw rate, held until the
+    /// next.
+    BodyVelocity,
+    Speed,
+    Heading,
+    SpeedHeading,
+    Depth,
+    Range,
+    Doppler,
+    BeaconTrack,
+    GroundTruth,
+}
+
+impl SourceKind {
+    /// The column keys this kind needs, and those it may have.
+    pub(crate) fn columns(self) -> (&'static [&'static str], &'static [&'static str]) {
+        match self {
+            SourceKind::Odometry => (&["distance", "heading_change"], &[]),
+            SourceKind::BodyOdometry => (&["forward", "lateral", "heading_change"], &[]),
+            SourceKind::BodyVelocity => (&["forward_speed", "lateral_speed"], &["yaw_rate"]),
+            SourceKind::Speed => (&["speed"], &[]),
+            SourceKind::Heading => (&["heading"], &[]),
+            SourceKind::SpeedHeading => (&["speed", "heading"], &[]),
+            SourceKind::Depth => (&["depth"], &[]),
+            SourceKind::Range => (&["beacon", "range"], &[]),
+            SourceKind::Doppler => (&["beacon", "radial_speed"], &[]),
+            SourceKind::BeaconTrack => (&["beacon"], &["z"]),
+            SourceKind::GroundTruth => (&[], &["heading"]),
+        }
+    }
+
+    /// Whether the kind holds a position: `x` and `y`, or `lat` and `lon`.
+    pub(crate) fn positioned(self) -> bool {
+        matches!(self, SourceKind::BeaconTrack | SourceKind::GroundTruth)
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LengthUnit {
+    #[default]
+    M,
+    Cm,
+    Mm,
+    Km,
+}
+
+impl LengthUnit {
+    pub(super) fn metres(self) -> f64 {
+        match self {
+            LengthUnit::M => 1.0,
+            LengthUnit::Cm => 0.01,
+            LengthUnit::Mm => 0.001,
+            LengthUnit::Km => 1000.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AngleUnit {
+    #[default]
+    Rad,
+    Deg,
+}
+
+impl AngleUnit {
+    pub(super) fn radians(self) -> f64 {
+        match self {
+            AngleUnit::Rad => 1.0,
+            AngleUnit::Deg => std::f64::consts::PI / 180.0,
+        }
+    }
+}
+
+/// The unit of a numeric time column (`time_unit`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeUnit {
+    #[default]
+    S,
+    Ms,
+    Us,
+    Ns,
+}
+
+impl TimeUnit {
+    pub(super) fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Us => 1e-6,
+            TimeUnit::Ns => 1e-9,
+        }
+    }
+}
+
+/// What to do with a row whose time is before the row above (`time_order`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeOrder {
+    /// Stop with an error naming the line (the default).
+    Refuse,
+    /// Read the whole file and sort it by time (a log written out of order).
+    Sort,
+    /// Drop the rows out of order, counted in the replay's summary: a row behind the
+    /// last row kept, or a row ahead of both its neighbours (a glitched time stamp).
+    Drop,
+}
+
+/// One CSV file: its kind, the time column and the column of each quantity.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Source {
+    pub kind: SourceKind,
+    /// Relative to the log description's directory.
+    pub file: PathBuf,
+    /// The time column: a number (seconds since any origin, or a UNIX epoch) in
+    /// `time_unit`, or text read with `time_format`.
+    pub time: String,
+    #[serde(default)]
+    pub time_unit: TimeUnit,
+    /// A strftime pattern for times written as text (`%H:%M:%S%.f` with `date`, or
+    /// `%Y-%m-%dT%H:%M:%S%.fZ`): times become UNIX seconds, UTC unless the pattern has
+    /// `%z`.
+    pub time_format: Option<String>,
+    /// `YYYY-MM-DD`, the day of the first row when `time_format` has no date; a time more
+    /// than 12 h before the row above is on the next day.
+    pub date: Option<String>,
+    /// Added to every time of this file, s.
+    #[serde(default)]
+    pub time_offset_s: f64,
+    /// Rows out of time order: `refuse` (default), `sort` or `drop`.
+    pub time_order: Option<TimeOrder>,
+    #[serde(default)]
+    pub length_unit: LengthUnit,
+    #[serde(default)]
+    pub angle_unit: AngleUnit,
+    /// `sort = true` is `time_order = "sort"` (the older key).
+    #[serde(default)]
+    pub sort: bool,
+    /// Headings of this file in the log's frame: `heading_offset_deg` plus the column
+    /// turned the frame's way, or the other way when `heading_clockwise` says so (a
+    /// compass, clockwise from north, in an ENU log: `heading_clockwise = true`,
+    /// `heading_offset_deg = 90`). Heading changes and the lateral axis follow the sense.
+    #[serde(default)]
+    pub heading_offset_deg: f64,
+    pub heading_clockwise: Option<bool>,
+    #[serde(default)]
+    pub latlon_unit: LatLonUnit,
+    pub distance: Option<String>,
+    pub heading_change: Option<String>,
+    pub forward: Option<String>,
+    pub lateral: Option<String>,
+    pub forward_speed: Option<String>,
+    pub lateral_speed: Option<String>,
+    pub yaw_rate: Option<String>,
+    pub speed: Option<String>,
+    pub heading: Option<String>,
+    pub depth: Option<String>,
+    pub beacon: Option<String>,
+    pub range: Option<String>,
+    pub radial_speed: Option<String>,
+    pub x: Option<String>,
+    pub y: Option<String>,
+    pub z: Option<String>,
+    pub lat: Option<String>,
+    pub lon: Option<String>,
+}
+
+impl Source {
+    /// The policy for rows out of time order.
+    pub fn time_order(&self) -> TimeOrder {
+        self.time_order.unwrap_or(if self.sort { TimeOrder::Sort } else { TimeOrder::Refuse })
+    }
+
+    pub(crate) fn column(&self, key: &str) -> Option<&String> {
+        match key {
+            "distance" => self.distance.as_ref(),
+            "heading_change" => self.heading_change.as_ref(),
+            "forward" => self.forward.as_ref(),
+            "lateral" => self.lateral.as_ref(),
+            "forward_speed" => self.forward_speed.as_ref(),
+            "lateral_speed" => self.lateral_speed.as_ref(),
+            "yaw_rate" => self.yaw_rate.as_ref(),
+            "speed" => self.speed.as_ref(),
+            "heading" => self.heading.as_ref(),
+            "depth" => self.depth.as_ref(),
+            "beacon" => self.beacon.as_ref(),
+            "range" => self.range.as_ref(),
+            "radial_speed" => self.radial_speed.as_ref(),
+            "x" => self.x.as_ref(),
+            "y" => self.y.as_ref(),
+            "z" => self.z.as_ref(),
+            "lat" => self.lat.as_ref(),
+            "lon" => self.lon.as_ref(),
+            _ => None,
+        }
+    }
+}
+
+pub(crate) const COLUMN_KEYS: [&str; 18] = [
+    "distance",
+    "heading_change",
+    "forward",
+    "lateral",
+    "forward_speed",
+    "lateral_speed",
+    "yaw_rate",
+    "speed",
+    "heading",
+    "depth",
+    "beacon",
+    "range",
+    "radial_speed",
+    "x",
+    "y",
+    "z",
+    "lat",
+    "lon",
+];
+
+/// Fixed beacon positions from a CSV file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeaconTable {
+    pub file: PathBuf,
+    pub id: String,
+    /// `x` and `y`, or `lat` and `lon` (in `latlon_unit`).
+    pub x: Option<String>,
+    pub y: Option<String>,
+    pub lat: Option<String>,
+    pub lon: Option<String>,
+    pub z: Option<String>,
+    #[serde(default)]
+    pub length_unit: LengthUnit,
+    #[serde(default)]
+    pub latlon_unit: LatLonUnit,
+}
+
+/// One fixed beacon given inline.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeaconEntry {
+    pub id: u32,
+    /// `x_m` and `y_m`, or `lat_deg` and `lon_deg`.
+    pub x_m: Option<f64>,
+    pub y_m: Option<f64>,
+    pub lat_deg: Option<f64>,
+    pub lon_deg: Option<f64>,
+    #[serde(default)]
+    pub z_m: f64,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InitialFrom {
+    /// The first ground-truth pose.
+    #[default]
+    GroundTruth,
+    /// `x_m`, `y_m`, `heading_deg`.
+    Given,
+    /// A robust multilateration of the ranges of the first `ranges_window_s` seconds
+    /// (three beacons at least), heading from `heading_deg` or the window's first heading
+    /// measurement: for a log whose start is unknown or doubtful.
+    Ranges,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadingFrom {
+    /// The ground truth's heading column.
+    #[default]
+    Column,
+    /// The direction of the ground-truth track over its first `track_m` metres (when
+    /// the heading column is missing or not to be trusted); replay only.
+    Track,
+}
+
+/// Where the estimators start.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Initial {
+    #[serde(default)]
+    pub from: InitialFrom,
+    #[serde(default)]
+    pub heading_from: HeadingFrom,
+    #[serde(default = "default_track_m")]
+    pub track_m: f64,
+    /// `from = "ranges"`: how long ranges are gathered from the first one, s.
+    #[serde(default = "default_ranges_window_s")]
+    pub ranges_window_s: f64,
+    pub x_m: Option<f64>,
+    pub y_m: Option<f64>,
+    pub heading_deg: Option<f64>,
+    /// Initial standard deviations (`sigma_position_m`, `sigma_heading_deg`, the old
+    /// names, are read too).
+    #[serde(default = "default_position_sigma_m", alias = "sigma_position_m")]
+    pub position_sigma_m: f64,
+    #[serde(default = "default_heading_sigma_deg", alias = "sigma_heading_deg")]
+    pub heading_sigma_deg: f64,
+}
+
+/// Left out, `[initial]` starts from the first ground-truth pose and its heading column.
+impl Default for Initial {
+    fn default() -> Self {
+        Self {
+            from: InitialFrom::default(),
+            heading_from: HeadingFrom::default(),
+            track_m: default_track_m(),
+            ranges_window_s: default_ranges_window_s(),
+            x_m: None,
+            y_m: None,
+            heading_deg: None,
+            position_sigma_m: default_position_sigma_m(),
+            heading_sigma_deg: default_heading_sigma_deg(),
+        }
+    }
+}
+
+impl Initial {
+    /// The given pose in NED (N, E, psi) when `from = "given"`.
+    pub fn given_pose(&self, frame: Frame) -> Option<(f64, f64, f64)> {
+        if self.from != InitialFrom::Given {
+            return None;
+        }
+        let p = frame.to_ned(self.x_m?, self.y_m?, 0.0);
+        Some((p.x, p.y, frame.heading_to_ned(self.heading_deg?.to_radians())))
+    }
+}
+
+pub(super) fn default_track_m() -> f64 {
+    2.0
+}
+pub(super) fn default_ranges_window_s() -> f64 {
+    30.0
+}
+pub(super) fn default_position_sigma_m() -> f64 {
+    1.0
+}
+pub(super) fn default_heading_sigma_deg() -> f64 {
+    5.0
+}
+
+/// The log description file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LogDescription {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default)]
+    pub frame: FrameKey,
+    /// Where latitudes and longitudes are 0 m north and east.
+    pub origin: Option<Origin>,
+    #[serde(default, rename = "source")]
+    pub sources: Vec<Source>,
+    pub beacons: Option<BeaconTable>,
+    #[serde(default, rename = "beacon")]
+    pub beacon_list: Vec<BeaconEntry>,
+    #[serde(default)]
+    pub initial: Initial,
+    /// `[[estimators]]` as in scenarios (`[[estimator]]`, the old name, is read too).
+    #[serde(alias = "estimator")]
+    pub estimators: Vec<EstimatorSpec>,
+    /// Noise keys every estimator takes unless it gives its own (`[noise]`): one place
+    /// for what the sensors are, the estimators differing in what they estimate. Its
+    /// keys are [`crate::scenario::estimator::NOISE_KEYS`].
+    #[serde(default)]
+    pub noise: BTreeMap<String, f64>,
+    /// What an item must respect before any estimator sees it.
+    #[serde(default)]
+    pub limits: Limits,
+}
