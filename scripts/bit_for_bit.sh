@@ -11,6 +11,7 @@ mkdir -p "$3"; cd "$3"
 $NEW scenarios --show hoff2024 | sed 's/^duration_s = 3600 .*/duration_s = 300/' > hoff300.toml
 $NEW scenarios --show hoff2024-pair | sed 's/^duration_s = 3600 .*/duration_s = 300/' > hoffpair300.toml
 $NEW scenarios --show hoff2024-kinematic | sed 's/^duration_s = 3600 .*/duration_s = 300/' > hoffkin300.toml
+$NEW scenarios --show rypkema-m1 | sed 's/^model = "channel" .*/model = "abstract"/' > m1abstract.toml
 cmp_json() { python3 -c "
 import json,sys
 def strip(v):
@@ -30,7 +31,7 @@ run_case sousa-pair mc sousa-pair --runs 2 --json
 run_case hoff2024-300s mc hoff300.toml --runs 1 --json
 run_case hoff2024-pair-300s mc hoffpair300.toml --runs 1 --json
 run_case hoff2024-kinematic-300s mc hoffkin300.toml --runs 1 --json
-for c in "rypkema-m1 fleet rypkema-m1 --runs 2" "plaza1 replay $REPO/data/plaza/plaza1.toml" \
+for c in "rypkema-m1 fleet rypkema-m1 --runs 2" "rypkema-m1-abstract fleet m1abstract.toml --runs 4" "plaza1 replay $REPO/data/plaza/plaza1.toml" \
   "plaza2 replay $REPO/data/plaza/plaza2.toml"; do
   set -- $c; n=$1; shift
   $OLD "$@" --json --out old-out-$n > old-$n.json 2>/dev/null; $NEW "$@" --json --out new-out-$n > new-$n.json 2>/dev/null

@@ -56,7 +56,7 @@ pub(crate) fn passive_usbl(s: &PassiveUsbl, cell: &PassiveUsblCell, home: Vector
 /// The ASV's start in a moving-beacon world: the best standoff for the vehicle's start
 /// depth and the ASV's reach (sousa Fig. 4.7), in the direction `asv.start_bearing_deg`
 /// from the vehicle.
-pub fn initial_asv_position(s: &MovingBeacon, cell: &MovingBeaconCell) -> Vector2<f64> {
+pub(crate) fn initial_asv_position(s: &MovingBeacon, cell: &MovingBeaconCell) -> Vector2<f64> {
     let reach = s.asv.max_speed_m_s * s.acoustics.ping_period_s;
     let grid = PolarGrid { radial: 20, angular: 36, refinements: 10 };
     let d = best_standoff((cell.depth_m - s.asv.transducer_depth_m).max(0.0), reach, grid).distance_m;

@@ -327,7 +327,6 @@ impl Observer for Recorder {
     }
 }
 
-pub use crate::helms::initial_asv_position;
 pub use crate::world::TruthPath;
 
 /// The columns of a recorded trajectory, one row per step: what trajectory.csv holds and

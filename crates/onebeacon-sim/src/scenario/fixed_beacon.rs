@@ -1,6 +1,8 @@
 //! Scenarios of kind `fixed_beacon` (garin2024): an AUV on a boustrophedon, a fixed
 //! beacon, range and Doppler from communication frames. Unknown keys are errors.
 
+use super::estimator::Host;
+use super::validate::*;
 use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
 use serde::{Deserialize, Serialize};
 
@@ -216,4 +218,81 @@ impl FixedBeacon {
     pub fn beacon_ned_m(&self) -> nalgebra::Vector2<f64> {
         nalgebra::Vector2::new(self.beacon.north_m, self.beacon.east_m)
     }
+}
+
+// ---- validation: the range checks of this world's keys
+
+pub(super) fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
+    use Rule::*;
+    check_file_name("name", &s.name)?;
+    check_count("runs", s.runs, 1, 1_000_000)?;
+
+    let m = &s.mission;
+    check_fields!("mission", m, {
+        dt_s: Positive,
+        speed_m_s: Positive,
+    });
+    if let Some(d) = m.duration_s {
+        check("mission.duration_s", d, Positive)?;
+    }
+
+    let p = &s.path;
+    check_fields!("path", p, {
+        start_north_m: Finite,
+        start_east_m: Finite,
+        leg_heading_deg: Finite,
+        leg_length_m: Positive,
+        leg_spacing_m: Positive,
+    });
+    check_count("path.legs", p.legs, 1, 10_000)?;
+
+    check_fields!("beacon", s.beacon, {
+        north_m: Finite,
+        east_m: Finite,
+    });
+
+    check_fields!("comms", s.comms, {
+        t_com_s: Positive,
+        frame_loss_prob: Probability,
+    });
+
+    let n = &s.sensors;
+    check_fields!("sensors", n, {
+        range_noise_m: NonNegative,
+        doppler_noise_m_s: NonNegative,
+        heading_noise_deg: NonNegative,
+        heading_bias_deg: NonNegative,
+        heading_bias_drift_deg_per_h: NonNegative,
+        gyro_noise_rad_s: NonNegative,
+        accel_noise_m_s2: NonNegative,
+    });
+
+    let i = &s.initial;
+    check_fields!("initial", i, {
+        position_sigma_m: Positive,
+        heading_sigma_deg: Positive,
+        speed_sigma_m_s: Positive,
+        yaw_rate_sigma_rad_s: Positive,
+        accel_sigma_m_s2: Positive,
+    });
+
+    check_estimators(&s.estimators, Host::FixedBeacon)?;
+
+    if let Some(v) = &s.sweep.t_com_s {
+        if v.is_empty() {
+            return Err(Violation {
+                key: "sweep.t_com_s".into(),
+                value: "[]".into(),
+                allowed: "must list at least one value, or be left out".into(),
+            });
+        }
+        for (j, &t) in v.iter().enumerate() {
+            check(&format!("sweep.t_com_s[{j}]"), t, Positive)?;
+        }
+    }
+
+    // the run must be of a workable size
+    let duration_key =
+        if m.duration_s.is_some() { "mission.duration_s" } else { "mission.speed_m_s (the path's length / speed_m_s)" };
+    check_steps(s.duration_s(), m.dt_s, duration_key)
 }

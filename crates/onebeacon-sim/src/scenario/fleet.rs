@@ -7,6 +7,7 @@
 //! Frames: keys are NED (`north`, `east`), headings from north; the paper's tables give
 //! ENU offsets (x east, y north), converted in the built-in files.
 
+use super::validate::*;
 use super::{World, default_runs, default_seed};
 use crate::vehicles::sandshark::SandSharkParams;
 use serde::{Deserialize, Serialize};
@@ -361,4 +362,146 @@ impl Fleet {
     pub fn scheduled(&self, t: f64) -> Option<&ScheduleEntry> {
         self.schedule.iter().rev().find(|e| e.t_s <= t)
     }
+}
+
+// ---- validation: the range checks of this world's keys
+
+pub(super) fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
+    check_file_name("name", &s.name)?;
+    check_count("runs", s.runs, 1, 1_000_000)?;
+    check_fields!("mission", s.mission, { duration_s: Positive, dt_s: Positive, ping_period_s: Positive });
+    if s.mission.dt_s > s.mission.ping_period_s {
+        return Err(violation("mission.dt_s", s.mission.dt_s, "must be at most mission.ping_period_s"));
+    }
+    check_steps(s.mission.duration_s, s.mission.dt_s, "mission.duration_s")?;
+    check_fields!("signal", s.signal, {
+        sound_speed_m_s: Positive,
+        water_depth_m: Positive,
+        snr_db_at_100m: Finite,
+        range_sigma_m: NonNegative,
+        angle_sigma_deg: NonNegative,
+        outlier_probability: Probability,
+        outlier_max_m: NonNegative,
+        mode_error_probability: Probability,
+        max_range_m: Positive,
+    });
+    for (key, v) in [("signal.surface_coef", s.signal.surface_coef), ("signal.bottom_coef", s.signal.bottom_coef)] {
+        if !(-1.0..=1.0).contains(&v) {
+            return Err(violation(key, v, "must be a reflection coefficient in [-1, 1]"));
+        }
+    }
+    check_fields!("sandshark", s.sandshark, {
+        max_turn_rate_deg_s: Positive,
+        heading_gain_per_s: Positive,
+        speed_time_constant_s: Positive,
+        coast_time_constant_s: Positive,
+        max_depth_rate_m_s: Positive,
+        depth_gain_per_s: Positive,
+        rise_rate_m_s: NonNegative,
+        heading_error_deg: NonNegative,
+        heading_error_time_s: Positive,
+        heading_white_deg: NonNegative,
+        attitude_white_deg: NonNegative,
+        speed_scale_sigma: NonNegative,
+        speed_white_m_s: NonNegative,
+        depth_white_m: NonNegative,
+    });
+    let n = &s.navigation;
+    check_count("navigation.particles", n.particles, 10, 100_000)?;
+    check_count("navigation.reinitialised", n.reinitialised, 0, n.particles - 1)?;
+    check_count("navigation.confirmations", n.confirmations, 1, 100)?;
+    check_fields!("navigation", s.navigation, {
+        max_range_m: Positive,
+        sigma_speed_m_s: NonNegative,
+        sigma_heading_deg: NonNegative,
+        beacon_speed_m_s: NonNegative,
+        floor: Probability,
+        beam_exponent: Positive,
+    });
+    check_fields!("dock", s.dock, { north_m: Finite, east_m: Finite, beacon_depth_m: NonNegative, gps_sigma_m: NonNegative });
+    check_count("boat (waypoints)", s.boat.len(), 1, 100_000)?;
+    for (i, w) in s.boat.iter().enumerate() {
+        for (k, v) in [("t_s", w.t_s), ("north_m", w.north_m), ("east_m", w.east_m)] {
+            check(&format!("boat[{i}].{k}"), v, Rule::Finite)?;
+        }
+        if i > 0 && w.t_s <= s.boat[i - 1].t_s {
+            return Err(violation(format!("boat[{i}].t_s"), w.t_s, "must be later than the waypoint before"));
+        }
+    }
+    check_count("schedule (entries)", s.schedule.len(), 1, 100_000)?;
+    for (i, e) in s.schedule.iter().enumerate() {
+        check(&format!("schedule[{i}].t_s"), e.t_s, Rule::NonNegative)?;
+        if i > 0 && e.t_s < s.schedule[i - 1].t_s {
+            return Err(violation(format!("schedule[{i}].t_s"), e.t_s, "must not be earlier than the entry before"));
+        }
+        if e.mode > MODES {
+            return Err(violation(format!("schedule[{i}].mode"), e.mode, format!("must be 0 (silent) to {MODES}")));
+        }
+    }
+    check_count("auvs (count)", s.auvs.len(), 1, 16)?;
+    let names: Vec<String> = s.auvs.iter().map(|a| a.name.clone()).collect();
+    check_names("auvs", &names)?;
+    for (i, a) in s.auvs.iter().enumerate() {
+        let at = |k: &str| format!("auvs[{i}].{k}");
+        for (k, v, rule) in [
+            ("start_north_m", a.start_north_m, Rule::Finite),
+            ("start_east_m", a.start_east_m, Rule::Finite),
+            ("start_heading_deg", a.start_heading_deg, Rule::Finite),
+            ("launch_s", a.launch_s, Rule::NonNegative),
+            ("speed_m_s", a.speed_m_s, Rule::Positive),
+            ("depth_m", a.depth_m, Rule::Positive),
+        ] {
+            check(&at(k), v, rule)?;
+        }
+        let water = s.signal.water_depth_m;
+        if a.depth_m >= water {
+            return Err(violation(
+                at("depth_m"),
+                a.depth_m,
+                format!("must be above the bed: less than signal.water_depth_m = {water} m"),
+            ));
+        }
+        for (j, m) in a.modes.iter().enumerate() {
+            let at = |k: &str| format!("auvs[{i}].modes[{j}].{k}");
+            if !(1..=MODES).contains(&m.mode) {
+                return Err(violation(at("mode"), m.mode, format!("must be 1 to {MODES}")));
+            }
+            if a.modes[..j].iter().any(|o| o.mode == m.mode) {
+                return Err(violation(at("mode"), m.mode, "must differ from this AUV's other modes"));
+            }
+            check(&at("offset_north_m"), m.offset_north_m, Rule::Finite)?;
+            check(&at("offset_east_m"), m.offset_east_m, Rule::Finite)?;
+            for key in m.required() {
+                let Some(v) = m.value(key) else {
+                    return Err(violation(at(key), "missing", format!("is needed by a {:?} behaviour", m.behaviour)));
+                };
+                check(&at(key), v, if *key == "heading_deg" { Rule::Finite } else { Rule::Positive })?;
+            }
+            if let Some(c) = m.ceiling_m.filter(|c| *c >= water) {
+                return Err(violation(
+                    at("ceiling_m"),
+                    c,
+                    format!("must be above the bed: less than signal.water_depth_m = {water} m"),
+                ));
+            }
+        }
+    }
+    match s.estimators.first() {
+        Some(FleetEstimator::Iusbl | FleetEstimator::IusblJoint) => {}
+        other => {
+            return Err(violation(
+                "estimators",
+                other.map(|e| e.label()),
+                "the first estimator flies the behaviours: it must be `iusbl` or `iusbl-joint`",
+            ));
+        }
+    }
+    if s.estimators.iter().enumerate().any(|(i, e)| s.estimators[..i].contains(e)) {
+        return Err(violation(
+            "estimators",
+            s.estimators.iter().map(|e| e.label()).collect::<Vec<_>>(),
+            "must all differ",
+        ));
+    }
+    Ok(())
 }

@@ -3,6 +3,8 @@
 //! steered by a guidance law, one-way travel-time ranges propagating at the speed of
 //! sound between moving ends. Unknown keys are errors.
 
+use super::estimator::Host;
+use super::validate::*;
 use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
 use crate::vehicles::rov::BodyPath;
 use serde::{Deserialize, Serialize};
@@ -317,4 +319,85 @@ impl MovingBeacon {
             range_m: self.acoustics.range_noise_m,
         }
     }
+}
+
+// ---- validation: the range checks of this world's keys
+
+/// One underwater vehicle's table (`prefix`: its key).
+fn check_vehicle(prefix: &str, v: &Vehicle) -> Result<(), Violation> {
+    use Rule::*;
+    let fields = [
+        ("depth_m", v.depth_m, NonNegative),
+        ("start_north_m", v.start_north_m, Finite),
+        ("start_east_m", v.start_east_m, Finite),
+        ("heading_deg", v.heading_deg, Finite),
+        ("speed_m_s", v.speed_m_s, NonNegative),
+        ("circle_radius_m", v.circle_radius_m, Positive),
+        ("spiral_descent_m_s", v.spiral_descent_m_s, NonNegative),
+        ("leg_length_m", v.leg_length_m, Positive),
+        ("leg_spacing_m", v.leg_spacing_m, Positive),
+    ];
+    check_table(prefix, &fields, v.name.as_ref())
+}
+
+pub(super) fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
+    use Rule::*;
+    check_file_name("name", &s.name)?;
+    check_count("runs", s.runs, 1, 1_000_000)?;
+    check_fields!("mission", s.mission, {
+        dt_s: Positive,
+        duration_s: Positive,
+    });
+    check_vehicle("vehicle", &s.vehicle)?;
+    check_count("other_vehicles (count)", s.other_vehicles.len(), 0, 31)?;
+    for (k, v) in s.other_vehicles.iter().enumerate() {
+        check_vehicle(&format!("other_vehicles[{k}]"), v)?;
+    }
+    let vehicles = s.vehicles(&s.base_cell());
+    let names: Vec<String> = vehicles.into_iter().filter_map(|v| v.name).collect();
+    check_vehicle_names(
+        &names,
+        "other_vehicles",
+        "must differ from the other vehicles' names (`auv` for `vehicle`, `auvN` for the N-th)",
+    )?;
+    let n = &s.sensors;
+    check_fields!("sensors", n, {
+        velocity_noise_m_s: Positive,
+        rate_noise_rad_s: Positive,
+        depth_noise_m: Positive,
+        attitude_noise_deg: Positive,
+    });
+    let a = &s.asv;
+    check_fields!("asv", a, {
+        max_speed_m_s: Positive,
+        max_turn_rate_deg_s: Positive,
+        gps_noise_m: NonNegative,
+        transducer_depth_m: NonNegative,
+        start_bearing_deg: Finite,
+    });
+    let c = &s.acoustics;
+    check_fields!("acoustics", c, {
+        ping_period_s: Positive,
+        sound_speed_m_s: Positive,
+        range_noise_m: Positive,
+    });
+    check_count("guidance.grid_radial", s.guidance.grid_radial, 1, 10_000)?;
+    check_count("guidance.grid_angular", s.guidance.grid_angular, 1, 10_000)?;
+    check_fields!("guidance", s.guidance, {
+        circle_radius_m: Positive,
+    });
+    let i = &s.initial;
+    check_fields!("initial", i, {
+        position_sigma_m: Positive,
+        depth_sigma_m: Positive,
+        attitude_sigma_deg: Positive,
+    });
+    check_estimators(&s.estimators, Host::MovingBeacon)?;
+    check_list_nonempty("sweep.path", &s.sweep.path)?;
+    check_list_nonempty("sweep.guidance", &s.sweep.guidance)?;
+    check_list_nonempty("sweep.depth_m", &s.sweep.depth_m)?;
+    for (j, &d) in s.sweep.depth_m.iter().flatten().enumerate() {
+        check(&format!("sweep.depth_m[{j}]"), d, NonNegative)?;
+    }
+    check_steps(s.mission.duration_s, s.mission.dt_s, "mission.duration_s")
 }

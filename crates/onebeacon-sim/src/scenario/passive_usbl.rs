@@ -3,6 +3,8 @@
 //! listens with a USBL, tracks the AUV from the bearings and the reports, and moves to
 //! where the next bearing tells the most. Unknown keys are errors.
 
+use super::estimator::Host;
+use super::validate::*;
 use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
 use serde::{Deserialize, Serialize};
 
@@ -392,4 +394,127 @@ impl PassiveUsbl {
             })
             .collect()
     }
+}
+
+// ---- validation: the range checks of this world's keys
+
+/// One AUV's table of a passive_usbl scenario (`prefix`: its key).
+fn check_auv(prefix: &str, a: &Auv) -> Result<(), Violation> {
+    use Rule::*;
+    let fields = [
+        ("centre_north_m", a.centre_north_m, Finite),
+        ("centre_east_m", a.centre_east_m, Finite),
+        ("circle_radius_m", a.circle_radius_m, Positive),
+        ("depth_m", a.depth_m, NonNegative),
+        ("speed_m_s", a.speed_m_s, NonNegative),
+        ("start_angle_deg", a.start_angle_deg, Finite),
+        ("ilos_lookahead_m", a.ilos_lookahead_m, Positive),
+        ("ilos_integral_gain", a.ilos_integral_gain, NonNegative),
+        ("path_gain", a.path_gain, NonNegative),
+    ];
+    check_table(prefix, &fields, a.name.as_ref())?;
+    // REMUS 100 tops out at 2.48 m/s (1525 rpm) and needs way on for its fins
+    if a.vehicle == AuvVehicle::Remus100 && !(0.5..=2.4).contains(&a.speed_m_s) {
+        return Err(Violation {
+            key: format!("{prefix}.speed_m_s"),
+            value: format!("{:?}", a.speed_m_s),
+            allowed: "must be from 0.5 to 2.4 m/s for a remus100 (its top speed is 2.48 m/s)".into(),
+        });
+    }
+    Ok(())
+}
+
+pub(super) fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
+    check_file_name("name", &s.name)?;
+    check_count("runs", s.runs, 1, 1_000_000)?;
+    check_fields!("mission", s.mission, {
+        duration_s: Positive,
+        message_period_s: Positive,
+        dt_s: Positive,
+    });
+    if s.mission.dt_s > s.mission.message_period_s {
+        return Err(Violation {
+            key: "mission.dt_s".into(),
+            value: format!("{:?}", s.mission.dt_s),
+            allowed: format!("must be at most mission.message_period_s ({})", s.mission.message_period_s),
+        });
+    }
+    check_steps(s.mission.duration_s, s.mission.dt_s, "mission.duration_s")?;
+    check_auv("auv", &s.auv)?;
+    check_count("other_auvs (count)", s.other_auvs.len(), 0, 31)?;
+    for (k, a) in s.other_auvs.iter().enumerate() {
+        check_auv(&format!("other_auvs[{k}]"), a)?;
+    }
+    let names: Vec<String> = s.auvs().into_iter().filter_map(|a| a.name).collect();
+    check_vehicle_names(
+        &names,
+        "other_auvs",
+        "must differ from the other AUVs' names (`auv` for `auv`, `auvN` for the N-th)",
+    )?;
+    // the trackers assume these unless told otherwise: a zero would be a likelihood
+    // of zero width
+    check_fields!("reports", s.reports, {
+        heading_noise_deg: Positive,
+        speed_noise_m_s: Positive,
+        depth_noise_m: Positive,
+    });
+    check_fields!("usbl", s.usbl, {
+        noise_deg_per_m: Positive,
+        transducer_depth_m: NonNegative,
+    });
+    check_fields!("asv", s.asv, {
+        max_speed_m_s: Positive,
+        max_turn_rate_deg_s: Positive,
+        nominal_speed_m_s: Positive,
+        along_track_gain: NonNegative,
+        lookahead_m: Positive,
+        ilos_integral_gain: NonNegative,
+        gps_noise_m: NonNegative,
+        compass_noise_deg: NonNegative,
+        start_distance_m: NonNegative,
+        start_bearing_deg: Finite,
+    });
+    check_fields!("current", s.current, {
+        speed_m_s: NonNegative,
+        toward_deg: Finite,
+        speed_sigma_m_s: NonNegative,
+        direction_sigma_deg: NonNegative,
+        time_constant_s: Positive,
+    });
+    let dynamic = s.asv.vehicle == AsvVehicle::Otter || s.auvs().iter().any(|a| a.vehicle == AuvVehicle::Remus100);
+    if s.current.flows() && !dynamic {
+        return Err(Violation {
+            key: "current.speed_m_s".into(),
+            value: format!("{:?}", s.current.speed_m_s),
+            allowed: "must be 0 unless a vehicle feels it (asv.vehicle = \"otter\" or an AUV's vehicle = \"remus100\"; kinematic vehicles move as commanded)".into(),
+        });
+    }
+    let g = &s.guidance;
+    check_fields!("guidance", g, {
+        r1_m: Positive,
+        r2_m: Positive,
+        lead_periods: NonNegative,
+        circle_radius_m: Positive,
+        offset_m: NonNegative,
+    });
+    if g.r2_m < g.r1_m {
+        return Err(Violation {
+            key: "guidance.r2_m".into(),
+            value: format!("{:?}", g.r2_m),
+            allowed: format!("must be at least guidance.r1_m ({})", g.r1_m),
+        });
+    }
+    check_count("guidance.radii", g.radii, 1, 1000)?;
+    check_count("guidance.angles", g.angles, 1, 10_000)?;
+    check_count("guidance.planner_particles", g.planner_particles, 1, 10_000_000)?;
+    check_fields!("initial", s.initial, {
+        position_sigma_m: Positive,
+        depth_sigma_m: Positive,
+        pitch_sigma_deg: Positive,
+        heading_sigma_deg: Positive,
+        speed_sigma_m_s: Positive,
+        rate_bias_sigma_deg_s: Positive,
+    });
+    check_estimators(&s.estimators, Host::PassiveUsbl)?;
+    check_list_nonempty("sweep.guidance", &s.sweep.guidance)
 }

@@ -161,3 +161,206 @@ pub(crate) fn own_fix(situation: &Situation) -> Result<&OwnFix, DecideError> {
 pub(crate) fn need(beliefs: &[&dyn Navigator], needed: usize) -> Result<(), DecideError> {
     if beliefs.len() < needed { Err(DecideError::Beliefs { needed, given: beliefs.len() }) } else { Ok(()) }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::autonomy::{Autonomy, AutonomySettings, Behaviour};
+    use super::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
+    use super::behaviours::Behaviours;
+    use super::fim::{FimGuidance, FimGuidanceConfig, FimMode};
+    use super::*;
+    use crate::guidance::bearing::{BearingPlanner, SpreadMetric};
+    use crate::guidance::{Metric, PolarGrid};
+    use crate::nav::{Estimate, Measurement, Outcome};
+    use approx::assert_abs_diff_eq;
+    use nalgebra::Matrix2;
+
+    /// A belief that stands still: an estimate at `at` heading `heading`, a command mode
+    /// and a beacon-relative position.
+    struct Fixed {
+        at: Vector3<f64>,
+        heading: f64,
+        sigma_m: f64,
+        mode: Option<usize>,
+        relative: Option<Vector3<f64>>,
+        body_velocity: Option<Vector3<f64>>,
+    }
+
+    impl Fixed {
+        fn at(north: f64, east: f64) -> Self {
+            Self {
+                at: Vector3::new(north, east, 20.0),
+                heading: 0.0,
+                sigma_m: 1.0,
+                mode: None,
+                relative: None,
+                body_velocity: None,
+            }
+        }
+    }
+
+    impl Navigator for Fixed {
+        fn process(&mut self, _: &Measurement) -> Outcome {
+            Outcome::Skipped
+        }
+        fn estimate(&self) -> Estimate {
+            Estimate {
+                t_s: 0.0,
+                position_ned_m: self.at,
+                horizontal_cov_m2: Matrix2::identity() * self.sigma_m.powi(2),
+                heading_state_rad: self.heading,
+                heading_var_rad2: 0.01,
+                roll_pitch_rad: [0.0; 2],
+                speed_m_s: Some(1.5),
+                range_bias_m: 0.0,
+                range_scale: 0.0,
+                distance_scale: 0.0,
+                turn_scale: 0.0,
+            }
+        }
+        fn command_mode(&self) -> Option<usize> {
+            self.mode
+        }
+        fn beacon_relative_ned_m(&self) -> Option<Vector3<f64>> {
+            self.relative
+        }
+        fn body_velocity_m_s(&self) -> Option<Vector3<f64>> {
+            self.body_velocity
+        }
+    }
+
+    fn surface(north: f64, east: f64) -> Situation {
+        let fix = OwnFix { position_m: Vector2::new(north, east), heading_rad: 0.0, speed_m_s: 1.0 };
+        Situation { t_s: 10.0, fix: Some(fix) }
+    }
+
+    fn bearing(mode: BearingMode) -> BearingGuidance {
+        BearingGuidance::new(BearingGuidanceConfig {
+            mode,
+            planner: BearingPlanner {
+                metric: SpreadMetric::Determinant,
+                r1_m: 16.0,
+                r2_m: 26.0,
+                radii: 3,
+                angles: 7,
+                sigma_usbl_rad_per_m: 0.022f64.to_radians(),
+            },
+            nominal_speed_m_s: 2.0,
+            period_s: 4.0,
+            planner_particles: 400,
+            lead_periods: 2.0,
+            circle_radius_m: 20.0,
+            offset_m: 20.0,
+            home_m: Vector2::new(-5.0, 3.0),
+        })
+    }
+
+    fn path(d: &Decided) -> (Vector2<f64>, Vector2<f64>) {
+        let Command::Path { from, to } = d.command else { panic!("{:?}", d.command) };
+        (from, to)
+    }
+
+    /// The baselines' geometry: static heads home; trailing 20 m behind an AUV heading
+    /// north at (100, 0) from (0, 0) is one period's reach (8 m) toward (80, 0); circling
+    /// at 20 m from 20 m east of the AUV steps 8 / 20 rad around it (capped at pi / 2).
+    #[test]
+    fn the_surface_vehicles_baselines() {
+        let auv = Fixed::at(100.0, 0.0);
+        let d = bearing(BearingMode::Static).decide(&surface(0.0, 0.0), &[&auv]).unwrap();
+        assert_eq!(path(&d), (Vector2::zeros(), Vector2::new(-5.0, 3.0)));
+        let d = bearing(BearingMode::Offset).decide(&surface(0.0, 0.0), &[&auv]).unwrap();
+        assert_abs_diff_eq!(path(&d).1, Vector2::new(8.0, 0.0), epsilon = 1e-12);
+        let d = bearing(BearingMode::Circle).decide(&surface(100.0, 20.0), &[&auv]).unwrap();
+        let a = std::f64::consts::FRAC_PI_2 + 8.0 / 20.0;
+        let circle = Vector2::new(100.0 + 20.0 * a.cos(), 20.0 * a.sin());
+        let step = circle - Vector2::new(100.0, 20.0);
+        assert_abs_diff_eq!(
+            path(&d).1,
+            Vector2::new(100.0, 20.0) + step.normalize() * 8.0_f64.min(step.norm()),
+            epsilon = 1e-9
+        );
+        assert!(d.snapshot.is_none());
+    }
+
+    /// The planner serves the least certain AUV, plans a waypoint on its half-annulus
+    /// (16-26 m from the lead-shifted belief), and keeps that leg until eq. 16 says it is
+    /// done: a second decision from the leg's start takes no new plan.
+    #[test]
+    fn the_planner_serves_the_least_certain_auv_and_keeps_its_leg() {
+        let sure = Fixed::at(50.0, 0.0);
+        let unsure = Fixed { sigma_m: 5.0, ..Fixed::at(0.0, 60.0) };
+        let mut g = bearing(BearingMode::Planner);
+        let d = g.decide(&surface(0.0, 0.0), &[&sure, &unsure]).unwrap();
+        let Some(GuidanceSnapshot::Bearing(b)) = &d.snapshot else { panic!("a plan") };
+        assert_eq!(b.vehicle, 1);
+        let r = (b.waypoint - b.belief_mean.xy()).norm();
+        assert!((16.0 - 1e-9..=26.0 + 1e-9).contains(&r), "{r}");
+        let (from, to) = path(&d);
+        assert_abs_diff_eq!(from, Vector2::zeros(), epsilon = 1e-12);
+        assert_abs_diff_eq!((to - from).norm(), 8.0_f64.min(b.waypoint.norm()), epsilon = 1e-9);
+        let again = g.decide(&surface(0.0, 0.0), &[&sure, &unsure]).unwrap();
+        assert!(again.snapshot.is_none());
+    }
+
+    /// A surface vehicle's guidance without its own fix, or without the beliefs it
+    /// reads, is an error (not a panic).
+    #[test]
+    fn missing_inputs_are_errors() {
+        let auv = Fixed::at(1.0, 1.0);
+        let blind = Situation { t_s: 0.0, fix: None };
+        assert_eq!(bearing(BearingMode::Planner).decide(&blind, &[&auv]).unwrap_err(), DecideError::NoFix);
+        assert_eq!(
+            bearing(BearingMode::Planner).decide(&surface(0.0, 0.0), &[]).unwrap_err(),
+            DecideError::Beliefs { needed: 1, given: 0 }
+        );
+    }
+
+    fn fim(mode: FimMode) -> FimGuidance {
+        FimGuidance::new(FimGuidanceConfig {
+            mode,
+            planner: crate::guidance::FimPlanner {
+                metric: Metric::ApproachB,
+                grid: PolarGrid { radial: 8, angular: 16, refinements: 6 },
+                range_var_m2: 1.0,
+                beacon_depth_m: 0.5,
+            },
+            period_s: 10.0,
+            max_speed_m_s: 2.0,
+            circle_radius_m: 25.0,
+            home_m: Vector2::new(7.0, 7.0),
+        })
+    }
+
+    /// The FIM guidance reaches within its set (20 m a ping), arrives by the next ping,
+    /// predicts the vehicle on its last body velocity (1 m/s north for 10 s), and its
+    /// baselines map approach A's metric.
+    #[test]
+    fn the_beacon_vehicles_waypoint() {
+        let auv = Fixed { body_velocity: Some(Vector3::new(1.0, 0.0, 0.0)), ..Fixed::at(30.0, 0.0) };
+        let d = fim(FimMode::Planner).decide(&surface(0.0, 0.0), &[&auv]).unwrap();
+        let Command::Waypoint { waypoint, arrive_s } = d.command else { panic!() };
+        assert!(waypoint.norm() <= 20.0 + 1e-9 && arrive_s == 20.0, "{waypoint} {arrive_s}");
+        let Some(GuidanceSnapshot::Fim(f)) = d.snapshot else { panic!() };
+        assert_abs_diff_eq!(f.target_next - f.target, Vector3::new(10.0, 0.0, 0.0), epsilon = 1e-12);
+        assert_eq!(f.planner.metric, Metric::ApproachB);
+        let d = fim(FimMode::Static).decide(&surface(0.0, 0.0), &[&auv]).unwrap();
+        let Some(GuidanceSnapshot::Fim(f)) = d.snapshot else { panic!() };
+        assert_eq!((f.waypoint, f.planner.metric), (Vector2::new(7.0, 7.0), Metric::ApproachA));
+    }
+
+    /// The AUV holds heading at depth until a mode is confirmed, then follows the mode's
+    /// behaviour: an abort stops the propeller.
+    #[test]
+    fn the_auvs_behaviour_follows_the_confirmed_mode() {
+        let autonomy = Autonomy::new(AutonomySettings::default(), vec![None, Some(Behaviour::Abort)]);
+        let mut b = Behaviours::new(autonomy);
+        let mut auv = Fixed { heading: 0.3, relative: Some(Vector3::new(10.0, 0.0, 2.0)), ..Fixed::at(0.0, 0.0) };
+        let now = Situation { t_s: 1.0, fix: None };
+        let Command::Setpoint { setpoint, mode, phase } = b.decide(&now, &[&auv]).unwrap().command else { panic!() };
+        assert_eq!((mode, phase), (None, Phase::Waiting));
+        assert_abs_diff_eq!(setpoint.heading_rad, 0.3, epsilon = 1e-12);
+        auv.mode = Some(1);
+        let Command::Setpoint { setpoint, mode, phase } = b.decide(&now, &[&auv]).unwrap().command else { panic!() };
+        assert_eq!((mode, phase, setpoint.speed_m_s), (Some(1), Phase::Surfacing, 0.0));
+    }
+}
