@@ -5,9 +5,10 @@
 //! stratified, residual) when the effective sample size falls below a threshold, and
 //! optional roughening.
 //!
-//! Work is split into chunks of [`CHUNK`] particles run in parallel ([`crate::par`]); each chunk
-//! draws from its own random stream, derived from (seed, step, chunk), and sums are
-//! reduced in chunk order, so a result does not depend on the thread count.
+//! Work is split into chunks of [`CHUNK`] particles run in parallel (rayon, with the
+//! default feature `parallel`; in order without it); each chunk draws from its own random
+//! stream, derived from (seed, step, chunk), and sums are reduced in chunk order, so a
+//! result depends neither on the thread count nor on the feature.
 
 use crate::par::*;
 use nalgebra::{SMatrix, SVector};
