@@ -84,14 +84,17 @@ for crate in CRATES:
             big.append(f"{crate}/src/{rel} ({n})")
         c = code(text)
         public += len(re.findall(r"^\s*pub (?:fn|struct|enum|trait|const|type|mod|static|use)\b", c, re.M))
-        # a place: a function (or file region) that calls a navigator constructor
+        # a place: a module that calls a navigator constructor (with its functions)
         for m in re.finditer(CONSTRUCTORS, c):
             fn = re.findall(r"fn (\w+)", c[: m.start()])
-            builders.append(f"{crate}/src/{rel}::{fn[-1] if fn else '?'}")
+            builders.append((f"{crate}/src/{rel}", fn[-1] if fn else "?"))
         scorers += [f"{crate}/src/{rel}: {m}" for m in re.findall(SCORING, c)]
     cyc, mutual = cycles(crate)
     print(f"{crate}: {public} public items; import cycles {len(cyc)} {cyc}; mutual imports {len(mutual)} {mutual}")
 print(f"files over 600 lines: {len(big)}: {', '.join(big)}")
-places = sorted(set(builders))
-print(f"places that build navigators: {len(places)}: {', '.join(places)}")
+places = {}
+for module, fn in builders:
+    places.setdefault(module, set()).add(fn)
+listed = ", ".join(f"{m} ({', '.join(sorted(f))})" for m, f in sorted(places.items()))
+print(f"modules that build navigators from specs: {len(places)}: {listed}")
 print(f"scoring implementations: {len(scorers)}: {'; '.join(scorers)}")

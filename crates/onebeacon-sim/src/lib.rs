@@ -7,6 +7,7 @@
 //! - [`pcrb`]: the posterior Cramer-Rao bound of the range-only moving-beacon case;
 //! - [`scenario`]: the TOML scenario schema, its validation and the built-in scenarios;
 //! - [`engine`](crate::engine): the one simulation loop, its worlds and its observers;
+//! - `factory`: every estimator spec to its navigator, the one place that builds them;
 //! - `helms`: each scenario's onboard controllers (the vehicles' decisions are the
 //!   onboard crate's [`onebeacon::vehicle`]; the worlds move the truth under them);
 //! - [`run`]: one simulated run, a pure function of (scenario, sweep cell, seed, run);
@@ -20,6 +21,7 @@ pub mod acoustics;
 pub mod budget;
 pub mod chain;
 mod engine;
+mod factory;
 pub mod fleet;
 mod helms;
 pub mod json;

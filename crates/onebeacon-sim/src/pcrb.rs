@@ -107,7 +107,7 @@ pub fn bearing_rmse_bound(
         let h = ScalarModel::<DIM>::jacobian(m, &x0);
         acc + h.transpose() * h / m.variance(&x0)
     });
-    let mut c = Cov8::from_diagonal(&PassiveUsblWorld::initial_sigma(s).map(|x| x * x));
+    let mut c = Cov8::from_diagonal(&crate::factory::tracker_sigma(s).map(|x| x * x));
     let mut sum = c[(0, 0)] + c[(1, 1)];
     let (steps, dt) = (s.steps(), s.mission.message_period_s);
     for k in 1..=steps {

@@ -4,13 +4,13 @@
 //! cell, seed, run index).
 
 use crate::engine::{self, Helm, Observer, Step, Track, VehicleTruth, World};
-use crate::helms;
 use crate::metrics::RunMetrics;
 use crate::scenario::{Cell, Scenario};
 use crate::world::{
     FixedBeaconWorld, FleetWorld, Information, MovingBeaconWorld, PassiveUsblWorld, bearing_information,
     range_information,
 };
+use crate::{factory, helms};
 use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::nav::Outcome;
 use onebeacon::nav::evaluation::{ErrorStats, horizontal_error};
@@ -156,13 +156,13 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
     match (s, cell) {
         (Scenario::FixedBeacon(s), Cell::FixedBeacon(c)) => {
             let mut world = FixedBeaconWorld::new(s, c, seed, run);
-            let mut tracks = world.tracks(s, seed, run);
+            let mut tracks = factory::fixed_beacon(s, world.unicycle_state(), seed, run);
             drive(&mut world, &mut tracks, &mut [], None, recorder)
         }
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let asv0 = helms::initial_asv_position(s, c);
             let mut world = MovingBeaconWorld::new(s, c, asv0, seed, run);
-            let mut tracks = world.tracks(s, seed, run);
+            let mut tracks = factory::moving_beacon(s, &world.states(), seed, run);
             let mut helms = helms::moving_beacon(s, c, asv0);
             let mut info = Information::new(range_information(s.sensor_noise()));
             let mut out = drive(&mut world, &mut tracks, &mut helms, Some(&mut info), recorder);
@@ -171,7 +171,7 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
         }
         (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(c)) => {
             let mut world = PassiveUsblWorld::new(s, seed, run);
-            let mut tracks = world.tracks(s, seed, run);
+            let mut tracks = factory::passive_usbl(s, &world.initial_states(), seed, run);
             let mut helms = helms::passive_usbl(s, c, world.asv_start());
             let mut info = Information::new(bearing_information(s.tracker_noise()));
             let mut out = drive(&mut world, &mut tracks, &mut helms, Some(&mut info), recorder);
@@ -180,7 +180,7 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
         }
         (Scenario::Fleet(s), Cell::Fleet) => {
             let mut world = FleetWorld::new(s, seed, run);
-            let mut tracks = world.tracks(s, seed, run);
+            let mut tracks = factory::fleet(s, seed, run);
             drive(&mut world, &mut tracks, &mut helms::fleet(s), None, recorder)
         }
         _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),

@@ -6,6 +6,7 @@
 //!   record or evaluation: only truth and the seeded random streams;
 //! - the worlds name no vehicle's mind: not `onebeacon::guidance`, nor the controllers
 //!   and behaviours of `onebeacon::vehicle`, nor the simulator's `helms` that build them;
+//!   and build no navigator (the simulator's `factory` does);
 //! - the engine names no world, record, configuration or controller factory;
 //! - within each crate the top-level modules import each other without a cycle.
 //!
@@ -158,6 +159,20 @@ const SIM_RULES: &[Rule] = &[
         ],
     },
     Rule {
+        name: "a world builds an estimator (the factory's job)",
+        within: &["world"],
+        forbidden: &[
+            "crate::factory",
+            "onebeacon::nav::GaussianTracker",
+            "onebeacon::nav::IusblNavigator",
+            "onebeacon::nav::ParticleTracker",
+            "onebeacon::nav::PlanarNavigator",
+            "onebeacon::nav::Range6DofNavigator",
+            "onebeacon::nav::SingleBeaconNavigator",
+            "onebeacon::nav::TrackingNavigator",
+        ],
+    },
+    Rule {
         name: "a world imports a vehicle's guidance or autonomy",
         within: &["world"],
         forbidden: &[
@@ -271,13 +286,19 @@ fn a_planted_violation_is_found() {
     };
     let mut sim = crate_sources("onebeacon-sim");
     sim.push(plant(&["world", "planted"], "use onebeacon::{nav::Kind, vehicle::{Situation, fim::FimGuidance as G}};"));
+    sim.push(plant(&["world", "planted2"], "fn t() { let _ = onebeacon::nav::ParticleTracker::new; }"));
     sim.push(plant(&["vehicles", "planted"], "fn f() { let _ = super::super::scenario::Host::Log; }"));
     sim.push(plant(&["engine"], "fn g() -> crate::run::Estimate { todo!() }"));
     let found = violations(&sim, SIM_RULES);
     let named: BTreeSet<&str> = found.iter().map(|(_, _, p)| p.as_str()).collect();
     assert_eq!(
         named,
-        BTreeSet::from(["onebeacon::vehicle::fim::FimGuidance", "crate::scenario::Host::Log", "crate::run::Estimate"]),
+        BTreeSet::from([
+            "onebeacon::vehicle::fim::FimGuidance",
+            "onebeacon::nav::ParticleTracker::new",
+            "crate::scenario::Host::Log",
+            "crate::run::Estimate"
+        ]),
         "{}",
         lines(&found)
     );

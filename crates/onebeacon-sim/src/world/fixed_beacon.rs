@@ -1,14 +1,13 @@
 //! The fixed-beacon world (garin2024): an AUV following a boustrophedon under the
 //! feedback-linearising controller, a fixed beacon, communication frames every T_com.
 
-use crate::engine::{Track, VehicleTruth, World};
-use crate::scenario::{FixedBeacon, FixedBeaconCell, Host};
-use crate::seed::{Stream, gauss, rng};
+use crate::engine::{VehicleTruth, World};
+use crate::scenario::{FixedBeacon, FixedBeaconCell};
 use crate::sensors::SensorSuite;
 use crate::vehicles::{Path, TruthState, feedback_linearising_control};
-use nalgebra::{SVector, Vector2, Vector3, Vector6};
-use onebeacon::models::unicycle::{Cov, State};
-use onebeacon::nav::{Measurement, SingleBeaconNavigator};
+use nalgebra::{Vector2, Vector3, Vector6};
+use onebeacon::models::unicycle::State;
+use onebeacon::nav::Measurement;
 use onebeacon::vehicle::Command;
 
 pub(crate) struct FixedBeaconWorld {
@@ -51,43 +50,10 @@ impl FixedBeaconWorld {
         }
     }
 
-    /// Every estimator of the scenario on the AUV, started at the truth plus one draw
-    /// (the same for all).
-    pub(crate) fn tracks(&self, s: &FixedBeacon, seed: u64, run: u64) -> Vec<Track> {
-        let i = &s.initial;
-        let sigma0 = SVector::<f64, 6>::from([
-            i.position_sigma_m,
-            i.position_sigma_m,
-            i.heading_sigma_deg.to_radians(),
-            i.speed_sigma_m_s,
-            i.yaw_rate_sigma_rad_s,
-            i.accel_sigma_m_s2,
-        ]);
-        let mut init_rng = rng(seed, run, Stream::Initial);
+    /// The AUV's truth now in the unicycle state layout [x, y, psi, v, Omega, a].
+    pub(crate) fn unicycle_state(&self) -> State {
         let t = &self.truth;
-        let z_true = State::from([t.pos.x, t.pos.y, t.psi, t.v, self.omega, self.accel]);
-        let z0 = z_true + sigma0.map(|sd| gauss(&mut init_rng, sd));
-        let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
-        s.estimators
-            .iter()
-            .map(|e| {
-                let nav = SingleBeaconNavigator::new(
-                    e.aiding(Host::FixedBeacon),
-                    e.ekf_tuning(),
-                    e.filter_kind(),
-                    0.0,
-                    z0,
-                    p0,
-                );
-                // the navigator's own default where the key is absent
-                let nav = match e.mirror_recovery {
-                    Some(on) => nav.with_mirror_recovery(on),
-                    None => nav,
-                }
-                .with_min_speed(e.min_speed_m_s);
-                Track { vehicle: 0, navigator: Box::new(nav) }
-            })
-            .collect()
+        State::from([t.pos.x, t.pos.y, t.psi, t.v, self.omega, self.accel])
     }
 }
 

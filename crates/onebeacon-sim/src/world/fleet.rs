@@ -7,21 +7,15 @@
 //! the navigators' receiver chains), or drawn as range, direction and mode (abstract).
 
 use crate::acoustics::channel::{Boundaries, Channel, simulate_ping};
-use crate::engine::{PilotRecord, Track, VehicleTruth, World};
-use crate::scenario::fleet::{Fleet, FleetEstimator, SignalModel, Transmitter};
+use crate::engine::{PilotRecord, VehicleTruth, World};
+use crate::scenario::fleet::{Fleet, SignalModel, Transmitter};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::autopilot::Command;
 use crate::vehicles::sandshark::{SandShark, SensorErrors};
 use nalgebra::Vector3;
 use onebeacon::dsp::beamform::{azimuth_inclination, pyramid_8cm};
-use onebeacon::dsp::receiver::{ModeReceiver, ReceiverConfig};
 use onebeacon::dsp::waveform::{Lfm, rypkema_modes};
-use onebeacon::filter::FilterKind;
-use onebeacon::filter::factored::FactoredSettings;
-use onebeacon::nav::{
-    Aiding, BeaconFix, Capture, IusblConfig, IusblNavigator, Kind, Measurement, Navigator, PlanarConfig,
-    PlanarNavigator,
-};
+use onebeacon::nav::{BeaconFix, Capture, Kind, Measurement};
 use onebeacon::vehicle::{Command as VehicleCommand, Phase, Setpoint, Situation};
 use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
@@ -98,58 +92,6 @@ impl FleetWorld {
             next_ping_s: 0.0,
             k: 0,
         }
-    }
-
-    /// The iUSBL navigator's settings from the scenario.
-    pub(crate) fn iusbl_config(s: &Fleet, factored: bool) -> IusblConfig {
-        let n = &s.navigation;
-        IusblConfig {
-            filter: FactoredSettings {
-                particles: n.particles,
-                max_range_m: n.max_range_m,
-                reinitialised: n.reinitialised,
-            },
-            factored,
-            sigma_speed_m_s: n.sigma_speed_m_s,
-            sigma_heading_rad: n.sigma_heading_deg.to_radians(),
-            beacon_speed_m_s: n.beacon_speed_m_s,
-            beacon_depth_m: s.dock.beacon_depth_m,
-            confirmations: n.confirmations,
-            floor: n.floor,
-            beam_exponent: n.beam_exponent,
-            fix_sigma_range_m: s.signal.range_sigma_m.max(0.05),
-            fix_sigma_angle_rad: s.signal.angle_sigma_deg.to_radians().max(0.5f64.to_radians()),
-            sound_speed_m_s: s.signal.sound_speed_m_s,
-            ..IusblConfig::default()
-        }
-    }
-
-    /// Every AUV's estimators, in the scenario's order.
-    pub(crate) fn tracks(&self, s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
-        let mut tracks = Vec::new();
-        for (v, a) in s.auvs.iter().enumerate() {
-            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
-            for e in &s.estimators {
-                let filter_seed: u64 = init_rng.random();
-                let navigator: Box<dyn Navigator> = match e {
-                    FleetEstimator::Iusbl | FleetEstimator::IusblJoint => {
-                        let config = Self::iusbl_config(s, *e == FleetEstimator::Iusbl);
-                        let receiver = (s.signal.model == SignalModel::Channel).then(|| {
-                            let rc = ReceiverConfig { sound_speed_m_s: s.signal.sound_speed_m_s, ..Default::default() };
-                            ModeReceiver::new(&self.waveforms, &self.elements, rc)
-                        });
-                        Box::new(IusblNavigator::new(config, receiver, filter_seed))
-                    }
-                    FleetEstimator::DeadReckoning => {
-                        let config = PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() };
-                        let pose = (a.start_north_m, a.start_east_m, a.start_heading_deg.to_radians());
-                        Box::new(PlanarNavigator::new(config, FilterKind::Ekf, 0.0, pose, 1.0, 0.05))
-                    }
-                };
-                tracks.push(Track { vehicle: v, navigator });
-            }
-        }
-        tracks
     }
 
     fn dt(&self) -> f64 {

@@ -4,19 +4,19 @@
 //! last ping; each ping reaches each vehicle when the wavefront meets it.
 
 use crate::acoustics::Ping;
-use crate::engine::{PilotRecord, Track, VehicleTruth, World};
+use crate::engine::{PilotRecord, VehicleTruth, World};
 use crate::scenario::moving_beacon::Vehicle;
 use crate::scenario::passive_usbl::AsvVehicle;
-use crate::scenario::{Host, MovingBeacon, MovingBeaconCell};
+use crate::scenario::{MovingBeacon, MovingBeaconCell};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::autopilot::{Command, MAX_STEP_S, step_over};
 use crate::vehicles::otter::OtterPilot;
 use crate::vehicles::rov::{body_velocity, rk4_step};
-use nalgebra::{DMatrix, SVector, Vector2, Vector3};
+use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::measure::ScalarModel;
-use onebeacon::models::kinematic6dof::{BodyVelocity, Cov, State, idx};
-use onebeacon::nav::{BeaconFix, Kind, Measurement, Range6DofNavigator, SensorNoise};
+use onebeacon::models::kinematic6dof::{BodyVelocity, State, idx};
+use onebeacon::nav::{BeaconFix, Kind, Measurement, SensorNoise};
 use onebeacon::vehicle::{Command as VehicleCommand, OwnFix, Situation};
 use rand_pcg::Pcg64Mcg;
 
@@ -136,30 +136,9 @@ impl<'a> MovingBeaconWorld<'a> {
         }
     }
 
-    /// Every estimator of the scenario on every vehicle, each vehicle's started at its
-    /// truth plus one draw (the same for all its estimators).
-    pub(crate) fn tracks(&self, s: &MovingBeacon, seed: u64, run: u64) -> Vec<Track> {
-        let i = &s.initial;
-        let a0 = i.attitude_sigma_deg.to_radians();
-        let sigma0 = SVector::<f64, 6>::from([i.position_sigma_m, i.position_sigma_m, i.depth_sigma_m, a0, a0, a0]);
-        let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
-        let mut tracks = Vec::new();
-        for (v, u) in self.vehicles.iter().enumerate() {
-            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
-            let eta0 = u.truth.state() + sigma0.map(|sd| gauss(&mut init_rng, sd));
-            tracks.extend(s.estimators.iter().map(|e| Track {
-                vehicle: v,
-                navigator: Box::new(Range6DofNavigator::new(
-                    e.sensor_noise(self.noise),
-                    e.aiding(Host::MovingBeacon),
-                    e.filter_kind(),
-                    0.0,
-                    eta0,
-                    p0,
-                )),
-            }));
-        }
-        tracks
+    /// Every vehicle's true state now.
+    pub(crate) fn states(&self) -> Vec<State> {
+        self.vehicles.iter().map(|u| *u.truth.state()).collect()
     }
 }
 

@@ -8,9 +8,9 @@
 //! legs, both under their autopilots by RK4 at 0.05 s or finer, in the water's current).
 //! Messages travel instantly (at 40 m the 27 ms of flight move the ASV 6 cm).
 
-use crate::engine::{PilotRecord, Track, VehicleTruth, World};
+use crate::engine::{PilotRecord, VehicleTruth, World};
+use crate::scenario::PassiveUsbl;
 use crate::scenario::passive_usbl::{AsvVehicle, Auv, AuvVehicle, Current};
-use crate::scenario::{EstimatorKind, PassiveUsbl};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::autopilot::{Command, MAX_STEP_S, Piloted, step_over};
@@ -21,9 +21,8 @@ use nalgebra::{DMatrix, SMatrix, SVector, Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
 use onebeacon::measure::{ScalarModel, Usbl, UsblAngle};
 use onebeacon::models::hoff::{DIM, idx};
-use onebeacon::nav::{BeaconFix, GaussianTracker, Kind, Measurement, Navigator, ParticleTracker, TrackerNoise};
+use onebeacon::nav::{BeaconFix, Kind, Measurement, TrackerNoise};
 use onebeacon::vehicle::{Command as VehicleCommand, OwnFix, Situation};
-use rand::RngExt;
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::FRAC_PI_2;
 
@@ -264,51 +263,15 @@ impl<'a> PassiveUsblWorld<'a> {
         self.asv0
     }
 
+    /// Every AUV's full state of eq. 4 at the start.
+    pub(crate) fn initial_states(&self) -> Vec<SVector<f64, DIM>> {
+        self.auvs.iter().map(|a| a.state(0.0)).collect()
+    }
+
     /// The true state of eq. 4 of AUV `v`, as a function of time.
     pub(crate) fn truth_state(s: &PassiveUsbl, v: usize) -> impl Fn(f64) -> SVector<f64, DIM> {
         let circle = Circle::new(s.auvs().swap_remove(v));
         move |t_s| circle.state(t_s)
-    }
-
-    /// The trackers' initial standard deviations, state order.
-    pub(crate) fn initial_sigma(s: &PassiveUsbl) -> SVector<f64, DIM> {
-        let i = &s.initial;
-        let bias = i.rate_bias_sigma_deg_s.to_radians();
-        SVector::<f64, DIM>::from([
-            i.position_sigma_m,
-            i.position_sigma_m,
-            i.depth_sigma_m,
-            i.pitch_sigma_deg.to_radians(),
-            i.heading_sigma_deg.to_radians(),
-            i.speed_sigma_m_s,
-            bias,
-            bias,
-        ])
-    }
-
-    /// Every estimator on every AUV, each AUV's started at its truth plus one draw (the
-    /// same for all its estimators; its particle filters share one seed).
-    pub(crate) fn tracks(&self, s: &PassiveUsbl, seed: u64, run: u64) -> Vec<Track> {
-        let sigma0 = Self::initial_sigma(s);
-        let mut tracks = Vec::new();
-        for (v, auv) in self.auvs.iter().enumerate() {
-            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
-            let mut x0 = auv.state(0.0) + sigma0.map(|sd| gauss(&mut init_rng, sd));
-            x0[idx::PSI] = wrap_angle(x0[idx::PSI]);
-            let pf_seed: u64 = init_rng.random();
-            for e in &s.estimators {
-                let config = e.tracker_config(s.tracker_noise());
-                let navigator: Box<dyn Navigator> = match e.kind {
-                    EstimatorKind::Particle => {
-                        let (n, settings) = e.particle_settings();
-                        Box::new(ParticleTracker::new(config, settings, n, 0.0, &x0, &sigma0, pf_seed))
-                    }
-                    _ => Box::new(GaussianTracker::new(config, e.filter_kind(), 0.0, &x0, &sigma0)),
-                };
-                tracks.push(Track { vehicle: v, navigator });
-            }
-        }
-        tracks
     }
 
     /// Moves the ASV over one period along the path from `p_a` to `p_t`, timed by
@@ -507,7 +470,7 @@ mod tests {
             s.current.speed_m_s = 0.2;
             s.current.toward_deg = 90.0;
             s.auv.ilos_integral_gain = kappa;
-            s.estimators = vec![EstimatorSpec::new(EstimatorKind::DeadReckoning)];
+            s.estimators = vec![EstimatorSpec::new(crate::scenario::EstimatorKind::DeadReckoning)];
             s.guidance.kind = crate::scenario::passive_usbl::GuidanceKind::Static;
             let cell = Cell::PassiveUsbl(s.base_cell());
             let out = simulate(&Scenario::PassiveUsbl(s), &cell, 1, 0, true);
