@@ -482,8 +482,16 @@ fn replay<'py>(
 /// covariance as arrays. A bad item raises InputError and leaves the filters as they were.
 #[pyclass(name = "Navigator", module = "onebeacon")]
 struct PyNavigator {
-    setup: StreamSetup,
+    /// Behind a lock: a navigator's filters are sent between threads, never shared.
+    setup: std::sync::Mutex<StreamSetup>,
     lines: Lines,
+}
+
+impl PyNavigator {
+    /// The setup (a panic of another thread left it as it was).
+    fn setup(&self) -> std::sync::MutexGuard<'_, StreamSetup> {
+        self.setup.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
 }
 
 #[pymethods]
@@ -492,19 +500,20 @@ impl PyNavigator {
     /// beacons, initial state, estimators; its sources are ignored).
     #[new]
     fn new(config: PathBuf) -> PyResult<Self> {
-        Ok(Self { setup: stream_setup(&config).map_err(input_error)?, lines: Lines::default() })
+        let setup = stream_setup(&config).map_err(input_error)?;
+        Ok(Self { setup: std::sync::Mutex::new(setup), lines: Lines::default() })
     }
 
     /// The estimators' names.
     #[getter]
     fn names(&self) -> Vec<String> {
-        self.setup.session.names.clone()
+        self.setup().session.names.clone()
     }
 
     /// Whether the estimators have started (a given pose, or the first ground truth).
     #[getter]
     fn started(&self) -> bool {
-        self.setup.session.started()
+        self.setup().session.started()
     }
 
     /// Feeds one item (a dict or a JSON string, in the configuration's frame, SI units):
@@ -516,10 +525,11 @@ impl PyNavigator {
             Ok(s) => s.to_str()?.to_string(),
             Err(_) => from_py(item, "item")?.to_string(),
         };
-        let max = self.setup.session.limits().max_line_bytes;
+        let mut setup = self.setup.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let max = setup.session.limits().max_line_bytes;
         let mut skipped = None;
         let mut infos = Vec::new();
-        let StreamSetup { session, beacons, frame } = &mut self.setup;
+        let StreamSetup { session, beacons, frame } = &mut *setup;
         let out = self.lines.push(session, beacons, *frame, line.as_bytes(), line.len() > max, |_, note| match note {
             Note::Skipped(m) => skipped = Some(m),
             Note::Info(m) => infos.push(m),
@@ -538,11 +548,12 @@ impl PyNavigator {
     /// `sigma_heading_rad`, `speed_m_s` (None without the state) and the calibration
     /// states.
     fn estimates<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        estimates(py, &self.setup.session)
+        estimates(py, &self.setup().session)
     }
 
     fn __repr__(&self) -> String {
-        format!("Navigator({:?}, started={})", self.setup.session.names, self.setup.session.started())
+        let setup = self.setup();
+        format!("Navigator({:?}, started={})", setup.session.names, setup.session.started())
     }
 }
 

@@ -171,3 +171,10 @@ pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
     }
     tracks
 }
+
+/// An estimator of a log description (replay, stream, Python): the planar family its
+/// configuration describes, built by the session at its start and again from its last
+/// sound pose.
+pub(crate) fn log(spec: &crate::scenario::EstimatorSpec) -> onebeacon::nav::session::Builder {
+    onebeacon::nav::planar::builder(spec.planar_config(), spec.filter_kind())
+}

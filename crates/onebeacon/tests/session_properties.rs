@@ -67,7 +67,8 @@ fn session() -> Session {
         ),
         ("dr".to_string(), PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() }, FilterKind::Ekf),
     ];
-    Session::new(Frame::Ned, estimators, start, (1.0, 0.1), None)
+    let builders = estimators.into_iter().map(|(n, c, f)| (n, onebeacon::nav::planar::builder(c, f))).collect();
+    Session::new(Frame::Ned, builders, start, (1.0, 0.1), None)
 }
 
 proptest! {

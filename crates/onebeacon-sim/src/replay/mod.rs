@@ -23,7 +23,7 @@ use std::collections::BTreeSet;
 
 /// A replayed log: the session with its statistics and rejections, and how many
 /// items the log had.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Replay {
     pub session: Session,
     pub items: usize,
@@ -69,7 +69,7 @@ impl Replay {
 /// A session of the description's estimators, starting at `start`, restricted to
 /// `beacons` when given (replay and stream).
 pub fn new_session(d: &LogDescription, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
-    let estimators = d.estimators.iter().map(|e| (e.name(), e.planar_config(), e.filter_kind())).collect();
+    let estimators = d.estimators.iter().map(|e| (e.name(), crate::factory::log(e))).collect();
     let sigmas = (d.initial.position_sigma_m, d.initial.heading_sigma_deg.to_radians());
     Session::new(d.frame.into(), estimators, start, sigmas, beacons).with_limits(d.limits)
 }

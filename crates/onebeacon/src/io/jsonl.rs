@@ -389,6 +389,7 @@ mod tests {
     use super::*;
     use crate::filter::FilterKind;
     use crate::nav::PlanarConfig;
+    use crate::nav::planar::builder;
     use crate::nav::session::Start;
 
     fn fixed() -> BTreeMap<u32, Vector3<f64>> {
@@ -447,7 +448,7 @@ mod tests {
         let config = PlanarConfig { aiding: crate::nav::Aiding::NONE, ..PlanarConfig::default() };
         let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
         let mut session =
-            Session::new(Frame::Ned, vec![("dr".into(), config, FilterKind::Ekf)], start, (1.0, 0.1), None);
+            Session::new(Frame::Ned, vec![("dr".into(), builder(config, FilterKind::Ekf))], start, (1.0, 0.1), None);
         let input = [
             r#"{"t_s": 0, "kind": "heading", "heading_rad": 0}"#,
             "not json",
@@ -479,7 +480,7 @@ mod tests {
         let session = || {
             let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
             let config = PlanarConfig::default();
-            Session::new(Frame::Ned, vec![("ekf".into(), config, FilterKind::Ekf)], start, (1.0, 0.1), None)
+            Session::new(Frame::Ned, vec![("ekf".into(), builder(config, FilterKind::Ekf))], start, (1.0, 0.1), None)
         };
         let mut good: Vec<Vec<u8>> = Vec::new();
         for k in 0..40 {

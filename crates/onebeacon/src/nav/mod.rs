@@ -216,6 +216,11 @@ pub trait Navigator: Send {
     fn body_velocity_m_s(&self) -> Option<Vector3<f64>> {
         None
     }
+    /// Each beacon's estimated range offset and its standard deviation (beacon, m, m),
+    /// for a navigator that estimates one per beacon.
+    fn beacon_offsets(&self) -> Vec<(u32, f64, f64)> {
+        Vec::new()
+    }
     /// The command mode the beacon's pings confirmed last (rypkema sec. 4.2), if any.
     fn command_mode(&self) -> Option<usize> {
         None

@@ -285,13 +285,6 @@ impl PlanarNavigator<STATES_WITH_OFFSETS> {
     ) -> Self {
         Self::start(config, filter, t_s, pose, (sigma_position_m, sigma_heading_rad))
     }
-
-    /// Each beacon heard with its estimated offset and the offset's standard deviation.
-    pub fn beacon_offsets(&self) -> Vec<(u32, f64, f64)> {
-        let (x, p) = (self.filter.mean(), self.filter.covariance());
-        let slot = |i: usize| STATES + i;
-        self.offset_beacons.iter().enumerate().map(|(i, &b)| (b, x[slot(i)], p[(slot(i), slot(i))].sqrt())).collect()
-    }
 }
 
 impl<const N: usize> PlanarNavigator<N> {
@@ -431,6 +424,14 @@ impl<const N: usize> PlanarNavigator<N> {
 }
 
 impl<const N: usize> Navigator for PlanarNavigator<N> {
+    /// Each beacon heard with its estimated offset and the offset's standard deviation
+    /// (none without [`PlanarConfig::estimate_beacon_offsets`]).
+    fn beacon_offsets(&self) -> Vec<(u32, f64, f64)> {
+        let (x, p) = (self.filter.mean(), self.filter.covariance());
+        let slot = |i: usize| STATES + i;
+        self.offset_beacons.iter().enumerate().map(|(i, &b)| (b, x[slot(i)], p[(slot(i), slot(i))].sqrt())).collect()
+    }
+
     /// Processes one measurement (measurements in time order; an earlier time is taken
     /// as now).
     fn process(&mut self, m: &Measurement) -> Outcome {
@@ -511,6 +512,20 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
             turn_scale: x[idx::TURN_SCALE],
         }
     }
+}
+
+/// The navigator a [`PlanarConfig`] describes, as a session builds it
+/// ([`super::session::Builder`]): the constant-velocity tracker of a craft without motion
+/// inputs (`track_accel_sigma_m_s2`), the planar navigator with an offset per beacon, or
+/// the planar navigator.
+pub fn builder(c: PlanarConfig, f: FilterKind) -> super::session::Builder {
+    Box::new(move |t0, pose, sigma_position_m, sigma_heading_rad| match c.track_accel_sigma_m_s2 {
+        Some(a) => Box::new(super::TrackingNavigator::new(c, a, f, t0, (pose.0, pose.1), sigma_position_m)),
+        None if c.estimate_beacon_offsets => {
+            Box::new(PlanarNavigator::with_beacon_offsets(c, f, t0, pose, sigma_position_m, sigma_heading_rad))
+        }
+        None => Box::new(PlanarNavigator::new(c, f, t0, pose, sigma_position_m, sigma_heading_rad)),
+    })
 }
 
 #[cfg(test)]

@@ -3,13 +3,9 @@
 //! the ground truth when it comes. Items are what a log or a live stream carries:
 //! measurements, beacon positions, ground truth, in the source's frame.
 
-use crate::filter::FilterKind;
 use crate::geo::Frame;
 use crate::nav::evaluation::{ErrorStats, horizontal_error};
-use crate::nav::planar::STATES_WITH_OFFSETS;
-use crate::nav::{
-    BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, PlanarConfig, PlanarNavigator, TrackingNavigator,
-};
+use crate::nav::{BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
 use nalgebra::Vector3;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -349,42 +345,18 @@ fn sound(e: &Estimate) -> bool {
         && p.determinant() > 0.0
 }
 
-/// One estimator of a session: the planar navigator, or the constant-velocity tracker
-/// of a craft without motion inputs ([`PlanarConfig::track_accel_sigma_m_s2`]).
-#[derive(Debug, Clone, PartialEq)]
-enum Estimator {
-    Planar(PlanarNavigator),
-    /// With an offset per beacon ([`PlanarConfig::estimate_beacon_offsets`]).
-    PlanarOffsets(Box<PlanarNavigator<STATES_WITH_OFFSETS>>),
-    Tracking(TrackingNavigator),
-}
-
-impl Estimator {
-    fn navigator(&mut self) -> &mut dyn Navigator {
-        match self {
-            Estimator::Planar(n) => n,
-            Estimator::PlanarOffsets(n) => n.as_mut(),
-            Estimator::Tracking(n) => n,
-        }
-    }
-
-    fn estimate(&self) -> Estimate {
-        match self {
-            Estimator::Planar(n) => n.estimate(),
-            Estimator::PlanarOffsets(n) => n.estimate(),
-            Estimator::Tracking(n) => n.estimate(),
-        }
-    }
-}
+/// Builds one estimator of a session at time t0 (s) from a pose (north, east, heading;
+/// m, m, rad) with the initial position and heading sigmas (m, rad): at the start, and
+/// again from its last sound pose.
+pub type Builder = Box<dyn Fn(f64, (f64, f64, f64), f64, f64) -> Box<dyn Navigator> + Send + Sync>;
 
 /// Every estimator on one stream. Estimates and errors are in NED.
-#[derive(Debug, Clone)]
 pub struct Session {
     pub names: Vec<String>,
     /// The frame of the items pushed.
     frame: Frame,
-    configs: Vec<(PlanarConfig, FilterKind)>,
-    navs: Vec<Estimator>,
+    builders: Vec<Builder>,
+    navs: Vec<Box<dyn Navigator>>,
     start: Start,
     sigma_position_m: f64,
     sigma_heading_rad: f64,
@@ -410,20 +382,26 @@ pub struct Session {
     last_sound: Vec<(f64, f64, f64)>,
 }
 
+impl std::fmt::Debug for Session {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Session").field("names", &self.names).field("started", &self.started()).finish_non_exhaustive()
+    }
+}
+
 impl Session {
     pub fn new(
         frame: Frame,
-        estimators: Vec<(String, PlanarConfig, FilterKind)>,
+        estimators: Vec<(String, Builder)>,
         start: Start,
         (sigma_position_m, sigma_heading_rad): (f64, f64),
         beacons: Option<BTreeSet<u32>>,
     ) -> Self {
         let n = estimators.len();
-        let (names, configs) = estimators.into_iter().map(|(n, c, f)| (n, (c, f))).unzip();
+        let (names, builders) = estimators.into_iter().unzip();
         Self {
             names,
             frame,
-            configs,
+            builders,
             navs: Vec::new(),
             start,
             sigma_position_m,
@@ -470,17 +448,13 @@ impl Session {
 
     /// Every estimator's latest estimate (empty before the start).
     pub fn final_estimates(&self) -> Vec<Estimate> {
-        self.navs.iter().map(Estimator::estimate).collect()
+        self.navs.iter().map(|n| n.estimate()).collect()
     }
 
     /// Each estimator's per-beacon range offsets (beacon, offset m, its sigma m); empty
     /// for one without them.
     pub fn beacon_offsets(&self) -> Vec<Vec<(u32, f64, f64)>> {
-        let offsets = |e: &Estimator| match e {
-            Estimator::PlanarOffsets(n) => n.beacon_offsets(),
-            _ => Vec::new(),
-        };
-        self.navs.iter().map(offsets).collect()
+        self.navs.iter().map(|n| n.beacon_offsets()).collect()
     }
 
     pub fn started(&self) -> bool {
@@ -488,23 +462,12 @@ impl Session {
     }
 
     fn begin(&mut self, t0: f64, pose: (f64, f64, f64)) {
-        self.navs = (0..self.configs.len()).map(|i| self.navigator(i, t0, pose)).collect();
+        self.navs = (0..self.builders.len()).map(|i| self.navigator(i, t0, pose)).collect();
         self.last_sound = vec![pose; self.navs.len()];
     }
 
-    fn navigator(&self, i: usize, t0: f64, pose: (f64, f64, f64)) -> Estimator {
-        let (c, f) = self.configs[i];
-        match c.track_accel_sigma_m_s2 {
-            Some(a) => {
-                Estimator::Tracking(TrackingNavigator::new(c, a, f, t0, (pose.0, pose.1), self.sigma_position_m))
-            }
-            None if c.estimate_beacon_offsets => Estimator::PlanarOffsets(Box::new(
-                PlanarNavigator::with_beacon_offsets(c, f, t0, pose, self.sigma_position_m, self.sigma_heading_rad),
-            )),
-            None => {
-                Estimator::Planar(PlanarNavigator::new(c, f, t0, pose, self.sigma_position_m, self.sigma_heading_rad))
-            }
-        }
+    fn navigator(&self, i: usize, t0: f64, pose: (f64, f64, f64)) -> Box<dyn Navigator> {
+        (self.builders[i])(t0, pose, self.sigma_position_m, self.sigma_heading_rad)
     }
 
     /// Records a rejection while the log has room.
@@ -592,7 +555,7 @@ impl Session {
                 if let Some(kind) = self.resolve(m).map_err(|reason| self.screen(item, reason))? {
                     let m = Measurement::new(t, kind.clone());
                     for (i, nav) in self.navs.iter_mut().enumerate() {
-                        let out = nav.navigator().process(&m);
+                        let out = nav.process(&m);
                         self.stats[i].push_outcome(&out, true);
                         outcomes[i] = Some(out);
                     }
@@ -614,7 +577,7 @@ impl Session {
             Input::Truth(p) => truth = Some(p),
             Input::BeaconPosition { .. } => {}
         }
-        let mut estimates: Vec<Estimate> = self.navs.iter().map(Estimator::estimate).collect();
+        let mut estimates: Vec<Estimate> = self.navs.iter().map(|n| n.estimate()).collect();
         // a filter whose state stops being sound starts again from its last sound
         // estimate: reported, never silently kept
         for (i, e) in estimates.iter_mut().enumerate() {
@@ -668,6 +631,13 @@ impl Session {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::filter::FilterKind;
+    use crate::nav::{PlanarConfig, PlanarNavigator};
+
+    /// Builders of the planar family for named configurations.
+    fn planar(est: Vec<(String, PlanarConfig, FilterKind)>) -> Vec<(String, Builder)> {
+        est.into_iter().map(|(n, c, f)| (n, crate::nav::planar::builder(c, f))).collect()
+    }
 
     /// An estimate is sound when finite with a positive definite horizontal covariance.
     #[test]
@@ -693,7 +663,7 @@ mod tests {
     #[test]
     fn a_real_gap_restarts_the_clock() {
         let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
-        let mut s = Session::new(Frame::Ned, vec![], start, (1.0, 0.1), None);
+        let mut s = Session::new(Frame::Ned, Vec::new(), start, (1.0, 0.1), None);
         let item = |t: f64| Item { t_s: t, input: Input::Measurement(Kind::Speed { speed_m_s: 1.0 }) };
         for t in [0.0, 1.0, 2.0] {
             assert!(s.push(&item(t)).is_ok());
@@ -744,7 +714,7 @@ mod tests {
                 config.noise.position_walk_m_per_sqrt_s = 0.0;
                 let est = vec![("ekf".to_string(), config, FilterKind::Ekf)];
                 // from the truth with a tiny initial sigma, so the state error stays small
-                let mut s = Session::new(Frame::Ned, est, start, (1e-3, 0.1), None);
+                let mut s = Session::new(Frame::Ned, planar(est), start, (1e-3, 0.1), None);
                 for k in 0..4000 {
                     let b = beacons[k % 3];
                     let range = b.norm() + noise.sample(&mut rng);
@@ -769,7 +739,7 @@ mod tests {
             ("cv".to_string(), track, FilterKind::Ekf),
             ("dr".to_string(), PlanarConfig::default(), FilterKind::Ekf),
         ];
-        let mut s = Session::new(Frame::Ned, est, start, (1.0, 0.1), None);
+        let mut s = Session::new(Frame::Ned, planar(est), start, (1.0, 0.1), None);
         for t in [0.0, 1.0, 2.0] {
             let odo = Kind::Odometry { distance_m: 1.0, heading_change_rad: 0.0 };
             s.push(&Item { t_s: t, input: Input::Measurement(odo) }).unwrap();
@@ -789,7 +759,7 @@ mod tests {
         let finals: Vec<Estimate> = [0.0, turns]
             .into_iter()
             .map(|offset| {
-                let mut s = Session::new(Frame::Ned, est.clone(), start, (1.0, 0.1), None);
+                let mut s = Session::new(Frame::Ned, planar(est.clone()), start, (1.0, 0.1), None);
                 for k in 0..50 {
                     let t = k as f64;
                     let odo = Kind::Odometry { distance_m: 1.0, heading_change_rad: 0.02 };
