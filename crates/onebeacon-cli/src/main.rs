@@ -182,7 +182,7 @@ enum Command {
     /// configures, scored against its ground truth: trajectory.csv, summary.json,
     /// rejected.csv, top_view.png and error.png in DIR, and a table (or --json).
     Replay {
-        /// The log description (TOML; see README "Replaying logs").
+        /// The log description (TOML; see docs/logs.md).
         log: PathBuf,
         /// Output directory (default: out/<log>-replay[-beacons-...]).
         #[arg(long, value_name = "DIR")]
@@ -268,7 +268,7 @@ enum DspCommand {
     /// Simulate one ping on every element of the array: a multichannel float WAV and a
     /// JSON sidecar with the truth (range_m, azimuth_deg, inclination_deg, mode, ...).
     Simulate {
-        /// Ping configuration (TOML; every key optional; see README).
+        /// Ping configuration (TOML; every key optional; see docs/scenarios.md).
         #[arg(long, value_name = "FILE")]
         config: Option<String>,
         /// The WAV to write; the sidecar gets the same name with .json.

@@ -20,18 +20,16 @@ use onebeacon::vehicle::fim::{FimGuidance, FimGuidanceConfig, FimMode};
 /// The ASV of a passive-USBL world, starting at `home`: it serves every AUV.
 pub(crate) fn passive_usbl(s: &PassiveUsbl, cell: &PassiveUsblCell, home: Vector2<f64>) -> Vec<Helm> {
     let g = &s.guidance;
-    let mode = match cell.guidance {
-        BearingKind::Determinant | BearingKind::MaxEigenvalue => BearingMode::Planner,
-        BearingKind::Static => BearingMode::Static,
-        BearingKind::Circle => BearingMode::Circle,
-        BearingKind::Offset => BearingMode::Offset,
+    // the baselines keep the determinant for their (unused) planner
+    let (mode, metric) = match cell.guidance {
+        BearingKind::Determinant => (BearingMode::Planner, SpreadMetric::Determinant),
+        BearingKind::MaxEigenvalue => (BearingMode::Planner, SpreadMetric::MaxEigenvalue),
+        BearingKind::Static => (BearingMode::Static, SpreadMetric::Determinant),
+        BearingKind::Circle => (BearingMode::Circle, SpreadMetric::Determinant),
+        BearingKind::Offset => (BearingMode::Offset, SpreadMetric::Determinant),
     };
     let planner = BearingPlanner {
-        metric: if cell.guidance == BearingKind::MaxEigenvalue {
-            SpreadMetric::MaxEigenvalue
-        } else {
-            SpreadMetric::Determinant
-        },
+        metric,
         r1_m: g.r1_m,
         r2_m: g.r2_m,
         radii: g.radii,

@@ -2,10 +2,10 @@
 //! stream. Every error is one line naming the file, the line, the column or key and
 //! what was expected.
 
-use super::csv::*;
+use super::csv::Table;
 use super::geodesy::{Geodetic, check_latlon};
-use super::merge::*;
-use super::rows::*;
+use super::merge::{Items, Rows};
+use super::rows::SourceRows;
 pub use super::schema::*;
 use crate::scenario::EstimatorSpec;
 use crate::scenario::load::deserialize;

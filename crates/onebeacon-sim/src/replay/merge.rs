@@ -1,8 +1,9 @@
 //! The merge of a log's sources into one time-ordered stream of items, each source read
 //! as the merge needs its next row.
 
-use super::log::*;
-use super::rows::*;
+use super::log::LogError;
+use super::rows::{Dropped, SourceRows};
+use super::schema::TimeOrder;
 use onebeacon::nav::session::Item;
 
 /// The rows of one source still to come.

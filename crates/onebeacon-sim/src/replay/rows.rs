@@ -1,9 +1,10 @@
 //! One source's rows into stream items: its clock (time cells to seconds), units and
 //! frame to SI and the log's frame, and the rows dropped out of time order.
 
-use super::csv::*;
+use super::csv::Table;
 use super::geodesy::Geodetic;
-use super::log::*;
+use super::log::{Log, LogError};
+use super::schema::{COLUMN_KEYS, Source, SourceKind, TimeOrder};
 use nalgebra::Vector3;
 use onebeacon::geo::Frame;
 use onebeacon::nav::Kind;
