@@ -5,7 +5,7 @@ use crate::{BadInput, plot, report};
 use anyhow::{Context, Result};
 use onebeacon::guidance::{PolarGrid, best_standoff};
 use onebeacon_sim::montecarlo::monte_carlo;
-use onebeacon_sim::run::{GuidanceSnapshot, simulate, simulate_with_belief};
+use onebeacon_sim::run::{GuidanceSnapshot, simulate, simulate_messages, simulate_with_belief};
 
 /// Particles drawn (by weight) for belief.png.
 const BELIEF_SAMPLES: usize = 50_000;
@@ -37,22 +37,53 @@ pub fn scenarios(show: Option<&str>) -> Result<()> {
 }
 
 /// `onebeacon run SCENARIO [--seed N] [--run I] [--ping K] [--message M] [--out DIR]`
-pub fn run(name: &str, seed: Option<u64>, run: u64, ping: usize, message: usize, out: Option<PathBuf>) -> Result<()> {
+pub fn run(
+    name: &str,
+    seed: Option<u64>,
+    run: u64,
+    ping: usize,
+    message: usize,
+    out: Option<PathBuf>,
+    messages: bool,
+) -> Result<()> {
+    use onebeacon_sim::Scenario;
     let s = scenario::load(name)?;
     crate::check_memory(name, &s, 1, 1)?;
     let seed = seed.unwrap_or(s.seed());
+    let streamable = match &s {
+        Scenario::PassiveUsbl(_) => true,
+        Scenario::Fleet(f) => f.signal.model == onebeacon_sim::scenario::fleet::SignalModel::Abstract,
+        _ => false,
+    };
+    if messages && !streamable {
+        return Err(BadInput(format!(
+            "--messages: {}: the vehicles' computers that `stream` runs are a passive_usbl world's surface vehicle and a fleet's AUVs with signal.model = \"abstract\"",
+            s.name()
+        ))
+        .into());
+    }
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name())));
     let staging = Staging::new(&dir)?;
     let cell = s.base_cell();
-    let passive = matches!(s, onebeacon_sim::Scenario::PassiveUsbl(_));
+    let passive = matches!(s, Scenario::PassiveUsbl(_));
     if passive && !(1..=s.steps()).contains(&message) {
         return Err(BadInput(format!("--message {message}: the run has messages 1 to {}", s.steps())).into());
     }
-    let result = if passive {
-        simulate_with_belief(&s, &cell, seed, run, message, BELIEF_SAMPLES)
+    let belief = passive.then_some((message, BELIEF_SAMPLES));
+    let (result, computers) = if messages {
+        simulate_messages(&s, &cell, seed, run, belief)
+    } else if passive {
+        (simulate_with_belief(&s, &cell, seed, run, message, BELIEF_SAMPLES), None)
     } else {
-        simulate(&s, &cell, seed, run, true)
+        (simulate(&s, &cell, seed, run, true), None)
     };
+    for c in computers.iter().flatten() {
+        let lines = |l: &mut dyn Iterator<Item = String>| l.map(|l| l + "\n").collect::<String>();
+        staging.write(&format!("{}.stream.toml", c.name), c.config.as_bytes())?;
+        staging.write(&format!("{}.input.jsonl", c.name), lines(&mut c.input.iter().cloned()).as_bytes())?;
+        let decisions = lines(&mut c.decisions.iter().map(|d| d.to_string()));
+        staging.write(&format!("{}.decisions.jsonl", c.name), decisions.as_bytes())?;
+    }
 
     let (vehicles, names) = (s.vehicle_names(), s.track_labels());
     staging.write("trajectory.csv", &report::trajectory_csv(&vehicles, &names, &result.trajectory)?)?;

@@ -97,6 +97,13 @@ enum Command {
         /// Output directory (default: out/<scenario>-run).
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Also write each vehicle computer's side of the run (passive_usbl: the surface
+        /// vehicle; fleet with the abstract signal model: each AUV): NAME.stream.toml (its
+        /// `stream` configuration), NAME.input.jsonl (what it heard) and
+        /// NAME.decisions.jsonl (the simulator's commands), for `onebeacon stream
+        /// NAME.stream.toml < NAME.input.jsonl`.
+        #[arg(long)]
+        messages: bool,
     },
     /// Monte Carlo over the scenario's sweep: a table per estimator, or JSON. With
     /// --shard I/N, one share of it (for many machines; `mc merge` combines the shares);
@@ -385,8 +392,8 @@ fn main() -> ExitCode {
     }
     let result = match cli.command {
         Command::Scenarios { show } => commands::scenarios(show.as_deref()),
-        Command::Run { scenario, seed, run, ping, message, out } => {
-            commands::run(&scenario, seed, run, ping, message, out)
+        Command::Run { scenario, seed, run, ping, message, out, messages } => {
+            commands::run(&scenario, seed, run, ping, message, out, messages)
         }
         Command::Mc { merge: Some(McCommand::Merge { partials, out, json }), .. } => {
             campaign::merge_partials(&partials, out, json)

@@ -7,7 +7,7 @@ use crate::{plot, report};
 use anyhow::{Context, Result};
 use onebeacon::io::jsonl;
 use onebeacon::nav::session::Session;
-use onebeacon_sim::replay::{Log, StreamSetup, replay as run_replay, stream_setup};
+use onebeacon_sim::replay::{Log, replay as run_replay, stream_setup};
 use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -135,11 +135,12 @@ fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
     Ok(w.into_inner()?)
 }
 
-/// `onebeacon stream CONFIG.toml`: JSON Lines on stdin, one JSON line per estimate on
-/// stdout, flushed after each; bad lines are reported on stderr and skipped.
+/// `onebeacon stream CONFIG.toml`: JSON Lines on stdin, one JSON line per estimate (and
+/// with a `[controller]`, the command) on stdout, flushed after each; bad lines are
+/// reported on stderr and skipped.
 pub fn stream(config: &Path) -> Result<()> {
-    let StreamSetup { mut session, beacons, frame } = stream_setup(config)?;
-    jsonl::run(&mut session, &beacons, frame, std::io::stdin().lock(), std::io::stdout().lock(), |line, m| {
+    let mut unit = stream_setup(config)?;
+    jsonl::run(&mut unit, std::io::stdin().lock(), std::io::stdout().lock(), |line, m| {
         eprintln!("stdin line {line}: {m}")
     })
     .context("cannot read stdin or write stdout")?;

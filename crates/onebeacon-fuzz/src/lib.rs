@@ -156,14 +156,15 @@ pub fn stream(data: &[u8]) {
     let fixed: BTreeMap<u32, Vector3<f64>> =
         [(0, Vector3::new(10.0, 0.0, 0.0)), (5, Vector3::new(-20.0, 30.0, 0.0))].into_iter().collect();
     let start = onebeacon::nav::session::Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
-    let mut session = new_session(&d, start, None);
+    let session = new_session(&d, &d.initial, start, None);
+    let mut unit = onebeacon::vehicle::unit::Unit::new(vec![session], fixed, Frame::Enu, None);
     let mut out = Vec::new();
-    jsonl::run(&mut session, &fixed, Frame::Enu, Cursor::new(data), &mut out, |_, _| {}).expect("in-memory I/O");
+    jsonl::run(&mut unit, Cursor::new(data), &mut out, |_, _| {}).expect("in-memory I/O");
     let text = std::str::from_utf8(&out).expect("the output is UTF-8");
     for line in text.lines() {
         assert!(line.starts_with('{') && line.ends_with('}'), "not a JSON object: {line}");
     }
-    for e in session.final_estimates() {
+    for e in unit.session(0).final_estimates() {
         assert!(e.north_m().is_finite() && e.east_m().is_finite(), "{e:?}");
     }
 }

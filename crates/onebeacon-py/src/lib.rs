@@ -7,12 +7,13 @@
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use onebeacon::io::jsonl::{Lines, Note};
 use onebeacon::nav::session::Session;
+use onebeacon::vehicle::unit::Unit;
 use onebeacon_sim::Scenario;
 use onebeacon_sim::budget::{Budget, concurrent_runs};
 use onebeacon_sim::chain::Chain;
 use onebeacon_sim::montecarlo::Progress;
 use onebeacon_sim::montecarlo::monte_carlo;
-use onebeacon_sim::replay::{Log, StreamSetup, beacon_filter, replay as run_replay, stream_setup};
+use onebeacon_sim::replay::{Log, beacon_filter, replay as run_replay, stream_setup};
 use onebeacon_sim::run::{StepRecord, simulate, trajectory};
 use onebeacon_sim::scenario::{self, BUILTINS, ping::PingConfig};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -483,14 +484,14 @@ fn replay<'py>(
 #[pyclass(name = "Navigator", module = "onebeacon")]
 struct PyNavigator {
     /// Behind a lock: a navigator's filters are sent between threads, never shared.
-    setup: std::sync::Mutex<StreamSetup>,
+    unit: std::sync::Mutex<Unit>,
     lines: Lines,
 }
 
 impl PyNavigator {
     /// The setup (a panic of another thread left it as it was).
-    fn setup(&self) -> std::sync::MutexGuard<'_, StreamSetup> {
-        self.setup.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    fn unit(&self) -> std::sync::MutexGuard<'_, Unit> {
+        self.unit.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 }
 
@@ -500,20 +501,20 @@ impl PyNavigator {
     /// beacons, initial state, estimators; its sources are ignored).
     #[new]
     fn new(config: PathBuf) -> PyResult<Self> {
-        let setup = stream_setup(&config).map_err(input_error)?;
-        Ok(Self { setup: std::sync::Mutex::new(setup), lines: Lines::default() })
+        let unit = stream_setup(&config).map_err(input_error)?;
+        Ok(Self { unit: std::sync::Mutex::new(unit), lines: Lines::default() })
     }
 
     /// The estimators' names.
     #[getter]
     fn names(&self) -> Vec<String> {
-        self.setup().session.names.clone()
+        self.unit().session(0).names.clone()
     }
 
     /// Whether the estimators have started (a given pose, or the first ground truth).
     #[getter]
     fn started(&self) -> bool {
-        self.setup().session.started()
+        self.unit().sessions().iter().all(|s| s.started())
     }
 
     /// Feeds one item (a dict or a JSON string, in the configuration's frame, SI units):
@@ -525,12 +526,11 @@ impl PyNavigator {
             Ok(s) => s.to_str()?.to_string(),
             Err(_) => from_py(item, "item")?.to_string(),
         };
-        let mut setup = self.setup.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        let max = setup.session.limits().max_line_bytes;
+        let mut unit = self.unit.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let max = unit.session(0).limits().max_line_bytes;
         let mut skipped = None;
         let mut infos = Vec::new();
-        let StreamSetup { session, beacons, frame } = &mut *setup;
-        let out = self.lines.push(session, beacons, *frame, line.as_bytes(), line.len() > max, |_, note| match note {
+        let out = self.lines.push(&mut unit, line.as_bytes(), line.len() > max, |_, note| match note {
             Note::Skipped(m) => skipped = Some(m),
             Note::Info(m) => infos.push(m),
         });
@@ -548,12 +548,21 @@ impl PyNavigator {
     /// `sigma_heading_rad`, `speed_m_s` (None without the state) and the calibration
     /// states.
     fn estimates<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        estimates(py, &self.setup().session)
+        estimates(py, self.unit().session(0))
+    }
+
+    /// The controller's current command (`[controller]`), as the `command` of a `stream`
+    /// line (a dict, in the configuration's frame), or None before its first decision or
+    /// without a controller.
+    fn command<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let unit = self.unit();
+        unit.command().map(|c| to_py(py, &onebeacon::io::jsonl::command_json(&c, unit.plan(), unit.frame))).transpose()
     }
 
     fn __repr__(&self) -> String {
-        let setup = self.setup();
-        format!("Navigator({:?}, started={})", setup.session.names, setup.session.started())
+        let unit = self.unit();
+        let s = unit.session(0);
+        format!("Navigator({:?}, started={})", s.names, s.started())
     }
 }
 

@@ -9,7 +9,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use onebeacon::io::jsonl::{Lines, item_json};
-use onebeacon_sim::replay::{Log, LogError, StreamSetup, replay, stream_setup};
+use onebeacon_sim::replay::{Log, LogError, replay, stream_setup};
 use std::hint::black_box;
 use std::path::PathBuf;
 
@@ -34,16 +34,16 @@ fn bench(c: &mut Criterion) {
     c.bench_function("plaza1 load (TOML, beacons, CSV headers)", |b| b.iter(|| black_box(Log::load(&path).unwrap())));
 
     // a started stream: plaza1's first 2000 items
-    let StreamSetup { mut session, beacons, frame } = stream_setup(&path).unwrap();
+    let mut unit = stream_setup(&path).unwrap();
     let mut lines = Lines::default();
     let mut t0 = 0.0;
     for item in full.items().unwrap().take(2000) {
         let item = item.unwrap();
         t0 = item.t_s;
-        lines.push(&mut session, &beacons, frame, item_json(&item).to_string().as_bytes(), false, |_, _| {});
+        lines.push(&mut unit, item_json(&item).to_string().as_bytes(), false, |_, _| {});
     }
-    assert!(session.started());
-    let names = session.names.len();
+    assert!(unit.session(0).started());
+    let names = unit.session(0).names.len();
     for (label, line) in [
         ("range", r#"{"t_s":T,"kind":"range","beacon":1,"range_m":30.0}"#),
         ("odometry", r#"{"t_s":T,"kind":"odometry","distance_m":0.01,"heading_change_rad":0.0}"#),
@@ -55,7 +55,7 @@ fn bench(c: &mut Criterion) {
                 t0 += 0.01 * (iters + 1) as f64;
                 let start = std::time::Instant::now();
                 for l in &batch {
-                    black_box(lines.push(&mut session, &beacons, frame, l.as_bytes(), false, |_, _| {}));
+                    black_box(lines.push(&mut unit, l.as_bytes(), false, |_, _| {}));
                 }
                 start.elapsed()
             })

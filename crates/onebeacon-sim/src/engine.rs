@@ -12,7 +12,7 @@
 
 use nalgebra::{Vector3, Vector6};
 use onebeacon::nav::{Estimate, Measurement, Navigator, Outcome};
-use onebeacon::vehicle::{Command, Controller, GuidanceSnapshot, Situation};
+use onebeacon::vehicle::{Command, Controller, Decided, Situation};
 
 /// The truth of one underwater vehicle at one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -117,7 +117,8 @@ pub(crate) struct Step<'a> {
 /// Something that watches a run.
 pub(crate) trait Observer {
     fn step(&mut self, step: &Step<'_>);
-    fn guidance(&mut self, _snapshot: &GuidanceSnapshot) {}
+    /// Helm `helm`'s decision on what its vehicle knew of itself.
+    fn decided(&mut self, _helm: usize, _situation: &Situation, _decided: &Decided) {}
     /// The outcome of track `track`'s processing of one measurement.
     fn outcome(&mut self, _track: usize, _outcome: &Outcome) {}
     /// Every track's navigator as it stands at step `k` (before [`Observer::step`]),
@@ -170,9 +171,7 @@ pub(crate) fn run(
             let beliefs: Vec<&dyn Navigator> = helm.serves.iter().map(|&v| &*tracks[reporter[v]].navigator).collect();
             let decided = helm.controller.decide(&situation, &beliefs).expect("a world gives its helms what they read");
             commands[h] = Some(decided.command);
-            if let Some(g) = decided.snapshot {
-                observers.iter_mut().for_each(|o| o.guidance(&g));
-            }
+            observers.iter_mut().for_each(|o| o.decided(h, &situation, &decided));
         }
         world.advance(k, &commands, &mut heard);
         for (i, t) in tracks.iter_mut().enumerate() {

@@ -4,22 +4,22 @@
 //! paired. A world gives its vehicles' initial truth; what estimates it is built here.
 
 use crate::engine::Track;
-use crate::scenario::fleet::{Fleet, FleetEstimator, SignalModel};
-use crate::scenario::{EstimatorKind, FixedBeacon, Host, MovingBeacon, PassiveUsbl};
+use crate::scenario::estimator::IusblKeys;
+use crate::scenario::fleet::{Fleet, SignalModel};
+use crate::scenario::{EstimatorKind, EstimatorSpec, FixedBeacon, Host, MovingBeacon, PassiveUsbl};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use nalgebra::SVector;
 use onebeacon::dsp::beamform::pyramid_8cm;
 use onebeacon::dsp::receiver::{ModeReceiver, ReceiverConfig};
 use onebeacon::dsp::waveform::rypkema_modes;
 use onebeacon::filter::FilterKind;
-use onebeacon::filter::factored::FactoredSettings;
 use onebeacon::geo::wrap_angle;
 use onebeacon::models::hoff::{DIM, idx};
 use onebeacon::models::kinematic6dof::{Cov as Cov6, State as Eta};
 use onebeacon::models::unicycle::{Cov, State};
-use onebeacon::nav::usbl_track::TrackState;
+use onebeacon::nav::usbl_track::{TrackState, TrackerNoise};
 use onebeacon::nav::{
-    Aiding, GaussianTracker, IusblConfig, IusblNavigator, Navigator, ParticleTracker, PlanarConfig, PlanarNavigator,
+    Aiding, GaussianTracker, IusblNavigator, Navigator, ParticleTracker, PlanarConfig, PlanarNavigator,
     Range6DofNavigator, SingleBeaconNavigator,
 };
 use rand::RngExt;
@@ -97,25 +97,36 @@ pub(crate) fn tracker_sigma(s: &PassiveUsbl) -> SVector<f64, DIM> {
     ])
 }
 
-/// Every estimator of a passive-USBL scenario on every AUV, each AUV's started at its
-/// truth `truth0[v]` plus one draw (the same for all its estimators; its particle
-/// filters share one seed).
-pub(crate) fn passive_usbl(s: &PassiveUsbl, truth0: &[TrackState], seed: u64, run: u64) -> Vec<Track> {
+/// Where a passive-USBL scenario's trackers of each AUV start: its truth `truth0[v]`
+/// plus one draw, and the seed its particle filters share.
+pub(crate) fn tracker_starts(s: &PassiveUsbl, truth0: &[TrackState], seed: u64, run: u64) -> Vec<(TrackState, u64)> {
+    let sigma0 = tracker_sigma(s);
+    truth0
+        .iter()
+        .enumerate()
+        .map(|(v, x)| {
+            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
+            let mut x0 = x + sigma0.map(|sd| gauss(&mut init_rng, sd));
+            x0[idx::PSI] = wrap_angle(x0[idx::PSI]);
+            (x0, init_rng.random())
+        })
+        .collect()
+}
+
+/// Every estimator of a passive-USBL scenario on every AUV, each AUV's started as
+/// [`tracker_starts`] says (the same for all its estimators).
+pub(crate) fn passive_usbl(s: &PassiveUsbl, starts: &[(TrackState, u64)]) -> Vec<Track> {
     let sigma0 = tracker_sigma(s);
     let mut tracks = Vec::new();
-    for (v, x) in truth0.iter().enumerate() {
-        let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
-        let mut x0 = x + sigma0.map(|sd| gauss(&mut init_rng, sd));
-        x0[idx::PSI] = wrap_angle(x0[idx::PSI]);
-        let pf_seed: u64 = init_rng.random();
+    for (v, (x0, pf_seed)) in starts.iter().enumerate() {
         for e in &s.estimators {
             let config = e.tracker_config(s.tracker_noise());
             let navigator: Box<dyn Navigator> = match e.kind {
                 EstimatorKind::Particle => {
                     let (n, settings) = e.particle_settings();
-                    Box::new(ParticleTracker::new(config, settings, n, 0.0, &x0, &sigma0, pf_seed))
+                    Box::new(ParticleTracker::new(config, settings, n, 0.0, x0, &sigma0, *pf_seed))
                 }
-                _ => Box::new(GaussianTracker::new(config, e.filter_kind(), 0.0, &x0, &sigma0)),
+                _ => Box::new(GaussianTracker::new(config, e.filter_kind(), 0.0, x0, &sigma0)),
             };
             tracks.push(Track { vehicle: v, navigator });
         }
@@ -123,48 +134,53 @@ pub(crate) fn passive_usbl(s: &PassiveUsbl, truth0: &[TrackState], seed: u64, ru
     tracks
 }
 
-/// The iUSBL navigator's settings from the scenario.
-pub(crate) fn iusbl_config(s: &Fleet, factored: bool) -> IusblConfig {
+/// The iUSBL navigator's settings of a fleet scenario (its navigation, dock and signal).
+pub(crate) fn iusbl_keys(s: &Fleet) -> IusblKeys {
     let n = &s.navigation;
-    IusblConfig {
-        filter: FactoredSettings { particles: n.particles, max_range_m: n.max_range_m, reinitialised: n.reinitialised },
-        factored,
+    IusblKeys {
+        particles: n.particles,
+        reinitialised: n.reinitialised,
+        max_range_m: n.max_range_m,
         sigma_speed_m_s: n.sigma_speed_m_s,
-        sigma_heading_rad: n.sigma_heading_deg.to_radians(),
+        sigma_heading_deg: n.sigma_heading_deg,
         beacon_speed_m_s: n.beacon_speed_m_s,
         beacon_depth_m: s.dock.beacon_depth_m,
         confirmations: n.confirmations,
         floor: n.floor,
         beam_exponent: n.beam_exponent,
-        fix_sigma_range_m: s.signal.range_sigma_m.max(0.05),
-        fix_sigma_angle_rad: s.signal.angle_sigma_deg.to_radians().max(0.5f64.to_radians()),
+        fix_range_sigma_m: s.signal.range_sigma_m.max(0.05),
+        fix_angle_sigma_deg: s.signal.angle_sigma_deg.max(0.5),
         sound_speed_m_s: s.signal.sound_speed_m_s,
-        ..IusblConfig::default()
     }
+}
+
+/// The seeds of each estimator of every AUV of a fleet scenario's run, in track order.
+pub(crate) fn fleet_seeds(s: &Fleet, seed: u64, run: u64) -> Vec<Vec<u64>> {
+    (0..s.auvs.len())
+        .map(|v| {
+            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
+            s.estimators.iter().map(|_| init_rng.random()).collect()
+        })
+        .collect()
 }
 
 /// Every AUV's estimators of a fleet scenario, in the scenario's order.
 pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
     let (waveforms, elements) = (rypkema_modes(), pyramid_8cm());
+    let keys = iusbl_keys(s);
     let mut tracks = Vec::new();
-    for (v, a) in s.auvs.iter().enumerate() {
-        let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
-        for e in &s.estimators {
-            let filter_seed: u64 = init_rng.random();
-            let navigator: Box<dyn Navigator> = match e {
-                FleetEstimator::Iusbl | FleetEstimator::IusblJoint => {
-                    let config = iusbl_config(s, *e == FleetEstimator::Iusbl);
-                    let receiver = (s.signal.model == SignalModel::Channel).then(|| {
-                        let rc = ReceiverConfig { sound_speed_m_s: s.signal.sound_speed_m_s, ..Default::default() };
-                        ModeReceiver::new(&waveforms, &elements, rc)
-                    });
-                    Box::new(IusblNavigator::new(config, receiver, filter_seed))
-                }
-                FleetEstimator::DeadReckoning => {
-                    let config = PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() };
-                    let pose = (a.start_north_m, a.start_east_m, a.start_heading_deg.to_radians());
-                    Box::new(PlanarNavigator::new(config, FilterKind::Ekf, 0.0, pose, 1.0, 0.05))
-                }
+    for ((v, a), seeds) in s.auvs.iter().enumerate().zip(fleet_seeds(s, seed, run)) {
+        for (e, filter_seed) in s.estimators.iter().zip(seeds) {
+            let navigator: Box<dyn Navigator> = if e.iusbl() {
+                let receiver = (s.signal.model == SignalModel::Channel).then(|| {
+                    let rc = ReceiverConfig { sound_speed_m_s: s.signal.sound_speed_m_s, ..Default::default() };
+                    ModeReceiver::new(&waveforms, &elements, rc)
+                });
+                Box::new(IusblNavigator::new(keys.config(*e == EstimatorKind::Iusbl), receiver, filter_seed))
+            } else {
+                let config = PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() };
+                let pose = (a.start_north_m, a.start_east_m, a.start_heading_deg.to_radians());
+                Box::new(PlanarNavigator::new(config, FilterKind::Ekf, 0.0, pose, 1.0, 0.05))
             };
             tracks.push(Track { vehicle: v, navigator });
         }
@@ -172,9 +188,52 @@ pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
     tracks
 }
 
-/// An estimator of a log description (replay, stream, Python): the planar family its
-/// configuration describes, built by the session at its start and again from its last
-/// sound pose.
-pub(crate) fn log(spec: &crate::scenario::EstimatorSpec) -> onebeacon::nav::session::Builder {
+/// An estimator of a log description (replay, stream, Python) on a vehicle that starts
+/// as `initial` says, built by the session at its start and again from its last sound
+/// pose: a USBL tracker (pf, bearing: hoff2024's eight states, the rest of the state
+/// from `initial`), the iUSBL navigator (which starts from its first fix), or the planar
+/// family.
+pub(crate) fn log(spec: &EstimatorSpec, initial: &crate::replay::schema::Initial) -> onebeacon::nav::session::Builder {
+    // the seed's 64 bits (TOML integers are signed)
+    let seed = spec.seed.or(initial.seed).unwrap_or(0) as u64;
+    if spec.kind.tracks_bearings() {
+        let config = spec.tracker_config(TrackerNoise::default());
+        let (particles, settings) = spec.particle_settings();
+        let filter = spec.filter_kind();
+        let particle = spec.kind == EstimatorKind::Particle;
+        let i = initial.clone();
+        return Box::new(move |t0, (north, east, heading), sigma_position, sigma_heading| {
+            let x0 = SVector::<f64, DIM>::from([
+                north,
+                east,
+                i.depth_m,
+                i.pitch_deg.to_radians(),
+                heading,
+                i.speed_m_s,
+                i.pitch_rate_bias_deg_s.to_radians(),
+                i.heading_rate_bias_deg_s.to_radians(),
+            ]);
+            let bias = i.rate_bias_sigma_deg_s.to_radians();
+            let sigma0 = SVector::<f64, DIM>::from([
+                sigma_position,
+                sigma_position,
+                i.depth_sigma_m,
+                i.pitch_sigma_deg.to_radians(),
+                sigma_heading,
+                i.speed_sigma_m_s,
+                bias,
+                bias,
+            ]);
+            if particle {
+                Box::new(ParticleTracker::new(config, settings, particles, t0, &x0, &sigma0, seed))
+            } else {
+                Box::new(GaussianTracker::new(config, filter, t0, &x0, &sigma0))
+            }
+        });
+    }
+    if spec.kind.iusbl() {
+        let config = spec.iusbl.clone().unwrap_or_default().config(spec.kind == EstimatorKind::Iusbl);
+        return Box::new(move |_, _, _, _| Box::new(IusblNavigator::new(config, None, seed)));
+    }
     onebeacon::nav::planar::builder(spec.planar_config(), spec.filter_kind())
 }

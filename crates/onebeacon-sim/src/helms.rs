@@ -5,50 +5,52 @@
 //! ([`onebeacon::vehicle`]).
 
 use crate::engine::Helm;
-use crate::scenario::fleet::{Fleet, MODES};
+use crate::scenario::fleet::Fleet;
 use crate::scenario::moving_beacon::GuidanceKind as FimKind;
 use crate::scenario::passive_usbl::GuidanceKind as BearingKind;
 use crate::scenario::{MovingBeacon, MovingBeaconCell, PassiveUsbl, PassiveUsblCell};
 use nalgebra::Vector2;
-use onebeacon::guidance::bearing::{BearingPlanner, SpreadMetric};
+use onebeacon::geo::Frame;
 use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, best_standoff};
-use onebeacon::vehicle::autonomy::{Autonomy, AutonomySettings};
-use onebeacon::vehicle::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
-use onebeacon::vehicle::behaviours::Behaviours;
 use onebeacon::vehicle::fim::{FimGuidance, FimGuidanceConfig, FimMode};
+use onebeacon::vehicle::spec::{BearingModeName, BearingSpec, BehavioursSpec, ControllerSpec, MetricName};
 
-/// The ASV of a passive-USBL world, starting at `home`: it serves every AUV.
-pub(crate) fn passive_usbl(s: &PassiveUsbl, cell: &PassiveUsblCell, home: Vector2<f64>) -> Vec<Helm> {
+/// The controller of a passive-USBL world's ASV, starting at `home`, as a stream
+/// configuration gives it (the planner knows the USBL as the first estimator assumes it).
+pub(crate) fn passive_usbl_spec(s: &PassiveUsbl, cell: &PassiveUsblCell, home: Vector2<f64>) -> ControllerSpec {
     let g = &s.guidance;
     // the baselines keep the determinant for their (unused) planner
     let (mode, metric) = match cell.guidance {
-        BearingKind::Determinant => (BearingMode::Planner, SpreadMetric::Determinant),
-        BearingKind::MaxEigenvalue => (BearingMode::Planner, SpreadMetric::MaxEigenvalue),
-        BearingKind::Static => (BearingMode::Static, SpreadMetric::Determinant),
-        BearingKind::Circle => (BearingMode::Circle, SpreadMetric::Determinant),
-        BearingKind::Offset => (BearingMode::Offset, SpreadMetric::Determinant),
+        BearingKind::Determinant => (BearingModeName::Planner, MetricName::Determinant),
+        BearingKind::MaxEigenvalue => (BearingModeName::Planner, MetricName::MaxEigenvalue),
+        BearingKind::Static => (BearingModeName::Static, MetricName::Determinant),
+        BearingKind::Circle => (BearingModeName::Circle, MetricName::Determinant),
+        BearingKind::Offset => (BearingModeName::Offset, MetricName::Determinant),
     };
-    let planner = BearingPlanner {
+    ControllerSpec::Bearing(BearingSpec {
+        mode,
         metric,
         r1_m: g.r1_m,
         r2_m: g.r2_m,
         radii: g.radii,
         angles: g.angles,
-        // the planner knows the USBL as the first estimator assumes it
-        sigma_usbl_rad_per_m: s.estimators[0].tracker_config(s.tracker_noise()).noise.usbl_sigma_rad_per_m,
-    };
-    let config = BearingGuidanceConfig {
-        mode,
-        planner,
+        usbl_sigma_deg_per_m: s.estimators[0].usbl_sigma_deg_per_m.unwrap_or(s.usbl.noise_deg_per_m),
         nominal_speed_m_s: s.asv.nominal_speed_m_s,
         period_s: s.mission.message_period_s,
         planner_particles: g.planner_particles,
         lead_periods: g.lead_periods,
         circle_radius_m: g.circle_radius_m,
         offset_m: g.offset_m,
-        home_m: home,
-    };
-    vec![Helm { controller: Box::new(BearingGuidance::new(config)), serves: (0..s.auvs().len()).collect() }]
+        home_x_m: home.x,
+        home_y_m: home.y,
+        decide_on: "own_fix".into(),
+    })
+}
+
+/// The ASV of a passive-USBL world, starting at `home`: it serves every AUV.
+pub(crate) fn passive_usbl(s: &PassiveUsbl, cell: &PassiveUsblCell, home: Vector2<f64>) -> Vec<Helm> {
+    let controller = passive_usbl_spec(s, cell, home).build(Frame::Ned).controller;
+    vec![Helm { controller, serves: (0..s.auvs().len()).collect() }]
 }
 
 /// The ASV's start in a moving-beacon world: the best standoff for the vehicle's start
@@ -88,18 +90,21 @@ pub(crate) fn moving_beacon(s: &MovingBeacon, cell: &MovingBeaconCell, home: Vec
     vec![Helm { controller: Box::new(FimGuidance::new(config)), serves: vec![0] }]
 }
 
+/// The controller of fleet AUV `v`, as a stream configuration gives it: its behaviours
+/// by command mode, deciding after each depth reading (the last of a step's sensors).
+pub(crate) fn fleet_spec(s: &Fleet, v: usize) -> ControllerSpec {
+    let a = &s.auvs[v];
+    ControllerSpec::Behaviours(BehavioursSpec {
+        speed_m_s: a.speed_m_s,
+        depth_m: a.depth_m,
+        modes: a.modes.clone(),
+        decide_on: "depth".into(),
+    })
+}
+
 /// Each fleet AUV's behaviours by command mode, on its own first estimator.
 pub(crate) fn fleet(s: &Fleet) -> Vec<Helm> {
-    s.auvs
-        .iter()
-        .enumerate()
-        .map(|(v, a)| {
-            let settings = AutonomySettings { speed_m_s: a.speed_m_s, depth_m: a.depth_m, ..Default::default() };
-            let mut modes = vec![None; MODES];
-            for m in &a.modes {
-                modes[m.mode - 1] = Some(m.behaviour());
-            }
-            Helm { controller: Box::new(Behaviours::new(Autonomy::new(settings, modes))), serves: vec![v] }
-        })
+    (0..s.auvs.len())
+        .map(|v| Helm { controller: fleet_spec(s, v).build(Frame::Ned).controller, serves: vec![v] })
         .collect()
 }

@@ -25,6 +25,7 @@ mod factory;
 pub mod fleet;
 mod helms;
 pub mod json;
+pub mod messages;
 pub mod metrics;
 pub mod montecarlo;
 pub mod partial;

@@ -4,6 +4,7 @@
 //! cell, seed, run index).
 
 use crate::engine::{self, Helm, Observer, Step, Track, VehicleTruth, World};
+use crate::messages::{Computer, Messages, fleet_computers, passive_usbl_computer};
 use crate::metrics::RunMetrics;
 use crate::scenario::{Cell, Scenario};
 use crate::world::{
@@ -142,22 +143,43 @@ pub fn recorded_bytes(s: &Scenario) -> f64 {
 /// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
 /// A cell of another world than the scenario's is a programming error.
 pub fn simulate(s: &Scenario, cell: &Cell, seed: u64, run: u64, record: bool) -> RunOutput {
-    simulate_recording(s, cell, seed, run, Recorder::new(record, None))
+    simulate_recording(s, cell, seed, run, Recorder::new(record, None), false).0
 }
 
 /// [`simulate`] recording every step, and the belief of the first vehicle's first
 /// estimator at step `step` (up to `samples` samples of it; None if it has none or the
 /// run is shorter).
 pub fn simulate_with_belief(s: &Scenario, cell: &Cell, seed: u64, run: u64, step: usize, samples: usize) -> RunOutput {
-    simulate_recording(s, cell, seed, run, Recorder::new(true, Some((step, samples))))
+    simulate_recording(s, cell, seed, run, Recorder::new(true, Some((step, samples))), false).0
 }
 
-fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: Recorder) -> RunOutput {
+/// [`simulate`] recording every step (and the belief at `belief`: step, samples), with
+/// what each vehicle's computer heard and decided ([`crate::messages`]); None for a
+/// world whose vehicles' computers a stream cannot run (fixed and moving beacon; a fleet
+/// with the channel model, whose captures are not JSON lines).
+pub fn simulate_messages(
+    s: &Scenario,
+    cell: &Cell,
+    seed: u64,
+    run: u64,
+    belief: Option<(usize, usize)>,
+) -> (RunOutput, Option<Vec<Computer>>) {
+    simulate_recording(s, cell, seed, run, Recorder::new(true, belief), true)
+}
+
+fn simulate_recording(
+    s: &Scenario,
+    cell: &Cell,
+    seed: u64,
+    run: u64,
+    recorder: Recorder,
+    messages: bool,
+) -> (RunOutput, Option<Vec<Computer>>) {
     match (s, cell) {
         (Scenario::FixedBeacon(s), Cell::FixedBeacon(c)) => {
             let mut world = FixedBeaconWorld::new(s, c, seed, run);
             let mut tracks = factory::fixed_beacon(s, world.unicycle_state(), seed, run);
-            drive(&mut world, &mut tracks, &mut [], None, recorder)
+            (drive(&mut world, &mut tracks, &mut [], vec![], recorder), None)
         }
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let asv0 = helms::initial_asv_position(s, c);
@@ -165,23 +187,36 @@ fn simulate_recording(s: &Scenario, cell: &Cell, seed: u64, run: u64, recorder: 
             let mut tracks = factory::moving_beacon(s, &world.states(), seed, run);
             let mut helms = helms::moving_beacon(s, c, asv0);
             let mut info = Information::new(range_information(s.sensor_noise()));
-            let mut out = drive(&mut world, &mut tracks, &mut helms, Some(&mut info), recorder);
+            let mut out = drive(&mut world, &mut tracks, &mut helms, vec![&mut info], recorder);
             out.information = info.into_inner();
-            out
+            (out, None)
         }
         (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(c)) => {
             let mut world = PassiveUsblWorld::new(s, seed, run);
-            let mut tracks = factory::passive_usbl(s, &world.initial_states(), seed, run);
+            let starts = factory::tracker_starts(s, &world.initial_states(), seed, run);
+            let mut tracks = factory::passive_usbl(s, &starts);
             let mut helms = helms::passive_usbl(s, c, world.asv_start());
             let mut info = Information::new(bearing_information(s.tracker_noise()));
-            let mut out = drive(&mut world, &mut tracks, &mut helms, Some(&mut info), recorder);
+            let computers = messages.then(|| vec![passive_usbl_computer(s, c, world.asv_start(), &starts)]);
+            let mut m = computers.map(|c| Messages::new(c, helms.iter().map(|h| h.serves.clone()).collect()));
+            let mut out = match &mut m {
+                Some(m) => drive(&mut world, &mut tracks, &mut helms, vec![&mut info, m], recorder),
+                None => drive(&mut world, &mut tracks, &mut helms, vec![&mut info], recorder),
+            };
             out.information = info.into_inner();
-            out
+            (out, m.map(Messages::into_inner))
         }
         (Scenario::Fleet(s), Cell::Fleet) => {
             let mut world = FleetWorld::new(s, seed, run);
             let mut tracks = factory::fleet(s, seed, run);
-            drive(&mut world, &mut tracks, &mut helms::fleet(s), None, recorder)
+            let mut helms = helms::fleet(s);
+            let computers = messages.then(|| fleet_computers(s, seed, run)).flatten();
+            let mut m = computers.map(|c| Messages::new(c, helms.iter().map(|h| h.serves.clone()).collect()));
+            let out = match &mut m {
+                Some(m) => drive(&mut world, &mut tracks, &mut helms, vec![m], recorder),
+                None => drive(&mut world, &mut tracks, &mut helms, vec![], recorder),
+            };
+            (out, m.map(Messages::into_inner))
         }
         _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),
     }
@@ -192,14 +227,14 @@ fn drive(
     world: &mut dyn World,
     tracks: &mut [Track],
     helms: &mut [Helm],
-    extra: Option<&mut dyn Observer>,
+    extra: Vec<&mut dyn Observer>,
     mut recorder: Recorder,
 ) -> RunOutput {
     let mut scoring = Scoring::new(tracks.iter().map(|t| t.vehicle).collect(), world.steps());
     {
         let mut observers: Vec<&mut dyn Observer> = vec![&mut scoring, &mut recorder];
-        if let Some(extra) = extra {
-            observers.push(extra);
+        for o in extra {
+            observers.push(o);
         }
         engine::run(world, tracks, helms, &mut observers);
     }
@@ -320,9 +355,9 @@ impl Observer for Recorder {
         });
     }
 
-    fn guidance(&mut self, snapshot: &GuidanceSnapshot) {
-        if self.on {
-            self.guidance.push(snapshot.clone());
+    fn decided(&mut self, _helm: usize, _situation: &onebeacon::vehicle::Situation, d: &onebeacon::vehicle::Decided) {
+        if let Some(g) = d.snapshot.as_ref().filter(|_| self.on) {
+            self.guidance.push(g.clone());
         }
     }
 }

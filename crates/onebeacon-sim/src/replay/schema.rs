@@ -334,6 +334,31 @@ pub struct Initial {
     pub position_sigma_m: f64,
     #[serde(default = "default_heading_sigma_deg", alias = "sigma_heading_deg")]
     pub heading_sigma_deg: f64,
+    /// When the estimators start, s (default: the first item's time).
+    pub t0_s: Option<f64>,
+    /// The seed of the vehicle's particle filters, any 64-bit integer (an estimator's
+    /// `seed` replaces it; default 0).
+    pub seed: Option<i64>,
+    /// The rest of a USBL tracker's state (kinds pf and bearing: hoff2024's eight
+    /// states) and its standard deviations; the rate biases start at 0 unless given.
+    #[serde(default)]
+    pub depth_m: f64,
+    #[serde(default)]
+    pub pitch_deg: f64,
+    #[serde(default)]
+    pub speed_m_s: f64,
+    #[serde(default)]
+    pub pitch_rate_bias_deg_s: f64,
+    #[serde(default)]
+    pub heading_rate_bias_deg_s: f64,
+    #[serde(default = "default_depth_sigma_m")]
+    pub depth_sigma_m: f64,
+    #[serde(default = "default_pitch_sigma_deg")]
+    pub pitch_sigma_deg: f64,
+    #[serde(default = "default_speed_sigma_m_s")]
+    pub speed_sigma_m_s: f64,
+    #[serde(default = "default_rate_bias_sigma_deg_s")]
+    pub rate_bias_sigma_deg_s: f64,
 }
 
 /// Left out, `[initial]` starts from the first ground-truth pose and its heading column.
@@ -349,6 +374,17 @@ impl Default for Initial {
             heading_deg: None,
             position_sigma_m: default_position_sigma_m(),
             heading_sigma_deg: default_heading_sigma_deg(),
+            t0_s: None,
+            seed: None,
+            depth_m: 0.0,
+            pitch_deg: 0.0,
+            speed_m_s: 0.0,
+            pitch_rate_bias_deg_s: 0.0,
+            heading_rate_bias_deg_s: 0.0,
+            depth_sigma_m: default_depth_sigma_m(),
+            pitch_sigma_deg: default_pitch_sigma_deg(),
+            speed_sigma_m_s: default_speed_sigma_m_s(),
+            rate_bias_sigma_deg_s: default_rate_bias_sigma_deg_s(),
         }
     }
 }
@@ -375,6 +411,19 @@ pub(super) fn default_position_sigma_m() -> f64 {
 }
 pub(super) fn default_heading_sigma_deg() -> f64 {
     5.0
+}
+// a tracker's, as hoff2024's built-in scenario
+fn default_depth_sigma_m() -> f64 {
+    1.0
+}
+fn default_pitch_sigma_deg() -> f64 {
+    2.0
+}
+fn default_speed_sigma_m_s() -> f64 {
+    0.3
+}
+fn default_rate_bias_sigma_deg_s() -> f64 {
+    0.05
 }
 
 /// The log description file.
@@ -406,4 +455,12 @@ pub struct LogDescription {
     /// What an item must respect before any estimator sees it.
     #[serde(default)]
     pub limits: Limits,
+    /// The vehicle's controller (stream): a surface vehicle's planner or an AUV's
+    /// behaviours, deciding on its estimators' beliefs.
+    pub controller: Option<onebeacon::vehicle::spec::ControllerSpec>,
+    /// `[[tracked]]` (stream): the vehicles a surface vehicle tracks, one `[initial]`
+    /// table each (a line's `vehicle` is its index); without it, one vehicle from
+    /// `[initial]`.
+    #[serde(default)]
+    pub tracked: Vec<Initial>,
 }

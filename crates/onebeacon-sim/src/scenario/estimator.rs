@@ -8,9 +8,12 @@
 
 use super::FilterName;
 use onebeacon::filter::FilterKind;
+use onebeacon::filter::factored::FactoredSettings;
 use onebeacon::filter::particle::{ParticleSettings, Resampler};
 use onebeacon::models::hoff::HoffProcess;
-use onebeacon::nav::{Aiding, EkfTuning, PlanarConfig, PlanarNoise, Robust, SensorNoise, TrackerConfig, TrackerNoise};
+use onebeacon::nav::{
+    Aiding, EkfTuning, IusblConfig, PlanarConfig, PlanarNoise, Robust, SensorNoise, TrackerConfig, TrackerNoise,
+};
 use serde::{Deserialize, Serialize};
 
 /// A heavy-tailed update (`robust` key).
@@ -83,6 +86,13 @@ pub enum EstimatorKind {
     /// The same models in an EKF or a UKF (`filter`).
     #[serde(rename = "bearing")]
     Bearing,
+    /// rypkema's factored iUSBL particle filter on the beacon's pings (fleet worlds,
+    /// logs of array fixes; its settings in `iusbl`).
+    #[serde(rename = "iusbl")]
+    Iusbl,
+    /// The same filter updated jointly (no factoring): what the factoring buys.
+    #[serde(rename = "iusbl-joint", alias = "iusbl_joint")]
+    IusblJoint,
 }
 
 impl EstimatorKind {
@@ -94,7 +104,19 @@ impl EstimatorKind {
             EstimatorKind::DeadReckoning => "dead-reckoning",
             EstimatorKind::Particle => "pf",
             EstimatorKind::Bearing => "bearing",
+            EstimatorKind::Iusbl => "iusbl",
+            EstimatorKind::IusblJoint => "iusbl-joint",
         }
+    }
+
+    /// Whether it tracks a vehicle by USBL bearings (hoff2024's trackers).
+    pub fn tracks_bearings(self) -> bool {
+        matches!(self, EstimatorKind::Particle | EstimatorKind::Bearing)
+    }
+
+    /// Whether it is rypkema's iUSBL navigator.
+    pub fn iusbl(self) -> bool {
+        matches!(self, EstimatorKind::Iusbl | EstimatorKind::IusblJoint)
     }
 
     /// The acoustic measurements the name stands for in `host`.
@@ -105,6 +127,8 @@ impl EstimatorKind {
             EstimatorKind::RangeEkf => host.acoustic(),
             EstimatorKind::DeadReckoning => Aiding::NONE,
             EstimatorKind::Particle | EstimatorKind::Bearing => Aiding::BEARING,
+            // array fixes, which no planar filter takes
+            EstimatorKind::Iusbl | EstimatorKind::IusblJoint => Aiding::NONE,
         }
     }
 }
@@ -210,6 +234,100 @@ pub struct EstimatorSpec {
     pub distance_scale_sigma: Option<f64>,
     pub estimate_turn_scale: Option<bool>,
     pub turn_scale_sigma: Option<f64>,
+    /// The seed of the estimator's random draws, any 64-bit integer (a particle
+    /// filter's; log; default: the vehicle's `[initial]` seed, else 0).
+    pub seed: Option<i64>,
+    /// The iUSBL navigator's settings (kinds iusbl and iusbl-joint on a log).
+    pub iusbl: Option<IusblKeys>,
+}
+
+/// The settings of rypkema's iUSBL navigator (`[estimators.iusbl]`); defaults are
+/// [`IusblConfig::default`]'s. A fleet scenario gives them from its `navigation`,
+/// `dock` and `signal` tables.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IusblKeys {
+    pub particles: usize,
+    /// Lowest-weighted particles of each domain drawn again uniformly at each update,
+    /// and the receiver's largest range, m.
+    pub reinitialised: usize,
+    pub max_range_m: f64,
+    pub sigma_speed_m_s: f64,
+    pub sigma_heading_deg: f64,
+    pub beacon_speed_m_s: f64,
+    pub beacon_depth_m: f64,
+    pub confirmations: usize,
+    pub floor: f64,
+    pub beam_exponent: f64,
+    /// The noise of an array fix's range (m) and direction (deg) as the filter weighs it.
+    pub fix_range_sigma_m: f64,
+    pub fix_angle_sigma_deg: f64,
+    pub sound_speed_m_s: f64,
+}
+
+impl Default for IusblKeys {
+    fn default() -> Self {
+        let c = IusblConfig::default();
+        Self {
+            particles: c.filter.particles,
+            reinitialised: c.filter.reinitialised,
+            max_range_m: c.filter.max_range_m,
+            sigma_speed_m_s: c.sigma_speed_m_s,
+            sigma_heading_deg: c.sigma_heading_rad.to_degrees(),
+            beacon_speed_m_s: c.beacon_speed_m_s,
+            beacon_depth_m: c.beacon_depth_m,
+            confirmations: c.confirmations,
+            floor: c.floor,
+            beam_exponent: c.beam_exponent,
+            fix_range_sigma_m: c.fix_sigma_range_m,
+            fix_angle_sigma_deg: c.fix_sigma_angle_rad.to_degrees(),
+            sound_speed_m_s: c.sound_speed_m_s,
+        }
+    }
+}
+
+impl IusblKeys {
+    /// The navigator's configuration, factored or joint.
+    pub fn config(&self, factored: bool) -> IusblConfig {
+        IusblConfig {
+            filter: FactoredSettings {
+                particles: self.particles,
+                max_range_m: self.max_range_m,
+                reinitialised: self.reinitialised,
+            },
+            factored,
+            sigma_speed_m_s: self.sigma_speed_m_s,
+            sigma_heading_rad: self.sigma_heading_deg.to_radians(),
+            beacon_speed_m_s: self.beacon_speed_m_s,
+            beacon_depth_m: self.beacon_depth_m,
+            confirmations: self.confirmations,
+            floor: self.floor,
+            beam_exponent: self.beam_exponent,
+            fix_sigma_range_m: self.fix_range_sigma_m,
+            fix_sigma_angle_rad: self.fix_angle_sigma_deg.to_radians(),
+            sound_speed_m_s: self.sound_speed_m_s,
+            ..IusblConfig::default()
+        }
+    }
+
+    /// The numeric keys with whether each must be > 0 (else >= 0).
+    pub(crate) fn numbers(&self) -> [(&'static str, f64, bool); 13] {
+        [
+            ("particles", self.particles as f64, true),
+            ("reinitialised", self.reinitialised as f64, false),
+            ("max_range_m", self.max_range_m, true),
+            ("sigma_speed_m_s", self.sigma_speed_m_s, true),
+            ("sigma_heading_deg", self.sigma_heading_deg, true),
+            ("beacon_speed_m_s", self.beacon_speed_m_s, false),
+            ("beacon_depth_m", self.beacon_depth_m, false),
+            ("confirmations", self.confirmations as f64, true),
+            ("floor", self.floor, false),
+            ("beam_exponent", self.beam_exponent, true),
+            ("fix_range_sigma_m", self.fix_range_sigma_m, true),
+            ("fix_angle_sigma_deg", self.fix_angle_sigma_deg, true),
+            ("sound_speed_m_s", self.sound_speed_m_s, true),
+        ]
+    }
 }
 
 /// Particles of a `pf` estimator without `particles` (hoff2024 sec. 5).
@@ -289,6 +407,8 @@ impl EstimatorSpec {
             distance_scale_sigma: None,
             estimate_turn_scale: None,
             turn_scale_sigma: None,
+            seed: None,
+            iusbl: None,
         }
     }
 
@@ -337,7 +457,7 @@ impl EstimatorSpec {
         use Sign::*;
         const RANGING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const FIXED_LOG: &[Host] = &[FixedBeacon, Log];
-        const USBL: &[Host] = &[PassiveUsbl];
+        const USBL: &[Host] = &[PassiveUsbl, Log];
         let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
         let mut keys = vec![
             ("range_sigma_m", self.range_sigma_m, Positive, RANGING),
@@ -346,6 +466,7 @@ impl EstimatorSpec {
             ("usbl_sigma_deg_per_m", self.usbl_sigma_deg_per_m, Positive, USBL),
             ("compass_sigma_deg", self.compass_sigma_deg, NonNegative, USBL),
             ("depth_sigma_m", self.depth_sigma_m, Positive, USBL),
+            ("seed", self.seed.map(|s| s as f64), Any, &[Log]),
             ("process_noise_scale", self.process_noise_scale, Positive, USBL),
             ("particles", self.particles.map(|n| n as f64), Positive, USBL),
             ("ess_fraction", self.ess_fraction, Positive, USBL),

@@ -8,7 +8,7 @@
 //! ENU offsets (x east, y north), converted in the built-in files.
 
 use super::validate::*;
-use super::{World, default_runs, default_seed};
+use super::{EstimatorKind, World, default_runs, default_seed};
 use crate::vehicles::sandshark::SandSharkParams;
 use serde::{Deserialize, Serialize};
 
@@ -40,35 +40,14 @@ pub struct Fleet {
     /// Which mode is sent from which beacon from when (in time order); mode 0: silent.
     pub schedule: Vec<ScheduleEntry>,
     pub auvs: Vec<FleetAuv>,
-    /// The estimators every AUV runs (the first flies the behaviours).
+    /// The estimators every AUV runs, by kind (the first flies the behaviours): `iusbl`,
+    /// `iusbl-joint`, `dead-reckoning`.
     #[serde(default = "default_estimators")]
-    pub estimators: Vec<FleetEstimator>,
+    pub estimators: Vec<EstimatorKind>,
 }
 
-fn default_estimators() -> Vec<FleetEstimator> {
-    vec![FleetEstimator::Iusbl, FleetEstimator::IusblJoint, FleetEstimator::DeadReckoning]
-}
-
-/// The estimators of a fleet world.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum FleetEstimator {
-    /// The factored iUSBL particle filter (rypkema sec. 3.3).
-    Iusbl,
-    /// The same filter updated jointly (no factoring): what the factoring buys.
-    IusblJoint,
-    /// Speed and compass heading integrated from the launch position (GPS at launch).
-    DeadReckoning,
-}
-
-impl FleetEstimator {
-    pub fn label(self) -> &'static str {
-        match self {
-            FleetEstimator::Iusbl => "iusbl",
-            FleetEstimator::IusblJoint => "iusbl-joint",
-            FleetEstimator::DeadReckoning => "dead-reckoning",
-        }
-    }
+fn default_estimators() -> Vec<EstimatorKind> {
+    vec![EstimatorKind::Iusbl, EstimatorKind::IusblJoint, EstimatorKind::DeadReckoning]
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -249,93 +228,8 @@ fn default_depth() -> f64 {
     2.5
 }
 
-/// The behaviours of `onebeacon::vehicle::autonomy`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BehaviourName {
-    Loiter,
-    Trackline,
-    OffsetFollow,
-    Return,
-    Abort,
-}
-
-/// One mode's behaviour and its parameters (offsets from the beacon, NED).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ModeBehaviour {
-    /// 1 to 4.
-    pub mode: usize,
-    pub behaviour: BehaviourName,
-    #[serde(default)]
-    pub offset_north_m: f64,
-    #[serde(default)]
-    pub offset_east_m: f64,
-    /// Loiter.
-    pub radius_m: Option<f64>,
-    #[serde(default)]
-    pub clockwise: bool,
-    /// Trackline and return: the line's heading, deg from north; its length, m.
-    pub heading_deg: Option<f64>,
-    pub length_m: Option<f64>,
-    /// Trackline and offset follow: the buffer, m.
-    pub buffer_m: Option<f64>,
-    /// Offset follow: the depth ceiling, m.
-    pub ceiling_m: Option<f64>,
-}
-
-impl ModeBehaviour {
-    /// The behaviour, its required keys checked by validation.
-    pub fn behaviour(&self) -> onebeacon::vehicle::autonomy::Behaviour {
-        use onebeacon::vehicle::autonomy::Behaviour as B;
-        let at = nalgebra::Vector2::new(self.offset_north_m, self.offset_east_m);
-        let heading = self.heading_deg.unwrap_or(0.0).to_radians();
-        let length = self.length_m.unwrap_or(0.0);
-        match self.behaviour {
-            BehaviourName::Loiter => {
-                B::Loiter { centre_m: at, radius_m: self.radius_m.unwrap_or(0.0), clockwise: self.clockwise }
-            }
-            BehaviourName::Trackline => B::Trackline {
-                centre_m: at,
-                heading_rad: heading,
-                length_m: length,
-                buffer_m: self.buffer_m.unwrap_or(0.0),
-            },
-            BehaviourName::OffsetFollow => B::OffsetFollow {
-                offset_m: at,
-                buffer_m: self.buffer_m.unwrap_or(0.0),
-                ceiling_m: self.ceiling_m.unwrap_or(0.0),
-            },
-            BehaviourName::Return => B::Return { end_m: at, heading_rad: heading, length_m: length },
-            BehaviourName::Abort => B::Abort,
-        }
-    }
-
-    /// The keys `behaviour` needs.
-    pub fn required(&self) -> &'static [&'static str] {
-        match self.behaviour {
-            BehaviourName::Loiter => &["radius_m"],
-            BehaviourName::Trackline => &["heading_deg", "length_m", "buffer_m"],
-            BehaviourName::OffsetFollow => &["buffer_m", "ceiling_m"],
-            BehaviourName::Return => &["heading_deg", "length_m"],
-            BehaviourName::Abort => &[],
-        }
-    }
-
-    pub fn value(&self, key: &str) -> Option<f64> {
-        match key {
-            "radius_m" => self.radius_m,
-            "heading_deg" => self.heading_deg,
-            "length_m" => self.length_m,
-            "buffer_m" => self.buffer_m,
-            "ceiling_m" => self.ceiling_m,
-            _ => None,
-        }
-    }
-}
-
-/// The mode numbers of rypkema's bank.
-pub const MODES: usize = 4;
+/// The behaviours by mode: the onboard crate's configuration types.
+pub use onebeacon::vehicle::spec::{BehaviourName, MODES, ModeBehaviour};
 
 impl Fleet {
     pub fn steps(&self) -> usize {
@@ -486,8 +380,15 @@ pub(super) fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
             }
         }
     }
+    if let Some(e) = s.estimators.iter().find(|e| !e.iusbl() && **e != EstimatorKind::DeadReckoning) {
+        return Err(violation(
+            "estimators",
+            e.label(),
+            "a fleet world runs `iusbl`, `iusbl-joint` and `dead-reckoning` (the others need what it does not give)",
+        ));
+    }
     match s.estimators.first() {
-        Some(FleetEstimator::Iusbl | FleetEstimator::IusblJoint) => {}
+        Some(e) if e.iusbl() => {}
         other => {
             return Err(violation(
                 "estimators",

@@ -4,6 +4,7 @@
 
 use super::Scenario;
 use super::estimator::{EstimatorKind, EstimatorSpec, Host, Sign};
+use onebeacon::nav::Aiding;
 
 pub(crate) struct Violation {
     pub key: String,
@@ -185,12 +186,20 @@ pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<()
             });
         }
         let particle = e.kind == EstimatorKind::Particle;
-        let tracker = particle || e.kind == EstimatorKind::Bearing;
-        if tracker != (host == Host::PassiveUsbl)
-            && (tracker || matches!(e.kind, EstimatorKind::RangeDoppler | EstimatorKind::Rosb))
+        let tracker = e.kind.tracks_bearings();
+        if e.kind.iusbl() && host != Host::Log {
+            return Err(Violation {
+                key: key("kind"),
+                value: format!("{:?}", e.kind.label()),
+                allowed: format!("navigates on a beacon's array fixes: a fleet world or a log, not a {}", host.label()),
+            });
+        }
+        // a log may carry USBL bearings (a surface vehicle's stream)
+        if tracker && !matches!(host, Host::PassiveUsbl | Host::Log)
+            || host == Host::PassiveUsbl && matches!(e.kind, EstimatorKind::RangeDoppler | EstimatorKind::Rosb)
         {
             let allowed = if tracker {
-                format!("tracks a vehicle by USBL bearings: a passive_usbl world only, not a {}", host.label())
+                format!("tracks a vehicle by USBL bearings: a passive_usbl world or a log, not a {}", host.label())
             } else {
                 "uses ranges; a passive_usbl world gives USBL bearings and the vehicle's reports (kinds pf, bearing, range-ekf, dead-reckoning)".to_string()
             };
@@ -216,7 +225,8 @@ pub(crate) fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<()
                 check(&key("ess_fraction"), f, Rule::Probability)?;
             }
         }
-        let (asked, has) = (e.aiding(host), host.acoustic());
+        let has = if host == Host::Log && tracker { Aiding::BEARING } else { host.acoustic() };
+        let asked = e.aiding(host);
         if (asked.doppler && !has.doppler) || (asked.range && !has.range) || (asked.bearing && !has.bearing) {
             let (k, value) = match &e.measurements {
                 Some(m) => (key("measurements"), format!("{m:?}").to_lowercase()),

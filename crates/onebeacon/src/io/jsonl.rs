@@ -4,8 +4,10 @@
 //! the line format is in docs/logs.md.
 
 use crate::geo::Frame;
-use crate::nav::session::{Input, Item, Session, Step, TruthPose, resolve_beacon};
+use crate::nav::session::{Input, Item, Step, TruthPose, resolve_beacon};
 use crate::nav::{BeaconFix, Kind, Outcome};
+use crate::vehicle::unit::{Plan, Unit};
+use crate::vehicle::{Command, OwnFix, Phase};
 use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
 use std::collections::{BTreeMap, BTreeSet};
@@ -83,16 +85,47 @@ pub fn item_json(item: &Item) -> Value {
 
 /// The kinds a line may have.
 pub const KINDS: &str = "odometry, body_odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
-    range_doppler, bearing, report, beacon_position, ground_truth";
+    range_doppler, bearing, report, array_fix, beacon_position, ground_truth, own_fix";
+
+/// The kinds as a list.
+pub fn kinds() -> Vec<&'static str> {
+    KINDS.split(", ").collect()
+}
+
+/// One parsed line: an item for the sessions (about vehicle `vehicle`, when the line
+/// names one), or the vehicle's own fix (in the line's frame).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Line {
+    Item { vehicle: Option<usize>, item: Item },
+    OwnFix { t_s: f64, fix: OwnFix },
+}
 
 /// Parses one JSON line into an item; `fixed` beacons resolve `beacon` ids, `tracked`
 /// ones (the ids of the `beacon_position` items the session took so far) are resolved
 /// by the session. The error names the key at fault and what is allowed.
 pub fn parse_item(line: &str, fixed: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u32>) -> Result<Item, LineError> {
-    parse(line, fixed, tracked).map_err(LineError)
+    match parse(line, fixed, tracked, 1).map_err(LineError)? {
+        Line::Item { item, .. } => Ok(item),
+        Line::OwnFix { .. } => Err(LineError("`own_fix` is a vehicle's own fix, not an item of a session".into())),
+    }
 }
 
-fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u32>) -> Result<Item, String> {
+/// Parses one JSON line of a stream whose computer estimates `vehicles` vehicles.
+pub fn parse_line(
+    line: &str,
+    fixed: &BTreeMap<u32, Vector3<f64>>,
+    tracked: &BTreeSet<u32>,
+    vehicles: usize,
+) -> Result<Line, LineError> {
+    parse(line, fixed, tracked, vehicles).map_err(LineError)
+}
+
+fn parse(
+    line: &str,
+    beacons: &BTreeMap<u32, Vector3<f64>>,
+    tracked: &BTreeSet<u32>,
+    vehicles: usize,
+) -> Result<Line, String> {
     let v: Map<String, Value> = serde_json::from_str(line).map_err(|e| format!("not a JSON object: {e}"))?;
     let finite = |key: &str, x: &Value| -> Result<f64, String> {
         x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| format!("`{key}` = {x} is not a finite number"))
@@ -115,6 +148,13 @@ fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u
         }
         b.t_tx_s = optional("t_tx_s")?;
         Ok(b)
+    };
+    let vehicle = match v.get("vehicle") {
+        None => None,
+        Some(x) => {
+            let n = x.as_u64().and_then(|n| usize::try_from(n).ok()).filter(|n| *n < vehicles);
+            Some(n.ok_or_else(|| format!("`vehicle` = {x} must be a vehicle index in 0..{vehicles}"))?)
+        }
     };
     let m = Input::Measurement;
     let input = match kind {
@@ -164,6 +204,24 @@ fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u
         "report" => {
             m(Kind::Report { heading_rad: num("heading_rad")?, speed_m_s: num("speed_m_s")?, depth_m: num("depth_m")? })
         }
+        "array_fix" => {
+            let mode = v.get("mode").and_then(Value::as_u64).and_then(|m| usize::try_from(m).ok());
+            m(Kind::ArrayFix {
+                beacon: beacon(tracked)?,
+                range_m: num("range_m")?,
+                azimuth_rad: num("azimuth_rad")?,
+                inclination_rad: num("inclination_rad")?,
+                mode: mode.ok_or("`mode` must be a command mode index (a non-negative integer)")?,
+            })
+        }
+        "own_fix" => {
+            let fix = OwnFix {
+                position_m: nalgebra::Vector2::new(num("x_m")?, num("y_m")?),
+                heading_rad: num("heading_rad")?,
+                speed_m_s: num("speed_m_s")?,
+            };
+            return Ok(Line::OwnFix { t_s, fix });
+        }
         "beacon_position" => {
             let beacon_id = beacon_id()?;
             let z = optional("z_m")?.unwrap_or(0.0);
@@ -175,7 +233,7 @@ fn parse(line: &str, beacons: &BTreeMap<u32, Vector3<f64>>, tracked: &BTreeSet<u
         }
         other => return Err(format!("unknown kind `{other}` (one of {KINDS})")),
     };
-    Ok(Item { t_s, input })
+    Ok(Line::Item { vehicle, item: Item { t_s, input } })
 }
 
 /// One output line: every estimator's estimate (estimators `names`) after input line
@@ -221,13 +279,55 @@ pub fn step_json(line: usize, step: &Step, names: &[String], frame: Frame) -> Va
     json!({"line": line, "t_s": step.t_s, "estimates": estimates})
 }
 
+/// A command as a JSON object, in `frame` (the stream's): a path (`from`, `to`, and the
+/// planner's waypoint and the vehicle it serves when `plan` is given), a waypoint, or a
+/// setpoint with the confirmed mode (index into the bank, null before one) and phase.
+pub fn command_json(command: &Command, plan: Option<Plan>, frame: Frame) -> Value {
+    let point = |p: nalgebra::Vector2<f64>| {
+        let (x, y, _) = frame.from_ned(&Vector3::new(p.x, p.y, 0.0));
+        (x, y)
+    };
+    match *command {
+        Command::Path { from, to } => {
+            let ((fx, fy), (tx, ty)) = (point(from), point(to));
+            let mut v = json!({"kind": "path", "from_x_m": fx, "from_y_m": fy, "to_x_m": tx, "to_y_m": ty});
+            if let Some(p) = plan {
+                let (wx, wy) = point(p.waypoint);
+                v["waypoint_x_m"] = json!(wx);
+                v["waypoint_y_m"] = json!(wy);
+                v["serving"] = json!(p.vehicle);
+            }
+            v
+        }
+        Command::Waypoint { waypoint, arrive_s } => {
+            let (x, y) = point(waypoint);
+            json!({"kind": "waypoint", "x_m": x, "y_m": y, "arrive_s": arrive_s})
+        }
+        Command::Setpoint { setpoint, mode, phase } => json!({
+            "kind": "setpoint",
+            "heading_rad": frame.heading_from_ned(setpoint.heading_rad),
+            "speed_m_s": setpoint.speed_m_s,
+            "depth_m": setpoint.depth_m,
+            "mode": mode,
+            "phase": match phase {
+                Phase::Waiting => "waiting",
+                Phase::Driving => "driving",
+                Phase::Drifting => "drifting",
+                Phase::Surfacing => "surfacing",
+            },
+        }),
+    }
+}
+
 /// What a stream keeps from line to line: the beacons whose positions it was given, the
-/// line count, and whether it said that it waits for its start.
+/// line count, whether it said that it waits for its start, and the controller's last
+/// complaint (said once until it changes).
 #[derive(Debug, Clone, Default)]
 pub struct Lines {
     tracked: BTreeSet<u32>,
     number: usize,
     waiting_told: bool,
+    undecided_told: Option<String>,
 }
 
 /// What [`Lines::push`] says of a line besides its output.
@@ -237,7 +337,7 @@ pub enum Note {
     /// session: why.
     Skipped(String),
     /// The line was taken, and something is worth saying (before the start, an
-    /// estimator started again).
+    /// estimator started again, the controller cannot decide yet).
     Info(String),
 }
 
@@ -247,15 +347,15 @@ impl Lines {
         self.number
     }
 
-    /// One input line (without its end; `too_long` when the reader cut it), into
-    /// `session` (fixed beacons `fixed`, lines in `frame`): the output line ([`step_json`])
-    /// when the session gave an estimate. `note` gets the line's number and what there
-    /// is to say of it. Nothing a line holds stops the stream or poisons the session.
+    /// One input line (without its end; `too_long` when the reader cut it), into `unit`:
+    /// the output line when there is one: the estimates of the line's session
+    /// ([`step_json`], with `vehicle` when the unit estimates several), and with a
+    /// controller its current command (`command`, [`command_json`]) and whether this line
+    /// made it decide (`decided`). `note` gets the line's number and what there is to
+    /// say of it. Nothing a line holds stops the stream or poisons the unit.
     pub fn push(
         &mut self,
-        session: &mut Session,
-        fixed: &BTreeMap<u32, Vector3<f64>>,
-        frame: Frame,
+        unit: &mut Unit,
         bytes: &[u8],
         too_long: bool,
         mut note: impl FnMut(usize, Note),
@@ -267,46 +367,107 @@ impl Lines {
             None
         };
         if too_long {
-            let max = session.limits().max_line_bytes;
+            let max = unit.session(0).limits().max_line_bytes;
             return skip(format!("longer than {max} bytes (limits.max_line_bytes); skipped"));
         }
         let Ok(line) = std::str::from_utf8(bytes) else { return skip("not UTF-8 text; skipped".into()) };
         if line.trim().is_empty() {
             return None;
         }
-        let item = match parse_item(line, fixed, &self.tracked) {
-            Ok(item) => item,
+        let vehicles = unit.sessions().len();
+        let parsed = match parse_line(line, &unit.fixed, &self.tracked, vehicles) {
+            Ok(p) => p,
             Err(e) => return skip(format!("{e}; skipped")),
         };
-        match session.push(&item) {
-            Ok(step) => {
+        let (t_s, kind, mut out) = match parsed {
+            Line::OwnFix { t_s, fix } => {
+                let far = 1e8;
+                if fix.position_m.iter().any(|v| v.abs() > far)
+                    || fix.heading_rad.abs() > 1e6
+                    || fix.speed_m_s.abs() > 1e3
+                {
+                    return skip("own_fix: a position beyond 1e8 m, a heading beyond 1e6 rad or a speed beyond 1000 m/s; skipped".into());
+                }
+                let p = unit.frame.to_ned(fix.position_m.x, fix.position_m.y, 0.0);
+                let ned = OwnFix { position_m: p.xy(), heading_rad: unit.frame.heading_to_ned(fix.heading_rad), ..fix };
+                unit.set_fix(ned);
+                (t_s, "own_fix", json!({"line": number, "t_s": t_s}))
+            }
+            Line::Item { vehicle, item } => {
+                let kind = match &item.input {
+                    Input::Measurement(m) => m.name(),
+                    Input::BeaconPosition { .. } => "beacon_position",
+                    Input::Truth(_) => "ground_truth",
+                };
+                let step = match unit.push(vehicle, &item) {
+                    Ok(step) => step,
+                    Err(screened) => return skip(format!("{screened}; screened out")),
+                };
                 if let Input::BeaconPosition { beacon_id, .. } = item.input {
                     self.tracked.insert(beacon_id);
                 }
-                let Some(step) = step else {
-                    if !std::mem::replace(&mut self.waiting_told, true) {
-                        note(number, Note::Info(format!("before the start: waiting for {}", session.waiting_for())));
+                let v = vehicle.unwrap_or(0);
+                let session = unit.session(v);
+                let out = match step {
+                    None => {
+                        if !std::mem::replace(&mut self.waiting_told, true) {
+                            note(
+                                number,
+                                Note::Info(format!("before the start: waiting for {}", session.waiting_for())),
+                            );
+                        }
+                        None
                     }
-                    return None;
+                    Some(step) => {
+                        for &i in &step.reinitialised {
+                            let name = &session.names[i];
+                            note(
+                                number,
+                                Note::Info(format!(
+                                    "{name}: its state stopped being finite and positive definite; started again from its last sound estimate"
+                                )),
+                            );
+                        }
+                        let mut out = step_json(number, &step, &session.names, unit.frame);
+                        if vehicles > 1 {
+                            out["vehicle"] = json!(v);
+                        }
+                        Some(out)
+                    }
                 };
-                for &i in &step.reinitialised {
-                    let name = &session.names[i];
-                    note(
-                        number,
-                        Note::Info(format!(
-                            "{name}: its state stopped being finite and positive definite; started again from its last sound estimate"
-                        )),
-                    );
+                match out {
+                    Some(out) => (item.t_s, kind, out),
+                    // before the start a controller has nothing to decide on
+                    None if !unit.has_controller() => return None,
+                    None => (item.t_s, kind, json!({"line": number, "t_s": item.t_s})),
                 }
-                Some(step_json(number, &step, &session.names, frame))
             }
-            Err(screened) => skip(format!("{screened}; screened out")),
+        };
+        if !unit.has_controller() {
+            return Some(out);
         }
+        let decided = unit.decides_on(kind).then(|| unit.decide(t_s)).flatten();
+        out["decided"] = json!(matches!(decided, Some(Ok(_))));
+        match decided {
+            Some(Err(e)) => {
+                let m = format!("the controller cannot decide: {e}");
+                if self.undecided_told.as_ref() != Some(&m) {
+                    note(number, Note::Info(m.clone()));
+                    self.undecided_told = Some(m);
+                }
+            }
+            Some(Ok(_)) => self.undecided_told = None,
+            None => {}
+        }
+        if let Some(c) = unit.command() {
+            out["command"] = command_json(&c, unit.plan(), unit.frame);
+        }
+        Some(out)
     }
 
     /// At the end of the input: `note` is told when the stream never reached its start.
-    pub fn finish(&self, session: &Session, mut note: impl FnMut(usize, Note)) {
-        if !session.started() {
+    pub fn finish(&self, unit: &Unit, mut note: impl FnMut(usize, Note)) {
+        if let Some(session) = unit.sessions().iter().find(|s| !s.started()) {
             note(
                 self.number,
                 Note::Info(format!(
@@ -318,22 +479,20 @@ impl Lines {
     }
 }
 
-/// Reads JSON Lines items from `input` into `session` (fixed beacons `fixed`, lines in
-/// `frame`), writing one [`step_json`] line per item to `output`, flushed after each.
-/// Nothing a line holds stops the stream: a line that is not UTF-8, longer than
-/// `limits.max_line_bytes`, not an item, or screened out by the session (time order,
-/// limits, unknown beacon) is skipped, and `report` gets its line number and why; so do
-/// an estimator started again and a stream that never reaches its start. Memory stays
-/// flat: one line is held at a time. Only an I/O error stops the stream.
+/// Reads JSON Lines from `input` into `unit`, writing one output line ([`Lines::push`])
+/// per line to `output`, flushed after each. Nothing a line holds stops the stream: a
+/// line that is not UTF-8, longer than `limits.max_line_bytes`, not an item, or
+/// screened out by the session (time order, limits, unknown beacon) is skipped, and
+/// `report` gets its line number and why; so do an estimator started again, a
+/// controller that cannot decide yet and a stream that never reaches its start. Memory
+/// stays flat: one line is held at a time. Only an I/O error stops the stream.
 pub fn run(
-    session: &mut Session,
-    fixed: &BTreeMap<u32, Vector3<f64>>,
-    frame: Frame,
+    unit: &mut Unit,
     mut input: impl BufRead,
     mut output: impl Write,
     mut report: impl FnMut(usize, &str),
 ) -> std::io::Result<()> {
-    let max_line = session.limits().max_line_bytes;
+    let max_line = unit.session(0).limits().max_line_bytes;
     let mut lines = Lines::default();
     let mut buf = Vec::new();
     let mut say = |line: usize, n: Note| match n {
@@ -344,12 +503,12 @@ pub fn run(
         if read == 0 {
             break;
         }
-        if let Some(out) = lines.push(session, fixed, frame, &buf, too_long, &mut say) {
+        if let Some(out) = lines.push(unit, &buf, too_long, &mut say) {
             writeln!(output, "{out}")?;
             output.flush()?;
         }
     }
-    lines.finish(session, say);
+    lines.finish(unit, say);
     Ok(())
 }
 
@@ -390,7 +549,11 @@ mod tests {
     use crate::filter::FilterKind;
     use crate::nav::PlanarConfig;
     use crate::nav::planar::builder;
-    use crate::nav::session::Start;
+    use crate::nav::session::{Session, Start};
+
+    fn unit(session: Session) -> Unit {
+        Unit::new(vec![session], fixed(), Frame::Ned, None)
+    }
 
     fn fixed() -> BTreeMap<u32, Vector3<f64>> {
         BTreeMap::from([(3, Vector3::new(10.0, -20.0, 5.0))])
@@ -413,6 +576,7 @@ mod tests {
             Kind::RangeDoppler { beacon: b, range_m: 42.5, radial_speed_m_s: -0.4 },
             Kind::Bearing { station: b, station_heading_rad: 0.3, azimuth_rad: -1.2, elevation_rad: 0.6 },
             Kind::Report { heading_rad: 1.1, speed_m_s: 1.5, depth_m: 30.0 },
+            Kind::ArrayFix { beacon: b, range_m: 80.0, azimuth_rad: 0.4, inclination_rad: 1.7, mode: 2 },
         ];
         let mut items: Vec<Item> =
             kinds.iter().map(|k| Item { t_s: 2.5, input: Input::Measurement(k.clone()) }).collect();
@@ -447,8 +611,13 @@ mod tests {
     fn run_skips_bad_lines_and_answers_every_good_one() {
         let config = PlanarConfig { aiding: crate::nav::Aiding::NONE, ..PlanarConfig::default() };
         let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
-        let mut session =
-            Session::new(Frame::Ned, vec![("dr".into(), builder(config, FilterKind::Ekf))], start, (1.0, 0.1), None);
+        let mut u = unit(Session::new(
+            Frame::Ned,
+            vec![("dr".into(), builder(config, FilterKind::Ekf))],
+            start,
+            (1.0, 0.1),
+            None,
+        ));
         let input = [
             r#"{"t_s": 0, "kind": "heading", "heading_rad": 0}"#,
             "not json",
@@ -460,8 +629,7 @@ mod tests {
         .join("\n");
         let mut out = Vec::new();
         let mut bad = Vec::new();
-        run(&mut session, &fixed(), Frame::Ned, input.as_bytes(), &mut out, |n, e| bad.push((n, e.to_string())))
-            .unwrap();
+        run(&mut u, input.as_bytes(), &mut out, |n, e| bad.push((n, e.to_string()))).unwrap();
         assert_eq!(bad.iter().map(|b| b.0).collect::<Vec<_>>(), [2, 5]);
         assert!(bad[1].1.contains("before the previous item's; screened out"), "{}", bad[1].1);
         let lines: Vec<Value> =
@@ -505,11 +673,11 @@ mod tests {
             (br#"{"t_s": 1.0, "kind": "speed", "speed_m_s": 1}"#.to_vec(), "before the previous"),
         ];
         let run_on = |lines: &[Vec<u8>]| {
-            let mut s = session();
+            let mut u = unit(session());
             let (mut out, mut told) = (Vec::new(), Vec::new());
             let input = lines.join(&b'\n');
-            run(&mut s, &fixed(), Frame::Ned, input.as_slice(), &mut out, |_, m| told.push(m.to_string())).unwrap();
-            (s.final_estimates()[0], String::from_utf8(out).unwrap().lines().count(), told)
+            run(&mut u, input.as_slice(), &mut out, |_, m| told.push(m.to_string())).unwrap();
+            (u.session(0).final_estimates()[0], String::from_utf8(out).unwrap().lines().count(), told)
         };
         let (clean, clean_lines, clean_told) = run_on(&good);
         assert!(clean_told.is_empty(), "{clean_told:?}");
@@ -532,12 +700,11 @@ mod tests {
     /// A stream that starts from ground truth and never gets one says so.
     #[test]
     fn a_stream_that_never_starts_says_so() {
-        let mut s = Session::new(Frame::Ned, vec![], Start::FirstTruth, (1.0, 0.1), None);
+        let mut u = unit(Session::new(Frame::Ned, vec![], Start::FirstTruth, (1.0, 0.1), None));
         let input = r#"{"t_s": 0, "kind": "speed", "speed_m_s": 1}
 {"t_s": 1, "kind": "speed", "speed_m_s": 1}"#;
         let mut told = Vec::new();
-        run(&mut s, &fixed(), Frame::Ned, input.as_bytes(), std::io::sink(), |n, m| told.push((n, m.to_string())))
-            .unwrap();
+        run(&mut u, input.as_bytes(), std::io::sink(), |n, m| told.push((n, m.to_string()))).unwrap();
         assert_eq!(told.len(), 2, "{told:?}");
         assert!(told[0].1.contains("waiting for the first ground_truth item"));
         assert!(told[1].1.contains("ended before the start"));

@@ -457,16 +457,32 @@ impl Session {
         self.navs.iter().map(|n| n.beacon_offsets()).collect()
     }
 
+    /// Estimator `i`'s navigator (None before the start).
+    pub fn navigator(&self, i: usize) -> Option<&dyn Navigator> {
+        self.navs.get(i).map(|n| &**n)
+    }
+
     pub fn started(&self) -> bool {
         !self.navs.is_empty()
     }
 
+    /// Starts the estimators by time `t_s` when their start is a given pose due by then
+    /// (a controller that decides before the first item reads them); whether they run.
+    pub fn start_by(&mut self, t_s: f64) -> bool {
+        if let (false, Start::At { t0_s, pose }) = (self.started(), self.start)
+            && t0_s.is_none_or(|t0| t_s >= t0)
+        {
+            self.begin(t0_s.unwrap_or(t_s), pose);
+        }
+        self.started()
+    }
+
     fn begin(&mut self, t0: f64, pose: (f64, f64, f64)) {
-        self.navs = (0..self.builders.len()).map(|i| self.navigator(i, t0, pose)).collect();
+        self.navs = (0..self.builders.len()).map(|i| self.build(i, t0, pose)).collect();
         self.last_sound = vec![pose; self.navs.len()];
     }
 
-    fn navigator(&self, i: usize, t0: f64, pose: (f64, f64, f64)) -> Box<dyn Navigator> {
+    fn build(&self, i: usize, t0: f64, pose: (f64, f64, f64)) -> Box<dyn Navigator> {
         (self.builders[i])(t0, pose, self.sigma_position_m, self.sigma_heading_rad)
     }
 
@@ -584,7 +600,7 @@ impl Session {
             if sound(e) {
                 self.last_sound[i] = (e.north_m(), e.east_m(), e.heading_state_rad);
             } else {
-                self.navs[i] = self.navigator(i, t, self.last_sound[i]);
+                self.navs[i] = self.build(i, t, self.last_sound[i]);
                 self.stats[i].reinitialised += 1;
                 reinitialised.push(i);
                 *e = self.navs[i].estimate();

@@ -20,6 +20,9 @@ pub mod autonomy;
 pub mod bearing;
 pub mod behaviours;
 pub mod fim;
+#[cfg(feature = "serde")]
+pub mod spec;
+pub mod unit;
 
 use crate::guidance::FimPlanner;
 use crate::nav::Navigator;
@@ -142,6 +145,9 @@ pub enum DecideError {
     /// The controller reads the beliefs of `needed` vehicles and was given `given`.
     #[error("the controller reads {needed} vehicles' beliefs, {given} given")]
     Beliefs { needed: usize, given: usize },
+    /// The navigators it reads have not started (no initial state yet).
+    #[error("the navigators have not started yet")]
+    NotStarted,
 }
 
 /// What turns beliefs into a command.

@@ -1,0 +1,137 @@
+//! The vehicles' computers on the stream: a simulated run's messages (`run --messages`)
+//! piped through `onebeacon stream` with the run's configuration give the simulator's
+//! own decisions, because the simulator and the vehicle run the same controllers.
+
+use serde_json::Value;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_onebeacon"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("onebeacon-onboard-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A built-in scenario with `edits` (line prefix -> replacement line) applied.
+fn edited(dir: &Path, builtin: &str, edits: &[(&str, &str)]) -> String {
+    let out = bin().args(["scenarios", "--show", builtin]).output().unwrap();
+    assert!(out.status.success());
+    let mut text = String::from_utf8(out.stdout).unwrap();
+    for (prefix, line) in edits {
+        let start = text.find(&format!("\n{prefix}")).unwrap_or_else(|| panic!("{builtin} has no {prefix}")) + 1;
+        let end = start + text[start..].find('\n').unwrap();
+        text.replace_range(start..end, line);
+    }
+    let p = dir.join(format!("{builtin}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+/// `run SCENARIO --messages` into `dir`/run.
+fn run_messages(scenario: &str, dir: &Path) -> PathBuf {
+    let out = dir.join("run");
+    let o = bin().args(["run", scenario, "--messages", "--out", out.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
+fn json_lines(text: &str) -> Vec<Value> {
+    text.lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+}
+
+/// `stream` on computer `name` of a run: its output lines that decided, and its stderr.
+fn stream_decisions(run: &Path, name: &str) -> (Vec<Value>, String) {
+    let config = run.join(format!("{name}.stream.toml"));
+    let input = std::fs::read(run.join(format!("{name}.input.jsonl"))).unwrap();
+    let mut child = bin()
+        .args(["stream", config.to_str().unwrap()])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || stdin.write_all(&input).unwrap());
+    let o = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let lines = json_lines(&String::from_utf8(o.stdout).unwrap());
+    let decided = lines.into_iter().filter(|l| l["decided"] == true).collect();
+    (decided, String::from_utf8(o.stderr).unwrap())
+}
+
+fn simulator_decisions(run: &Path, name: &str) -> Vec<Value> {
+    json_lines(&std::fs::read_to_string(run.join(format!("{name}.decisions.jsonl"))).unwrap())
+}
+
+/// hoff2024's surface vehicle with two AUVs (hoff2024-pair, 200 s, 2e4 particles): fed
+/// its own fixes and the AUVs' messages, the stream's planner gives the simulator's
+/// legs and waypoints, decision for decision, and serves both AUVs.
+#[test]
+fn the_stream_gives_the_simulated_surface_vehicles_waypoints() {
+    let dir = scratch("asv");
+    let scenario = edited(
+        &dir,
+        "hoff2024-pair",
+        &[
+            ("duration_s", "duration_s = 200"),
+            ("particles", "particles = 20000"),
+            ("kind = \"det\"", "kind = \"det\"\nplanner_particles = 2000"),
+        ],
+    );
+    let run = run_messages(&scenario, &dir);
+    let (stream, stderr) = stream_decisions(&run, "asv");
+    assert!(stderr.is_empty(), "{stderr}");
+    let sim = simulator_decisions(&run, "asv");
+    // one decision per message period, the first on the trackers' initial beliefs
+    assert_eq!(sim.len(), 50);
+    assert_eq!(stream.len(), sim.len());
+    for (s, d) in stream.iter().zip(&sim) {
+        assert_eq!(s["t_s"], d["t_s"]);
+        assert_eq!(s["command"], d["command"], "at {} s", d["t_s"]);
+    }
+    let served: std::collections::BTreeSet<u64> =
+        sim.iter().map(|d| d["command"]["serving"].as_u64().unwrap()).collect();
+    assert_eq!(served.len(), 2, "the planner serves both AUVs: {served:?}");
+}
+
+/// rypkema-m1's quokka (the abstract signal model, the whole mission): fed its sensors
+/// and the beacon's pings, the stream confirms the simulator's modes and gives its
+/// behaviours' setpoints. The simulator decides at the start of a step on what was
+/// heard before it; the stream after the step's depth reading: its decision k is the
+/// simulator's k + 1.
+#[test]
+fn the_stream_gives_the_simulated_auvs_modes_and_commands() {
+    let dir = scratch("auv");
+    let scenario = edited(&dir, "rypkema-m1", &[("model", "model = \"abstract\"")]);
+    let run = run_messages(&scenario, &dir);
+    let (stream, stderr) = stream_decisions(&run, "quokka");
+    assert!(stderr.is_empty(), "{stderr}");
+    let sim = simulator_decisions(&run, "quokka");
+    assert_eq!(stream.len(), sim.len());
+    for (s, d) in stream.iter().zip(&sim[1..]) {
+        assert_eq!(s["command"], d["command"], "at {} s", s["t_s"]);
+    }
+    let seen: std::collections::BTreeSet<String> =
+        stream.iter().map(|s| format!("{} {}", s["command"]["mode"], s["command"]["phase"])).collect();
+    // waiting for a mode, then the schedule's modes 1, 2 and 3 (bank indices 0-2): the
+    // loiters, and the return to the dock that ends afloat
+    for expected in ["null \"waiting\"", "0 \"driving\"", "1 \"driving\"", "2 \"surfacing\""] {
+        assert!(seen.contains(expected), "{expected} not among {seen:?}");
+    }
+}
+
+/// A scenario whose vehicles' computers the stream cannot run is refused by its name.
+#[test]
+fn messages_of_a_world_without_a_streamable_computer_are_refused() {
+    let o = bin().args(["run", "garin2024", "--messages", "--out", "/nonexistent/x"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("--messages: garin2024") && e.contains("passive_usbl"), "{e}");
+}

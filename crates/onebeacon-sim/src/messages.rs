@@ -1,0 +1,237 @@
+//! What each vehicle's computer heard and decided in a simulated run, as `onebeacon
+//! stream` reads and writes it: per controller (a passive-USBL world's surface vehicle,
+//! each fleet AUV), its stream configuration (the scenario's estimators and controller,
+//! the run's initial states and seeds), its JSON Lines input (its own fixes, the beacon
+//! positions and the measurements of the vehicles it estimates) and the commands the
+//! simulator's controller gave. Feeding the input to `stream` with the configuration
+//! gives the same commands: the simulator and the vehicle run the same code.
+
+use crate::engine::{Observer, Step};
+use crate::scenario::estimator::EstimatorSpec;
+use crate::scenario::fleet::{Fleet, SignalModel};
+use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
+use crate::{factory, helms};
+use nalgebra::{Vector2, Vector3};
+use onebeacon::geo::Frame;
+use onebeacon::io::jsonl::{command_json, item_json};
+use onebeacon::models::hoff::idx;
+use onebeacon::nav::session::{Input, Item};
+use onebeacon::nav::usbl_track::TrackState;
+use onebeacon::vehicle::unit::Plan;
+use onebeacon::vehicle::{Decided, GuidanceSnapshot, Situation};
+use serde_json::{Value, json};
+use toml::{Table, Value as Toml};
+
+/// One vehicle computer's side of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Computer {
+    /// The vehicle (`asv`, or the AUV's name).
+    pub name: String,
+    /// Its stream configuration (TOML).
+    pub config: String,
+    /// The JSON lines it heard, in order.
+    pub input: Vec<String>,
+    /// Each decision of the simulator's controller: `{"t_s", "command"}`, the command as
+    /// `stream` writes it.
+    pub decisions: Vec<Value>,
+}
+
+/// The observer that writes each computer's input and decisions.
+pub(crate) struct Messages {
+    /// Per helm: the vehicles it serves, and what it heard and decided.
+    serves: Vec<Vec<usize>>,
+    computers: Vec<Computer>,
+    /// Per helm: the beacons' positions its input last gave, and the planner's last plan.
+    beacons: Vec<Vec<(u32, Vector3<f64>)>>,
+    plans: Vec<Option<Plan>>,
+}
+
+impl Messages {
+    /// For computers `computers` (their names and configurations), helm `h` serving
+    /// `serves[h]`.
+    pub(crate) fn new(computers: Vec<Computer>, serves: Vec<Vec<usize>>) -> Self {
+        let n = computers.len();
+        Self { serves, computers, beacons: vec![Vec::new(); n], plans: vec![None; n] }
+    }
+
+    pub(crate) fn into_inner(self) -> Vec<Computer> {
+        self.computers
+    }
+}
+
+impl Observer for Messages {
+    fn step(&mut self, s: &Step<'_>) {
+        for (h, c) in self.computers.iter_mut().enumerate() {
+            let several = self.serves[h].len() > 1;
+            for (i, &v) in self.serves[h].iter().enumerate() {
+                for m in &s.heard[v] {
+                    // the beacon's position before a measurement that names it
+                    if let Some(b) = m.kind.beacon() {
+                        let known = &mut self.beacons[h];
+                        if !known.contains(&(b.id, b.position_ned_m)) {
+                            known.retain(|(id, _)| *id != b.id);
+                            known.push((b.id, b.position_ned_m));
+                            let input = Input::BeaconPosition { beacon_id: b.id, position: b.position_ned_m };
+                            c.input.push(item_json(&Item { t_s: m.t_s, input }).to_string());
+                        }
+                    }
+                    let mut line = item_json(&Item { t_s: m.t_s, input: Input::Measurement(m.kind.clone()) });
+                    if several {
+                        line["vehicle"] = json!(i);
+                    }
+                    c.input.push(line.to_string());
+                }
+            }
+        }
+    }
+
+    fn decided(&mut self, h: usize, situation: &Situation, d: &Decided) {
+        let c = &mut self.computers[h];
+        if let Some(fix) = situation.fix {
+            let p = fix.position_m;
+            c.input.push(
+                json!({"t_s": situation.t_s, "kind": "own_fix", "x_m": p.x, "y_m": p.y,
+                    "heading_rad": fix.heading_rad, "speed_m_s": fix.speed_m_s})
+                .to_string(),
+            );
+        }
+        if let Some(GuidanceSnapshot::Bearing(b)) = &d.snapshot {
+            self.plans[h] = Some(Plan { vehicle: b.vehicle, waypoint: b.waypoint });
+        }
+        c.decisions.push(json!({"t_s": situation.t_s, "command": command_json(&d.command, self.plans[h], Frame::Ned)}));
+    }
+}
+
+/// A stream configuration's top: its name, frame and start.
+fn config_table(name: &str, description: String) -> Table {
+    let mut t = Table::new();
+    t.insert("name".into(), name.into());
+    t.insert("description".into(), description.into());
+    t.insert("frame".into(), "ned".into());
+    t
+}
+
+/// The surface vehicle's computer of a passive-USBL run: its trackers of every AUV
+/// started where the simulator started them (`x0`, with their particle filters' seeds),
+/// its planner, starting at `home`.
+pub(crate) fn passive_usbl_computer(
+    s: &PassiveUsbl,
+    cell: &PassiveUsblCell,
+    home: Vector2<f64>,
+    starts: &[(TrackState, u64)],
+) -> Computer {
+    let mut t = config_table(
+        "asv",
+        format!("The surface vehicle's computer of a simulated {} run (onebeacon run --messages)", s.name),
+    );
+    let i = &s.initial;
+    let tracked: Vec<Toml> = starts
+        .iter()
+        .map(|(x0, seed)| {
+            let mut v = Table::new();
+            v.insert("from".into(), "given".into());
+            v.insert("t0_s".into(), 0.0.into());
+            // the seed's 64 bits as TOML's signed integer
+            v.insert("seed".into(), Toml::Integer(*seed as i64));
+            for (k, x) in [
+                ("x_m", x0[idx::X]),
+                ("y_m", x0[idx::Y]),
+                ("depth_m", x0[idx::Z]),
+                ("pitch_deg", x0[idx::THETA].to_degrees()),
+                ("heading_deg", x0[idx::PSI].to_degrees()),
+                ("speed_m_s", x0[idx::U]),
+                ("pitch_rate_bias_deg_s", x0[idx::B_THETA].to_degrees()),
+                ("heading_rate_bias_deg_s", x0[idx::B_PSI].to_degrees()),
+                ("position_sigma_m", i.position_sigma_m),
+                ("heading_sigma_deg", i.heading_sigma_deg),
+                ("depth_sigma_m", i.depth_sigma_m),
+                ("pitch_sigma_deg", i.pitch_sigma_deg),
+                ("speed_sigma_m_s", i.speed_sigma_m_s),
+                ("rate_bias_sigma_deg_s", i.rate_bias_sigma_deg_s),
+            ] {
+                v.insert(k.into(), x.into());
+            }
+            Toml::Table(v)
+        })
+        .collect();
+    t.insert("tracked".into(), Toml::Array(tracked));
+    // the world's noise, which the trackers assume unless told otherwise, written out
+    let estimators = s.estimators.iter().map(|e| {
+        let mut e = e.clone();
+        e.usbl_sigma_deg_per_m = e.usbl_sigma_deg_per_m.or(Some(s.usbl.noise_deg_per_m));
+        e.compass_sigma_deg = e.compass_sigma_deg.or(Some(s.asv.compass_noise_deg));
+        e.heading_sigma_deg = e.heading_sigma_deg.or(Some(s.reports.heading_noise_deg));
+        e.speed_sigma_m_s = e.speed_sigma_m_s.or(Some(s.reports.speed_noise_m_s));
+        e.depth_sigma_m = e.depth_sigma_m.or(Some(s.reports.depth_noise_m));
+        e.name = Some(e.name());
+        e
+    });
+    insert_estimators(&mut t, estimators);
+    insert_controller(&mut t, &helms::passive_usbl_spec(s, cell, home));
+    computer("asv", &t)
+}
+
+/// Each AUV's computer of a fleet run: its estimators with the run's seeds, its
+/// behaviours. The channel model's captures are not JSON lines: None.
+pub(crate) fn fleet_computers(s: &Fleet, seed: u64, run: u64) -> Option<Vec<Computer>> {
+    if s.signal.model == SignalModel::Channel {
+        return None;
+    }
+    let keys = factory::iusbl_keys(s);
+    let seeds = factory::fleet_seeds(s, seed, run);
+    Some(
+        s.auvs
+            .iter()
+            .enumerate()
+            .map(|(v, a)| {
+                let mut t = config_table(
+                    &a.name,
+                    format!("{}'s computer in a simulated {} run (onebeacon run --messages)", a.name, s.name),
+                );
+                let mut init = Table::new();
+                init.insert("from".into(), "given".into());
+                init.insert("t0_s".into(), 0.0.into());
+                // the dead reckoning's start
+                for (k, x) in [
+                    ("x_m", a.start_north_m),
+                    ("y_m", a.start_east_m),
+                    ("heading_deg", a.start_heading_deg),
+                    ("position_sigma_m", 1.0),
+                    ("heading_sigma_deg", 0.05f64.to_degrees()),
+                ] {
+                    init.insert(k.into(), x.into());
+                }
+                t.insert("initial".into(), Toml::Table(init));
+                let estimators = s.estimators.iter().zip(&seeds[v]).map(|(&kind, &seed)| {
+                    let mut e = EstimatorSpec::new(kind);
+                    e.seed = Some(seed as i64);
+                    if kind != EstimatorKind::DeadReckoning {
+                        e.iusbl = Some(keys.clone());
+                    }
+                    e
+                });
+                insert_estimators(&mut t, estimators);
+                insert_controller(&mut t, &helms::fleet_spec(s, v));
+                computer(&a.name, &t)
+            })
+            .collect(),
+    )
+}
+
+fn insert_estimators(t: &mut Table, estimators: impl Iterator<Item = EstimatorSpec>) {
+    let list = estimators.map(|e| Toml::try_from(e).expect("an estimator is TOML")).collect();
+    t.insert("estimators".into(), Toml::Array(list));
+}
+
+fn insert_controller(t: &mut Table, c: &onebeacon::vehicle::spec::ControllerSpec) {
+    t.insert("controller".into(), Toml::try_from(c).expect("a controller is TOML"));
+}
+
+fn computer(name: &str, t: &Table) -> Computer {
+    Computer {
+        name: name.into(),
+        config: toml::to_string(t).expect("a table is TOML"),
+        input: Vec::new(),
+        decisions: Vec::new(),
+    }
+}

@@ -1,0 +1,334 @@
+//! A controller as a configuration file describes it (the `[controller]` table of a
+//! stream configuration; feature `serde`): hoff2024's surface vehicle (`kind =
+//! "bearing"`) or rypkema's AUV (`kind = "behaviours"`). Positions are in the file's
+//! frame, angles in degrees in keys named `*_deg`; [`ControllerSpec::build`] gives the
+//! controller in NED.
+
+use super::autonomy::{Autonomy, AutonomySettings, Behaviour};
+use super::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
+use super::behaviours::Behaviours;
+use super::unit::{DecideOn, Helm};
+use crate::geo::Frame;
+use crate::guidance::bearing::{BearingPlanner, SpreadMetric};
+use nalgebra::Vector2;
+use serde::{Deserialize, Serialize};
+
+/// The `[controller]` table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ControllerSpec {
+    /// hoff2024's surface vehicle: it tracks AUVs by their USBL bearings and plans where
+    /// to go next (sec. 3); decides on each `own_fix` line.
+    Bearing(BearingSpec),
+    /// rypkema's AUV: the command mode its iUSBL navigator confirmed selects a
+    /// beacon-relative behaviour (sec. 4.1-4.2); decides on each `depth` line.
+    Behaviours(BehavioursSpec),
+}
+
+/// Where the surface vehicle goes (`mode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BearingModeName {
+    Planner,
+    Static,
+    Circle,
+    Offset,
+}
+
+/// How the planner scores a candidate (`metric`, eq. 10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MetricName {
+    Determinant,
+    MaxEigenvalue,
+}
+
+/// `kind = "bearing"`: defaults are hoff2024's (sec. 5, the built-in scenario's).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BearingSpec {
+    pub mode: BearingModeName,
+    pub metric: MetricName,
+    /// The half-annulus about the belief, m, and its candidates (radii x angles).
+    pub r1_m: f64,
+    pub r2_m: f64,
+    pub radii: usize,
+    pub angles: usize,
+    /// The USBL's noise the planner assumes, deg per metre of range (eq. 3).
+    pub usbl_sigma_deg_per_m: f64,
+    /// The surface vehicle's speed along its legs, m/s, and the message period, s.
+    pub nominal_speed_m_s: f64,
+    pub period_s: f64,
+    pub planner_particles: usize,
+    pub lead_periods: f64,
+    pub circle_radius_m: f64,
+    pub offset_m: f64,
+    /// The point a static surface vehicle holds (the file's frame).
+    pub home_x_m: f64,
+    pub home_y_m: f64,
+    /// The line kind after which it decides.
+    pub decide_on: String,
+}
+
+impl Default for BearingSpec {
+    fn default() -> Self {
+        Self {
+            mode: BearingModeName::Planner,
+            metric: MetricName::Determinant,
+            r1_m: 16.0,
+            r2_m: 26.0,
+            radii: 3,
+            angles: 19,
+            usbl_sigma_deg_per_m: 0.01,
+            nominal_speed_m_s: 2.2,
+            period_s: 4.0,
+            planner_particles: 20_000,
+            lead_periods: 2.0,
+            circle_radius_m: 20.0,
+            offset_m: 20.0,
+            home_x_m: 0.0,
+            home_y_m: 0.0,
+            decide_on: "own_fix".into(),
+        }
+    }
+}
+
+/// `kind = "behaviours"`: the AUV's transit speed and depth and its behaviour per
+/// command mode.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BehavioursSpec {
+    pub speed_m_s: f64,
+    pub depth_m: f64,
+    /// `[[controller.modes]]`: one behaviour per command mode.
+    pub modes: Vec<ModeBehaviour>,
+    pub decide_on: String,
+}
+
+impl Default for BehavioursSpec {
+    fn default() -> Self {
+        let d = AutonomySettings::default();
+        Self { speed_m_s: d.speed_m_s, depth_m: d.depth_m, modes: Vec::new(), decide_on: "depth".into() }
+    }
+}
+
+/// The command modes a bank holds (rypkema: 4).
+pub const MODES: usize = 4;
+
+/// A behaviour's name (`behaviour`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BehaviourName {
+    Loiter,
+    Trackline,
+    OffsetFollow,
+    Return,
+    Abort,
+}
+
+/// One mode's behaviour and its parameters (offsets from the beacon, NED).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModeBehaviour {
+    /// 1 to 4.
+    pub mode: usize,
+    pub behaviour: BehaviourName,
+    #[serde(default)]
+    pub offset_north_m: f64,
+    #[serde(default)]
+    pub offset_east_m: f64,
+    /// Loiter.
+    pub radius_m: Option<f64>,
+    #[serde(default)]
+    pub clockwise: bool,
+    /// Trackline and return: the line's heading, deg from north; its length, m.
+    pub heading_deg: Option<f64>,
+    pub length_m: Option<f64>,
+    /// Trackline and offset follow: the buffer, m.
+    pub buffer_m: Option<f64>,
+    /// Offset follow: the depth ceiling, m.
+    pub ceiling_m: Option<f64>,
+}
+
+impl ModeBehaviour {
+    /// The behaviour (its required keys checked by [`ControllerSpec::check`]).
+    pub fn behaviour(&self) -> Behaviour {
+        let at = Vector2::new(self.offset_north_m, self.offset_east_m);
+        let heading = self.heading_deg.unwrap_or(0.0).to_radians();
+        let length = self.length_m.unwrap_or(0.0);
+        match self.behaviour {
+            BehaviourName::Loiter => {
+                Behaviour::Loiter { centre_m: at, radius_m: self.radius_m.unwrap_or(0.0), clockwise: self.clockwise }
+            }
+            BehaviourName::Trackline => Behaviour::Trackline {
+                centre_m: at,
+                heading_rad: heading,
+                length_m: length,
+                buffer_m: self.buffer_m.unwrap_or(0.0),
+            },
+            BehaviourName::OffsetFollow => Behaviour::OffsetFollow {
+                offset_m: at,
+                buffer_m: self.buffer_m.unwrap_or(0.0),
+                ceiling_m: self.ceiling_m.unwrap_or(0.0),
+            },
+            BehaviourName::Return => Behaviour::Return { end_m: at, heading_rad: heading, length_m: length },
+            BehaviourName::Abort => Behaviour::Abort,
+        }
+    }
+
+    /// The keys `behaviour` needs.
+    pub fn required(&self) -> &'static [&'static str] {
+        match self.behaviour {
+            BehaviourName::Loiter => &["radius_m"],
+            BehaviourName::Trackline => &["heading_deg", "length_m", "buffer_m"],
+            BehaviourName::OffsetFollow => &["buffer_m", "ceiling_m"],
+            BehaviourName::Return => &["heading_deg", "length_m"],
+            BehaviourName::Abort => &[],
+        }
+    }
+
+    /// The value of a numeric key (None when absent or not a key).
+    pub fn value(&self, key: &str) -> Option<f64> {
+        match key {
+            "radius_m" => self.radius_m,
+            "heading_deg" => self.heading_deg,
+            "length_m" => self.length_m,
+            "buffer_m" => self.buffer_m,
+            "ceiling_m" => self.ceiling_m,
+            _ => None,
+        }
+    }
+}
+
+/// The behaviours of a bank of [`MODES`] modes (None: the mode keeps the current one).
+pub fn mode_bank(modes: &[ModeBehaviour]) -> Vec<Option<Behaviour>> {
+    let mut bank = vec![None; MODES];
+    for m in modes {
+        bank[m.mode - 1] = Some(m.behaviour());
+    }
+    bank
+}
+
+/// A key of the `[controller]` table that is not what it may be.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("key `controller.{key}` = {value}: {allowed}")]
+pub struct SpecError {
+    pub key: String,
+    pub value: String,
+    pub allowed: String,
+}
+
+impl ControllerSpec {
+    /// The line kind after which the controller decides.
+    pub fn decide_on(&self) -> &str {
+        match self {
+            ControllerSpec::Bearing(b) => &b.decide_on,
+            ControllerSpec::Behaviours(b) => &b.decide_on,
+        }
+    }
+
+    /// Checks the keys; `kinds` are the line kinds a stream may carry.
+    pub fn check(&self, kinds: &[&str]) -> Result<(), SpecError> {
+        let bad = |key: &str, value: String, allowed: &str| {
+            Err(SpecError { key: key.into(), value, allowed: allowed.into() })
+        };
+        if !kinds.contains(&self.decide_on()) {
+            return bad("decide_on", format!("{:?}", self.decide_on()), &format!("one of {}", kinds.join(", ")));
+        }
+        let positive = |key: &str, v: f64| {
+            if v.is_finite() && v > 0.0 { Ok(()) } else { bad(key, format!("{v:?}"), "must be a number > 0") }
+        };
+        match self {
+            ControllerSpec::Bearing(b) => {
+                positive("r1_m", b.r1_m)?;
+                if !(b.r2_m.is_finite() && b.r2_m >= b.r1_m) {
+                    return bad("r2_m", format!("{:?}", b.r2_m), "must be a number >= r1_m");
+                }
+                for (key, v) in [
+                    ("usbl_sigma_deg_per_m", b.usbl_sigma_deg_per_m),
+                    ("nominal_speed_m_s", b.nominal_speed_m_s),
+                    ("period_s", b.period_s),
+                    ("circle_radius_m", b.circle_radius_m),
+                    ("offset_m", b.offset_m),
+                ] {
+                    positive(key, v)?;
+                }
+                if !(b.lead_periods.is_finite() && b.lead_periods >= 0.0) {
+                    return bad("lead_periods", format!("{:?}", b.lead_periods), "must be a number >= 0");
+                }
+                for (key, n) in [("radii", b.radii), ("angles", b.angles), ("planner_particles", b.planner_particles)] {
+                    if !(1..=10_000_000).contains(&n) {
+                        return bad(key, n.to_string(), "must be a count in 1..=10000000");
+                    }
+                }
+                if !(b.home_x_m.is_finite() && b.home_y_m.is_finite()) {
+                    return bad("home_x_m", format!("({:?}, {:?})", b.home_x_m, b.home_y_m), "must be finite");
+                }
+            }
+            ControllerSpec::Behaviours(b) => {
+                positive("speed_m_s", b.speed_m_s)?;
+                if !(b.depth_m.is_finite() && b.depth_m >= 0.0) {
+                    return bad("depth_m", format!("{:?}", b.depth_m), "must be a depth >= 0");
+                }
+                for (i, m) in b.modes.iter().enumerate() {
+                    if !(1..=MODES).contains(&m.mode) {
+                        return bad(&format!("modes[{i}].mode"), m.mode.to_string(), "must be 1 to 4");
+                    }
+                    if b.modes[..i].iter().any(|o| o.mode == m.mode) {
+                        return bad(&format!("modes[{i}].mode"), m.mode.to_string(), "is given twice");
+                    }
+                    for k in m.required() {
+                        let v = m.value(k);
+                        let ok = v.is_some_and(|v| v.is_finite() && (*k == "heading_deg" || v > 0.0));
+                        if !ok {
+                            let value = v.map_or("(absent)".into(), |v| format!("{v:?}"));
+                            return bad(&format!("modes[{i}].{k}"), value, "the behaviour needs it, a number > 0");
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The controller, in NED from a file in `frame`, with the line kind it decides on.
+    pub fn build(&self, frame: Frame) -> Helm {
+        let decide_on = DecideOn(self.decide_on().to_string());
+        let controller: Box<dyn super::Controller> = match self {
+            ControllerSpec::Bearing(b) => {
+                let home = frame.to_ned(b.home_x_m, b.home_y_m, 0.0);
+                Box::new(BearingGuidance::new(BearingGuidanceConfig {
+                    mode: match b.mode {
+                        BearingModeName::Planner => BearingMode::Planner,
+                        BearingModeName::Static => BearingMode::Static,
+                        BearingModeName::Circle => BearingMode::Circle,
+                        BearingModeName::Offset => BearingMode::Offset,
+                    },
+                    planner: BearingPlanner {
+                        metric: match b.metric {
+                            MetricName::Determinant => SpreadMetric::Determinant,
+                            MetricName::MaxEigenvalue => SpreadMetric::MaxEigenvalue,
+                        },
+                        r1_m: b.r1_m,
+                        r2_m: b.r2_m,
+                        radii: b.radii,
+                        angles: b.angles,
+                        sigma_usbl_rad_per_m: b.usbl_sigma_deg_per_m.to_radians(),
+                    },
+                    nominal_speed_m_s: b.nominal_speed_m_s,
+                    period_s: b.period_s,
+                    planner_particles: b.planner_particles,
+                    lead_periods: b.lead_periods,
+                    circle_radius_m: b.circle_radius_m,
+                    offset_m: b.offset_m,
+                    home_m: home.xy(),
+                }))
+            }
+            ControllerSpec::Behaviours(b) => {
+                let settings = AutonomySettings { speed_m_s: b.speed_m_s, depth_m: b.depth_m, ..Default::default() };
+                Box::new(Behaviours::new(Autonomy::new(settings, mode_bank(&b.modes))))
+            }
+        };
+        Helm { controller, decide_on }
+    }
+}
