@@ -140,7 +140,7 @@ fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
 /// reported on stderr and skipped.
 pub fn stream(config: &Path) -> Result<()> {
     let mut unit = stream_setup(config)?;
-    jsonl::run(&mut unit, std::io::stdin().lock(), std::io::stdout().lock(), |line, m| {
+    onebeacon::io::stream::run(&mut unit, std::io::stdin().lock(), std::io::stdout().lock(), |line, m| {
         eprintln!("stdin line {line}: {m}")
     })
     .context("cannot read stdin or write stdout")?;

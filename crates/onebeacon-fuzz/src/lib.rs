@@ -5,7 +5,7 @@
 
 use nalgebra::Vector3;
 use onebeacon::geo::Frame;
-use onebeacon::io::jsonl;
+use onebeacon::io::stream;
 use onebeacon_sim::acoustics::channel::simulate_ping;
 use onebeacon_sim::acoustics::wav::Recording;
 use onebeacon_sim::replay::{Log, LogDescription, LogError, new_session, replay};
@@ -148,7 +148,7 @@ pub fn log_csv(data: &[u8]) {
     });
 }
 
-/// Bytes on a stream's stdin ([`jsonl::run`] with [`LOG`]'s estimators and beacons,
+/// Bytes on a stream's stdin ([`stream::run`] with [`LOG`]'s estimators and beacons,
 /// starting at a given pose): it reads to the end, every output line is one JSON
 /// object, and the final estimates are finite.
 pub fn stream(data: &[u8]) {
@@ -159,7 +159,7 @@ pub fn stream(data: &[u8]) {
     let session = new_session(&d, &d.initial, start, None);
     let mut unit = onebeacon::vehicle::unit::Unit::new(vec![session], fixed, Frame::Enu, None);
     let mut out = Vec::new();
-    jsonl::run(&mut unit, Cursor::new(data), &mut out, |_, _| {}).expect("in-memory I/O");
+    stream::run(&mut unit, Cursor::new(data), &mut out, |_, _| {}).expect("in-memory I/O");
     let text = std::str::from_utf8(&out).expect("the output is UTF-8");
     for line in text.lines() {
         assert!(line.starts_with('{') && line.ends_with('}'), "not a JSON object: {line}");

@@ -5,7 +5,7 @@
 //! `ValueError`) with the CLI's one-line messages.
 
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
-use onebeacon::io::jsonl::{Lines, Note};
+use onebeacon::io::stream::{Lines, Note};
 use onebeacon::nav::session::Session;
 use onebeacon::vehicle::unit::Unit;
 use onebeacon_sim::Scenario;

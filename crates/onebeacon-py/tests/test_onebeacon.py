@@ -366,3 +366,24 @@ def test_dsp_process_takes_real_numbers_only_and_one_capture(cli, tmp_path):
         onebeacon.dsp.process(longer, fs)
     with pytest.raises(onebeacon.InputError, match="dimensions"):
         onebeacon.dsp.process(samples[np.newaxis], fs)
+
+
+def test_the_navigator_gives_its_controllers_command(tmp_path):
+    # a surface vehicle tracking one AUV by USBL, holding its home point (the static
+    # baseline: the path from where it is to home, whatever the AUV does)
+    config = tmp_path / "asv.toml"
+    config.write_text(
+        'name = "asv"\nframe = "ned"\n'
+        '[[tracked]]\nfrom = "given"\nt0_s = 0.0\nx_m = 50.0\ny_m = 0.0\nheading_deg = 90.0\ndepth_m = 20.0\n'
+        '[[estimators]]\nkind = "bearing"\n'
+        '[controller]\nkind = "bearing"\nmode = "static"\nhome_x_m = 10.0\nhome_y_m = -20.0\n'
+    )
+    nav = onebeacon.Navigator(config)
+    assert nav.command() is None
+    # it decides on its own fixes only
+    out = nav.feed({"t_s": 0.0, "kind": "report", "heading_rad": 1.57, "speed_m_s": 1.5, "depth_m": 20.0})
+    assert out["decided"] is False and "command" not in out and out["estimates"][0]["name"] == "bearing"
+    out = nav.feed({"t_s": 1.0, "kind": "own_fix", "x_m": 3.0, "y_m": 4.0, "heading_rad": 0.0, "speed_m_s": 1.0})
+    assert out["decided"] is True
+    expected = {"kind": "path", "from_x_m": 3.0, "from_y_m": 4.0, "to_x_m": 10.0, "to_y_m": -20.0}
+    assert out["command"] == expected and nav.command() == expected

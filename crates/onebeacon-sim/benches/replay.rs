@@ -8,7 +8,8 @@
 //! checks and every estimator's update, the output line): a range, an odometry item.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use onebeacon::io::jsonl::{Lines, item_json};
+use onebeacon::io::jsonl::item_json;
+use onebeacon::io::stream::Lines;
 use onebeacon_sim::replay::{Log, LogError, replay, stream_setup};
 use std::hint::black_box;
 use std::path::PathBuf;

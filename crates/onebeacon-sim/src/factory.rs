@@ -188,41 +188,42 @@ pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
     tracks
 }
 
-/// An estimator of a log description (replay, stream, Python) on a vehicle that starts
-/// as `initial` says, built by the session at its start and again from its last sound
-/// pose: a USBL tracker (pf, bearing: hoff2024's eight states, the rest of the state
-/// from `initial`), the iUSBL navigator (which starts from its first fix), or the planar
-/// family.
-pub(crate) fn log(spec: &EstimatorSpec, initial: &crate::replay::schema::Initial) -> onebeacon::nav::session::Builder {
+/// What a log's USBL tracker starts from besides its pose (hoff2024's state order):
+/// depth, pitch, speed and the two rate biases (m, rad, m/s, rad/s), the standard
+/// deviations of depth, pitch, speed and biases, and the seed of the vehicle's particle
+/// filters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TrackerStart {
+    pub state: [f64; 5],
+    pub sigma: [f64; 4],
+    pub seed: Option<i64>,
+}
+
+/// An estimator of a log description (replay, stream, Python) on a vehicle whose
+/// trackers start as `start` says, built by the session at its start and again from its
+/// last sound pose: a USBL tracker (pf, bearing: hoff2024's eight states), the iUSBL
+/// navigator (which starts from its first fix), or the planar family.
+pub(crate) fn log(spec: &EstimatorSpec, start: TrackerStart) -> onebeacon::nav::session::Builder {
     // the seed's 64 bits (TOML integers are signed)
-    let seed = spec.seed.or(initial.seed).unwrap_or(0) as u64;
+    let seed = spec.seed.or(start.seed).unwrap_or(0) as u64;
     if spec.kind.tracks_bearings() {
         let config = spec.tracker_config(TrackerNoise::default());
         let (particles, settings) = spec.particle_settings();
         let filter = spec.filter_kind();
         let particle = spec.kind == EstimatorKind::Particle;
-        let i = initial.clone();
+        let ([depth, pitch, speed, pitch_bias, heading_bias], [s_depth, s_pitch, s_speed, s_bias]) =
+            (start.state, start.sigma);
         return Box::new(move |t0, (north, east, heading), sigma_position, sigma_heading| {
-            let x0 = SVector::<f64, DIM>::from([
-                north,
-                east,
-                i.depth_m,
-                i.pitch_deg.to_radians(),
-                heading,
-                i.speed_m_s,
-                i.pitch_rate_bias_deg_s.to_radians(),
-                i.heading_rate_bias_deg_s.to_radians(),
-            ]);
-            let bias = i.rate_bias_sigma_deg_s.to_radians();
+            let x0 = SVector::<f64, DIM>::from([north, east, depth, pitch, heading, speed, pitch_bias, heading_bias]);
             let sigma0 = SVector::<f64, DIM>::from([
                 sigma_position,
                 sigma_position,
-                i.depth_sigma_m,
-                i.pitch_sigma_deg.to_radians(),
+                s_depth,
+                s_pitch,
                 sigma_heading,
-                i.speed_sigma_m_s,
-                bias,
-                bias,
+                s_speed,
+                s_bias,
+                s_bias,
             ]);
             if particle {
                 Box::new(ParticleTracker::new(config, settings, particles, t0, &x0, &sigma0, seed))

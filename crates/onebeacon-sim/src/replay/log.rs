@@ -337,7 +337,7 @@ impl Log {
         let first = items.next().transpose()?;
         let first_t = first.as_ref().map_or(0.0, |i| i.t_s);
         if let Some(pose) = init.given_pose(self.frame) {
-            return Ok((first_t, pose));
+            return Ok((init.t0_s.unwrap_or(first_t), pose));
         }
         let mut truth = first.into_iter().map(Ok).chain(items).filter_map(|i| match i {
             Ok(i) => match i.input.to_ned(self.frame) {

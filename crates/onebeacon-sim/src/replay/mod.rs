@@ -75,13 +75,19 @@ pub fn new_session(
     start: Start,
     beacons: Option<BTreeSet<u32>>,
 ) -> Session {
-    let estimators = d.estimators.iter().map(|e| (e.name(), crate::factory::log(e, initial))).collect();
+    let estimators = d.estimators.iter().map(|e| (e.name(), crate::factory::log(e, initial.tracker_start()))).collect();
     let sigmas = (initial.position_sigma_m, initial.heading_sigma_deg.to_radians());
     Session::new(d.frame.into(), estimators, start, sigmas, beacons).with_limits(d.limits)
 }
 
 /// The session a log describes, started at its initial pose.
 pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
+    if !log.description.tracked.is_empty() {
+        return Err(LogError::File {
+            file: log.description.name.clone(),
+            message: "key `tracked`: a stream's surface vehicle tracking several vehicles; replay runs the one vehicle of `[initial]`".into(),
+        });
+    }
     let start = log.initial_start()?;
     let d = &log.description;
     let session = new_session(d, &d.initial, Start::At { t0_s: Some(start.t0_s), pose: start.pose }, beacons);

@@ -390,6 +390,26 @@ impl Default for Initial {
 }
 
 impl Initial {
+    /// What a USBL tracker starts from besides the pose.
+    pub(crate) fn tracker_start(&self) -> crate::factory::TrackerStart {
+        crate::factory::TrackerStart {
+            state: [
+                self.depth_m,
+                self.pitch_deg.to_radians(),
+                self.speed_m_s,
+                self.pitch_rate_bias_deg_s.to_radians(),
+                self.heading_rate_bias_deg_s.to_radians(),
+            ],
+            sigma: [
+                self.depth_sigma_m,
+                self.pitch_sigma_deg.to_radians(),
+                self.speed_sigma_m_s,
+                self.rate_bias_sigma_deg_s.to_radians(),
+            ],
+            seed: self.seed,
+        }
+    }
+
     /// The given pose in NED (N, E, psi) when `from = "given"`.
     pub fn given_pose(&self, frame: Frame) -> Option<(f64, f64, f64)> {
         if self.from != InitialFrom::Given {

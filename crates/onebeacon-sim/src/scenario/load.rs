@@ -213,7 +213,7 @@ mod tests {
         let e = err(&format!("{p}[[estimators]]\nkind = \"rosb\"\n"));
         assert!(e.contains("estimators[0].kind") && e.contains("passive_usbl world gives USBL bearings"), "{e}");
         let e = err("name = \"x\"\n[[estimators]]\nkind = \"pf\"\n");
-        assert!(e.contains("estimators[0].kind") && e.contains("passive_usbl world only"), "{e}");
+        assert!(e.contains("estimators[0].kind") && e.contains("a passive_usbl world or a log"), "{e}");
         let e = err(&format!("{p}[[estimators]]\nkind = \"pf\"\ness_fraction = 1.5\n"));
         assert!(e.contains("estimators[0].ess_fraction") && e.contains("probability"), "{e}");
         let e = err(&format!("{p}[[estimators]]\nkind = \"pf\"\nrange_sigma_m = 1.0\n"));

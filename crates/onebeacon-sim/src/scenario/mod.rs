@@ -11,6 +11,7 @@ mod builtin;
 pub mod estimator;
 pub mod fixed_beacon;
 pub mod fleet;
+pub mod iusbl;
 pub(crate) mod load;
 pub mod moving_beacon;
 pub mod passive_usbl;

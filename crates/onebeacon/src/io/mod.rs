@@ -2,3 +2,5 @@
 
 #[cfg(feature = "stream")]
 pub mod jsonl;
+#[cfg(feature = "stream")]
+pub mod stream;
