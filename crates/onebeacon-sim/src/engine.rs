@@ -11,6 +11,7 @@
 //! estimator runs in every world and a new world scores every estimator.
 
 use nalgebra::{Vector3, Vector6};
+use onebeacon::nav::restart::{Builder, Restart};
 use onebeacon::nav::{Estimate, Measurement, Navigator, Outcome};
 use onebeacon::vehicle::{Command, Controller, Decided, Situation};
 
@@ -94,10 +95,21 @@ pub(crate) struct Helm {
     pub serves: Vec<usize>,
 }
 
-/// One estimator on one vehicle.
+/// One estimator on one vehicle, with the restart policy of an unsound estimator (the
+/// session's: [`Restart`]).
 pub(crate) struct Track {
     pub vehicle: usize,
     pub navigator: Box<dyn Navigator>,
+    restart: Restart,
+}
+
+impl Track {
+    /// The estimator `builder` gives at time 0 from `pose` (north, east, heading) with
+    /// initial sigmas `sigmas` (position m, heading rad), on vehicle `vehicle`.
+    pub(crate) fn new(vehicle: usize, builder: Builder, pose: (f64, f64, f64), sigmas: (f64, f64)) -> Self {
+        let restart = Restart::new(builder, pose, sigmas);
+        Self { vehicle, navigator: restart.build(0.0, pose), restart }
+    }
 }
 
 /// What observers see of one step.
@@ -119,6 +131,8 @@ pub(crate) trait Observer {
     fn step(&mut self, step: &Step<'_>);
     /// Helm `helm`'s decision on what its vehicle knew of itself.
     fn decided(&mut self, _helm: usize, _situation: &Situation, _decided: &Decided) {}
+    /// Track `track`'s estimator stopped being sound and started again ([`Restart`]).
+    fn restarted(&mut self, _track: usize) {}
     /// The outcome of track `track`'s processing of one measurement.
     fn outcome(&mut self, _track: usize, _outcome: &Outcome) {}
     /// Every track's navigator as it stands at step `k` (before [`Observer::step`]),
@@ -180,9 +194,94 @@ pub(crate) fn run(
                 observers.iter_mut().for_each(|o| o.outcome(i, &outcome));
             }
             estimates[i] = t.navigator.estimate();
+            if t.restart.apply(&mut t.navigator, &mut estimates[i], world.t_s(k)) {
+                observers.iter_mut().for_each(|o| o.restarted(i));
+            }
         }
         for (v, tr) in truth.iter_mut().enumerate() {
             *tr = world.truth(v);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use onebeacon::nav::Kind;
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// A dead-reckoning navigator whose state turns to NaN when it processes anything.
+    struct Fragile {
+        inner: Box<dyn Navigator>,
+        broken: bool,
+    }
+
+    impl Navigator for Fragile {
+        fn process(&mut self, _: &Measurement) -> Outcome {
+            self.broken = true;
+            Outcome::Applied
+        }
+        fn estimate(&self) -> Estimate {
+            let mut e = self.inner.estimate();
+            if self.broken {
+                e.position_ned_m.x = f64::NAN;
+            }
+            e
+        }
+    }
+
+    /// One vehicle that hears one speed a step for three steps.
+    struct Still;
+
+    impl World for Still {
+        fn vehicles(&self) -> usize {
+            1
+        }
+        fn steps(&self) -> usize {
+            3
+        }
+        fn t_s(&self, k: usize) -> f64 {
+            k as f64
+        }
+        fn truth(&self, _: usize) -> VehicleTruth {
+            VehicleTruth { eta: Vector6::zeros(), speed_m_s: 0.0, distance_m: 0.0 }
+        }
+        fn beacon_ned_m(&self) -> Vector3<f64> {
+            Vector3::zeros()
+        }
+        fn advance(&mut self, k: usize, _: &[Option<Command>], heard: &mut [Vec<Measurement>]) {
+            heard[0].push(Measurement::new(k as f64, Kind::Speed { speed_m_s: 1.0 }));
+        }
+    }
+
+    struct Restarts(Vec<usize>);
+
+    impl Observer for Restarts {
+        fn step(&mut self, _: &Step<'_>) {}
+        fn restarted(&mut self, track: usize) {
+            self.0.push(track);
+        }
+    }
+
+    /// The engine applies the session's policy: an estimator whose state stops being
+    /// sound is built again from its last sound pose at the step's time, and observers
+    /// are told; every step breaks it again here, so three steps, three restarts.
+    #[test]
+    fn an_unsound_estimator_starts_again_as_in_the_session() {
+        let builds = Arc::new(AtomicUsize::new(0));
+        let counted = builds.clone();
+        let planar = onebeacon::nav::planar::builder(Default::default(), onebeacon::filter::FilterKind::Ekf);
+        let builder: Builder = Box::new(move |t0, at, sp, sh| {
+            counted.fetch_add(1, Ordering::SeqCst);
+            Box::new(Fragile { inner: planar(t0, at, sp, sh), broken: false })
+        });
+        let mut tracks = vec![Track::new(0, builder, (5.0, -3.0, 0.2), (1.0, 0.1))];
+        let mut restarts = Restarts(Vec::new());
+        run(&mut Still, &mut tracks, &mut [], &mut [&mut restarts]);
+        assert_eq!(restarts.0, [0, 0, 0]);
+        assert_eq!(builds.load(Ordering::SeqCst), 4);
+        let e = tracks[0].navigator.estimate();
+        assert_eq!((e.north_m(), e.east_m(), e.heading_rad(), e.t_s), (5.0, -3.0, 0.2, 3.0));
     }
 }

@@ -17,10 +17,10 @@ use onebeacon::geo::wrap_angle;
 use onebeacon::models::hoff::{DIM, idx};
 use onebeacon::models::kinematic6dof::{Cov as Cov6, State as Eta};
 use onebeacon::models::unicycle::{Cov, State};
+use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::{TrackState, TrackerNoise};
 use onebeacon::nav::{
-    Aiding, GaussianTracker, IusblNavigator, Navigator, ParticleTracker, PlanarConfig, PlanarNavigator,
-    Range6DofNavigator, SingleBeaconNavigator,
+    Aiding, GaussianTracker, IusblNavigator, ParticleTracker, PlanarConfig, Range6DofNavigator, SingleBeaconNavigator,
 };
 use rand::RngExt;
 
@@ -39,18 +39,24 @@ pub(crate) fn fixed_beacon(s: &FixedBeacon, z_true: State, seed: u64, run: u64) 
     let mut init_rng = rng(seed, run, Stream::Initial);
     let z0 = z_true + sigma0.map(|sd| gauss(&mut init_rng, sd));
     let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
+    let pose = (z0[0], z0[1], z0[2]);
     s.estimators
         .iter()
         .map(|e| {
-            let nav =
-                SingleBeaconNavigator::new(e.aiding(Host::FixedBeacon), e.ekf_tuning(), e.filter_kind(), 0.0, z0, p0);
-            // the navigator's own default where the key is absent
-            let nav = match e.mirror_recovery {
-                Some(on) => nav.with_mirror_recovery(on),
-                None => nav,
-            }
-            .with_min_speed(e.min_speed_m_s);
-            Track { vehicle: 0, navigator: Box::new(nav) }
+            let (aiding, tuning, filter) = (e.aiding(Host::FixedBeacon), e.ekf_tuning(), e.filter_kind());
+            let (mirror, min_speed) = (e.mirror_recovery, e.min_speed_m_s);
+            let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
+                let mut z = z0;
+                (z[0], z[1], z[2]) = (north, east, heading);
+                let nav = SingleBeaconNavigator::new(aiding, tuning, filter, t0, z, p0);
+                // the navigator's own default where the key is absent
+                let nav = match mirror {
+                    Some(on) => nav.with_mirror_recovery(on),
+                    None => nav,
+                };
+                Box::new(nav.with_min_speed(min_speed))
+            });
+            Track::new(0, builder, pose, (i.position_sigma_m, sigma0[2]))
         })
         .collect()
 }
@@ -66,16 +72,16 @@ pub(crate) fn moving_beacon(s: &MovingBeacon, truth0: &[Eta], seed: u64, run: u6
     for (v, eta) in truth0.iter().enumerate() {
         let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
         let eta0 = eta + sigma0.map(|sd| gauss(&mut init_rng, sd));
-        tracks.extend(s.estimators.iter().map(|e| Track {
-            vehicle: v,
-            navigator: Box::new(Range6DofNavigator::new(
-                e.sensor_noise(s.sensor_noise()),
-                e.aiding(Host::MovingBeacon),
-                e.filter_kind(),
-                0.0,
-                eta0,
-                p0,
-            )),
+        let pose = (eta0[0], eta0[1], eta0[5]);
+        tracks.extend(s.estimators.iter().map(|e| {
+            let (noise, aiding, filter) =
+                (e.sensor_noise(s.sensor_noise()), e.aiding(Host::MovingBeacon), e.filter_kind());
+            let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
+                let mut eta = eta0;
+                (eta[0], eta[1], eta[5]) = (north, east, heading);
+                Box::new(Range6DofNavigator::new(noise, aiding, filter, t0, eta, p0))
+            });
+            Track::new(v, builder, pose, (i.position_sigma_m, a0))
         }));
     }
     tracks
@@ -118,17 +124,21 @@ pub(crate) fn tracker_starts(s: &PassiveUsbl, truth0: &[TrackState], seed: u64, 
 pub(crate) fn passive_usbl(s: &PassiveUsbl, starts: &[(TrackState, u64)]) -> Vec<Track> {
     let sigma0 = tracker_sigma(s);
     let mut tracks = Vec::new();
-    for (v, (x0, pf_seed)) in starts.iter().enumerate() {
+    for (v, &(x0, pf_seed)) in starts.iter().enumerate() {
         for e in &s.estimators {
-            let config = e.tracker_config(s.tracker_noise());
-            let navigator: Box<dyn Navigator> = match e.kind {
-                EstimatorKind::Particle => {
-                    let (n, settings) = e.particle_settings();
-                    Box::new(ParticleTracker::new(config, settings, n, 0.0, x0, &sigma0, *pf_seed))
+            let (config, filter) = (e.tracker_config(s.tracker_noise()), e.filter_kind());
+            let particle = (e.kind == EstimatorKind::Particle).then(|| e.particle_settings());
+            let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
+                let mut x = x0;
+                (x[idx::X], x[idx::Y], x[idx::PSI]) = (north, east, heading);
+                match particle {
+                    Some((n, settings)) => {
+                        Box::new(ParticleTracker::new(config, settings, n, t0, &x, &sigma0, pf_seed))
+                    }
+                    None => Box::new(GaussianTracker::new(config, filter, t0, &x, &sigma0)),
                 }
-                _ => Box::new(GaussianTracker::new(config, e.filter_kind(), 0.0, x0, &sigma0)),
-            };
-            tracks.push(Track { vehicle: v, navigator });
+            });
+            tracks.push(Track::new(v, builder, (x0[idx::X], x0[idx::Y], x0[idx::PSI]), (sigma0[0], sigma0[idx::PSI])));
         }
     }
     tracks
@@ -171,18 +181,23 @@ pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
     let mut tracks = Vec::new();
     for ((v, a), seeds) in s.auvs.iter().enumerate().zip(fleet_seeds(s, seed, run)) {
         for (e, filter_seed) in s.estimators.iter().zip(seeds) {
-            let navigator: Box<dyn Navigator> = if e.iusbl() {
-                let receiver = (s.signal.model == SignalModel::Channel).then(|| {
-                    let rc = ReceiverConfig { sound_speed_m_s: s.signal.sound_speed_m_s, ..Default::default() };
-                    ModeReceiver::new(&waveforms, &elements, rc)
-                });
-                Box::new(IusblNavigator::new(keys.config(*e == EstimatorKind::Iusbl), receiver, filter_seed))
+            let pose = (a.start_north_m, a.start_east_m, a.start_heading_deg.to_radians());
+            let builder: Builder = if e.iusbl() {
+                let config = keys.config(*e == EstimatorKind::Iusbl);
+                let channel = s.signal.model == SignalModel::Channel;
+                let (elements, sound) = (elements.clone(), s.signal.sound_speed_m_s);
+                Box::new(move |_, _, _, _| {
+                    let receiver = channel.then(|| {
+                        let rc = ReceiverConfig { sound_speed_m_s: sound, ..Default::default() };
+                        ModeReceiver::new(&waveforms, &elements, rc)
+                    });
+                    Box::new(IusblNavigator::new(config, receiver, filter_seed))
+                })
             } else {
                 let config = PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() };
-                let pose = (a.start_north_m, a.start_east_m, a.start_heading_deg.to_radians());
-                Box::new(PlanarNavigator::new(config, FilterKind::Ekf, 0.0, pose, 1.0, 0.05))
+                onebeacon::nav::planar::builder(config, FilterKind::Ekf)
             };
-            tracks.push(Track { vehicle: v, navigator });
+            tracks.push(Track::new(v, builder, pose, (1.0, 0.05)));
         }
     }
     tracks
@@ -203,7 +218,7 @@ pub(crate) struct TrackerStart {
 /// trackers start as `start` says, built by the session at its start and again from its
 /// last sound pose: a USBL tracker (pf, bearing: hoff2024's eight states), the iUSBL
 /// navigator (which starts from its first fix), or the planar family.
-pub(crate) fn log(spec: &EstimatorSpec, start: TrackerStart) -> onebeacon::nav::session::Builder {
+pub(crate) fn log(spec: &EstimatorSpec, start: TrackerStart) -> Builder {
     // the seed's 64 bits (TOML integers are signed)
     let seed = spec.seed.or(start.seed).unwrap_or(0) as u64;
     if spec.kind.tracks_bearings() {

@@ -286,6 +286,10 @@ impl Observer for Scoring {
     fn outcome(&mut self, track: usize, outcome: &Outcome) {
         self.acc[track].push_outcome(outcome, true);
     }
+
+    fn restarted(&mut self, track: usize) {
+        self.acc[track].reinitialised += 1;
+    }
 }
 
 /// Every step and every guidance decision, when asked for, and the belief at one step.

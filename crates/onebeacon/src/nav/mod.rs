@@ -13,6 +13,7 @@ pub mod fix;
 pub mod iusbl;
 pub mod planar;
 pub mod range_6dof;
+pub mod restart;
 pub mod session;
 pub mod single_beacon;
 pub mod tracking;

@@ -515,10 +515,10 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
 }
 
 /// The navigator a [`PlanarConfig`] describes, as a session builds it
-/// ([`super::session::Builder`]): the constant-velocity tracker of a craft without motion
+/// ([`super::restart::Builder`]): the constant-velocity tracker of a craft without motion
 /// inputs (`track_accel_sigma_m_s2`), the planar navigator with an offset per beacon, or
 /// the planar navigator.
-pub fn builder(c: PlanarConfig, f: FilterKind) -> super::session::Builder {
+pub fn builder(c: PlanarConfig, f: FilterKind) -> super::restart::Builder {
     Box::new(move |t0, pose, sigma_position_m, sigma_heading_rad| match c.track_accel_sigma_m_s2 {
         Some(a) => Box::new(super::TrackingNavigator::new(c, a, f, t0, (pose.0, pose.1), sigma_position_m)),
         None if c.estimate_beacon_offsets => {

@@ -5,6 +5,7 @@
 
 use crate::geo::Frame;
 use crate::nav::evaluation::{ErrorStats, horizontal_error};
+use crate::nav::restart::Restart;
 use crate::nav::{BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
 use nalgebra::Vector3;
 use std::collections::{BTreeMap, BTreeSet};
@@ -333,30 +334,17 @@ fn measured_value(m: &Kind) -> f64 {
     }
 }
 
-/// Whether an estimate is sound: finite, with a positive definite horizontal covariance
-/// and a finite heading variance.
-fn sound(e: &Estimate) -> bool {
-    let p = &e.horizontal_cov_m2;
-    e.position_ned_m.iter().all(|v| v.is_finite())
-        && e.heading_state_rad.is_finite()
-        && e.heading_var_rad2.is_finite()
-        && p.iter().all(|v| v.is_finite())
-        && p[(0, 0)] > 0.0
-        && p.determinant() > 0.0
-}
-
-/// Builds one estimator of a session at time t0 (s) from a pose (north, east, heading;
-/// m, m, rad) with the initial position and heading sigmas (m, rad): at the start, and
-/// again from its last sound pose.
-pub type Builder = Box<dyn Fn(f64, (f64, f64, f64), f64, f64) -> Box<dyn Navigator> + Send + Sync>;
+pub use super::restart::Builder;
 
 /// Every estimator on one stream. Estimates and errors are in NED.
 pub struct Session {
     pub names: Vec<String>,
     /// The frame of the items pushed.
     frame: Frame,
+    /// Until the start, the estimators' builders; then each one's restart policy.
     builders: Vec<Builder>,
     navs: Vec<Box<dyn Navigator>>,
+    restarts: Vec<Restart>,
     start: Start,
     sigma_position_m: f64,
     sigma_heading_rad: f64,
@@ -378,8 +366,6 @@ pub struct Session {
     last_t: Option<f64>,
     /// Items in a row that jumped past the gap: the latest's time and their count.
     jump: Option<(f64, usize)>,
-    /// Each estimator's last sound pose (N, E, psi), to start it again from.
-    last_sound: Vec<(f64, f64, f64)>,
 }
 
 impl std::fmt::Debug for Session {
@@ -417,7 +403,7 @@ impl Session {
             limits: Limits::default(),
             last_t: None,
             jump: None,
-            last_sound: Vec::new(),
+            restarts: Vec::new(),
         }
     }
 
@@ -478,12 +464,9 @@ impl Session {
     }
 
     fn begin(&mut self, t0: f64, pose: (f64, f64, f64)) {
-        self.navs = (0..self.builders.len()).map(|i| self.build(i, t0, pose)).collect();
-        self.last_sound = vec![pose; self.navs.len()];
-    }
-
-    fn build(&self, i: usize, t0: f64, pose: (f64, f64, f64)) -> Box<dyn Navigator> {
-        (self.builders[i])(t0, pose, self.sigma_position_m, self.sigma_heading_rad)
+        let sigmas = (self.sigma_position_m, self.sigma_heading_rad);
+        self.restarts = std::mem::take(&mut self.builders).into_iter().map(|b| Restart::new(b, pose, sigmas)).collect();
+        self.navs = self.restarts.iter().map(|r| r.build(t0, pose)).collect();
     }
 
     /// Records a rejection while the log has room.
@@ -597,13 +580,9 @@ impl Session {
         // a filter whose state stops being sound starts again from its last sound
         // estimate: reported, never silently kept
         for (i, e) in estimates.iter_mut().enumerate() {
-            if sound(e) {
-                self.last_sound[i] = (e.north_m(), e.east_m(), e.heading_state_rad);
-            } else {
-                self.navs[i] = self.build(i, t, self.last_sound[i]);
+            if self.restarts[i].apply(&mut self.navs[i], e, t) {
                 self.stats[i].reinitialised += 1;
                 reinitialised.push(i);
-                *e = self.navs[i].estimate();
             }
         }
         let errors = truth.map(|p| {
@@ -648,30 +627,11 @@ impl Session {
 mod tests {
     use super::*;
     use crate::filter::FilterKind;
-    use crate::nav::{PlanarConfig, PlanarNavigator};
+    use crate::nav::PlanarConfig;
 
     /// Builders of the planar family for named configurations.
     fn planar(est: Vec<(String, PlanarConfig, FilterKind)>) -> Vec<(String, Builder)> {
         est.into_iter().map(|(n, c, f)| (n, crate::nav::planar::builder(c, f))).collect()
-    }
-
-    /// An estimate is sound when finite with a positive definite horizontal covariance.
-    #[test]
-    fn soundness() {
-        let pose = (1.0, 2.0, 0.5);
-        let nav = PlanarNavigator::new(PlanarConfig::default(), FilterKind::Ekf, 0.0, pose, 1.0, 0.1);
-        let good = nav.estimate();
-        assert!(sound(&good));
-        let mut e = good;
-        e.position_ned_m.x = f64::NAN;
-        assert!(!sound(&e));
-        let mut e = good;
-        e.horizontal_cov_m2[(0, 1)] = 2.0; // |rho| > 1: not positive definite
-        e.horizontal_cov_m2[(1, 0)] = 2.0;
-        assert!(!sound(&e));
-        let mut e = good;
-        e.heading_var_rad2 = f64::INFINITY;
-        assert!(!sound(&e));
     }
 
     /// A lone jump in time is screened out; three items in a row on a new clock (a
