@@ -78,10 +78,10 @@ pub fn run(
         (simulate(&s, &cell, seed, run, true), None)
     };
     for c in computers.iter().flatten() {
-        let lines = |l: &mut dyn Iterator<Item = String>| l.map(|l| l + "\n").collect::<String>();
+        let input: String = c.input.iter().map(|l| format!("{l}\n")).collect();
+        let decisions: String = c.decisions.iter().map(|d| format!("{d}\n")).collect();
         staging.write(&format!("{}.stream.toml", c.name), c.config.as_bytes())?;
-        staging.write(&format!("{}.input.jsonl", c.name), lines(&mut c.input.iter().cloned()).as_bytes())?;
-        let decisions = lines(&mut c.decisions.iter().map(|d| d.to_string()));
+        staging.write(&format!("{}.input.jsonl", c.name), input.as_bytes())?;
         staging.write(&format!("{}.decisions.jsonl", c.name), decisions.as_bytes())?;
     }
 

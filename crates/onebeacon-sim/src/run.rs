@@ -199,10 +199,9 @@ fn simulate_recording(
             let mut info = Information::new(bearing_information(s.tracker_noise()));
             let computers = messages.then(|| vec![passive_usbl_computer(s, c, world.asv_start(), &starts)]);
             let mut m = computers.map(|c| Messages::new(c, helms.iter().map(|h| h.serves.clone()).collect()));
-            let mut out = match &mut m {
-                Some(m) => drive(&mut world, &mut tracks, &mut helms, vec![&mut info, m], recorder),
-                None => drive(&mut world, &mut tracks, &mut helms, vec![&mut info], recorder),
-            };
+            let mut extra: Vec<&mut dyn Observer> = vec![&mut info];
+            extra.extend(m.as_mut().map(|m| m as &mut dyn Observer));
+            let mut out = drive(&mut world, &mut tracks, &mut helms, extra, recorder);
             out.information = info.into_inner();
             (out, m.map(Messages::into_inner))
         }
@@ -212,10 +211,8 @@ fn simulate_recording(
             let mut helms = helms::fleet(s);
             let computers = messages.then(|| fleet_computers(s, seed, run)).flatten();
             let mut m = computers.map(|c| Messages::new(c, helms.iter().map(|h| h.serves.clone()).collect()));
-            let out = match &mut m {
-                Some(m) => drive(&mut world, &mut tracks, &mut helms, vec![m], recorder),
-                None => drive(&mut world, &mut tracks, &mut helms, vec![], recorder),
-            };
+            let extra = m.as_mut().map(|m| m as &mut dyn Observer).into_iter().collect();
+            let out = drive(&mut world, &mut tracks, &mut helms, extra, recorder);
             (out, m.map(Messages::into_inner))
         }
         _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),

@@ -139,17 +139,18 @@ pub struct Navigation {
 
 impl Default for Navigation {
     fn default() -> Self {
-        let c = onebeacon::nav::IusblConfig::default();
+        // the iUSBL navigator's defaults, as a log's `[estimators.iusbl]` has them
+        let k = super::iusbl::IusblKeys::default();
         Self {
-            particles: c.filter.particles,
-            reinitialised: c.filter.reinitialised,
-            max_range_m: c.filter.max_range_m,
-            sigma_speed_m_s: c.sigma_speed_m_s,
-            sigma_heading_deg: c.sigma_heading_rad.to_degrees(),
-            beacon_speed_m_s: c.beacon_speed_m_s,
-            floor: c.floor,
-            beam_exponent: c.beam_exponent,
-            confirmations: c.confirmations,
+            particles: k.particles,
+            reinitialised: k.reinitialised,
+            max_range_m: k.max_range_m,
+            sigma_speed_m_s: k.sigma_speed_m_s,
+            sigma_heading_deg: k.sigma_heading_deg,
+            beacon_speed_m_s: k.beacon_speed_m_s,
+            floor: k.floor,
+            beam_exponent: k.beam_exponent,
+            confirmations: k.confirmations,
         }
     }
 }

@@ -93,12 +93,11 @@ impl Unit {
     pub fn push(&mut self, vehicle: Option<usize>, item: &Item) -> Result<Option<Step>, Screened> {
         match (vehicle, &item.input) {
             (None, crate::nav::session::Input::BeaconPosition { .. }) => {
-                let mut last = Ok(None);
-                for s in &mut self.sessions {
-                    last = s.push(item);
-                    last.as_ref().map_err(Clone::clone)?;
+                let (last, others) = self.sessions.split_last_mut().expect("at least one session");
+                for s in others {
+                    s.push(item)?;
                 }
-                last
+                last.push(item)
             }
             (v, _) => self.sessions[v.unwrap_or(0)].push(item),
         }
