@@ -2,6 +2,7 @@
 //! piped through `onebeacon stream` with the run's configuration give the simulator's
 //! own decisions, because the simulator and the vehicle run the same controllers.
 
+use onebeacon::config::stream::StreamConfig;
 use serde_json::Value;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -45,7 +46,9 @@ fn json_lines(text: &str) -> Vec<Value> {
     text.lines().map(|l| serde_json::from_str(l).unwrap()).collect()
 }
 
-/// `stream` on computer `name` of a run: its output lines that decided, and its stderr.
+/// `stream` on computer `name` of a run: its output lines that decided, and its stderr;
+/// the onboard crate alone, reading the configuration as a `StreamConfig`, writes the
+/// same bytes.
 fn stream_decisions(run: &Path, name: &str) -> (Vec<Value>, String) {
     let config = run.join(format!("{name}.stream.toml"));
     let input = std::fs::read(run.join(format!("{name}.input.jsonl"))).unwrap();
@@ -61,6 +64,14 @@ fn stream_decisions(run: &Path, name: &str) -> (Vec<Value>, String) {
     let o = child.wait_with_output().unwrap();
     writer.join().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // the configuration is the onboard crate's, and its computer alone says the same
+    let text = std::fs::read_to_string(&config).unwrap();
+    let onboard: StreamConfig = toml::from_str(&text).unwrap();
+    let mut unit = onboard.checked().unwrap().unit().unwrap();
+    let mut out = Vec::new();
+    let input = std::fs::read(run.join(format!("{name}.input.jsonl"))).unwrap();
+    onebeacon::io::stream::run(&mut unit, input.as_slice(), &mut out, |_, _| {}).unwrap();
+    assert!(out == o.stdout, "the onboard crate alone and `stream` differ on {name}");
     let lines = json_lines(&String::from_utf8(o.stdout).unwrap());
     let decided = lines.into_iter().filter(|l| l["decided"] == true).collect();
     (decided, String::from_utf8(o.stderr).unwrap())

@@ -8,7 +8,7 @@ use onebeacon::geo::Frame;
 use onebeacon::io::stream;
 use onebeacon_sim::acoustics::channel::simulate_ping;
 use onebeacon_sim::acoustics::wav::Recording;
-use onebeacon_sim::replay::{Log, LogDescription, LogError, new_session, replay};
+use onebeacon_sim::replay::{Log, LogDescription, LogError, replay};
 use onebeacon_sim::scenario::ping::PingConfig;
 use onebeacon_sim::seed::{Stream, rng};
 use std::collections::BTreeMap;
@@ -156,7 +156,7 @@ pub fn stream(data: &[u8]) {
     let fixed: BTreeMap<u32, Vector3<f64>> =
         [(0, Vector3::new(10.0, 0.0, 0.0)), (5, Vector3::new(-20.0, 30.0, 0.0))].into_iter().collect();
     let start = onebeacon::nav::session::Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
-    let session = new_session(&d, &d.initial, start, None);
+    let session = d.stream_config(Vec::new()).session(&d.initial, start, None);
     let mut unit = onebeacon::vehicle::unit::Unit::new(vec![session], fixed, Frame::Enu, None);
     let mut out = Vec::new();
     stream::run(&mut unit, Cursor::new(data), &mut out, |_, _| {}).expect("in-memory I/O");

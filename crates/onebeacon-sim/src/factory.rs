@@ -6,7 +6,7 @@
 use crate::engine::Track;
 use crate::scenario::estimator::IusblKeys;
 use crate::scenario::fleet::{Fleet, SignalModel};
-use crate::scenario::{EstimatorKind, EstimatorSpec, FixedBeacon, Host, MovingBeacon, PassiveUsbl};
+use crate::scenario::{EstimatorKind, FixedBeacon, Host, MovingBeacon, PassiveUsbl};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use nalgebra::SVector;
 use onebeacon::dsp::beamform::pyramid_8cm;
@@ -18,7 +18,7 @@ use onebeacon::models::hoff::{DIM, idx};
 use onebeacon::models::kinematic6dof::{Cov as Cov6, State as Eta};
 use onebeacon::models::unicycle::{Cov, State};
 use onebeacon::nav::restart::Builder;
-use onebeacon::nav::usbl_track::{TrackState, TrackerNoise};
+use onebeacon::nav::usbl_track::TrackState;
 use onebeacon::nav::{
     Aiding, GaussianTracker, IusblNavigator, ParticleTracker, PlanarConfig, Range6DofNavigator, SingleBeaconNavigator,
 };
@@ -201,55 +201,4 @@ pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
         }
     }
     tracks
-}
-
-/// What a log's USBL tracker starts from besides its pose (hoff2024's state order):
-/// depth, pitch, speed and the two rate biases (m, rad, m/s, rad/s), the standard
-/// deviations of depth, pitch, speed and biases, and the seed of the vehicle's particle
-/// filters.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct TrackerStart {
-    pub state: [f64; 5],
-    pub sigma: [f64; 4],
-    pub seed: Option<i64>,
-}
-
-/// An estimator of a log description (replay, stream, Python) on a vehicle whose
-/// trackers start as `start` says, built by the session at its start and again from its
-/// last sound pose: a USBL tracker (pf, bearing: hoff2024's eight states), the iUSBL
-/// navigator (which starts from its first fix), or the planar family.
-pub(crate) fn log(spec: &EstimatorSpec, start: TrackerStart) -> Builder {
-    // the seed's 64 bits (TOML integers are signed)
-    let seed = spec.seed.or(start.seed).unwrap_or(0) as u64;
-    if spec.kind.tracks_bearings() {
-        let config = spec.tracker_config(TrackerNoise::default());
-        let (particles, settings) = spec.particle_settings();
-        let filter = spec.filter_kind();
-        let particle = spec.kind == EstimatorKind::Particle;
-        let ([depth, pitch, speed, pitch_bias, heading_bias], [s_depth, s_pitch, s_speed, s_bias]) =
-            (start.state, start.sigma);
-        return Box::new(move |t0, (north, east, heading), sigma_position, sigma_heading| {
-            let x0 = SVector::<f64, DIM>::from([north, east, depth, pitch, heading, speed, pitch_bias, heading_bias]);
-            let sigma0 = SVector::<f64, DIM>::from([
-                sigma_position,
-                sigma_position,
-                s_depth,
-                s_pitch,
-                sigma_heading,
-                s_speed,
-                s_bias,
-                s_bias,
-            ]);
-            if particle {
-                Box::new(ParticleTracker::new(config, settings, particles, t0, &x0, &sigma0, seed))
-            } else {
-                Box::new(GaussianTracker::new(config, filter, t0, &x0, &sigma0))
-            }
-        });
-    }
-    if spec.kind.iusbl() {
-        let config = spec.iusbl.clone().unwrap_or_default().config(spec.kind == EstimatorKind::Iusbl);
-        return Box::new(move |_, _, _, _| Box::new(IusblNavigator::new(config, None, seed)));
-    }
-    onebeacon::nav::planar::builder(spec.planar_config(), spec.filter_kind())
 }

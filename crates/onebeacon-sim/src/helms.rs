@@ -10,10 +10,10 @@ use crate::scenario::moving_beacon::GuidanceKind as FimKind;
 use crate::scenario::passive_usbl::GuidanceKind as BearingKind;
 use crate::scenario::{MovingBeacon, MovingBeaconCell, PassiveUsbl, PassiveUsblCell};
 use nalgebra::Vector2;
+use onebeacon::config::controller::{BearingModeName, BearingSpec, BehavioursSpec, ControllerSpec, MetricName};
 use onebeacon::geo::Frame;
 use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, best_standoff};
 use onebeacon::vehicle::fim::{FimGuidance, FimGuidanceConfig, FimMode};
-use onebeacon::vehicle::spec::{BearingModeName, BearingSpec, BehavioursSpec, ControllerSpec, MetricName};
 
 /// The controller of a passive-USBL world's ASV, starting at `home`, as a stream
 /// configuration gives it (the planner knows the USBL as the first estimator assumes it).

@@ -7,11 +7,13 @@
 //! gives the same commands: the simulator and the vehicle run the same code.
 
 use crate::engine::{Observer, Step};
-use crate::scenario::estimator::EstimatorSpec;
 use crate::scenario::fleet::{Fleet, SignalModel};
 use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
 use crate::{factory, helms};
 use nalgebra::{Vector2, Vector3};
+use onebeacon::config::controller::ControllerSpec;
+use onebeacon::config::estimator::EstimatorSpec;
+use onebeacon::config::stream::{FrameKey, Initial, InitialFrom, StreamConfig};
 use onebeacon::geo::Frame;
 use onebeacon::io::jsonl::{command_json, item_json};
 use onebeacon::models::hoff::idx;
@@ -20,7 +22,6 @@ use onebeacon::nav::usbl_track::TrackState;
 use onebeacon::vehicle::unit::Plan;
 use onebeacon::vehicle::{Decided, GuidanceSnapshot, Situation};
 use serde_json::{Value, json};
-use toml::{Table, Value as Toml};
 
 /// One vehicle computer's side of a run.
 #[derive(Debug, Clone, PartialEq)]
@@ -102,13 +103,33 @@ impl Observer for Messages {
     }
 }
 
-/// A stream configuration's top: its name, frame and start.
-fn config_table(name: &str, description: String) -> Table {
-    let mut t = Table::new();
-    t.insert("name".into(), name.into());
-    t.insert("description".into(), description.into());
-    t.insert("frame".into(), "ned".into());
-    t
+/// A stream configuration of `estimators` and `controller`, NED, its vehicles yet to
+/// be given.
+fn config(name: &str, description: String, estimators: Vec<EstimatorSpec>, controller: ControllerSpec) -> StreamConfig {
+    StreamConfig {
+        name: name.into(),
+        description,
+        frame: FrameKey::Ned,
+        beacons: Vec::new(),
+        initial: Initial::default(),
+        tracked: Vec::new(),
+        estimators,
+        noise: Default::default(),
+        limits: Default::default(),
+        controller: Some(controller),
+    }
+}
+
+/// A vehicle given at time 0 at (`x_m`, `y_m`, `heading_deg`).
+fn given(x_m: f64, y_m: f64, heading_deg: f64) -> Initial {
+    Initial {
+        from: InitialFrom::Given,
+        t0_s: Some(0.0),
+        x_m: Some(x_m),
+        y_m: Some(y_m),
+        heading_deg: Some(heading_deg),
+        ..Initial::default()
+    }
 }
 
 /// The surface vehicle's computer of a passive-USBL run: its trackers of every AUV
@@ -120,55 +141,46 @@ pub(crate) fn passive_usbl_computer(
     home: Vector2<f64>,
     starts: &[(TrackState, u64)],
 ) -> Computer {
-    let mut t = config_table(
-        "asv",
-        format!("The surface vehicle's computer of a simulated {} run (onebeacon run --messages)", s.name),
-    );
     let i = &s.initial;
-    let tracked: Vec<Toml> = starts
+    let tracked = starts
         .iter()
-        .map(|(x0, seed)| {
-            let mut v = Table::new();
-            v.insert("from".into(), "given".into());
-            v.insert("t0_s".into(), 0.0.into());
+        .map(|(x0, seed)| Initial {
             // the seed's 64 bits as TOML's signed integer
-            v.insert("seed".into(), Toml::Integer(*seed as i64));
-            for (k, x) in [
-                ("x_m", x0[idx::X]),
-                ("y_m", x0[idx::Y]),
-                ("depth_m", x0[idx::Z]),
-                ("pitch_deg", x0[idx::THETA].to_degrees()),
-                ("heading_deg", x0[idx::PSI].to_degrees()),
-                ("speed_m_s", x0[idx::U]),
-                ("pitch_rate_bias_deg_s", x0[idx::B_THETA].to_degrees()),
-                ("heading_rate_bias_deg_s", x0[idx::B_PSI].to_degrees()),
-                ("position_sigma_m", i.position_sigma_m),
-                ("heading_sigma_deg", i.heading_sigma_deg),
-                ("depth_sigma_m", i.depth_sigma_m),
-                ("pitch_sigma_deg", i.pitch_sigma_deg),
-                ("speed_sigma_m_s", i.speed_sigma_m_s),
-                ("rate_bias_sigma_deg_s", i.rate_bias_sigma_deg_s),
-            ] {
-                v.insert(k.into(), x.into());
-            }
-            Toml::Table(v)
+            seed: Some(*seed as i64),
+            depth_m: x0[idx::Z],
+            pitch_deg: x0[idx::THETA].to_degrees(),
+            speed_m_s: x0[idx::U],
+            pitch_rate_bias_deg_s: x0[idx::B_THETA].to_degrees(),
+            heading_rate_bias_deg_s: x0[idx::B_PSI].to_degrees(),
+            position_sigma_m: i.position_sigma_m,
+            heading_sigma_deg: i.heading_sigma_deg,
+            depth_sigma_m: i.depth_sigma_m,
+            pitch_sigma_deg: i.pitch_sigma_deg,
+            speed_sigma_m_s: i.speed_sigma_m_s,
+            rate_bias_sigma_deg_s: i.rate_bias_sigma_deg_s,
+            ..given(x0[idx::X], x0[idx::Y], x0[idx::PSI].to_degrees())
         })
         .collect();
-    t.insert("tracked".into(), Toml::Array(tracked));
     // the world's noise, which the trackers assume unless told otherwise, written out
-    let estimators = s.estimators.iter().map(|e| {
-        let mut e = e.clone();
-        e.usbl_sigma_deg_per_m = e.usbl_sigma_deg_per_m.or(Some(s.usbl.noise_deg_per_m));
-        e.compass_sigma_deg = e.compass_sigma_deg.or(Some(s.asv.compass_noise_deg));
-        e.heading_sigma_deg = e.heading_sigma_deg.or(Some(s.reports.heading_noise_deg));
-        e.speed_sigma_m_s = e.speed_sigma_m_s.or(Some(s.reports.speed_noise_m_s));
-        e.depth_sigma_m = e.depth_sigma_m.or(Some(s.reports.depth_noise_m));
-        e.name = Some(e.name());
-        e
-    });
-    insert_estimators(&mut t, estimators);
-    insert_controller(&mut t, &helms::passive_usbl_spec(s, cell, home));
-    computer("asv", &t)
+    let estimators = s
+        .estimators
+        .iter()
+        .map(|e| {
+            let mut e = e.clone();
+            e.usbl_sigma_deg_per_m = e.usbl_sigma_deg_per_m.or(Some(s.usbl.noise_deg_per_m));
+            e.compass_sigma_deg = e.compass_sigma_deg.or(Some(s.asv.compass_noise_deg));
+            e.heading_sigma_deg = e.heading_sigma_deg.or(Some(s.reports.heading_noise_deg));
+            e.speed_sigma_m_s = e.speed_sigma_m_s.or(Some(s.reports.speed_noise_m_s));
+            e.depth_sigma_m = e.depth_sigma_m.or(Some(s.reports.depth_noise_m));
+            e.name = Some(e.name());
+            e
+        })
+        .collect();
+    let description =
+        format!("The surface vehicle's computer of a simulated {} run (onebeacon run --messages)", s.name);
+    let config =
+        StreamConfig { tracked, ..config("asv", description, estimators, helms::passive_usbl_spec(s, cell, home)) };
+    computer("asv", &config)
 }
 
 /// Each AUV's computer of a fleet run: its estimators with the run's seeds, its
@@ -184,53 +196,40 @@ pub(crate) fn fleet_computers(s: &Fleet, seed: u64, run: u64) -> Option<Vec<Comp
             .iter()
             .enumerate()
             .map(|(v, a)| {
-                let mut t = config_table(
-                    &a.name,
-                    format!("{}'s computer in a simulated {} run (onebeacon run --messages)", a.name, s.name),
-                );
-                let mut init = Table::new();
-                init.insert("from".into(), "given".into());
-                init.insert("t0_s".into(), 0.0.into());
-                // the dead reckoning's start
-                for (k, x) in [
-                    ("x_m", a.start_north_m),
-                    ("y_m", a.start_east_m),
-                    ("heading_deg", a.start_heading_deg),
-                    ("position_sigma_m", 1.0),
-                    ("heading_sigma_deg", 0.05f64.to_degrees()),
-                ] {
-                    init.insert(k.into(), x.into());
-                }
-                t.insert("initial".into(), Toml::Table(init));
-                let estimators = s.estimators.iter().zip(&seeds[v]).map(|(&kind, &seed)| {
-                    let mut e = EstimatorSpec::new(kind);
-                    e.seed = Some(seed as i64);
-                    if kind != EstimatorKind::DeadReckoning {
-                        e.iusbl = Some(keys.clone());
-                    }
-                    e
-                });
-                insert_estimators(&mut t, estimators);
-                insert_controller(&mut t, &helms::fleet_spec(s, v));
-                computer(&a.name, &t)
+                let estimators = s
+                    .estimators
+                    .iter()
+                    .zip(&seeds[v])
+                    .map(|(&kind, &seed)| {
+                        let mut e = EstimatorSpec::new(kind);
+                        e.seed = Some(seed as i64);
+                        if kind != EstimatorKind::DeadReckoning {
+                            e.iusbl = Some(keys.clone());
+                        }
+                        e
+                    })
+                    .collect();
+                let description =
+                    format!("{}'s computer in a simulated {} run (onebeacon run --messages)", a.name, s.name);
+                let config = StreamConfig {
+                    // the dead reckoning's start
+                    initial: Initial {
+                        position_sigma_m: 1.0,
+                        heading_sigma_deg: 0.05f64.to_degrees(),
+                        ..given(a.start_north_m, a.start_east_m, a.start_heading_deg)
+                    },
+                    ..config(&a.name, description, estimators, helms::fleet_spec(s, v))
+                };
+                computer(&a.name, &config)
             })
             .collect(),
     )
 }
 
-fn insert_estimators(t: &mut Table, estimators: impl Iterator<Item = EstimatorSpec>) {
-    let list = estimators.map(|e| Toml::try_from(e).expect("an estimator is TOML")).collect();
-    t.insert("estimators".into(), Toml::Array(list));
-}
-
-fn insert_controller(t: &mut Table, c: &onebeacon::vehicle::spec::ControllerSpec) {
-    t.insert("controller".into(), Toml::try_from(c).expect("a controller is TOML"));
-}
-
-fn computer(name: &str, t: &Table) -> Computer {
+fn computer(name: &str, config: &StreamConfig) -> Computer {
     Computer {
         name: name.into(),
-        config: toml::to_string(t).expect("a table is TOML"),
+        config: toml::to_string(config).expect("a stream configuration is TOML"),
         input: Vec::new(),
         decisions: Vec::new(),
     }

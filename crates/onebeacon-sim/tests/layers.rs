@@ -156,6 +156,7 @@ const SIM_RULES: &[Rule] = &[
             "crate::metrics",
             "crate::montecarlo",
             "crate::chain",
+            "onebeacon::config",
         ],
     },
     Rule {
@@ -289,6 +290,7 @@ fn a_planted_violation_is_found() {
     sim.push(plant(&["world", "planted2"], "fn t() { let _ = onebeacon::nav::ParticleTracker::new; }"));
     sim.push(plant(&["vehicles", "planted"], "fn f() { let _ = super::super::scenario::Host::Log; }"));
     sim.push(plant(&["engine"], "fn g() -> crate::run::Estimate { todo!() }"));
+    sim.push(plant(&["sensors", "planted"], "use onebeacon::config::stream::Initial;"));
     let found = violations(&sim, SIM_RULES);
     let named: BTreeSet<&str> = found.iter().map(|(_, _, p)| p.as_str()).collect();
     assert_eq!(
@@ -297,7 +299,8 @@ fn a_planted_violation_is_found() {
             "onebeacon::vehicle::fim::FimGuidance",
             "onebeacon::nav::ParticleTracker::new",
             "crate::scenario::Host::Log",
-            "crate::run::Estimate"
+            "crate::run::Estimate",
+            "onebeacon::config::stream::Initial"
         ]),
         "{}",
         lines(&found)

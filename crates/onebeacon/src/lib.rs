@@ -12,11 +12,15 @@
 //!   the onboard [`nav::session`] that a vehicle's computer runs;
 //! - [`vehicle`]: the vehicle's own decisions: controllers that turn the navigators'
 //!   beliefs into commands (hoff's planner, sousa's FIM guidance, rypkema's behaviours);
+//! - [`config`]: what a vehicle's computer is configured with: estimators, controller,
+//!   stream (feature `serde`);
 //! - [`io`]: the JSON Lines codec of the session (feature `stream`, adds serde_json).
 //!
 //! Conventions: NED frame (x north, y east, z down), SI units, radians, heading from
 //! north toward east. Equation numbers in comments refer to the source papers.
 
+#[cfg(feature = "serde")]
+pub mod config;
 pub mod dsp;
 pub mod filter;
 pub mod geo;

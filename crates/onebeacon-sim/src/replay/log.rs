@@ -10,6 +10,7 @@ pub use super::schema::*;
 use crate::scenario::EstimatorSpec;
 use crate::scenario::load::deserialize;
 use nalgebra::Vector3;
+use onebeacon::config::stream::{Beacon, StreamConfig};
 use onebeacon::geo::Frame;
 use onebeacon::nav::Kind;
 use onebeacon::nav::session::Input;
@@ -78,14 +79,28 @@ impl LogDescription {
     /// Parses and checks the text of a log description; `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, LogError> {
         let mut d: LogDescription = deserialize(text, name)?;
-        super::validate::validate_log(&d)
-            .map_err(|v| LogError::Description(crate::scenario::load::invalid(name, v)))?;
-        for e in &mut d.estimators {
-            for (key, v) in &d.noise {
-                e.key_mut(key).expect("validated: a noise key").get_or_insert(*v);
-            }
-        }
+        let invalid = |v| LogError::Description(crate::scenario::load::invalid(name, v));
+        // the onboard keys as a stream checks them, with `[noise]` handed out
+        d.estimators = d.stream_config(Vec::new()).checked().map_err(invalid)?.estimators;
+        super::validate::validate_log(&d).map_err(invalid)?;
         Ok(d)
+    }
+
+    /// The stream configuration the description holds, with the fixed beacons `beacons`
+    /// (the log's resolved: [`LogDescription::fixed_beacons`]).
+    pub fn stream_config(&self, beacons: Vec<Beacon>) -> StreamConfig {
+        StreamConfig {
+            name: self.name.clone(),
+            description: self.description.clone(),
+            frame: self.frame,
+            beacons,
+            initial: self.initial.clone(),
+            tracked: self.tracked.clone(),
+            estimators: self.estimators.clone(),
+            noise: self.noise.clone(),
+            limits: self.limits,
+            controller: self.controller.clone(),
+        }
     }
 
     /// The geodetic origin: `[origin]`, or the first latitude and longitude of the log

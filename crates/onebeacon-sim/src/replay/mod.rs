@@ -15,6 +15,7 @@ pub(crate) mod validate;
 pub use log::{Log, LogDescription, LogError};
 pub use rows::Dropped;
 
+use onebeacon::config::stream::Beacon;
 use onebeacon::nav::session::{Input, Session, Start, Step};
 use onebeacon::vehicle::unit::Unit;
 
@@ -67,19 +68,6 @@ impl Replay {
     }
 }
 
-/// A session of the description's estimators on a vehicle that starts as `initial`
-/// says, starting at `start`, restricted to `beacons` when given (replay and stream).
-pub fn new_session(
-    d: &LogDescription,
-    initial: &schema::Initial,
-    start: Start,
-    beacons: Option<BTreeSet<u32>>,
-) -> Session {
-    let estimators = d.estimators.iter().map(|e| (e.name(), crate::factory::log(e, initial.tracker_start()))).collect();
-    let sigmas = (initial.position_sigma_m, initial.heading_sigma_deg.to_radians());
-    Session::new(d.frame.into(), estimators, start, sigmas, beacons).with_limits(d.limits)
-}
-
 /// The session a log describes, started at its initial pose.
 pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
     if !log.description.tracked.is_empty() {
@@ -90,7 +78,8 @@ pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session,
     }
     let start = log.initial_start()?;
     let d = &log.description;
-    let session = new_session(d, &d.initial, Start::At { t0_s: Some(start.t0_s), pose: start.pose }, beacons);
+    let at = Start::At { t0_s: Some(start.t0_s), pose: start.pose };
+    let session = d.stream_config(Vec::new()).session(&d.initial, at, beacons);
     Ok(session.with_position_sigma(start.position_sigma_m))
 }
 
@@ -105,45 +94,17 @@ pub fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Opt
     Ok(Some(ids.into_iter().collect()))
 }
 
-/// The vehicle's computer `onebeacon stream CONFIG` (and the Python `Navigator`) runs:
-/// one session per vehicle it estimates (its own from `[initial]`, or each of
-/// `[[tracked]]`), each started at its given pose or at the first ground-truth line, and
-/// the `[controller]` when there is one; no rejection log (a stream reports each line as
-/// it comes).
+/// The vehicle's computer `onebeacon stream CONFIG` (and the Python `Navigator`) runs,
+/// from a log description: its stream configuration with the fixed beacons of its files
+/// ([`onebeacon::config::stream::StreamConfig::unit`]).
 pub fn stream_setup(config: &std::path::Path) -> Result<Unit, LogError> {
-    use log::{HeadingFrom, InitialFrom};
     let d = LogDescription::load(config)?;
     let base = config.parent().unwrap_or(std::path::Path::new("."));
-    let fixed = d.fixed_beacons(base)?;
-    let frame = onebeacon::geo::Frame::from(d.frame);
-    let refuse = |message: String| Err(LogError::File { file: config.display().to_string(), message });
-    let vehicles: Vec<(String, &schema::Initial)> = if d.tracked.is_empty() {
-        vec![("initial".into(), &d.initial)]
-    } else {
-        d.tracked.iter().enumerate().map(|(v, i)| (format!("tracked[{v}]"), i)).collect()
-    };
-    let mut sessions = Vec::new();
-    for (section, init) in vehicles {
-        let start = match init.given_pose(frame) {
-            Some(pose) => Start::At { t0_s: init.t0_s, pose },
-            None if init.from == InitialFrom::Ranges => {
-                return refuse(format!(
-                    "key `{section}.from` = \"ranges\": needs a window of the log; a stream starts from the first ground_truth line or a given pose"
-                ));
-            }
-            None if init.heading_from == HeadingFrom::Track => {
-                return refuse(format!(
-                    "key `{section}.heading_from` = \"track\": needs the whole log; a stream starts from the first ground_truth line's heading (\"column\") or a given pose"
-                ));
-            }
-            None => Start::FirstTruth,
-        };
-        let session = new_session(&d, init, start, None);
-        let limits = onebeacon::nav::session::Limits { max_rejections: 0, ..*session.limits() };
-        sessions.push(session.with_limits(limits));
-    }
-    let helm = d.controller.as_ref().map(|c| c.build(frame));
-    Ok(Unit::new(sessions, fixed, frame, helm))
+    let beacons =
+        d.fixed_beacons(base)?.into_iter().map(|(id, p)| Beacon { id, x_m: p.x, y_m: p.y, z_m: p.z }).collect();
+    d.stream_config(beacons)
+        .unit()
+        .map_err(|v| LogError::File { file: config.display().to_string(), message: v.to_string() })
 }
 
 /// Runs every estimator of `log` over its stream, giving `record` one trajectory row

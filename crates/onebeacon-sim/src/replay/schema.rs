@@ -2,30 +2,13 @@
 //! units, clocks, beacons, start and limits), deserialised and documented.
 
 pub use super::geodesy::{LatLonUnit, Origin};
-use crate::scenario::EstimatorSpec;
-use onebeacon::geo::Frame;
+use onebeacon::config::controller::ControllerSpec;
+use onebeacon::config::estimator::EstimatorSpec;
+pub use onebeacon::config::stream::{FrameKey, HeadingFrom, Initial, InitialFrom};
 use onebeacon::nav::session::Limits;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-
-/// The frame of the log's x, y, z and headings (`frame` key).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FrameKey {
-    #[default]
-    Ned,
-    Enu,
-}
-
-impl From<FrameKey> for Frame {
-    fn from(f: FrameKey) -> Self {
-        match f {
-            FrameKey::Ned => Frame::Ned,
-            FrameKey::Enu => Frame::Enu,
-        }
-    }
-}
 
 /// What a CSV source holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -287,166 +270,10 @@ pub struct BeaconEntry {
     pub z_m: f64,
 }
 
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum InitialFrom {
-    /// The first ground-truth pose.
-    #[default]
-    GroundTruth,
-    /// `x_m`, `y_m`, `heading_deg`.
-    Given,
-    /// A robust multilateration of the ranges of the first `ranges_window_s` seconds
-    /// (three beacons at least), heading from `heading_deg` or the window's first heading
-    /// measurement: for a log whose start is unknown or doubtful.
-    Ranges,
-}
-
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum HeadingFrom {
-    /// The ground truth's heading column.
-    #[default]
-    Column,
-    /// The direction of the ground-truth track over its first `track_m` metres (when
-    /// the heading column is missing or not to be trusted); replay only.
-    Track,
-}
-
-/// Where the estimators start.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Initial {
-    #[serde(default)]
-    pub from: InitialFrom,
-    #[serde(default)]
-    pub heading_from: HeadingFrom,
-    #[serde(default = "default_track_m")]
-    pub track_m: f64,
-    /// `from = "ranges"`: how long ranges are gathered from the first one, s.
-    #[serde(default = "default_ranges_window_s")]
-    pub ranges_window_s: f64,
-    pub x_m: Option<f64>,
-    pub y_m: Option<f64>,
-    pub heading_deg: Option<f64>,
-    /// Initial standard deviations (`sigma_position_m`, `sigma_heading_deg`, the old
-    /// names, are read too).
-    #[serde(default = "default_position_sigma_m", alias = "sigma_position_m")]
-    pub position_sigma_m: f64,
-    #[serde(default = "default_heading_sigma_deg", alias = "sigma_heading_deg")]
-    pub heading_sigma_deg: f64,
-    /// When the estimators start, s (default: the first item's time).
-    pub t0_s: Option<f64>,
-    /// The seed of the vehicle's particle filters, any 64-bit integer (an estimator's
-    /// `seed` replaces it; default 0).
-    pub seed: Option<i64>,
-    /// The rest of a USBL tracker's state (kinds pf and bearing: hoff2024's eight
-    /// states) and its standard deviations; the rate biases start at 0 unless given.
-    #[serde(default)]
-    pub depth_m: f64,
-    #[serde(default)]
-    pub pitch_deg: f64,
-    #[serde(default)]
-    pub speed_m_s: f64,
-    #[serde(default)]
-    pub pitch_rate_bias_deg_s: f64,
-    #[serde(default)]
-    pub heading_rate_bias_deg_s: f64,
-    #[serde(default = "default_depth_sigma_m")]
-    pub depth_sigma_m: f64,
-    #[serde(default = "default_pitch_sigma_deg")]
-    pub pitch_sigma_deg: f64,
-    #[serde(default = "default_speed_sigma_m_s")]
-    pub speed_sigma_m_s: f64,
-    #[serde(default = "default_rate_bias_sigma_deg_s")]
-    pub rate_bias_sigma_deg_s: f64,
-}
-
-/// Left out, `[initial]` starts from the first ground-truth pose and its heading column.
-impl Default for Initial {
-    fn default() -> Self {
-        Self {
-            from: InitialFrom::default(),
-            heading_from: HeadingFrom::default(),
-            track_m: default_track_m(),
-            ranges_window_s: default_ranges_window_s(),
-            x_m: None,
-            y_m: None,
-            heading_deg: None,
-            position_sigma_m: default_position_sigma_m(),
-            heading_sigma_deg: default_heading_sigma_deg(),
-            t0_s: None,
-            seed: None,
-            depth_m: 0.0,
-            pitch_deg: 0.0,
-            speed_m_s: 0.0,
-            pitch_rate_bias_deg_s: 0.0,
-            heading_rate_bias_deg_s: 0.0,
-            depth_sigma_m: default_depth_sigma_m(),
-            pitch_sigma_deg: default_pitch_sigma_deg(),
-            speed_sigma_m_s: default_speed_sigma_m_s(),
-            rate_bias_sigma_deg_s: default_rate_bias_sigma_deg_s(),
-        }
-    }
-}
-
-impl Initial {
-    /// What a USBL tracker starts from besides the pose.
-    pub(crate) fn tracker_start(&self) -> crate::factory::TrackerStart {
-        crate::factory::TrackerStart {
-            state: [
-                self.depth_m,
-                self.pitch_deg.to_radians(),
-                self.speed_m_s,
-                self.pitch_rate_bias_deg_s.to_radians(),
-                self.heading_rate_bias_deg_s.to_radians(),
-            ],
-            sigma: [
-                self.depth_sigma_m,
-                self.pitch_sigma_deg.to_radians(),
-                self.speed_sigma_m_s,
-                self.rate_bias_sigma_deg_s.to_radians(),
-            ],
-            seed: self.seed,
-        }
-    }
-
-    /// The given pose in NED (N, E, psi) when `from = "given"`.
-    pub fn given_pose(&self, frame: Frame) -> Option<(f64, f64, f64)> {
-        if self.from != InitialFrom::Given {
-            return None;
-        }
-        let p = frame.to_ned(self.x_m?, self.y_m?, 0.0);
-        Some((p.x, p.y, frame.heading_to_ned(self.heading_deg?.to_radians())))
-    }
-}
-
-pub(super) fn default_track_m() -> f64 {
-    2.0
-}
-pub(super) fn default_ranges_window_s() -> f64 {
-    30.0
-}
-pub(super) fn default_position_sigma_m() -> f64 {
-    1.0
-}
-pub(super) fn default_heading_sigma_deg() -> f64 {
-    5.0
-}
-// a tracker's, as hoff2024's built-in scenario
-fn default_depth_sigma_m() -> f64 {
-    1.0
-}
-fn default_pitch_sigma_deg() -> f64 {
-    2.0
-}
-fn default_speed_sigma_m_s() -> f64 {
-    0.3
-}
-fn default_rate_bias_sigma_deg_s() -> f64 {
-    0.05
-}
-
-/// The log description file.
+/// The log description file: the keys of a stream configuration
+/// ([`onebeacon::config::stream::StreamConfig`], which documents them) and where the
+/// log's data are (its sources, its beacons' file or positions in latitude and
+/// longitude, the origin); [`LogDescription::stream_config`] gives the former.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LogDescription {
@@ -469,7 +296,7 @@ pub struct LogDescription {
     pub estimators: Vec<EstimatorSpec>,
     /// Noise keys every estimator takes unless it gives its own (`[noise]`): one place
     /// for what the sensors are, the estimators differing in what they estimate. Its
-    /// keys are [`crate::scenario::estimator::NOISE_KEYS`].
+    /// keys are [`onebeacon::config::estimator::NOISE_KEYS`].
     #[serde(default)]
     pub noise: BTreeMap<String, f64>,
     /// What an item must respect before any estimator sees it.
@@ -477,7 +304,7 @@ pub struct LogDescription {
     pub limits: Limits,
     /// The vehicle's controller (stream): a surface vehicle's planner or an AUV's
     /// behaviours, deciding on its estimators' beliefs.
-    pub controller: Option<onebeacon::vehicle::spec::ControllerSpec>,
+    pub controller: Option<ControllerSpec>,
     /// `[[tracked]]` (stream): the vehicles a surface vehicle tracks, one `[initial]`
     /// table each (a line's `vehicle` is its index); without it, one vehicle from
     /// `[initial]`.

@@ -1,10 +1,10 @@
-//! Range checks on a parsed log description: each source's column keys, its time keys,
-//! the beacons, the noise keys, the estimators, the start and the limits. The first
+//! Range checks on a parsed log description's own keys: each source's column keys, its
+//! time keys, the beacons and the origin (the keys it shares with a stream configuration
+//! are checked by [`onebeacon::config::stream::StreamConfig::check`]). The first
 //! violation is reported with its key.
 
-use super::log::{COLUMN_KEYS, InitialFrom, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
-use crate::scenario::estimator::{Host, NOISE_KEYS};
-use crate::scenario::validate::{Rule, Violation, check, check_count, check_estimators, check_fields, check_file_name};
+use super::log::{COLUMN_KEYS, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
+use crate::scenario::validate::{Rule, Violation, check};
 
 /// A position given as exactly one pair: `x`/`y` or `lat`/`lon` (the keys named by
 /// `keys`, at `at`).
@@ -70,9 +70,8 @@ fn check_time(i: usize, s: &Source) -> Result<(), Violation> {
     check(&at("time_offset_s"), s.time_offset_s, Rule::Finite)
 }
 
-/// A log description: each source's column keys, the estimators, the start.
+/// A log description's own keys: each source's column keys, the beacons, the origin.
 pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
-    check_file_name("name", &d.name)?;
     if let Some(o) = &d.origin
         && !crate::replay::geodesy::on_earth(o.lat_deg, o.lon_deg)
     {
@@ -143,88 +142,6 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
         for v in [b.x_m, b.y_m, b.lat_deg, b.lon_deg, Some(b.z_m)].into_iter().flatten() {
             check(&format!("beacon[{i}]"), v, Rule::Finite)?;
         }
-    }
-    for (key, v) in &d.noise {
-        let Some((_, positive)) = NOISE_KEYS.iter().find(|(k, _)| k == key) else {
-            let keys: Vec<&str> = NOISE_KEYS.iter().map(|k| k.0).collect();
-            return Err(Violation {
-                key: format!("noise.{key}"),
-                value: format!("{v:?}"),
-                allowed: format!("is not a noise key (keys: {})", keys.join(", ")),
-            });
-        };
-        check(&format!("noise.{key}"), *v, if *positive { Rule::Positive } else { Rule::NonNegative })?;
-    }
-    check_estimators(&d.estimators, Host::Log)?;
-    for (e, spec) in d.estimators.iter().enumerate() {
-        if spec.iusbl.is_some() && !spec.kind.iusbl() {
-            return Err(Violation {
-                key: format!("estimators[{e}].iusbl"),
-                value: "(set)".into(),
-                allowed: format!("applies to kinds iusbl and iusbl-joint only, not to {:?}", spec.kind.label()),
-            });
-        }
-        for (key, v, positive) in spec.iusbl.iter().flat_map(|k| k.numbers()) {
-            check(
-                &format!("estimators[{e}].iusbl.{key}"),
-                v,
-                if positive { Rule::Positive } else { Rule::NonNegative },
-            )?;
-        }
-    }
-    check_initial("initial", &d.initial)?;
-    for (v, init) in d.tracked.iter().enumerate() {
-        check_initial(&format!("tracked[{v}]"), init)?;
-    }
-    if let Some(c) = &d.controller {
-        c.check(&onebeacon::io::jsonl::kinds()).map_err(|e| Violation {
-            key: format!("controller.{}", e.key),
-            value: e.value,
-            allowed: e.allowed,
-        })?;
-    }
-    let l = &d.limits;
-    check_fields!("limits", l, {
-        max_range_m: Positive,
-        max_speed_m_s: Positive,
-        max_rate_rad_s: Positive,
-        max_depth_m: Positive,
-        max_time_gap_s: Positive,
-    });
-    check_count("limits.max_beacons", l.max_beacons, 1, 1 << 20)?;
-    check_count("limits.max_rejections", l.max_rejections, 0, 100_000_000)?;
-    check_count("limits.max_line_bytes", l.max_line_bytes, 64, 1 << 26)?;
-    Ok(())
-}
-
-/// One `[initial]` table (or one of `[[tracked]]`, `section` naming it).
-fn check_initial(section: &str, init: &crate::replay::schema::Initial) -> Result<(), Violation> {
-    if init.from == InitialFrom::Given && (init.x_m.is_none() || init.y_m.is_none() || init.heading_deg.is_none()) {
-        return Err(Violation {
-            key: format!("{section}.from"),
-            value: "\"given\"".into(),
-            allowed: format!("needs {section}.x_m, {section}.y_m and {section}.heading_deg"),
-        });
-    }
-    for (key, v, rule) in [
-        ("position_sigma_m", init.position_sigma_m, Rule::Positive),
-        ("heading_sigma_deg", init.heading_sigma_deg, Rule::Positive),
-        ("track_m", init.track_m, Rule::Positive),
-        ("ranges_window_s", init.ranges_window_s, Rule::Positive),
-        ("depth_m", init.depth_m, Rule::Finite),
-        ("pitch_deg", init.pitch_deg, Rule::Finite),
-        ("speed_m_s", init.speed_m_s, Rule::Finite),
-        ("pitch_rate_bias_deg_s", init.pitch_rate_bias_deg_s, Rule::Finite),
-        ("heading_rate_bias_deg_s", init.heading_rate_bias_deg_s, Rule::Finite),
-        ("depth_sigma_m", init.depth_sigma_m, Rule::Positive),
-        ("pitch_sigma_deg", init.pitch_sigma_deg, Rule::Positive),
-        ("speed_sigma_m_s", init.speed_sigma_m_s, Rule::Positive),
-        ("rate_bias_sigma_deg_s", init.rate_bias_sigma_deg_s, Rule::Positive),
-    ] {
-        check(&format!("{section}.{key}"), v, rule)?;
-    }
-    if let Some(t) = init.t0_s {
-        check(&format!("{section}.t0_s"), t, Rule::Finite)?;
     }
     Ok(())
 }

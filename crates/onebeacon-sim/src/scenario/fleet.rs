@@ -230,7 +230,7 @@ fn default_depth() -> f64 {
 }
 
 /// The behaviours by mode: the onboard crate's configuration types.
-pub use onebeacon::vehicle::spec::{BehaviourName, MODES, ModeBehaviour};
+pub use onebeacon::config::controller::{BehaviourName, MODES, ModeBehaviour};
 
 impl Fleet {
     pub fn steps(&self) -> usize {

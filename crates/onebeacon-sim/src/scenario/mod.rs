@@ -8,10 +8,8 @@
 //! unit in their name; angles in config are degrees (`*_deg`), radians inside.
 
 mod builtin;
-pub mod estimator;
 pub mod fixed_beacon;
 pub mod fleet;
-pub mod iusbl;
 pub(crate) mod load;
 pub mod moving_beacon;
 pub mod passive_usbl;
@@ -19,14 +17,15 @@ pub mod ping;
 pub(crate) mod validate;
 
 pub use builtin::{BUILTINS, Builtin, builtin};
-pub use estimator::{EstimatorKind, EstimatorSpec, Host};
+pub use estimator::{EstimatorKind, EstimatorSpec, FilterName, Host};
 pub use fixed_beacon::{FixedBeacon, FixedBeaconCell};
 pub use fleet::Fleet;
 pub use load::{ScenarioError, load, load_builtin, load_file, parse};
 pub use moving_beacon::{MovingBeacon, MovingBeaconCell};
+/// The `[[estimators]]` vocabulary is the onboard crate's: a vehicle reads it too.
+pub use onebeacon::config::{estimator, iusbl};
 pub use passive_usbl::{PassiveUsbl, PassiveUsblCell};
 
-use onebeacon::filter::{FilterKind, UkfParams};
 use serde::{Deserialize, Serialize};
 
 /// Which world a scenario describes.
@@ -43,40 +42,6 @@ pub enum World {
     /// AUVs navigating on one beacon with inverted USBLs, commanded by its chirps
     /// (rypkema).
     Fleet,
-}
-
-/// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum FilterName {
-    /// Extended Kalman filter.
-    #[default]
-    Ekf,
-    /// Unscented Kalman filter (Merwe sigma points: `ukf_alpha`, `ukf_beta`, `ukf_kappa`).
-    Ukf,
-}
-
-impl FilterName {
-    /// The filter with its parameters; absent UKF keys take [`UkfParams::default`].
-    pub fn kind(self, alpha: Option<f64>, beta: Option<f64>, kappa: Option<f64>) -> FilterKind {
-        let d = UkfParams::default();
-        match self {
-            FilterName::Ekf => FilterKind::Ekf,
-            FilterName::Ukf => FilterKind::Ukf(UkfParams {
-                alpha: alpha.unwrap_or(d.alpha),
-                beta: beta.unwrap_or(d.beta),
-                kappa: kappa.unwrap_or(d.kappa),
-            }),
-        }
-    }
-
-    /// Suffix of a default estimator name: "" for the EKF, "-ukf".
-    pub fn suffix(self) -> &'static str {
-        match self {
-            FilterName::Ekf => "",
-            FilterName::Ukf => "-ukf",
-        }
-    }
 }
 
 pub(crate) fn default_seed() -> u64 {

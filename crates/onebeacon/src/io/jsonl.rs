@@ -82,14 +82,7 @@ pub fn item_json(item: &Item) -> Value {
     }
 }
 
-/// The kinds a line may have.
-pub const KINDS: &str = "odometry, body_odometry, speed, heading, depth, attitude, body_velocity, inertial, range, doppler, \
-    range_doppler, bearing, report, array_fix, beacon_position, ground_truth, own_fix";
-
-/// The kinds as a list.
-pub fn kinds() -> Vec<&'static str> {
-    KINDS.split(", ").collect()
-}
+pub use super::{KINDS, kinds};
 
 /// One parsed line: an item for the sessions (about vehicle `vehicle`, when the line
 /// names one), or the vehicle's own fix (in the line's frame).

@@ -146,7 +146,7 @@ pub struct Rejection {
 /// session goes on. (With the `serde` feature it reads from a `[limits]` table, every key
 /// optional.)
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(default, deny_unknown_fields))]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize), serde(default, deny_unknown_fields))]
 pub struct Limits {
     /// Largest plausible range, m.
     pub max_range_m: f64,

@@ -20,8 +20,6 @@ pub mod autonomy;
 pub mod bearing;
 pub mod behaviours;
 pub mod fim;
-#[cfg(feature = "serde")]
-pub mod spec;
 pub mod unit;
 
 use crate::guidance::FimPlanner;

@@ -4,12 +4,13 @@
 //! frame, angles in degrees in keys named `*_deg`; [`ControllerSpec::build`] gives the
 //! controller in NED.
 
-use super::autonomy::{Autonomy, AutonomySettings, Behaviour};
-use super::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
-use super::behaviours::Behaviours;
-use super::unit::{DecideOn, Helm};
+use super::check::Violation;
 use crate::geo::Frame;
 use crate::guidance::bearing::{BearingPlanner, SpreadMetric};
+use crate::vehicle::autonomy::{Autonomy, AutonomySettings, Behaviour};
+use crate::vehicle::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
+use crate::vehicle::behaviours::Behaviours;
+use crate::vehicle::unit::{DecideOn, Helm};
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
@@ -209,15 +210,6 @@ pub fn mode_bank(modes: &[ModeBehaviour]) -> Vec<Option<Behaviour>> {
     bank
 }
 
-/// A key of the `[controller]` table that is not what it may be.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("key `controller.{key}` = {value}: {allowed}")]
-pub struct SpecError {
-    pub key: String,
-    pub value: String,
-    pub allowed: String,
-}
-
 impl ControllerSpec {
     /// The line kind after which the controller decides.
     pub fn decide_on(&self) -> &str {
@@ -228,9 +220,9 @@ impl ControllerSpec {
     }
 
     /// Checks the keys; `kinds` are the line kinds a stream may carry.
-    pub fn check(&self, kinds: &[&str]) -> Result<(), SpecError> {
+    pub fn check(&self, kinds: &[&str]) -> Result<(), Violation> {
         let bad = |key: &str, value: String, allowed: &str| {
-            Err(SpecError { key: key.into(), value, allowed: allowed.into() })
+            Err(Violation { key: format!("controller.{key}"), value, allowed: allowed.into() })
         };
         if !kinds.contains(&self.decide_on()) {
             return bad("decide_on", format!("{:?}", self.decide_on()), &format!("one of {}", kinds.join(", ")));
@@ -294,7 +286,7 @@ impl ControllerSpec {
     /// The controller, in NED from a file in `frame`, with the line kind it decides on.
     pub fn build(&self, frame: Frame) -> Helm {
         let decide_on = DecideOn(self.decide_on().to_string());
-        let controller: Box<dyn super::Controller> = match self {
+        let controller: Box<dyn crate::vehicle::Controller> = match self {
             ControllerSpec::Bearing(b) => {
                 let home = frame.to_ned(b.home_x_m, b.home_y_m, 0.0);
                 Box::new(BearingGuidance::new(BearingGuidanceConfig {

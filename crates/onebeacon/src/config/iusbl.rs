@@ -2,8 +2,8 @@
 //! stream gives them (`[estimators.iusbl]`), and as a fleet scenario's `navigation`,
 //! `dock` and `signal` tables do.
 
-use onebeacon::filter::factored::FactoredSettings;
-use onebeacon::nav::IusblConfig;
+use crate::filter::factored::FactoredSettings;
+use crate::nav::IusblConfig;
 use serde::{Deserialize, Serialize};
 
 /// The settings of rypkema's iUSBL navigator (`[estimators.iusbl]`); defaults are

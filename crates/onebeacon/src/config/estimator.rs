@@ -6,13 +6,52 @@
 //! 3-7), 6-DOF kinematics in `moving_beacon` worlds (sousa 3.1), the stochastic
 //! unicycle of hoff2024 eq. 4 in `passive_usbl` worlds, planar odometry on logs.
 
-use super::FilterName;
+use super::check::{Rule, Violation, check, check_count, check_names, check_ukf};
 pub use super::iusbl::IusblKeys;
-use onebeacon::filter::FilterKind;
-use onebeacon::filter::particle::{ParticleSettings, Resampler};
-use onebeacon::models::hoff::HoffProcess;
-use onebeacon::nav::{Aiding, EkfTuning, PlanarConfig, PlanarNoise, Robust, SensorNoise, TrackerConfig, TrackerNoise};
+use crate::filter::particle::{ParticleSettings, Resampler};
+use crate::filter::{FilterKind, UkfParams};
+use crate::models::hoff::{DIM, HoffProcess};
+use crate::nav::restart::Builder;
+use crate::nav::{
+    Aiding, EkfTuning, GaussianTracker, IusblNavigator, ParticleTracker, PlanarConfig, PlanarNoise, Robust,
+    SensorNoise, TrackerConfig, TrackerNoise,
+};
+use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
+
+/// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FilterName {
+    /// Extended Kalman filter.
+    #[default]
+    Ekf,
+    /// Unscented Kalman filter (Merwe sigma points: `ukf_alpha`, `ukf_beta`, `ukf_kappa`).
+    Ukf,
+}
+
+impl FilterName {
+    /// The filter with its parameters; absent UKF keys take [`UkfParams::default`].
+    pub fn kind(self, alpha: Option<f64>, beta: Option<f64>, kappa: Option<f64>) -> FilterKind {
+        let d = UkfParams::default();
+        match self {
+            FilterName::Ekf => FilterKind::Ekf,
+            FilterName::Ukf => FilterKind::Ukf(UkfParams {
+                alpha: alpha.unwrap_or(d.alpha),
+                beta: beta.unwrap_or(d.beta),
+                kappa: kappa.unwrap_or(d.kappa),
+            }),
+        }
+    }
+
+    /// Suffix of a default estimator name: "" for the EKF, "-ukf".
+    pub fn suffix(self) -> &'static str {
+        match self {
+            FilterName::Ekf => "",
+            FilterName::Ukf => "-ukf",
+        }
+    }
+}
 
 /// A heavy-tailed update (`robust` key).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
@@ -258,14 +297,6 @@ pub const NOISE_KEYS: [(&str, bool); 9] = [
     ("position_walk_m_per_sqrt_s", false),
 ];
 
-/// What a numeric key must be.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Sign {
-    Positive,
-    NonNegative,
-    Any,
-}
-
 impl EstimatorSpec {
     /// An estimator of `kind` with every other key at its default.
     pub fn new(kind: EstimatorKind) -> Self {
@@ -361,9 +392,9 @@ impl EstimatorSpec {
     }
 
     /// The numeric tuning keys that are set, with their rule and their hosts.
-    pub(crate) fn tuning_keys(&self) -> Vec<(&'static str, f64, Sign, &'static [Host])> {
+    fn tuning_keys(&self) -> Vec<(&'static str, f64, Rule, &'static [Host])> {
         use Host::*;
-        use Sign::*;
+        use Rule::*;
         const RANGING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const FIXED_LOG: &[Host] = &[FixedBeacon, Log];
         const USBL: &[Host] = &[PassiveUsbl, Log];
@@ -375,7 +406,7 @@ impl EstimatorSpec {
             ("usbl_sigma_deg_per_m", self.usbl_sigma_deg_per_m, Positive, USBL),
             ("compass_sigma_deg", self.compass_sigma_deg, NonNegative, USBL),
             ("depth_sigma_m", self.depth_sigma_m, Positive, USBL),
-            ("seed", self.seed.map(|s| s as f64), Any, &[Log]),
+            ("seed", self.seed.map(|s| s as f64), Finite, &[Log]),
             ("process_noise_scale", self.process_noise_scale, Positive, USBL),
             ("particles", self.particles.map(|n| n as f64), Positive, USBL),
             ("ess_fraction", self.ess_fraction, Positive, USBL),
@@ -393,17 +424,17 @@ impl EstimatorSpec {
             ("nis_gate", self.nis_gate, Positive, &[PassiveUsbl, Log]),
             ("huber_k", self.huber_k, Positive, &[Log]),
             ("student_t_dof", self.student_t_dof, Positive, &[Log]),
-            ("mirror_recovery", flag(self.mirror_recovery), Any, &[FixedBeacon]),
+            ("mirror_recovery", flag(self.mirror_recovery), Finite, &[FixedBeacon]),
             ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
-            ("estimate_bias", flag(self.estimate_bias), Any, &[Log]),
-            ("estimate_beacon_offsets", flag(self.estimate_beacon_offsets), Any, &[Log]),
-            ("bias_m", self.bias_m, Any, &[Log]),
+            ("estimate_bias", flag(self.estimate_bias), Finite, &[Log]),
+            ("estimate_beacon_offsets", flag(self.estimate_beacon_offsets), Finite, &[Log]),
+            ("bias_m", self.bias_m, Finite, &[Log]),
             ("bias_sigma_m", self.bias_sigma_m, Positive, &[Log]),
-            ("estimate_range_scale", flag(self.estimate_range_scale), Any, &[Log]),
+            ("estimate_range_scale", flag(self.estimate_range_scale), Finite, &[Log]),
             ("range_scale_sigma", self.range_scale_sigma, Positive, &[Log]),
-            ("estimate_distance_scale", flag(self.estimate_distance_scale), Any, &[Log]),
+            ("estimate_distance_scale", flag(self.estimate_distance_scale), Finite, &[Log]),
             ("distance_scale_sigma", self.distance_scale_sigma, Positive, &[Log]),
-            ("estimate_turn_scale", flag(self.estimate_turn_scale), Any, &[Log]),
+            ("estimate_turn_scale", flag(self.estimate_turn_scale), Finite, &[Log]),
             ("turn_scale_sigma", self.turn_scale_sigma, Positive, &[Log]),
         ];
         for q in self.q_diag.iter().flatten() {
@@ -517,10 +548,181 @@ impl EstimatorSpec {
     }
 }
 
+/// What a log's or a stream's USBL tracker starts from besides its pose (hoff2024's
+/// state order): depth, pitch, speed and the two rate biases (m, rad, m/s, rad/s), the
+/// standard deviations of depth, pitch, speed and biases, and the seed of the vehicle's
+/// particle filters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackerStart {
+    pub state: [f64; 5],
+    pub sigma: [f64; 4],
+    pub seed: Option<i64>,
+}
+
+impl EstimatorSpec {
+    /// The estimator on a log or a stream, on a vehicle whose trackers start as `start`
+    /// says, built by the session at its start and again from its last sound pose: a USBL
+    /// tracker (pf, bearing: hoff2024's eight states), the iUSBL navigator (which starts
+    /// from its first fix), or the planar family.
+    pub fn builder(&self, start: TrackerStart) -> Builder {
+        // the seed's 64 bits (TOML integers are signed)
+        let seed = self.seed.or(start.seed).unwrap_or(0) as u64;
+        if self.kind.tracks_bearings() {
+            let config = self.tracker_config(TrackerNoise::default());
+            let (particles, settings) = self.particle_settings();
+            let filter = self.filter_kind();
+            let particle = self.kind == EstimatorKind::Particle;
+            let ([depth, pitch, speed, pitch_bias, heading_bias], [s_depth, s_pitch, s_speed, s_bias]) =
+                (start.state, start.sigma);
+            return Box::new(move |t0, (north, east, heading), sigma_position, sigma_heading| {
+                let x0 =
+                    SVector::<f64, DIM>::from([north, east, depth, pitch, heading, speed, pitch_bias, heading_bias]);
+                let sigma0 = SVector::<f64, DIM>::from([
+                    sigma_position,
+                    sigma_position,
+                    s_depth,
+                    s_pitch,
+                    sigma_heading,
+                    s_speed,
+                    s_bias,
+                    s_bias,
+                ]);
+                if particle {
+                    Box::new(ParticleTracker::new(config, settings, particles, t0, &x0, &sigma0, seed))
+                } else {
+                    Box::new(GaussianTracker::new(config, filter, t0, &x0, &sigma0))
+                }
+            });
+        }
+        if self.kind.iusbl() {
+            let config = self.iusbl.clone().unwrap_or_default().config(self.kind == EstimatorKind::Iusbl);
+            return Box::new(move |_, _, _, _| Box::new(IusblNavigator::new(config, None, seed)));
+        }
+        crate::nav::planar::builder(self.planar_config(), self.filter_kind())
+    }
+}
+
+/// The `[[estimators]]` tables of `host`: names, the UKF's parameters, every tuning
+/// key that is set (it must apply to the host and be in range), and the acoustic
+/// measurements (the host must give them).
+pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Violation> {
+    check_names("estimators", &specs.iter().map(|e| e.name()).collect::<Vec<_>>())?;
+    // the planar state has 4 to 8 components; 7 bounds kappa for the common case
+    let states = match host {
+        Host::Log => 7,
+        Host::PassiveUsbl => 8,
+        Host::FixedBeacon | Host::MovingBeacon => 6,
+    };
+    for (k, e) in specs.iter().enumerate() {
+        let key = |f: &str| format!("estimators[{k}].{f}");
+        check_ukf(&format!("estimators[{k}]"), states, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
+        for (name, v, rule, hosts) in e.tuning_keys() {
+            if !hosts.contains(&host) {
+                let flag = name.starts_with("estimate_") || name == "mirror_recovery";
+                let value = if flag { (v != 0.0).to_string() } else { format!("{v:?}") };
+                let applies: Vec<&str> = hosts.iter().map(|h| h.label()).collect();
+                return Err(Violation {
+                    key: key(name),
+                    value,
+                    allowed: format!("does not apply to a {} (it applies to: {})", host.label(), applies.join(", ")),
+                });
+            }
+            check(&key(name), v, rule)?;
+        }
+        if e.estimate_beacon_offsets == Some(true)
+            && (e.estimate_bias == Some(true) || e.track_accel_sigma_m_s2.is_some())
+        {
+            return Err(Violation {
+                key: key("estimate_beacon_offsets"),
+                value: "true".into(),
+                allowed: "replaces the shared offset of estimate_bias (give one of the two), and does not apply to the tracker (track_accel_sigma_m_s2)".into(),
+            });
+        }
+        if e.robust.is_some() && host != Host::Log {
+            return Err(Violation {
+                key: key("robust"),
+                value: format!("{:?}", e.robust),
+                allowed: format!("does not apply to a {} (it applies to: log)", host.label()),
+            });
+        }
+        if e.iusbl.is_some() && !e.kind.iusbl() {
+            return Err(Violation {
+                key: key("iusbl"),
+                value: "(set)".into(),
+                allowed: format!("applies to kinds iusbl and iusbl-joint only, not to {:?}", e.kind.label()),
+            });
+        }
+        for (name, v, positive) in e.iusbl.iter().flat_map(|k| k.numbers()) {
+            check(&key(&format!("iusbl.{name}")), v, if positive { Rule::Positive } else { Rule::NonNegative })?;
+        }
+        let particle = e.kind == EstimatorKind::Particle;
+        let tracker = e.kind.tracks_bearings();
+        if e.kind.iusbl() && host != Host::Log {
+            return Err(Violation {
+                key: key("kind"),
+                value: format!("{:?}", e.kind.label()),
+                allowed: format!("navigates on a beacon's array fixes: a fleet world or a log, not a {}", host.label()),
+            });
+        }
+        // a log may carry USBL bearings (a surface vehicle's stream)
+        if tracker && !matches!(host, Host::PassiveUsbl | Host::Log)
+            || host == Host::PassiveUsbl && matches!(e.kind, EstimatorKind::RangeDoppler | EstimatorKind::Rosb)
+        {
+            let allowed = if tracker {
+                format!("tracks a vehicle by USBL bearings: a passive_usbl world or a log, not a {}", host.label())
+            } else {
+                "uses ranges; a passive_usbl world gives USBL bearings and the vehicle's reports (kinds pf, bearing, range-ekf, dead-reckoning)".to_string()
+            };
+            return Err(Violation { key: key("kind"), value: format!("{:?}", e.kind.label()), allowed });
+        }
+        let pf_only = [
+            ("particles", e.particles.is_some()),
+            ("resampler", e.resampler.is_some()),
+            ("ess_fraction", e.ess_fraction.is_some()),
+            ("roughening_k", e.roughening_k.is_some()),
+            ("min_effective_particles", e.min_effective_particles.is_some()),
+        ];
+        if let Some((name, _)) = pf_only.iter().find(|(_, set)| *set).filter(|_| !particle) {
+            return Err(Violation {
+                key: key(name),
+                value: "(set)".into(),
+                allowed: format!("applies to a particle filter (kind = \"pf\") only, not to kind {:?}", e.kind.label()),
+            });
+        }
+        if particle {
+            check_count(&key("particles"), e.particles.unwrap_or(1), 1, 50_000_000)?;
+            if let Some(f) = e.ess_fraction {
+                check(&key("ess_fraction"), f, Rule::Probability)?;
+            }
+        }
+        let has = if host == Host::Log && tracker { Aiding::BEARING } else { host.acoustic() };
+        let asked = e.aiding(host);
+        if (asked.doppler && !has.doppler) || (asked.range && !has.range) || (asked.bearing && !has.bearing) {
+            let (k, value) = match &e.measurements {
+                Some(m) => (key("measurements"), format!("{m:?}").to_lowercase()),
+                None => (key("kind"), format!("{:?}", e.kind.label())),
+            };
+            let gives = match host {
+                Host::MovingBeacon => "ranges only",
+                Host::PassiveUsbl => "USBL bearings only",
+                Host::FixedBeacon | Host::Log => "ranges and Doppler speeds only",
+            };
+            let uses = if asked.doppler && !has.doppler {
+                "Doppler speeds"
+            } else if asked.range && !has.range {
+                "ranges"
+            } else {
+                "USBL bearings"
+            };
+            return Err(Violation { key: k, value, allowed: format!("uses {uses}; a {} gives {gives}", host.label()) });
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scenario::validate::check_estimators;
 
     fn spec(text: &str) -> EstimatorSpec {
         toml::from_str(text).unwrap()
