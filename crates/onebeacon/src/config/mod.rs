@@ -1,13 +1,16 @@
 //! What a vehicle's computer is configured with (feature `serde`): the
 //! `[[estimators]]` vocabulary shared by scenarios, logs and streams ([`estimator`],
-//! with the iUSBL navigator's table in [`iusbl`]), the `[controller]` table
+//! with the iUSBL navigator's table in [`iusbl`], its checks beside it and each spec's
+//! navigator on a log or a stream), the `[controller]` table
 //! ([`controller`]), the stream configuration that puts them together into a
 //! [`crate::vehicle::unit::Unit`] ([`stream`]), and the rules a key obeys with the
 //! one-line error that names it ([`check`]). A vehicle reads its configuration with this
 //! crate alone; the simulator reads its scenarios and logs into the same types.
 
+mod builder;
 pub mod check;
 pub mod controller;
 pub mod estimator;
+mod estimator_check;
 pub mod iusbl;
 pub mod stream;

@@ -1,0 +1,257 @@
+//! The checks of `[[estimators]]` tables: each key applies to the host it is given in
+//! and is in range; the first violation is reported with its key.
+
+use super::check::{Rule, Violation, check, check_count, check_names, check_ukf};
+use super::estimator::{EstimatorKind, EstimatorSpec, Host};
+use crate::nav::Aiding;
+
+impl EstimatorSpec {
+    /// The numeric tuning keys that are set, with their rule and their hosts.
+    fn tuning_keys(&self) -> Vec<(&'static str, f64, Rule, &'static [Host])> {
+        use Host::*;
+        use Rule::*;
+        const RANGING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
+        const FIXED_LOG: &[Host] = &[FixedBeacon, Log];
+        const USBL: &[Host] = &[PassiveUsbl, Log];
+        let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
+        let mut keys = vec![
+            ("range_sigma_m", self.range_sigma_m, Positive, RANGING),
+            ("doppler_sigma_m_s", self.doppler_sigma_m_s, Positive, FIXED_LOG),
+            ("heading_sigma_deg", self.heading_sigma_deg, Positive, &[FixedBeacon, PassiveUsbl, Log]),
+            ("usbl_sigma_deg_per_m", self.usbl_sigma_deg_per_m, Positive, USBL),
+            ("compass_sigma_deg", self.compass_sigma_deg, NonNegative, USBL),
+            ("depth_sigma_m", self.depth_sigma_m, Positive, USBL),
+            ("seed", self.seed.map(|s| s as f64), Finite, &[Log]),
+            ("process_noise_scale", self.process_noise_scale, Positive, USBL),
+            ("particles", self.particles.map(|n| n as f64), Positive, USBL),
+            ("ess_fraction", self.ess_fraction, Positive, USBL),
+            ("roughening_k", self.roughening_k, Positive, USBL),
+            ("min_effective_particles", self.min_effective_particles, NonNegative, USBL),
+            ("yaw_rate_sigma_rad_s", self.yaw_rate_sigma_rad_s, Positive, &[FixedBeacon]),
+            ("accel_sigma_m_s2", self.accel_sigma_m_s2, Positive, &[FixedBeacon]),
+            ("distance_sigma_frac", self.distance_sigma_frac, NonNegative, &[Log]),
+            ("heading_change_sigma_frac", self.heading_change_sigma_frac, NonNegative, &[Log]),
+            ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, NonNegative, &[Log]),
+            ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[PassiveUsbl, Log]),
+            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, &[Log]),
+            ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
+            ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
+            ("nis_gate", self.nis_gate, Positive, &[PassiveUsbl, Log]),
+            ("huber_k", self.huber_k, Positive, &[Log]),
+            ("student_t_dof", self.student_t_dof, Positive, &[Log]),
+            ("mirror_recovery", flag(self.mirror_recovery), Finite, &[FixedBeacon]),
+            ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
+            ("estimate_bias", flag(self.estimate_bias), Finite, &[Log]),
+            ("estimate_beacon_offsets", flag(self.estimate_beacon_offsets), Finite, &[Log]),
+            ("bias_m", self.bias_m, Finite, &[Log]),
+            ("bias_sigma_m", self.bias_sigma_m, Positive, &[Log]),
+            ("estimate_range_scale", flag(self.estimate_range_scale), Finite, &[Log]),
+            ("range_scale_sigma", self.range_scale_sigma, Positive, &[Log]),
+            ("estimate_distance_scale", flag(self.estimate_distance_scale), Finite, &[Log]),
+            ("distance_scale_sigma", self.distance_scale_sigma, Positive, &[Log]),
+            ("estimate_turn_scale", flag(self.estimate_turn_scale), Finite, &[Log]),
+            ("turn_scale_sigma", self.turn_scale_sigma, Positive, &[Log]),
+        ];
+        for q in self.q_diag.iter().flatten() {
+            keys.push(("q_diag", Some(*q), NonNegative, &[FixedBeacon]));
+        }
+        for q in self.process_sigma.iter().flatten() {
+            keys.push(("process_sigma", Some(*q), NonNegative, USBL));
+        }
+        keys.into_iter().filter_map(|(k, v, s, h)| v.map(|v| (k, v, s, h))).collect()
+    }
+}
+
+/// The `[[estimators]]` tables of `host`: names, the UKF's parameters, every tuning
+/// key that is set (it must apply to the host and be in range), and the acoustic
+/// measurements (the host must give them).
+pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Violation> {
+    check_names("estimators", &specs.iter().map(|e| e.name()).collect::<Vec<_>>())?;
+    // the planar state has 4 to 8 components; 7 bounds kappa for the common case
+    let states = match host {
+        Host::Log => 7,
+        Host::PassiveUsbl => 8,
+        Host::FixedBeacon | Host::MovingBeacon => 6,
+    };
+    for (k, e) in specs.iter().enumerate() {
+        let key = |f: &str| format!("estimators[{k}].{f}");
+        check_ukf(&format!("estimators[{k}]"), states, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
+        for (name, v, rule, hosts) in e.tuning_keys() {
+            if !hosts.contains(&host) {
+                let flag = name.starts_with("estimate_") || name == "mirror_recovery";
+                let value = if flag { (v != 0.0).to_string() } else { format!("{v:?}") };
+                let applies: Vec<&str> = hosts.iter().map(|h| h.label()).collect();
+                return Err(Violation {
+                    key: key(name),
+                    value,
+                    allowed: format!("does not apply to a {} (it applies to: {})", host.label(), applies.join(", ")),
+                });
+            }
+            check(&key(name), v, rule)?;
+        }
+        if e.estimate_beacon_offsets == Some(true)
+            && (e.estimate_bias == Some(true) || e.track_accel_sigma_m_s2.is_some())
+        {
+            return Err(Violation {
+                key: key("estimate_beacon_offsets"),
+                value: "true".into(),
+                allowed: "replaces the shared offset of estimate_bias (give one of the two), and does not apply to the tracker (track_accel_sigma_m_s2)".into(),
+            });
+        }
+        if e.robust.is_some() && host != Host::Log {
+            return Err(Violation {
+                key: key("robust"),
+                value: format!("{:?}", e.robust),
+                allowed: format!("does not apply to a {} (it applies to: log)", host.label()),
+            });
+        }
+        if e.iusbl.is_some() && !e.kind.iusbl() {
+            return Err(Violation {
+                key: key("iusbl"),
+                value: "(set)".into(),
+                allowed: format!("applies to kinds iusbl and iusbl-joint only, not to {:?}", e.kind.label()),
+            });
+        }
+        for (name, v, positive) in e.iusbl.iter().flat_map(|k| k.numbers()) {
+            check(&key(&format!("iusbl.{name}")), v, if positive { Rule::Positive } else { Rule::NonNegative })?;
+        }
+        let particle = e.kind == EstimatorKind::Particle;
+        let tracker = e.kind.tracks_bearings();
+        if e.kind.iusbl() && host != Host::Log {
+            return Err(Violation {
+                key: key("kind"),
+                value: format!("{:?}", e.kind.label()),
+                allowed: format!("navigates on a beacon's array fixes: a fleet world or a log, not a {}", host.label()),
+            });
+        }
+        // a log may carry USBL bearings (a surface vehicle's stream)
+        if tracker && !matches!(host, Host::PassiveUsbl | Host::Log)
+            || host == Host::PassiveUsbl && matches!(e.kind, EstimatorKind::RangeDoppler | EstimatorKind::Rosb)
+        {
+            let allowed = if tracker {
+                format!("tracks a vehicle by USBL bearings: a passive_usbl world or a log, not a {}", host.label())
+            } else {
+                "uses ranges; a passive_usbl world gives USBL bearings and the vehicle's reports (kinds pf, bearing, range-ekf, dead-reckoning)".to_string()
+            };
+            return Err(Violation { key: key("kind"), value: format!("{:?}", e.kind.label()), allowed });
+        }
+        let pf_only = [
+            ("particles", e.particles.is_some()),
+            ("resampler", e.resampler.is_some()),
+            ("ess_fraction", e.ess_fraction.is_some()),
+            ("roughening_k", e.roughening_k.is_some()),
+            ("min_effective_particles", e.min_effective_particles.is_some()),
+        ];
+        if let Some((name, _)) = pf_only.iter().find(|(_, set)| *set).filter(|_| !particle) {
+            return Err(Violation {
+                key: key(name),
+                value: "(set)".into(),
+                allowed: format!("applies to a particle filter (kind = \"pf\") only, not to kind {:?}", e.kind.label()),
+            });
+        }
+        if particle {
+            check_count(&key("particles"), e.particles.unwrap_or(1), 1, 50_000_000)?;
+            if let Some(f) = e.ess_fraction {
+                check(&key("ess_fraction"), f, Rule::Probability)?;
+            }
+        }
+        let has = if host == Host::Log && tracker { Aiding::BEARING } else { host.acoustic() };
+        let asked = e.aiding(host);
+        if (asked.doppler && !has.doppler) || (asked.range && !has.range) || (asked.bearing && !has.bearing) {
+            let (k, value) = match &e.measurements {
+                Some(m) => (key("measurements"), format!("{m:?}").to_lowercase()),
+                None => (key("kind"), format!("{:?}", e.kind.label())),
+            };
+            let gives = match host {
+                Host::MovingBeacon => "ranges only",
+                Host::PassiveUsbl => "USBL bearings only",
+                Host::FixedBeacon | Host::Log => "ranges and Doppler speeds only",
+            };
+            let uses = if asked.doppler && !has.doppler {
+                "Doppler speeds"
+            } else if asked.range && !has.range {
+                "ranges"
+            } else {
+                "USBL bearings"
+            };
+            return Err(Violation { key: k, value, allowed: format!("uses {uses}; a {} gives {gives}", host.label()) });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nav::SensorNoise;
+
+    fn spec(text: &str) -> EstimatorSpec {
+        toml::from_str(text).unwrap()
+    }
+
+    fn error(text: &str, host: Host) -> String {
+        match check_estimators(&[spec(text)], host) {
+            Ok(()) => String::new(),
+            Err(v) => format!("{} = {}: {}", v.key, v.value, v.allowed),
+        }
+    }
+
+    /// The short names and what they stand for in each host (written out by hand).
+    #[test]
+    fn short_names_expand_per_host() {
+        use EstimatorKind::*;
+        let (rd, r, none) = (Aiding::RANGE_DOPPLER, Aiding::RANGE, Aiding::NONE);
+        for (kind, fixed, moving, log) in
+            [(RangeDoppler, rd, rd, rd), (Rosb, r, r, r), (RangeEkf, rd, r, rd), (DeadReckoning, none, none, none)]
+        {
+            let e = EstimatorSpec::new(kind);
+            assert_eq!(
+                [e.aiding(Host::FixedBeacon), e.aiding(Host::MovingBeacon), e.aiding(Host::Log)],
+                [fixed, moving, log]
+            );
+        }
+        // old spellings and the full form
+        assert_eq!(spec("kind = \"range_ekf\"").kind, RangeEkf);
+        assert_eq!(spec("kind = \"dead_reckoning\"").kind, DeadReckoning);
+        let doppler_only = spec("kind = \"range-ekf\"\nmeasurements = [\"doppler\"]");
+        assert_eq!(doppler_only.aiding(Host::Log), Aiding { range: false, doppler: true, bearing: false });
+    }
+
+    /// One table means the same in every host where its keys apply, and is refused by
+    /// name where they do not.
+    #[test]
+    fn one_table_every_host() {
+        let shared = "kind = \"rosb\"\nname = \"r\"\nrange_sigma_m = 2.0\nfilter = \"ukf\"\nukf_alpha = 0.5";
+        for host in [Host::FixedBeacon, Host::MovingBeacon, Host::Log] {
+            assert_eq!(error(shared, host), "", "{host:?}");
+        }
+        let e = spec(shared);
+        assert_eq!(e.ekf_tuning().r_range_m2, 4.0);
+        assert_eq!(e.planar_config().noise.range_sigma_m, 2.0);
+        let sensors =
+            SensorNoise { velocity_m_s: 0.1, rate_rad_s: 0.01, depth_m: 0.1, attitude_rad: 0.02, range_m: 1.0 };
+        assert_eq!(e.sensor_noise(sensors).range_m, 2.0);
+        assert_eq!(e.sensor_noise(sensors).velocity_m_s, 0.1);
+
+        assert_eq!(
+            error("kind = \"rosb\"\nnis_gate = 3.0", Host::FixedBeacon),
+            "estimators[0].nis_gate = 3.0: does not apply to a fixed_beacon world (it applies to: passive_usbl world, log)"
+        );
+        assert_eq!(
+            error("kind = \"range+doppler\"", Host::MovingBeacon),
+            "estimators[0].kind = \"range+doppler\": uses Doppler speeds; a moving_beacon world gives ranges only"
+        );
+        assert!(error("kind = \"rosb\"\nq_diag = [1, 1, 1, 1, -1, 1]", Host::FixedBeacon).contains(">= 0"));
+        assert!(error("kind = \"rosb\"\nrange_sigma_m = 0.0", Host::Log).contains("> 0"));
+    }
+
+    /// Left out, garin2024's noise keys are eq. 25's variances exactly (no square root
+    /// and square in between).
+    #[test]
+    fn fixed_beacon_defaults_are_eq_25() {
+        let t = EstimatorSpec::new(EstimatorKind::RangeDoppler).ekf_tuning();
+        assert_eq!((t.r_heading_rad2, t.r_yaw_rate_rad2_s2, t.r_accel_m2_s4), (1.0, 0.005, 0.005));
+        assert_eq!((t.r_range_m2, t.r_doppler_m2_s2), (12.0, 0.2));
+        assert_eq!(t.q_diag, [0.25f64.powi(8); 6]);
+    }
+}
