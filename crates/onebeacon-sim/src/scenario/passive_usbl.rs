@@ -380,6 +380,7 @@ impl PassiveUsbl {
             heading_sigma_rad: self.reports.heading_noise_deg.to_radians(),
             speed_sigma_m_s: self.reports.speed_noise_m_s,
             depth_sigma_m: self.reports.depth_noise_m,
+            usbl_as_printed: false,
         }
     }
 

@@ -204,6 +204,9 @@ pub struct EstimatorSpec {
     pub heading_sigma_deg: Option<f64>,
     /// USBL bearings: sigma_USBL, deg per metre of range (passive_usbl).
     pub usbl_sigma_deg_per_m: Option<f64>,
+    /// Read hoff2024's eq. 6 as printed: sigma_USBL r (eq. 3) as the angles' variance
+    /// instead of their standard deviation (passive_usbl; default false).
+    pub usbl_as_printed: Option<bool>,
     /// The station's compass error, deg (passive_usbl).
     pub compass_sigma_deg: Option<f64>,
     /// The vehicle's reported depth, m (passive_usbl).
@@ -308,6 +311,7 @@ impl EstimatorSpec {
             doppler_sigma_m_s: None,
             heading_sigma_deg: None,
             usbl_sigma_deg_per_m: None,
+            usbl_as_printed: None,
             compass_sigma_deg: None,
             depth_sigma_m: None,
             process_noise_scale: None,
@@ -423,6 +427,7 @@ impl EstimatorSpec {
                 heading_sigma_rad: self.heading_sigma_deg.map_or(n.heading_sigma_rad, f64::to_radians),
                 speed_sigma_m_s: self.speed_sigma_m_s.unwrap_or(n.speed_sigma_m_s),
                 depth_sigma_m: self.depth_sigma_m.unwrap_or(n.depth_sigma_m),
+                usbl_as_printed: self.usbl_as_printed.unwrap_or(n.usbl_as_printed),
             },
             aiding: self.aiding(Host::PassiveUsbl),
             nis_gate: self.nis_gate.unwrap_or(d.nis_gate),

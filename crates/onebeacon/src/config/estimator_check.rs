@@ -19,6 +19,7 @@ impl EstimatorSpec {
             ("doppler_sigma_m_s", self.doppler_sigma_m_s, Positive, FIXED_LOG),
             ("heading_sigma_deg", self.heading_sigma_deg, Positive, &[FixedBeacon, PassiveUsbl, Log]),
             ("usbl_sigma_deg_per_m", self.usbl_sigma_deg_per_m, Positive, USBL),
+            ("usbl_as_printed", flag(self.usbl_as_printed), Finite, USBL),
             ("compass_sigma_deg", self.compass_sigma_deg, NonNegative, USBL),
             ("depth_sigma_m", self.depth_sigma_m, Positive, USBL),
             ("seed", self.seed.map(|s| s as f64), Finite, &[Log]),
@@ -78,7 +79,7 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
         check_ukf(&format!("estimators[{k}]"), states, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
         for (name, v, rule, hosts) in e.tuning_keys() {
             if !hosts.contains(&host) {
-                let flag = name.starts_with("estimate_") || name == "mirror_recovery";
+                let flag = name.starts_with("estimate_") || matches!(name, "mirror_recovery" | "usbl_as_printed");
                 let value = if flag { (v != 0.0).to_string() } else { format!("{v:?}") };
                 let applies: Vec<&str> = hosts.iter().map(|h| h.label()).collect();
                 return Err(Violation {

@@ -61,7 +61,6 @@ impl ParticleLikelihood for UsblBearing {
         let u = &self.usbl;
         let (sb, cb) = (self.azimuth_rad + u.heading_rad).sin_cos();
         let (se, ce) = self.elevation_rad.sin_cos();
-        let s2 = u.sigma_rad_per_m * u.sigma_rad_per_m;
         let (g2, c2) = (u.position_sigma_m * u.position_sigma_m, u.heading_sigma_rad * u.heading_sigma_rad);
         let o = u.position_ned_m;
         let [px, py, pz, ..] = x else { panic!("hoff2024's state has {DIM} components") };
@@ -82,7 +81,7 @@ impl ParticleLikelihood for UsblBearing {
                 cross_e[j] = se * dz - ce * h; // the same for the elevation (eq. 2), times r
                 dot_e[j] = ce * dz + se * h;
                 // eq. 3, plus the station's pose errors to first order (Usbl::variances)
-                let base = (s2 * r2).max(1e-12);
+                let base = u.base_variance(r2).max(1e-12);
                 var_a[j] = base + g2 / h2.max(1e-12) + c2;
                 var_e[j] = base + g2 * dz * dz / (r2 * r2).max(1e-24);
                 prod[j] = var_a[j] * var_e[j];

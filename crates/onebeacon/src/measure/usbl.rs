@@ -10,7 +10,8 @@ use std::f64::consts::PI;
 /// The USBL on the surface vehicle: its NED position and heading when the message
 /// arrives, the baseline noise sigma_USBL in rad per metre of range (the paper's deg/m,
 /// converted), and how well the station knows its own position (GPS, m per horizontal
-/// axis) and heading (compass, rad): the paper takes both as exact (zero).
+/// axis) and heading (compass, rad): the paper takes both as exact (zero). `as_printed`
+/// reads eq. 6 as the paper prints it (see [`Usbl::base_variance`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Usbl {
     pub position_ned_m: Vector3<f64>,
@@ -18,6 +19,7 @@ pub struct Usbl {
     pub sigma_rad_per_m: f64,
     pub position_sigma_m: f64,
     pub heading_sigma_rad: f64,
+    pub as_printed: bool,
 }
 
 /// Which angle of a [`Usbl`] a scalar model measures.
@@ -46,7 +48,25 @@ impl Usbl {
 
     /// A USBL whose station knows its own pose exactly.
     pub fn exact(position_ned_m: Vector3<f64>, heading_rad: f64, sigma_rad_per_m: f64) -> Self {
-        Self { position_ned_m, heading_rad, sigma_rad_per_m, position_sigma_m: 0.0, heading_sigma_rad: 0.0 }
+        Self {
+            position_ned_m,
+            heading_rad,
+            sigma_rad_per_m,
+            position_sigma_m: 0.0,
+            heading_sigma_rad: 0.0,
+            as_printed: false,
+        }
+    }
+
+    /// The variance of each angle from eq. 3 at squared range `r2`: (sigma_USBL r)^2; as
+    /// printed, eq. 6's covariance diag(sigma_alpha, sigma_phi) puts eq. 3's sigma where a
+    /// variance belongs: sigma_USBL r itself (rad taken as rad^2).
+    pub fn base_variance(&self, r2: f64) -> f64 {
+        if self.as_printed {
+            self.sigma_rad_per_m * r2.sqrt() // eq. 6 as printed
+        } else {
+            self.sigma_rad_per_m * self.sigma_rad_per_m * r2 // eq. 3, squared
+        }
     }
 
     /// The variances of the azimuth and the elevation of a vehicle at `p`: eq. 3's
@@ -58,7 +78,7 @@ impl Usbl {
         let d = p - self.position_ned_m;
         let h2 = (d.x * d.x + d.y * d.y).max(1e-12);
         let r2 = h2 + d.z * d.z;
-        let base = self.sigma_rad_per_m * self.sigma_rad_per_m * r2; // eq. 3
+        let base = self.base_variance(r2);
         let g2 = self.position_sigma_m * self.position_sigma_m;
         let c2 = self.heading_sigma_rad * self.heading_sigma_rad;
         (base + g2 / h2 + c2, base + g2 * d.z * d.z / (r2 * r2))
@@ -148,6 +168,21 @@ mod tests {
                 assert_abs_diff_eq!(ScalarModel::<4>::jacobian(&m, &x), finite_difference::<4>(&m, &x), epsilon = 1e-7);
             }
         }
+    }
+
+    /// Eq. 6 as printed at 35 m with Table 1's filter column (0.022 deg/m): the angles'
+    /// variance is 0.022 x 35 = 0.77 deg = 0.013439 rad (as rad^2), a standard deviation of
+    /// 6.64 deg, where the squared reading gives 0.77 deg.
+    #[test]
+    fn eq_6_as_printed_takes_sigma_as_the_variance() {
+        let literal = Usbl { as_printed: true, ..Usbl::exact(Vector3::zeros(), 0.0, 0.022f64.to_radians()) };
+        let p = Vector3::new(21.0, 0.0, 28.0); // 35 m away
+        let (var_az, var_el) = literal.variances(&p);
+        assert_abs_diff_eq!(var_az, 0.77f64.to_radians(), epsilon = 1e-12);
+        assert_abs_diff_eq!(var_el, 0.77f64.to_radians(), epsilon = 1e-12);
+        assert_abs_diff_eq!(var_az.sqrt().to_degrees(), 6.642, epsilon = 1e-3);
+        let squared = Usbl { as_printed: false, ..literal };
+        assert_abs_diff_eq!(squared.variances(&p).0.sqrt().to_degrees(), 0.77, epsilon = 1e-12);
     }
 
     /// The station's pose errors in the variances against the spread of the angles

@@ -240,8 +240,8 @@ mod tests {
     /// The USBL likelihood (residuals as atan2 of cross and dot products, in single-
     /// precision lanes) against eq. 6 written with `Usbl::angles` and
     /// `Usbl::variances` in f64, particle by particle: around the station, across the
-    /// azimuth's +-pi, almost overhead, with and without the station's pose errors;
-    /// within 1e-4 relative (single precision's share).
+    /// azimuth's +-pi, almost overhead, with and without the station's pose errors, and
+    /// with eq. 6 read as printed; within 1e-4 relative (single precision's share).
     #[test]
     fn usbl_likelihood_matches_eq_6() {
         use nalgebra::Vector3;
@@ -256,13 +256,14 @@ mod tests {
         let comps: Vec<Vec<f64>> =
             (0..DIM).map(|k| pts.iter().map(|p| if k < 3 { p[k] } else { 0.0 }).collect()).collect();
         let view: Vec<&[f64]> = comps.iter().map(|c| &c[..]).collect();
-        for (gps, compass) in [(0.0, 0.0), (1.0, 0.02)] {
+        for (gps, compass, as_printed) in [(0.0, 0.0, false), (1.0, 0.02, false), (0.0, 0.0, true)] {
             let usbl = Usbl {
                 position_ned_m: Vector3::new(10.0, -4.0, 0.5),
                 heading_rad: 3.0,
                 sigma_rad_per_m: 0.01f64.to_radians(),
                 position_sigma_m: gps,
                 heading_sigma_rad: compass,
+                as_printed,
             };
             let bearing = UsblBearing { usbl, azimuth_rad: 0.2, elevation_rad: 0.9 };
             let mut got = vec![0.0; n];

@@ -28,6 +28,9 @@ pub struct TrackerNoise {
     pub heading_sigma_rad: f64,
     pub speed_sigma_m_s: f64,
     pub depth_sigma_m: f64,
+    /// Eq. 6 read as printed: eq. 3's sigma as the angles' variance
+    /// ([`Usbl::base_variance`]); false (the default) takes it as their standard deviation.
+    pub usbl_as_printed: bool,
 }
 
 impl Default for TrackerNoise {
@@ -41,6 +44,7 @@ impl Default for TrackerNoise {
             heading_sigma_rad: 0.15f64.sqrt(),
             speed_sigma_m_s: 0.06f64.sqrt(),
             depth_sigma_m: 0.15f64.sqrt(),
+            usbl_as_printed: false,
         }
     }
 }
@@ -77,6 +81,7 @@ impl TrackerNoise {
             sigma_rad_per_m: self.usbl_sigma_rad_per_m,
             position_sigma_m: station.sigma_m,
             heading_sigma_rad: self.station_heading_sigma_rad,
+            as_printed: self.usbl_as_printed,
         }
     }
 }
