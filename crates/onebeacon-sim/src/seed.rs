@@ -17,6 +17,10 @@ pub enum Stream {
     Current = 5,
     /// A moving beacon's own GPS (the fleet world's boat).
     BeaconGps = 6,
+    /// A vehicle's clock.
+    Clock = 7,
+    /// The beacon's clock.
+    BeaconClock = 8,
 }
 
 /// SplitMix64 finaliser: a bijective mixing of 64 bits.

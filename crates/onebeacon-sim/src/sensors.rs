@@ -119,8 +119,9 @@ impl SensorSuite {
     }
 
     /// A communication frame from `beacon` (None if lost): OWTT range (eq. 19) and
-    /// Doppler radial speed (eq. 13-14), each with white noise.
-    pub fn comm_frame(&mut self, truth: &TruthState, beacon: Vector2<f64>) -> Option<Kind> {
+    /// Doppler radial speed (eq. 13-14), each with white noise; the range also carries
+    /// `clock_m`, what the two ends' clocks add to it.
+    pub fn comm_frame(&mut self, truth: &TruthState, beacon: Vector2<f64>, clock_m: f64) -> Option<Kind> {
         // always draw all three numbers so that a loss does not shift later draws
         let lost = self.acoustic.random::<f64>() < self.frame_loss_prob;
         let (n, x) = (&self.noise, state(truth));
@@ -134,7 +135,7 @@ impl SensorSuite {
         let bearing_to_beacon = d.y.atan2(d.x) + std::f64::consts::PI; // eq. 14
         Some(Kind::RangeDoppler {
             beacon: BeaconFix::fixed(0, nalgebra::Vector3::new(beacon.x, beacon.y, 0.0)),
-            range_m: d.norm() + range_noise,
+            range_m: d.norm() + range_noise + clock_m,
             radial_speed_m_s: truth.v * (bearing_to_beacon - truth.psi).cos() + doppler_noise, // eq. 13
         })
     }
@@ -149,7 +150,8 @@ mod tests {
     fn noise_free_measurements_equal_the_truth() {
         let mut s = SensorSuite::new(&Sensors::noise_free(), 0.0, 3, 0);
         let truth = TruthState { pos: Vector2::new(10.0, 0.0), psi: std::f64::consts::PI, v: 1.5 };
-        let Some(Kind::RangeDoppler { range_m, radial_speed_m_s, .. }) = s.comm_frame(&truth, Vector2::zeros()) else {
+        let Some(Kind::RangeDoppler { range_m, radial_speed_m_s, .. }) = s.comm_frame(&truth, Vector2::zeros(), 0.0)
+        else {
             panic!("a frame")
         };
         assert_abs_diff_eq!(range_m, 10.0, epsilon = 1e-12);
@@ -169,7 +171,7 @@ mod tests {
         let truth = TruthState { pos: Vector2::new(30.0, 40.0), psi: 0.0, v: 1.0 };
         let (mut n, mut sum2, mut lost) = (0, 0.0, 0);
         for _ in 0..20_000 {
-            match s.comm_frame(&truth, Vector2::zeros()) {
+            match s.comm_frame(&truth, Vector2::zeros(), 0.0) {
                 Some(Kind::RangeDoppler { range_m, .. }) => {
                     n += 1;
                     sum2 += (range_m - 50.0).powi(2);

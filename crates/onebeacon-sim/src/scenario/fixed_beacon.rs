@@ -35,6 +35,9 @@ pub struct FixedBeacon {
     pub comms: Comms,
     #[serde(default)]
     pub sensors: Sensors,
+    /// `[sea]`: clocks (off by default).
+    #[serde(default)]
+    pub sea: super::sea::Sea,
     #[serde(default)]
     pub initial: Initial,
     #[serde(default = "default_estimators")]
@@ -226,6 +229,7 @@ pub(super) fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
     use Rule::*;
     check_file_name("name", &s.name)?;
     check_count("runs", s.runs, 1, 1_000_000)?;
+    s.sea.check()?;
 
     let m = &s.mission;
     check_fields!("mission", m, {

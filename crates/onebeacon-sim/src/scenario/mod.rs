@@ -14,6 +14,7 @@ pub(crate) mod load;
 pub mod moving_beacon;
 pub mod passive_usbl;
 pub mod ping;
+pub mod sea;
 pub(crate) mod validate;
 
 pub use builtin::{BUILTINS, Builtin, builtin};

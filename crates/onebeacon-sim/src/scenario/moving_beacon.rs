@@ -36,6 +36,9 @@ pub struct MovingBeacon {
     pub asv: Asv,
     #[serde(default)]
     pub acoustics: Acoustics,
+    /// `[sea]`: clocks (off by default).
+    #[serde(default)]
+    pub sea: super::sea::Sea,
     #[serde(default)]
     pub guidance: Guidance,
     #[serde(default)]
@@ -344,6 +347,7 @@ pub(super) fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
     use Rule::*;
     check_file_name("name", &s.name)?;
     check_count("runs", s.runs, 1, 1_000_000)?;
+    s.sea.check()?;
     check_fields!("mission", s.mission, {
         dt_s: Positive,
         duration_s: Positive,

@@ -1,8 +1,11 @@
 //! The fixed-beacon world (garin2024): an AUV following a boustrophedon under the
 //! feedback-linearising controller, a fixed beacon, communication frames every T_com.
 
+use crate::acoustics::clock::Clock;
 use crate::engine::{VehicleTruth, World};
+use crate::scenario::sea::FIXED_BEACON_SOUND_SPEED_M_S;
 use crate::scenario::{FixedBeacon, FixedBeaconCell};
+use crate::seed::{Stream, rng};
 use crate::sensors::SensorSuite;
 use crate::vehicles::{Path, TruthState, feedback_linearising_control};
 use nalgebra::{Vector2, Vector3, Vector6};
@@ -22,6 +25,8 @@ pub(crate) struct FixedBeaconWorld {
     omega: f64,
     accel: f64,
     sensors: SensorSuite,
+    /// The AUV's clock and the beacon's: their difference is a range error.
+    clocks: [Clock; 2],
     /// Frames sent so far.
     frame_index: u64,
     distance_m: f64,
@@ -45,6 +50,7 @@ impl FixedBeaconWorld {
             omega,
             accel,
             sensors: SensorSuite::new(&s.sensors, s.comms.frame_loss_prob, seed, run),
+            clocks: [Stream::Clock, Stream::BeaconClock].map(|c| Clock::new(&s.sea.clocks, rng(seed, run, c))),
             frame_index: 0,
             distance_m: 0.0,
         }
@@ -97,7 +103,13 @@ impl World for FixedBeaconWorld {
         let due = ((t + 1e-9) / self.t_com_s).floor() as u64;
         if due > self.frame_index {
             self.frame_index = due;
-            if let Some(frame) = self.sensors.comm_frame(&self.truth, self.beacon) {
+            // the travel time read between the beacon's clock at transmission and the
+            // AUV's at reception
+            let c = FIXED_BEACON_SOUND_SPEED_M_S;
+            let t_tx = t - (self.truth.pos - self.beacon).norm() / c;
+            let [auv, beacon] = &mut self.clocks;
+            let clock_m = c * (auv.error_s(t) - beacon.error_s(t_tx));
+            if let Some(frame) = self.sensors.comm_frame(&self.truth, self.beacon, clock_m) {
                 heard[0].push(Measurement::new(t, frame));
             }
         }
@@ -132,6 +144,36 @@ mod tests {
         assert_ne!(a.metrics, other.metrics);
         assert_eq!(a.trajectory.len(), 481);
         assert_eq!(a.frames_decoded, 40);
+    }
+
+    /// Clocks that drift apart: with noise-free sensors a range's error is c times what
+    /// the AUV's clock read at reception minus what the beacon's read at transmission, a
+    /// straight line in time through zero when the clocks only drift (plus the beacon's
+    /// drift over the travel time, under a centimetre here); 1 ppm apart is 5.4 m after
+    /// an hour.
+    #[test]
+    fn drifting_clocks_make_a_range_error_that_grows_with_time() {
+        let mut s = garin();
+        s.sensors = Sensors::noise_free();
+        s.mission.duration_s = Some(3600.0);
+        s.sea.clocks.drift_sigma_ppm = 1.0;
+        let mut world = FixedBeaconWorld::new(&s, &s.base_cell(), 1, 0);
+        let mut errors = Vec::new();
+        for k in 1..=world.steps() {
+            let mut heard = vec![Vec::new()];
+            world.advance(k, &[], &mut heard);
+            for m in &heard[0] {
+                if let onebeacon::nav::Kind::RangeDoppler { range_m, .. } = m.kind {
+                    errors.push((m.t_s, range_m - (world.truth.pos - world.beacon).norm()));
+                }
+            }
+        }
+        let (t_end, e_end) = *errors.last().unwrap();
+        let slope = e_end / t_end;
+        assert!(e_end.abs() > 0.5, "the clocks drifted apart by {e_end} m in an hour");
+        for (t, e) in &errors {
+            assert!((e - slope * t).abs() < 0.01, "at {t} s: {e} m off the line {slope} m/s");
+        }
     }
 
     #[test]

@@ -4,6 +4,7 @@
 //! last ping; each ping reaches each vehicle when the wavefront meets it.
 
 use crate::acoustics::Ping;
+use crate::acoustics::clock::Clock;
 use crate::engine::{PilotRecord, VehicleTruth, World};
 use crate::scenario::moving_beacon::Vehicle;
 use crate::scenario::passive_usbl::AsvVehicle;
@@ -55,6 +56,8 @@ impl TruthPath {
 struct InFlight {
     ping: Ping,
     gps: Vector3<f64>,
+    /// What the beacon's clock read minus the true time at transmission, s.
+    clock_s: f64,
     /// Which vehicles heard it already.
     heard: Vec<bool>,
 }
@@ -69,6 +72,8 @@ struct Underwater {
     /// The range noise stream; None: the world's acoustic stream (the first vehicle's,
     /// as in a single-vehicle world).
     range_rng: Option<Pcg64Mcg>,
+    /// The vehicle's clock, which times the pings' arrivals.
+    clock: Clock,
     nu_meas: BodyVelocity,
     distance_m: f64,
 }
@@ -91,6 +96,8 @@ pub(crate) struct MovingBeaconWorld<'a> {
     in_flight: Vec<InFlight>,
     /// GPS errors of the ASV (and the first vehicle's range errors).
     acoustic_rng: Pcg64Mcg,
+    /// The beacon's clock, which times the pings' transmissions.
+    beacon_clock: Clock,
     /// The current step.
     k: usize,
 }
@@ -108,6 +115,7 @@ impl<'a> MovingBeaconWorld<'a> {
                 velocity_rng: vehicle_rng(seed, run, v, Stream::Imu),
                 attitude_rng: vehicle_rng(seed, run, v, Stream::Heading),
                 range_rng: (v > 0).then(|| vehicle_rng(seed, run, v, Stream::Acoustic)),
+                clock: Clock::new(&s.sea.clocks, vehicle_rng(seed, run, v, Stream::Clock)),
                 nu_meas: BodyVelocity::zeros(),
                 distance_m: 0.0,
             })
@@ -132,6 +140,7 @@ impl<'a> MovingBeaconWorld<'a> {
             next_ping: 0.0,
             in_flight: Vec::new(),
             acoustic_rng: rng(seed, run, Stream::Acoustic),
+            beacon_clock: Clock::new(&s.sea.clocks, rng(seed, run, Stream::BeaconClock)),
             k: 0,
         }
     }
@@ -191,6 +200,7 @@ impl World for MovingBeaconWorld<'_> {
         self.in_flight.push(InFlight {
             ping: Ping { t_tx: t0, origin: self.beacon_ned_m() },
             gps,
+            clock_s: self.beacon_clock.error_s(t0),
             heard: vec![false; self.vehicles.len()],
         });
         self.next_ping += s.acoustics.ping_period_s;
@@ -244,7 +254,9 @@ impl World for MovingBeaconWorld<'_> {
                 // drawn apart, on the position the ASV reports)
                 let rng = veh.range_rng.as_mut().unwrap_or(&mut self.acoustic_rng);
                 let range_noise = noise.range_model(&BeaconFix::fixed(0, f.ping.origin)).noise(&x, rng);
-                let range_m = c * (t_rx - f.ping.t_tx) + range_noise;
+                // the travel time as the two clocks read it
+                let clock_m = c * (veh.clock.error_s(t_rx) - f.clock_s);
+                let range_m = c * (t_rx - f.ping.t_tx) + clock_m + range_noise;
                 let beacon = BeaconFix {
                     id: 0,
                     position_ned_m: f.gps,
