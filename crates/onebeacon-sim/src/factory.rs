@@ -19,9 +19,7 @@ use onebeacon::models::kinematic6dof::{Cov as Cov6, State as Eta};
 use onebeacon::models::unicycle::{Cov, State};
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
-use onebeacon::nav::{
-    Aiding, GaussianTracker, IusblNavigator, ParticleTracker, PlanarConfig, Range6DofNavigator, SingleBeaconNavigator,
-};
+use onebeacon::nav::{Aiding, IusblNavigator, PlanarConfig, Range6DofNavigator, SingleBeaconNavigator};
 use rand::RngExt;
 
 /// Every estimator of a fixed-beacon scenario on its AUV, started at the truth `z_true`
@@ -126,18 +124,7 @@ pub(crate) fn passive_usbl(s: &PassiveUsbl, starts: &[(TrackState, u64)]) -> Vec
     let mut tracks = Vec::new();
     for (v, &(x0, pf_seed)) in starts.iter().enumerate() {
         for e in &s.estimators {
-            let (config, filter) = (e.tracker_config(s.tracker_noise()), e.filter_kind());
-            let particle = (e.kind == EstimatorKind::Particle).then(|| e.particle_settings());
-            let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
-                let mut x = x0;
-                (x[idx::X], x[idx::Y], x[idx::PSI]) = (north, east, heading);
-                match particle {
-                    Some((n, settings)) => {
-                        Box::new(ParticleTracker::new(config, settings, n, t0, &x, &sigma0, pf_seed))
-                    }
-                    None => Box::new(GaussianTracker::new(config, filter, t0, &x, &sigma0)),
-                }
-            });
+            let builder = e.tracker_builder(s.tracker_noise(), x0, sigma0, pf_seed);
             tracks.push(Track::new(v, builder, (x0[idx::X], x0[idx::Y], x0[idx::PSI]), (sigma0[0], sigma0[idx::PSI])));
         }
     }

@@ -15,7 +15,7 @@ use onebeacon::config::controller::ControllerSpec;
 use onebeacon::config::estimator::EstimatorSpec;
 use onebeacon::config::stream::{FrameKey, Initial, InitialFrom, StreamConfig};
 use onebeacon::geo::Frame;
-use onebeacon::io::jsonl::{command_json, item_json};
+use onebeacon::io::jsonl::{command_json, item_json, own_fix_json};
 use onebeacon::models::hoff::idx;
 use onebeacon::nav::session::{Input, Item};
 use onebeacon::nav::usbl_track::TrackState;
@@ -88,13 +88,8 @@ impl Observer for Messages {
 
     fn decided(&mut self, h: usize, situation: &Situation, d: &Decided) {
         let c = &mut self.computers[h];
-        if let Some(fix) = situation.fix {
-            let p = fix.position_m;
-            c.input.push(
-                json!({"t_s": situation.t_s, "kind": "own_fix", "x_m": p.x, "y_m": p.y,
-                    "heading_rad": fix.heading_rad, "speed_m_s": fix.speed_m_s})
-                .to_string(),
-            );
+        if let Some(fix) = &situation.fix {
+            c.input.push(own_fix_json(situation.t_s, fix).to_string());
         }
         if let Some(GuidanceSnapshot::Bearing(b)) = &d.snapshot {
             self.plans[h] = Some(Plan { vehicle: b.vehicle, waypoint: b.waypoint });

@@ -17,6 +17,13 @@ use std::collections::{BTreeMap, BTreeSet};
 #[error("{0}")]
 pub struct LineError(String);
 
+/// A vehicle's own fix at `t_s` as a JSON line (`own_fix`; its frame as given).
+pub fn own_fix_json(t_s: f64, fix: &OwnFix) -> Value {
+    let p = fix.position_m;
+    json!({"t_s": t_s, "kind": "own_fix", "x_m": p.x, "y_m": p.y, "heading_rad": fix.heading_rad,
+        "speed_m_s": fix.speed_m_s})
+}
+
 /// One stream item as a JSON line (SI units, the log's frame).
 pub fn item_json(item: &Item) -> Value {
     let t = item.t_s;

@@ -85,11 +85,7 @@ impl Lines {
                 (t_s, "own_fix", json!({"line": number, "t_s": t_s}))
             }
             Line::Item { vehicle, item } => {
-                let kind = match &item.input {
-                    Input::Measurement(m) => m.name(),
-                    Input::BeaconPosition { .. } => "beacon_position",
-                    Input::Truth(_) => "ground_truth",
-                };
+                let kind = item.input.name();
                 let step = match unit.push(vehicle, &item) {
                     Ok(step) => step,
                     Err(screened) => return skip(format!("{screened}; screened out")),

@@ -38,6 +38,15 @@ pub struct Item {
 }
 
 impl Input {
+    /// Its kind as logs and streams name it (`range`, `beacon_position`, ...).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Input::Measurement(m) => m.name(),
+            Input::BeaconPosition { .. } => "beacon_position",
+            Input::Truth(_) => "ground_truth",
+        }
+    }
+
     /// This input, given in `frame`, in NED: the one place where logs and streams
     /// change frame.
     pub fn to_ned(self, frame: Frame) -> Input {
@@ -479,11 +488,12 @@ impl Session {
     /// Screens `item` out: counted, logged, reported.
     fn screen(&mut self, item: &Item, reason: String) -> Screened {
         self.screened += 1;
-        let (kind, beacon_id, value) = match &item.input {
-            Input::Measurement(m) => (m.name(), m.beacon().map_or(0, |b| b.id), measured_value(m)),
-            Input::BeaconPosition { beacon_id, .. } => ("beacon_position", *beacon_id, f64::NAN),
-            Input::Truth(_) => ("ground_truth", 0, f64::NAN),
+        let (beacon_id, value) = match &item.input {
+            Input::Measurement(m) => (m.beacon().map_or(0, |b| b.id), measured_value(m)),
+            Input::BeaconPosition { beacon_id, .. } => (*beacon_id, f64::NAN),
+            Input::Truth(_) => (0, f64::NAN),
         };
+        let kind = item.input.name();
         let r = Rejection { estimator: None, t_s: item.t_s, kind, beacon_id, value, nis: f64::NAN, reason };
         self.log_rejection(r.clone());
         Screened { reason: r.reason }
