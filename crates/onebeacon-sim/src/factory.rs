@@ -19,7 +19,7 @@ use onebeacon::models::kinematic6dof::{Cov as Cov6, State as Eta};
 use onebeacon::models::unicycle::{Cov, State};
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
-use onebeacon::nav::{Aiding, IusblNavigator, PlanarConfig, Range6DofNavigator, SingleBeaconNavigator};
+use onebeacon::nav::{Aiding, IusblNavigator, PlanarConfig, SingleBeaconNavigator, range_6dof};
 use rand::RngExt;
 
 /// Every estimator of a fixed-beacon scenario on its AUV, started at the truth `z_true`
@@ -74,10 +74,11 @@ pub(crate) fn moving_beacon(s: &MovingBeacon, truth0: &[Eta], seed: u64, run: u6
         tracks.extend(s.estimators.iter().map(|e| {
             let (noise, aiding, filter) =
                 (e.sensor_noise(s.sensor_noise()), e.aiding(Host::MovingBeacon), e.filter_kind());
+            let (calibration, gate) = (e.range_calibration(), e.range_gate());
             let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
                 let mut eta = eta0;
                 (eta[0], eta[1], eta[5]) = (north, east, heading);
-                Box::new(Range6DofNavigator::new(noise, aiding, filter, t0, eta, p0))
+                range_6dof::boxed(noise, aiding, filter, t0, (eta, p0), calibration, gate)
             });
             Track::new(v, builder, pose, (i.position_sigma_m, a0))
         }));

@@ -12,7 +12,10 @@ pub use super::iusbl::IusblKeys;
 use crate::filter::particle::{ParticleSettings, Resampler};
 use crate::filter::{FilterKind, UkfParams};
 use crate::models::hoff::HoffProcess;
-use crate::nav::{Aiding, EkfTuning, PlanarConfig, PlanarNoise, Robust, SensorNoise, TrackerConfig, TrackerNoise};
+use crate::nav::{
+    Aiding, EkfTuning, OffsetPrior, PlanarConfig, PlanarNoise, RangeCalibration, Robust, SensorNoise, TrackerConfig,
+    TrackerNoise,
+};
 use serde::{Deserialize, Serialize};
 
 /// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table.
@@ -259,7 +262,14 @@ pub struct EstimatorSpec {
     pub robust: Option<RobustName>,
     pub huber_k: Option<f64>,
     pub student_t_dof: Option<f64>,
+    /// A range offset state (log, moving_beacon: a clock offset, a latency), starting at
+    /// `bias_m` with `bias_sigma_m`, walking with `bias_walk_m_per_sqrt_s`.
     pub estimate_bias: Option<bool>,
+    /// A drift state of the range offset, m/s (moving_beacon: a clock's frequency error,
+    /// 1 ppm at 1500 m/s is 1.5e-3 m/s), prior standard deviation `bias_drift_sigma_m_s`;
+    /// implies `estimate_bias`.
+    pub estimate_bias_drift: Option<bool>,
+    pub bias_drift_sigma_m_s: Option<f64>,
     /// An offset per beacon instead of one shared (log).
     pub estimate_beacon_offsets: Option<bool>,
     pub bias_m: Option<f64>,
@@ -279,6 +289,10 @@ pub struct EstimatorSpec {
 
 /// Particles of a `pf` estimator without `particles` (hoff2024 sec. 5).
 pub const DEFAULT_PARTICLES: usize = 500_000;
+/// The prior standard deviation of a range offset's drift, m/s, when
+/// `bias_drift_sigma_m_s` is not given: 3 ppm of clock drift at 1500 m/s, the spread of
+/// an uncompensated crystal (a disciplined or chip-scale clock drifts far less).
+pub const DEFAULT_BIAS_DRIFT_SIGMA_M_S: f64 = 4.5e-3;
 /// A `pf` estimator's `min_effective_particles` when not given.
 pub const DEFAULT_MIN_EFFECTIVE: f64 = 20.0;
 
@@ -338,6 +352,8 @@ impl EstimatorSpec {
             huber_k: None,
             student_t_dof: None,
             estimate_bias: None,
+            estimate_bias_drift: None,
+            bias_drift_sigma_m_s: None,
             estimate_beacon_offsets: None,
             bias_m: None,
             bias_sigma_m: None,
@@ -409,6 +425,32 @@ impl EstimatorSpec {
     /// `range_sigma_m` when given.
     pub fn sensor_noise(&self, sensors: SensorNoise) -> SensorNoise {
         SensorNoise { range_m: self.range_sigma_m.unwrap_or(sensors.range_m), ..sensors }
+    }
+
+    /// The range calibration states of the 6-DOF filter (moving_beacon): the offset with
+    /// its drift and the range scale that are asked for, with [`PlanarConfig::default`]'s
+    /// priors and walk where a key is absent.
+    pub fn range_calibration(&self) -> RangeCalibration {
+        let c = PlanarConfig::default();
+        let drift = self.estimate_bias_drift == Some(true);
+        let offset = (self.estimate_bias == Some(true) || drift).then(|| OffsetPrior {
+            initial_m: self.bias_m.unwrap_or(c.bias_m),
+            sigma_m: self.bias_sigma_m.unwrap_or(c.bias_sigma_m),
+            walk_m_per_sqrt_s: self.bias_walk_m_per_sqrt_s.unwrap_or(c.noise.bias_walk_m_per_sqrt_s),
+            drift_sigma_m_s: drift.then(|| self.bias_drift_sigma_m_s.unwrap_or(DEFAULT_BIAS_DRIFT_SIGMA_M_S)),
+        });
+        let scale_sigma =
+            (self.estimate_range_scale == Some(true)).then(|| self.range_scale_sigma.unwrap_or(c.range_scale_sigma));
+        RangeCalibration { offset, scale_sigma }
+    }
+
+    /// The range gate and heavy-tailed update asked for (`nis_gate`, `robust`).
+    pub fn range_gate(&self) -> (f64, Option<Robust>) {
+        let robust = self.robust.map(|r| match r {
+            RobustName::Huber => Robust::Huber { k: self.huber_k.unwrap_or(1.345) },
+            RobustName::StudentT => Robust::StudentT { dof: self.student_t_dof.unwrap_or(4.0) },
+        });
+        (self.nis_gate.unwrap_or(f64::INFINITY), robust)
     }
 
     /// The trackers' configuration (passive_usbl): the world's noise `n` (a matched
@@ -484,10 +526,7 @@ impl EstimatorSpec {
             estimate_turn_scale: self.estimate_turn_scale.unwrap_or(c.estimate_turn_scale),
             turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
             nis_gate: self.nis_gate,
-            robust: self.robust.map(|r| match r {
-                RobustName::Huber => Robust::Huber { k: self.huber_k.unwrap_or(1.345) },
-                RobustName::StudentT => Robust::StudentT { dof: self.student_t_dof.unwrap_or(4.0) },
-            }),
+            robust: self.range_gate().1,
             noise,
             track_accel_sigma_m_s2: self.track_accel_sigma_m_s2,
         }

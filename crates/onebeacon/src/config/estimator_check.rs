@@ -13,6 +13,7 @@ impl EstimatorSpec {
         const RANGING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const FIXED_LOG: &[Host] = &[FixedBeacon, Log];
         const USBL: &[Host] = &[PassiveUsbl, Log];
+        const MOVING_LOG: &[Host] = &[MovingBeacon, Log];
         let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
         let mut keys = vec![
             ("range_sigma_m", self.range_sigma_m, Positive, RANGING),
@@ -34,20 +35,22 @@ impl EstimatorSpec {
             ("heading_change_sigma_frac", self.heading_change_sigma_frac, NonNegative, &[Log]),
             ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, NonNegative, &[Log]),
             ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[PassiveUsbl, Log]),
-            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, &[Log]),
+            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, MOVING_LOG),
             ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
-            ("nis_gate", self.nis_gate, Positive, &[PassiveUsbl, Log]),
-            ("huber_k", self.huber_k, Positive, &[Log]),
-            ("student_t_dof", self.student_t_dof, Positive, &[Log]),
+            ("nis_gate", self.nis_gate, Positive, &[MovingBeacon, PassiveUsbl, Log]),
+            ("huber_k", self.huber_k, Positive, MOVING_LOG),
+            ("student_t_dof", self.student_t_dof, Positive, MOVING_LOG),
             ("mirror_recovery", flag(self.mirror_recovery), Finite, &[FixedBeacon]),
             ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
-            ("estimate_bias", flag(self.estimate_bias), Finite, &[Log]),
+            ("estimate_bias", flag(self.estimate_bias), Finite, MOVING_LOG),
+            ("estimate_bias_drift", flag(self.estimate_bias_drift), Finite, &[MovingBeacon]),
+            ("bias_drift_sigma_m_s", self.bias_drift_sigma_m_s, Positive, &[MovingBeacon]),
             ("estimate_beacon_offsets", flag(self.estimate_beacon_offsets), Finite, &[Log]),
-            ("bias_m", self.bias_m, Finite, &[Log]),
-            ("bias_sigma_m", self.bias_sigma_m, Positive, &[Log]),
-            ("estimate_range_scale", flag(self.estimate_range_scale), Finite, &[Log]),
-            ("range_scale_sigma", self.range_scale_sigma, Positive, &[Log]),
+            ("bias_m", self.bias_m, Finite, MOVING_LOG),
+            ("bias_sigma_m", self.bias_sigma_m, Positive, MOVING_LOG),
+            ("estimate_range_scale", flag(self.estimate_range_scale), Finite, MOVING_LOG),
+            ("range_scale_sigma", self.range_scale_sigma, Positive, MOVING_LOG),
             ("estimate_distance_scale", flag(self.estimate_distance_scale), Finite, &[Log]),
             ("distance_scale_sigma", self.distance_scale_sigma, Positive, &[Log]),
             ("estimate_turn_scale", flag(self.estimate_turn_scale), Finite, &[Log]),
@@ -68,13 +71,14 @@ impl EstimatorSpec {
 /// measurements (the host must give them).
 pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Violation> {
     check_names("estimators", &specs.iter().map(|e| e.name()).collect::<Vec<_>>())?;
-    // the planar state has 4 to 8 components; 7 bounds kappa for the common case
-    let states = match host {
-        Host::Log => 7,
-        Host::PassiveUsbl => 8,
-        Host::FixedBeacon | Host::MovingBeacon => 6,
-    };
     for (k, e) in specs.iter().enumerate() {
+        // the planar state has 4 to 8 components; 7 bounds kappa for the common case
+        let states = match host {
+            Host::Log => 7,
+            Host::PassiveUsbl => 8,
+            Host::FixedBeacon => 6,
+            Host::MovingBeacon => 6 + e.range_calibration().states(),
+        };
         let key = |f: &str| format!("estimators[{k}].{f}");
         check_ukf(&format!("estimators[{k}]"), states, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
         for (name, v, rule, hosts) in e.tuning_keys() {
@@ -99,11 +103,11 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
                 allowed: "replaces the shared offset of estimate_bias (give one of the two), and does not apply to the tracker (track_accel_sigma_m_s2)".into(),
             });
         }
-        if e.robust.is_some() && host != Host::Log {
+        if e.robust.is_some() && !matches!(host, Host::Log | Host::MovingBeacon) {
             return Err(Violation {
                 key: key("robust"),
                 value: format!("{:?}", e.robust),
-                allowed: format!("does not apply to a {} (it applies to: log)", host.label()),
+                allowed: format!("does not apply to a {} (it applies to: moving_beacon world, log)", host.label()),
             });
         }
         if e.iusbl.is_some() && !e.kind.iusbl() {
@@ -236,14 +240,38 @@ mod tests {
 
         assert_eq!(
             error("kind = \"rosb\"\nnis_gate = 3.0", Host::FixedBeacon),
-            "estimators[0].nis_gate = 3.0: does not apply to a fixed_beacon world (it applies to: passive_usbl world, log)"
+            "estimators[0].nis_gate = 3.0: does not apply to a fixed_beacon world (it applies to: moving_beacon world, passive_usbl world, log)"
         );
         assert_eq!(
             error("kind = \"range+doppler\"", Host::MovingBeacon),
             "estimators[0].kind = \"range+doppler\": uses Doppler speeds; a moving_beacon world gives ranges only"
         );
         assert!(error("kind = \"rosb\"\nq_diag = [1, 1, 1, 1, -1, 1]", Host::FixedBeacon).contains(">= 0"));
+        assert_eq!(
+            error("kind = \"rosb\"\nestimate_bias_drift = true", Host::FixedBeacon),
+            "estimators[0].estimate_bias_drift = true: does not apply to a fixed_beacon world (it applies to: moving_beacon world)"
+        );
+        assert_eq!(
+            error("kind = \"range-ekf\"\nestimate_bias_drift = true\nrobust = \"huber\"", Host::MovingBeacon),
+            ""
+        );
         assert!(error("kind = \"rosb\"\nrange_sigma_m = 0.0", Host::Log).contains("> 0"));
+    }
+
+    /// The drift implies the offset; the states follow the pose in the order offset,
+    /// drift, scale; the priors are the keys' or the documented defaults.
+    #[test]
+    fn calibration_keys_make_calibration_states() {
+        use crate::nav::OffsetPrior;
+        let drift = spec("kind = \"range-ekf\"\nestimate_bias_drift = true\nbias_sigma_m = 2.0");
+        let o = OffsetPrior { initial_m: 0.0, sigma_m: 2.0, walk_m_per_sqrt_s: 0.005, drift_sigma_m_s: Some(4.5e-3) };
+        assert_eq!(drift.range_calibration().offset, Some(o));
+        assert_eq!(drift.range_calibration().states(), 2);
+        let all =
+            spec("kind = \"range-ekf\"\nestimate_bias = true\nestimate_range_scale = true\nrange_scale_sigma = 0.02");
+        assert_eq!(all.range_calibration().scale_sigma, Some(0.02));
+        assert_eq!(all.range_calibration().states(), 2);
+        assert_eq!(spec("kind = \"range-ekf\"").range_calibration().states(), 0);
     }
 
     /// Left out, garin2024's noise keys are eq. 25's variances exactly (no square root

@@ -13,6 +13,7 @@ pub mod fix;
 pub mod iusbl;
 pub mod planar;
 pub mod range_6dof;
+pub mod range_calibration;
 pub mod restart;
 pub mod session;
 pub mod single_beacon;
@@ -24,6 +25,7 @@ pub use iusbl::{IusblConfig, IusblNavigator};
 pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
 
 pub use range_6dof::{Range6DofNavigator, SensorNoise};
+pub use range_calibration::{OffsetPrior, RangeCalibration};
 pub use single_beacon::{EkfTuning, SingleBeaconNavigator};
 pub use tracking::TrackingNavigator;
 pub use usbl_track::{GaussianTracker, ParticleTracker, TrackerConfig, TrackerNoise};

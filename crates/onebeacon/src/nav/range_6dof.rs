@@ -3,11 +3,12 @@
 //! (eq. 3.3-3.6), and OWTT range updates to a beacon whose position travels with the
 //! measurement (eq. 3.7-3.10).
 
-use super::{Aiding, BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
-use crate::filter::{AnyFilter, FilterKind, GaussianFilter, MeasurementModel, ProcessModel};
+use super::range_calibration::{Calibrated, CalibratedRange, Layout, RangeCalibration};
+use super::{Aiding, BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
+use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::measure::{Range3d, StateComponent};
 use crate::models::kinematic6dof::{BodyVelocity, Cov, DIM, Kinematic6Dof, State, idx};
-use nalgebra::{SVector, Vector1};
+use nalgebra::{SMatrix, SVector, Vector1};
 
 /// Noise of the vehicle's sensors as the filter models them (standard deviations).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,13 +52,22 @@ impl SensorNoise {
 /// range updates at their receive time ([`Kind::Range`], the beacon's position and GPS
 /// error travelling with it), and depth with attitude: a depth is held and fused with
 /// the next attitude fix ([`Kind::Attitude`]) in one update (eq. 3.3-3.6).
+///
+/// With a [`RangeCalibration`] the state has `N` = 6 + its states components: a range
+/// offset (a clock offset), its drift (a clock's frequency error) and a range scale (an
+/// effective sound speed), read by every range update.
 #[derive(Debug, Clone)]
-pub struct Range6DofNavigator {
+pub struct Range6DofNavigator<const N: usize = DIM> {
     noise: SensorNoise,
     /// The depth sensor and AHRS models, built once.
     depth_attitude: [StateComponent; 4],
     aiding: Aiding,
-    filter: AnyFilter<DIM>,
+    calibration: Layout,
+    offset_walk_m_per_sqrt_s: f64,
+    /// A range whose NIS exceeds it is rejected; a heavy-tailed range update.
+    gate: f64,
+    robust: Option<Robust>,
+    filter: AnyFilter<N>,
     t_s: f64,
     nu: BodyVelocity,
     depth: Option<f64>,
@@ -68,24 +78,102 @@ impl Range6DofNavigator {
     /// `aiding.range` (dead reckoning on attitude and depth otherwise); it has no
     /// Doppler model.
     pub fn new(noise: SensorNoise, aiding: Aiding, filter: FilterKind, t0_s: f64, eta0: State, p0: Cov) -> Self {
-        let filter = AnyFilter::new(filter, eta0, p0);
-        let depth_attitude = noise.depth_attitude_models();
-        Self { noise, depth_attitude, aiding, filter, t_s: t0_s, nu: BodyVelocity::zeros(), depth: None }
+        Self::calibrated(noise, aiding, filter, t0_s, (eta0, p0), RangeCalibration::default())
+    }
+}
+
+/// The navigator of `spec`'s calibration states (6 to 9 of them), its ranges gated at
+/// `gate` (a NIS; infinity: none) with the update `robust` asks for.
+pub fn boxed(
+    noise: SensorNoise,
+    aiding: Aiding,
+    filter: FilterKind,
+    t0_s: f64,
+    start: (State, Cov),
+    calibration: RangeCalibration,
+    (gate, robust): (f64, Option<Robust>),
+) -> Box<dyn Navigator> {
+    fn make<const N: usize>(
+        n: SensorNoise,
+        a: Aiding,
+        f: FilterKind,
+        t: f64,
+        s: (State, Cov),
+        c: RangeCalibration,
+        g: (f64, Option<Robust>),
+    ) -> Box<dyn Navigator> {
+        Box::new(Range6DofNavigator::<N>::calibrated(n, a, f, t, s, c).with_range_gate(g.0, g.1))
+    }
+    let g = (gate, robust);
+    match calibration.states() {
+        0 => make::<6>(noise, aiding, filter, t0_s, start, calibration, g),
+        1 => make::<7>(noise, aiding, filter, t0_s, start, calibration, g),
+        2 => make::<8>(noise, aiding, filter, t0_s, start, calibration, g),
+        _ => make::<9>(noise, aiding, filter, t0_s, start, calibration, g),
+    }
+}
+
+impl<const N: usize> Range6DofNavigator<N> {
+    /// A navigator with the calibration states of `calibration` behind the pose
+    /// `start` = (eta0, p0); `N` must be 6 + `calibration.states()`.
+    ///
+    /// # Panics
+    /// When `N` does not match the calibration.
+    pub fn calibrated(
+        noise: SensorNoise,
+        aiding: Aiding,
+        filter: FilterKind,
+        t0_s: f64,
+        (eta0, p0): (State, Cov),
+        calibration: RangeCalibration,
+    ) -> Self {
+        assert_eq!(N, DIM + calibration.states(), "state dimension against the calibration states");
+        let (mut x, mut p) = (SVector::<f64, N>::zeros(), SMatrix::<f64, N, N>::zeros());
+        x.fixed_rows_mut::<DIM>(0).copy_from(&eta0);
+        p.fixed_view_mut::<DIM, DIM>(0, 0).copy_from(&p0);
+        for (i, (value, sigma)) in calibration.prior().into_iter().enumerate() {
+            (x[DIM + i], p[(DIM + i, DIM + i)]) = (value, sigma * sigma);
+        }
+        Self {
+            noise,
+            depth_attitude: noise.depth_attitude_models(),
+            aiding,
+            calibration: calibration.layout(DIM),
+            offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
+            gate: f64::INFINITY,
+            robust: None,
+            filter: AnyFilter::new(filter, x, p),
+            t_s: t0_s,
+            nu: BodyVelocity::zeros(),
+            depth: None,
+        }
     }
 
-    pub fn state(&self) -> &State {
+    /// Ranges whose NIS exceeds `gate` are rejected; `robust` makes the range update
+    /// heavy-tailed.
+    pub fn with_range_gate(mut self, gate: f64, robust: Option<Robust>) -> Self {
+        (self.gate, self.robust) = (gate, robust);
+        self
+    }
+
+    /// The state: eta, then the calibration states.
+    pub fn state(&self) -> &SVector<f64, N> {
         self.filter.mean()
     }
-    pub fn covariance(&self) -> &Cov {
+    pub fn covariance(&self) -> &SMatrix<f64, N, N> {
         self.filter.covariance()
     }
 
     /// Dead reckoning to `t_s` on the held body velocities: P = F P F' + G Q G' with
-    /// G = dt J (eq. 3.2).
+    /// G = dt J (eq. 3.2); the calibration states as [`Calibrated`] moves them.
     fn advance_to(&mut self, t_s: f64) {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
-            let model = self.noise.process_model(self.nu);
+            let model = Calibrated::<_, DIM> {
+                inner: self.noise.process_model(self.nu),
+                layout: self.calibration,
+                offset_walk_m_per_sqrt_s: self.offset_walk_m_per_sqrt_s,
+            };
             let q = model.noise_covariance(self.filter.mean(), dt);
             self.filter.predict(&model, dt, &q);
             self.t_s = t_s;
@@ -93,16 +181,7 @@ impl Range6DofNavigator {
     }
 }
 
-/// One update of `filter` with the stacked `models` and their values `z`.
-fn update<const M: usize, H: MeasurementModel<DIM, M>>(
-    filter: &mut AnyFilter<DIM>,
-    models: &H,
-    z: SVector<f64, M>,
-) -> Outcome {
-    super::gated_update(filter, models, z, f64::INFINITY, None)
-}
-
-impl Navigator for Range6DofNavigator {
+impl<const N: usize> Navigator for Range6DofNavigator<N> {
     fn body_velocity_m_s(&self) -> Option<nalgebra::Vector3<f64>> {
         Some(self.nu.fixed_rows::<3>(0).into_owned())
     }
@@ -121,19 +200,24 @@ impl Navigator for Range6DofNavigator {
             Kind::Attitude { roll_rad, pitch_rad, heading_rad } => {
                 self.advance_to(m.t_s);
                 let (f, models) = (&mut self.filter, &self.depth_attitude);
+                let ungated = f64::INFINITY;
                 match self.depth.take() {
-                    Some(depth) => update(f, models, SVector::from([depth, roll_rad, pitch_rad, heading_rad])),
+                    Some(depth) => {
+                        let z = SVector::from([depth, roll_rad, pitch_rad, heading_rad]);
+                        super::gated_update(f, models, z, ungated, None)
+                    }
                     None => {
                         let [_, roll, pitch, yaw] = models;
-                        update(f, &[roll, pitch, yaw], SVector::from([roll_rad, pitch_rad, heading_rad]))
+                        let z = SVector::from([roll_rad, pitch_rad, heading_rad]);
+                        super::gated_update(f, &[roll, pitch, yaw], z, ungated, None)
                     }
                 }
             }
             Kind::Range { beacon, range_m } | Kind::RangeDoppler { beacon, range_m, .. } if self.aiding.range => {
                 // range update (eq. 3.7-3.10) at the receive time
                 self.advance_to(m.t_s);
-                let model = self.noise.range_model(&beacon);
-                update(&mut self.filter, &[model], Vector1::new(range_m))
+                let model = CalibratedRange { range: self.noise.range_model(&beacon), layout: self.calibration };
+                super::gated_update(&mut self.filter, &[model], Vector1::new(range_m), self.gate, self.robust)
             }
             _ => Outcome::Skipped,
         }
@@ -141,6 +225,7 @@ impl Navigator for Range6DofNavigator {
 
     fn estimate(&self) -> Estimate {
         let (x, p) = (self.filter.mean(), self.filter.covariance());
+        let state = |i: Option<usize>| i.map_or(0.0, |i| x[i]);
         Estimate {
             t_s: self.t_s,
             position_ned_m: x.fixed_rows::<3>(0).into_owned(),
@@ -149,8 +234,8 @@ impl Navigator for Range6DofNavigator {
             heading_var_rad2: p[(idx::YAW, idx::YAW)],
             roll_pitch_rad: [x[idx::ROLL], x[idx::PITCH]],
             speed_m_s: None,
-            range_bias_m: 0.0,
-            range_scale: 0.0,
+            range_bias_m: state(self.calibration.offset),
+            range_scale: state(self.calibration.scale),
             distance_scale: 0.0,
             turn_scale: 0.0,
         }
@@ -161,7 +246,7 @@ impl Navigator for Range6DofNavigator {
 mod tests {
     use super::*;
     use crate::filter::UkfParams;
-    use crate::nav::BeaconFix;
+    use crate::nav::{BeaconFix, OffsetPrior};
     use nalgebra::Vector3;
 
     fn noise() -> SensorNoise {
@@ -206,6 +291,52 @@ mod tests {
             // the covariance shrank accordingly
             assert!(f.estimate().horizontal_cov_m2.trace() < 0.05);
         }
+    }
+
+    /// A still vehicle 20 m deep hears a beacon circling 30 m around a point 60 m north
+    /// of it for an hour; the vehicle's clock runs 1 ppm fast after a 1 ms offset, so
+    /// every range reads 1.5 + 1.5e-3 t m long (1500 m/s), with no other noise. The
+    /// navigator with an offset and a drift state ends on the truth (within 3 of its
+    /// sigmas and 5 cm) with the drift it was given; the one without them ends about the
+    /// final offset (6.9 m) off.
+    #[test]
+    fn a_clock_state_takes_up_a_drifting_clock() {
+        let truth = State::from([0.0, 0.0, 20.0, 0.0, 0.0, 0.3]);
+        let p0 = Cov::from_diagonal(&SVector::from([1.0, 1.0, 0.01, 1e-4, 1e-4, 1e-4]));
+        let (offset_m, drift_m_s) = (1.5, 1.5e-3);
+        let still = SensorNoise { velocity_m_s: 1e-3, ..noise() };
+        let prior = OffsetPrior { initial_m: 0.0, sigma_m: 5.0, walk_m_per_sqrt_s: 0.0, drift_sigma_m_s: Some(4.5e-3) };
+        let clock = RangeCalibration { offset: Some(prior), scale_sigma: None };
+        let mut plain = Range6DofNavigator::new(still, Aiding::RANGE, FilterKind::Ekf, 0.0, truth, p0);
+        let mut clocked =
+            Range6DofNavigator::<8>::calibrated(still, Aiding::RANGE, FilterKind::Ekf, 0.0, (truth, p0), clock);
+        for k in 1..=3600 {
+            let t = k as f64;
+            let mut events = vec![
+                Kind::BodyVelocity { nu: [0.0; 6] },
+                Kind::Depth { depth_m: 20.0 },
+                Kind::Attitude { roll_rad: 0.0, pitch_rad: 0.0, heading_rad: 0.3 },
+            ];
+            if k % 10 == 0 {
+                let a = t * 2.0 * std::f64::consts::PI / 600.0;
+                let beacon = Vector3::new(60.0 + 30.0 * a.cos(), 30.0 * a.sin(), 0.0);
+                let range_m = (truth.fixed_rows::<3>(0) - beacon).norm() + offset_m + drift_m_s * t;
+                events.push(Kind::Range { beacon: BeaconFix::fixed(0, beacon), range_m });
+            }
+            for e in events {
+                let m = Measurement::new(t, e);
+                assert!(!matches!(clocked.process(&m), Outcome::Failed(_)));
+                plain.process(&m);
+            }
+        }
+        let err = |x: &SVector<f64, 2>| (x - truth.fixed_rows::<2>(0)).norm();
+        let (x, p) = (clocked.state(), clocked.covariance());
+        let e = err(&x.fixed_rows::<2>(0).into_owned());
+        assert!(e < 0.05 && e < 3.0 * p.fixed_view::<2, 2>(0, 0).trace().sqrt(), "with the clock: {e} m");
+        assert!((x[7] - drift_m_s).abs() < 3.0 * p[(7, 7)].sqrt() + 1e-6, "drift {} against {drift_m_s}", x[7]);
+        assert!((clocked.estimate().range_bias_m - (offset_m + drift_m_s * 3600.0)).abs() < 0.05);
+        let e_plain = err(&plain.state().fixed_rows::<2>(0).into_owned());
+        assert!(e_plain > 3.0, "without the clock: {e_plain} m");
     }
 
     /// Prediction agrees with the model and inflates P by the mapped input noise.
