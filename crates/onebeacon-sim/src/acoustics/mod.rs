@@ -5,6 +5,7 @@
 
 pub mod channel;
 pub mod clock;
+pub mod profile;
 pub mod propagation;
 pub mod wav;
 

@@ -5,6 +5,7 @@
 
 use crate::acoustics::Ping;
 use crate::acoustics::clock::Clock;
+use crate::acoustics::profile::Profile;
 use crate::engine::{PilotRecord, VehicleTruth, World};
 use crate::scenario::moving_beacon::Vehicle;
 use crate::scenario::passive_usbl::AsvVehicle;
@@ -98,6 +99,8 @@ pub(crate) struct MovingBeaconWorld<'a> {
     acoustic_rng: Pcg64Mcg,
     /// The beacon's clock, which times the pings' transmissions.
     beacon_clock: Clock,
+    /// The sea's sound-speed profile, when it has one (`[sea.sound_speed]`).
+    profile: Option<Profile>,
     /// The current step.
     k: usize,
 }
@@ -141,6 +144,7 @@ impl<'a> MovingBeaconWorld<'a> {
             in_flight: Vec::new(),
             acoustic_rng: rng(seed, run, Stream::Acoustic),
             beacon_clock: Clock::new(&s.sea.clocks, rng(seed, run, Stream::BeaconClock)),
+            profile: s.sea.sound_speed.as_ref().map(|p| p.profile()),
             k: 0,
         }
     }
@@ -254,9 +258,19 @@ impl World for MovingBeaconWorld<'_> {
                 // drawn apart, on the position the ASV reports)
                 let rng = veh.range_rng.as_mut().unwrap_or(&mut self.acoustic_rng);
                 let range_noise = noise.range_model(&BeaconFix::fixed(0, f.ping.origin)).noise(&x, rng);
-                // the travel time as the two clocks read it
+                // the travel time, along the eigenray of the sea's profile when it has
+                // one (the arrival stays the straight ray's: the two differ by
+                // milliseconds, over which the vehicle moves millimetres)
+                let travel_s = match &self.profile {
+                    None => t_rx - f.ping.t_tx,
+                    Some(profile) => {
+                        let o = f.ping.origin;
+                        profile.travel_time((x.fixed_rows::<2>(0) - o.xy()).norm(), o.z, x[idx::D])
+                    }
+                };
+                // as the two clocks read it
                 let clock_m = c * (veh.clock.error_s(t_rx) - f.clock_s);
-                let range_m = c * (t_rx - f.ping.t_tx) + clock_m + range_noise;
+                let range_m = c * travel_s + clock_m + range_noise;
                 let beacon = BeaconFix {
                     id: 0,
                     position_ned_m: f.gps,
