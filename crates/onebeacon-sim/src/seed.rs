@@ -21,6 +21,8 @@ pub enum Stream {
     Clock = 7,
     /// The beacon's clock.
     BeaconClock = 8,
+    /// A receiver's acoustic link: its losses and outliers.
+    Link = 9,
 }
 
 /// SplitMix64 finaliser: a bijective mixing of 64 bits.

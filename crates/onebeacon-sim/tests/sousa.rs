@@ -290,3 +290,29 @@ fn the_range_scale_state_finds_the_effective_speed() {
     );
     assert!(ep.position_ned_m.xy().norm() > 1.0, "without: {} m", ep.position_ned_m.xy().norm());
 }
+
+/// The link of `[sea.link]` loses pings in the moving_beacon world: an hour of pings
+/// every 10 s to a still vehicle (about 360), half lost in bursts of 4. The count heard
+/// is within 5 standard errors of half the clean world's (a Markov chain's variance, n p
+/// (1 - p) (1 + rho) / (1 - rho) with rho = 0.5).
+#[test]
+fn the_link_loses_pings() {
+    let mut s = sousa();
+    s.mission.duration_s = 3600.0;
+    let base = Scenario::MovingBeacon(s.clone());
+    s.sea.link.loss_prob = 0.5;
+    s.sea.link.loss_burst_mean = Some(4.0);
+    let lossy = Scenario::MovingBeacon(s);
+    let cell = match base.base_cell() {
+        Cell::MovingBeacon(mut c) => {
+            c.path = PathKind::Stationary;
+            Cell::MovingBeacon(c)
+        }
+        _ => unreachable!(),
+    };
+    let clean = simulate(&base, &cell, 1, 0, false).frames_decoded as f64;
+    let heard = simulate(&lossy, &cell, 1, 0, false).frames_decoded as f64;
+    let se = (clean * 0.25 * 3.0).sqrt();
+    assert!(clean >= 355.0, "{clean} pings on a clean link");
+    assert!((heard - clean / 2.0).abs() < 5.0 * se, "{heard} of {clean} pings heard");
+}

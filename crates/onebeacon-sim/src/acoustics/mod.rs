@@ -5,6 +5,7 @@
 
 pub mod channel;
 pub mod clock;
+pub mod link;
 pub mod profile;
 pub mod propagation;
 pub mod wav;

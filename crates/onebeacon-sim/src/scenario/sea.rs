@@ -5,6 +5,7 @@
 
 use super::validate::{Rule, Violation, check};
 use crate::acoustics::clock::ClockErrors;
+use crate::acoustics::link::LinkErrors;
 use crate::acoustics::profile::Profile;
 use onebeacon::dsp::sound_speed::mackenzie;
 use serde::{Deserialize, Serialize};
@@ -22,6 +23,8 @@ pub struct Sea {
     /// `[sea.sound_speed]`: the water's sound speed by depth, which the pings travel
     /// through while the vehicles convert with the scenario's one speed.
     pub sound_speed: Option<SoundSpeed>,
+    /// `[sea.link]`: lost messages, multipath and false ranges.
+    pub link: LinkErrors,
 }
 
 /// `[sea.sound_speed]`: a cast, as speeds or as temperatures (Mackenzie 1981) at
@@ -95,8 +98,42 @@ impl SoundSpeed {
     }
 }
 
+fn check_link(l: &LinkErrors) -> Result<(), Violation> {
+    for (key, v) in [
+        ("sea.link.loss_prob", l.loss_prob),
+        ("sea.link.multipath_prob", l.multipath_prob),
+        ("sea.link.false_prob", l.false_prob),
+    ] {
+        check(key, v, Rule::Probability)?;
+    }
+    check("sea.link.multipath_excess_m", l.multipath_excess_m, Rule::NonNegative)?;
+    check("sea.link.false_max_range_m", l.false_max_range_m, Rule::NonNegative)?;
+    let bad = |key: &str, v: f64, allowed: String| Err(Violation { key: key.into(), value: format!("{v:?}"), allowed });
+    if l.loss_prob >= 1.0 {
+        return bad("sea.link.loss_prob", l.loss_prob, "must be below 1 (every message lost)".into());
+    }
+    if l.multipath_prob + l.false_prob > 1.0 {
+        return bad("sea.link.false_prob", l.false_prob, "with multipath_prob, at most 1 in all".into());
+    }
+    if let Some(b) = l.loss_burst_mean {
+        let least = 1.0 / (1.0 - l.loss_prob);
+        if !(b.is_finite() && b >= least) {
+            return bad(
+                "sea.link.loss_burst_mean",
+                b,
+                format!("a mean run of lost messages >= 1 / (1 - loss_prob) = {least} (independent losses)"),
+            );
+        }
+    }
+    if l.false_prob > 0.0 && l.false_max_range_m <= 0.0 {
+        return bad("sea.link.false_max_range_m", l.false_max_range_m, "must be > 0 with false_prob".into());
+    }
+    Ok(())
+}
+
 impl Sea {
     pub(super) fn check(&self) -> Result<(), Violation> {
+        check_link(&self.link)?;
         if let Some(s) = &self.sound_speed {
             s.check()?;
         }

@@ -5,6 +5,7 @@
 
 use crate::acoustics::Ping;
 use crate::acoustics::clock::Clock;
+use crate::acoustics::link::Link;
 use crate::acoustics::profile::Profile;
 use crate::engine::{PilotRecord, VehicleTruth, World};
 use crate::scenario::moving_beacon::Vehicle;
@@ -75,6 +76,8 @@ struct Underwater {
     range_rng: Option<Pcg64Mcg>,
     /// The vehicle's clock, which times the pings' arrivals.
     clock: Clock,
+    /// Its acoustic link: losses and outliers.
+    link: Link,
     nu_meas: BodyVelocity,
     distance_m: f64,
 }
@@ -119,6 +122,7 @@ impl<'a> MovingBeaconWorld<'a> {
                 attitude_rng: vehicle_rng(seed, run, v, Stream::Heading),
                 range_rng: (v > 0).then(|| vehicle_rng(seed, run, v, Stream::Acoustic)),
                 clock: Clock::new(&s.sea.clocks, vehicle_rng(seed, run, v, Stream::Clock)),
+                link: Link::new(&s.sea.link, vehicle_rng(seed, run, v, Stream::Link)),
                 nu_meas: BodyVelocity::zeros(),
                 distance_m: 0.0,
             })
@@ -270,7 +274,8 @@ impl World for MovingBeaconWorld<'_> {
                 };
                 // as the two clocks read it
                 let clock_m = c * (veh.clock.error_s(t_rx) - f.clock_s);
-                let range_m = c * travel_s + clock_m + range_noise;
+                // lost, or heard on another path
+                let Some(range_m) = veh.link.hear(c * travel_s + clock_m + range_noise) else { continue };
                 let beacon = BeaconFix {
                     id: 0,
                     position_ned_m: f.gps,
