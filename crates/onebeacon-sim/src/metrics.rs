@@ -123,7 +123,7 @@ impl RunMetrics {
 /// of all runs' mean errors (section 4.1.1); they are counted and left out of the
 /// error statistics, NEES included; `nees_mean_all_runs` keeps them, since a diverged
 /// run is exactly what a consistency check must also see.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CellSummary {
     pub runs: usize,
     pub outliers: usize,
@@ -147,6 +147,9 @@ pub struct CellSummary {
     /// Mean over inlier runs of the mean error in the first and second half, m.
     pub mean_error_first_half_m: f64,
     pub mean_error_second_half_m: f64,
+    /// Every run's mean error in run order, outliers included, m: what paired
+    /// comparisons between estimators or cells of the same runs are made of.
+    pub run_mean_errors_m: Vec<f64>,
 }
 
 /// Aggregates runs (in run order) into a cell summary.
@@ -181,6 +184,7 @@ pub fn summarise(runs: &[RunMetrics]) -> CellSummary {
         failed_updates: runs.iter().map(|r| r.failed_updates).sum(),
         mean_error_first_half_m: avg(&|r| r.mean_error_first_half_m),
         mean_error_second_half_m: avg(&|r| r.mean_error_second_half_m),
+        run_mean_errors_m: runs.iter().map(|r| r.mean_error_m).collect(),
     }
 }
 
