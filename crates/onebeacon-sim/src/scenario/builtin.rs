@@ -11,6 +11,7 @@ pub struct Builtin {
 pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "garin2024", toml: include_str!("../../../../scenarios/garin2024.toml") },
     Builtin { name: "sousa", toml: include_str!("../../../../scenarios/sousa.toml") },
+    Builtin { name: "sousa-sea", toml: include_str!("../../../../scenarios/sousa-sea.toml") },
     Builtin { name: "sousa-pair", toml: include_str!("../../../../scenarios/sousa-pair.toml") },
     Builtin { name: "hoff2024", toml: include_str!("../../../../scenarios/hoff2024.toml") },
     Builtin { name: "hoff2024-kinematic", toml: include_str!("../../../../scenarios/hoff2024-kinematic.toml") },
