@@ -19,7 +19,7 @@ use onebeacon::models::kinematic6dof::{Cov as Cov6, State as Eta};
 use onebeacon::models::unicycle::{Cov, State};
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
-use onebeacon::nav::{Aiding, IusblNavigator, PlanarConfig, SingleBeaconNavigator, range_6dof};
+use onebeacon::nav::{Aiding, IusblNavigator, PlanarConfig, range_6dof, single_beacon};
 use rand::RngExt;
 
 /// Every estimator of a fixed-beacon scenario on its AUV, started at the truth `z_true`
@@ -42,17 +42,18 @@ pub(crate) fn fixed_beacon(s: &FixedBeacon, z_true: State, seed: u64, run: u64) 
         .iter()
         .map(|e| {
             let (aiding, tuning, filter) = (e.aiding(Host::FixedBeacon), e.ekf_tuning(), e.filter_kind());
-            let (mirror, min_speed) = (e.mirror_recovery, e.min_speed_m_s);
+            let (gate, robust) = e.range_gate();
+            let guards = single_beacon::Guards {
+                min_speed_m_s: e.min_speed_m_s,
+                mirror: e.mirror_recovery.unwrap_or(true),
+                gate,
+                robust,
+            };
+            let calibration = e.range_calibration();
             let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
                 let mut z = z0;
                 (z[0], z[1], z[2]) = (north, east, heading);
-                let nav = SingleBeaconNavigator::new(aiding, tuning, filter, t0, z, p0);
-                // the navigator's own default where the key is absent
-                let nav = match mirror {
-                    Some(on) => nav.with_mirror_recovery(on),
-                    None => nav,
-                };
-                Box::new(nav.with_min_speed(min_speed))
+                single_beacon::boxed(aiding, tuning, filter, t0, (z, p0), calibration, guards)
             });
             Track::new(0, builder, pose, (i.position_sigma_m, sigma0[2]))
         })

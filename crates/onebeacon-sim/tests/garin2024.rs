@@ -96,3 +96,27 @@ fn the_robust_filter_keeps_every_run() {
     }
     assert!(lost > 0, "these runs must hold some the published filter loses");
 }
+
+/// garin2024-sea at CI scale (T_com 3 s, 30 runs): the filter with a clock state and
+/// Student-t ranges against the paper's, paired run by run: the mean of the differences
+/// and its 95 % t interval (29 degrees of freedom, t = 2.045) lie below zero.
+#[test]
+fn garin2024_sea_the_clock_state_and_student_t_ranges_beat_the_paper_filter() {
+    let Scenario::FixedBeacon(mut s) = parse(builtin("garin2024-sea").unwrap().toml, "garin2024-sea").unwrap() else {
+        unreachable!()
+    };
+    assert!(s.sea.link.false_prob > 0.0 && s.sea.clocks.drift_sigma_ppm > 0.0);
+    s.sweep.t_com_s = Some(vec![3.0]);
+    let r = monte_carlo(&Scenario::FixedBeacon(s), 30, 1, None, &|| {}).unwrap();
+    let (sea, paper) = (cell(&r, 0, "range+doppler-sea"), cell(&r, 0, "range+doppler"));
+    let d: Vec<f64> = sea.run_mean_errors_m.iter().zip(&paper.run_mean_errors_m).map(|(a, p)| a - p).collect();
+    let n = d.len() as f64;
+    let mean = d.iter().sum::<f64>() / n;
+    let sd = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let upper = mean + 2.045 * sd / n.sqrt();
+    eprintln!(
+        "sea {:.2} m, paper {:.2} m; paired difference {mean:.2} m, upper 95 % {upper:.2}",
+        sea.mean_error_m, paper.mean_error_m
+    );
+    assert!(upper < 0.0, "paired difference {mean} m, upper bound {upper}");
+}

@@ -10,6 +10,7 @@ pub struct Builtin {
 /// All built-in scenarios.
 pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "garin2024", toml: include_str!("../../../../scenarios/garin2024.toml") },
+    Builtin { name: "garin2024-sea", toml: include_str!("../../../../scenarios/garin2024-sea.toml") },
     Builtin { name: "sousa", toml: include_str!("../../../../scenarios/sousa.toml") },
     Builtin { name: "sousa-sea", toml: include_str!("../../../../scenarios/sousa-sea.toml") },
     Builtin { name: "sousa-pair", toml: include_str!("../../../../scenarios/sousa-pair.toml") },

@@ -13,7 +13,8 @@ impl EstimatorSpec {
         const RANGING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const FIXED_LOG: &[Host] = &[FixedBeacon, Log];
         const USBL: &[Host] = &[PassiveUsbl, Log];
-        const MOVING_LOG: &[Host] = &[MovingBeacon, Log];
+        const CALIBRATING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
+        const CLOCKED: &[Host] = &[FixedBeacon, MovingBeacon];
         let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
         let mut keys = vec![
             ("range_sigma_m", self.range_sigma_m, Positive, RANGING),
@@ -35,22 +36,22 @@ impl EstimatorSpec {
             ("heading_change_sigma_frac", self.heading_change_sigma_frac, NonNegative, &[Log]),
             ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, NonNegative, &[Log]),
             ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[PassiveUsbl, Log]),
-            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, MOVING_LOG),
+            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, CALIBRATING),
             ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
-            ("nis_gate", self.nis_gate, Positive, &[MovingBeacon, PassiveUsbl, Log]),
-            ("huber_k", self.huber_k, Positive, MOVING_LOG),
-            ("student_t_dof", self.student_t_dof, Positive, MOVING_LOG),
+            ("nis_gate", self.nis_gate, Positive, &[FixedBeacon, MovingBeacon, PassiveUsbl, Log]),
+            ("huber_k", self.huber_k, Positive, RANGING),
+            ("student_t_dof", self.student_t_dof, Positive, RANGING),
             ("mirror_recovery", flag(self.mirror_recovery), Finite, &[FixedBeacon]),
             ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
-            ("estimate_bias", flag(self.estimate_bias), Finite, MOVING_LOG),
-            ("estimate_bias_drift", flag(self.estimate_bias_drift), Finite, &[MovingBeacon]),
-            ("bias_drift_sigma_m_s", self.bias_drift_sigma_m_s, Positive, &[MovingBeacon]),
+            ("estimate_bias", flag(self.estimate_bias), Finite, CALIBRATING),
+            ("estimate_bias_drift", flag(self.estimate_bias_drift), Finite, CLOCKED),
+            ("bias_drift_sigma_m_s", self.bias_drift_sigma_m_s, Positive, CLOCKED),
             ("estimate_beacon_offsets", flag(self.estimate_beacon_offsets), Finite, &[Log]),
-            ("bias_m", self.bias_m, Finite, MOVING_LOG),
-            ("bias_sigma_m", self.bias_sigma_m, Positive, MOVING_LOG),
-            ("estimate_range_scale", flag(self.estimate_range_scale), Finite, MOVING_LOG),
-            ("range_scale_sigma", self.range_scale_sigma, Positive, MOVING_LOG),
+            ("bias_m", self.bias_m, Finite, CALIBRATING),
+            ("bias_sigma_m", self.bias_sigma_m, Positive, CALIBRATING),
+            ("estimate_range_scale", flag(self.estimate_range_scale), Finite, CALIBRATING),
+            ("range_scale_sigma", self.range_scale_sigma, Positive, CALIBRATING),
             ("estimate_distance_scale", flag(self.estimate_distance_scale), Finite, &[Log]),
             ("distance_scale_sigma", self.distance_scale_sigma, Positive, &[Log]),
             ("estimate_turn_scale", flag(self.estimate_turn_scale), Finite, &[Log]),
@@ -76,8 +77,7 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
         let states = match host {
             Host::Log => 7,
             Host::PassiveUsbl => 8,
-            Host::FixedBeacon => 6,
-            Host::MovingBeacon => 6 + e.range_calibration().states(),
+            Host::FixedBeacon | Host::MovingBeacon => 6 + e.range_calibration().states(),
         };
         let key = |f: &str| format!("estimators[{k}].{f}");
         check_ukf(&format!("estimators[{k}]"), states, (e.ukf_alpha, e.ukf_beta, e.ukf_kappa))?;
@@ -103,11 +103,14 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
                 allowed: "replaces the shared offset of estimate_bias (give one of the two), and does not apply to the tracker (track_accel_sigma_m_s2)".into(),
             });
         }
-        if e.robust.is_some() && !matches!(host, Host::Log | Host::MovingBeacon) {
+        if e.robust.is_some() && host == Host::PassiveUsbl {
             return Err(Violation {
                 key: key("robust"),
                 value: format!("{:?}", e.robust),
-                allowed: format!("does not apply to a {} (it applies to: moving_beacon world, log)", host.label()),
+                allowed: format!(
+                    "does not apply to a {} (it applies to: fixed_beacon world, moving_beacon world, log)",
+                    host.label()
+                ),
             });
         }
         if e.iusbl.is_some() && !e.kind.iusbl() {
@@ -239,8 +242,8 @@ mod tests {
         assert_eq!(e.sensor_noise(sensors).velocity_m_s, 0.1);
 
         assert_eq!(
-            error("kind = \"rosb\"\nnis_gate = 3.0", Host::FixedBeacon),
-            "estimators[0].nis_gate = 3.0: does not apply to a fixed_beacon world (it applies to: moving_beacon world, passive_usbl world, log)"
+            error("kind = \"pf\"\nhuber_k = 3.0", Host::PassiveUsbl),
+            "estimators[0].huber_k = 3.0: does not apply to a passive_usbl world (it applies to: fixed_beacon world, moving_beacon world, log)"
         );
         assert_eq!(
             error("kind = \"range+doppler\"", Host::MovingBeacon),
@@ -248,8 +251,8 @@ mod tests {
         );
         assert!(error("kind = \"rosb\"\nq_diag = [1, 1, 1, 1, -1, 1]", Host::FixedBeacon).contains(">= 0"));
         assert_eq!(
-            error("kind = \"rosb\"\nestimate_bias_drift = true", Host::FixedBeacon),
-            "estimators[0].estimate_bias_drift = true: does not apply to a fixed_beacon world (it applies to: moving_beacon world)"
+            error("kind = \"rosb\"\nestimate_bias_drift = true", Host::Log),
+            "estimators[0].estimate_bias_drift = true: does not apply to a log (it applies to: fixed_beacon world, moving_beacon world)"
         );
         assert_eq!(
             error("kind = \"range-ekf\"\nestimate_bias_drift = true\nrobust = \"huber\"", Host::MovingBeacon),

@@ -8,7 +8,7 @@
 //! with c reads every range c_eff / c too long, the scale k = c_eff / c - 1.
 
 use crate::filter::ProcessModel;
-use crate::measure::{Range3d, ScalarModel};
+use crate::measure::ScalarModel;
 use nalgebra::{SMatrix, SVector};
 
 /// Which calibration states a navigator estimates, each with its prior.
@@ -92,12 +92,34 @@ impl<P: ProcessModel<B>, const B: usize, const N: usize> ProcessModel<N> for Cal
     }
 
     fn jacobian(&self, x: &SVector<f64, N>, dt: f64) -> SMatrix<f64, N, N> {
-        let mut f = SMatrix::<f64, N, N>::identity();
-        f.fixed_view_mut::<B, B>(0, 0).copy_from(&self.inner.jacobian(&x.fixed_rows::<B>(0).into_owned(), dt));
+        self.embed(&self.inner.jacobian(&x.fixed_rows::<B>(0).into_owned(), dt), dt)
+    }
+
+    fn transition(&self, x: &SVector<f64, N>, dt: f64) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
+        let (pose, f) = self.inner.transition(&x.fixed_rows::<B>(0).into_owned(), dt);
+        let mut n = *x;
+        n.fixed_rows_mut::<B>(0).copy_from(&pose);
         if let (Some(o), Some(d)) = (self.layout.offset, self.layout.drift) {
-            f[(o, d)] = dt;
+            n[o] += x[d] * dt; // b(t + dt) = b(t) + b' dt
         }
-        f
+        (n, self.embed(&f, dt))
+    }
+
+    /// The pose's own (sparse) F P F' + Q when there is no calibration state, so that
+    /// a navigator without one computes exactly what its pose model does.
+    fn propagate_covariance(
+        &self,
+        f: &SMatrix<f64, N, N>,
+        p: &SMatrix<f64, N, N>,
+        q: &SMatrix<f64, N, N>,
+    ) -> SMatrix<f64, N, N> {
+        if N != B {
+            return f * p * f.transpose() + q;
+        }
+        let block = |m: &SMatrix<f64, N, N>| m.fixed_view::<B, B>(0, 0).into_owned();
+        let mut out = SMatrix::<f64, N, N>::zeros();
+        out.fixed_view_mut::<B, B>(0, 0).copy_from(&self.inner.propagate_covariance(&block(f), &block(p), &block(q)));
+        out
     }
 
     fn noise_covariance(&self, x: &SVector<f64, N>, dt: f64) -> SMatrix<f64, N, N> {
@@ -114,16 +136,30 @@ impl<P: ProcessModel<B>, const B: usize, const N: usize> ProcessModel<N> for Cal
     }
 }
 
-/// A range as the calibrated sensor reads it, (1 + k) r + b (r of [`Range3d`], eq.
-/// 3.7 of sousa), with the offset and scale read from the state where the layout puts
-/// them (zero where it has none).
+impl<P, const B: usize> Calibrated<P, B> {
+    /// The pose's Jacobian `f` in the full state's, with the offset's dependence on its
+    /// drift.
+    fn embed<const N: usize>(&self, f: &SMatrix<f64, B, B>, dt: f64) -> SMatrix<f64, N, N> {
+        let mut full = SMatrix::<f64, N, N>::identity();
+        full.fixed_view_mut::<B, B>(0, 0).copy_from(f);
+        if let (Some(o), Some(d)) = (self.layout.offset, self.layout.drift) {
+            full[(o, d)] = dt;
+        }
+        full
+    }
+}
+
+/// A range as the calibrated sensor reads it, (1 + k) r + b (r of the geometric model
+/// `R`: [`crate::measure::Range3d`], sousa eq. 3.7, or `Range2d`, garin2024 eq. 19),
+/// with the offset and scale read from the state where the layout puts them (zero where
+/// it has none).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct CalibratedRange {
-    pub range: Range3d,
+pub(crate) struct CalibratedRange<R> {
+    pub range: R,
     pub layout: Layout,
 }
 
-impl<const N: usize> ScalarModel<N> for CalibratedRange {
+impl<R: ScalarModel<N>, const N: usize> ScalarModel<N> for CalibratedRange<R> {
     fn predict(&self, x: &SVector<f64, N>) -> f64 {
         let r = ScalarModel::<N>::predict(&self.range, x);
         let k = self.layout.scale.map_or(0.0, |i| x[i]);
@@ -151,6 +187,7 @@ impl<const N: usize> ScalarModel<N> for CalibratedRange {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::measure::Range3d;
     use crate::models::kinematic6dof::Kinematic6Dof;
     use approx::assert_abs_diff_eq;
     use nalgebra::Vector3;

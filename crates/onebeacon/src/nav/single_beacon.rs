@@ -7,11 +7,12 @@
 //! (eq. 18 left, 22). [`Aiding::RANGE`] is the ROSB baseline: the same filter without
 //! the Doppler speed; [`Aiding::NONE`] is dead reckoning on the inertial sensors.
 
-use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome};
+use super::range_calibration::{Calibrated, CalibratedRange, RangeCalibration};
+use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::{AnyFilter, FilterError, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::measure::{RadialSpeed2d, Range2d, ScalarModel, StateComponent};
 use crate::models::unicycle::{Cov, DIM, State, UnicycleAccel, idx};
-use nalgebra::{SVector, Vector2, Vector3};
+use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
 /// Process and measurement noise of the filter. [`Default`] is garin2024 eq. 25.
 ///
@@ -69,16 +70,17 @@ struct Frame {
 /// the previous one and updates with heading, yaw rate and acceleration, stacked with
 /// the range (and Doppler speed) of a frame decoded since ([`Kind::RangeDoppler`] or
 /// [`Kind::Range`]), as in garin2024 eq. 18.
+///
+/// With a [`RangeCalibration`] the state has `N` = 6 + its states components (a range
+/// offset, its drift, a range scale), read by every range.
 #[derive(Debug, Clone)]
-pub struct SingleBeaconNavigator {
+pub struct SingleBeaconNavigator<const N: usize = DIM> {
     aiding: Aiding,
     tuning: EkfTuning,
-    model: UnicycleAccel,
-    /// The model's Q per step (it depends on neither the state nor dt).
-    q: Cov,
+    model: Calibrated<UnicycleAccel, DIM>,
     /// The AHRS heading, gyro and accelerometer models, built once.
     inertial: [StateComponent; 3],
-    filter: AnyFilter<DIM>,
+    filter: AnyFilter<N>,
     t_s: f64,
     pending: Option<Frame>,
     /// The last beacon heard, NED, m.
@@ -88,25 +90,96 @@ pub struct SingleBeaconNavigator {
     unmirror: bool,
     /// [`Self::with_min_speed`].
     min_speed_m_s: Option<f64>,
+    /// [`Self::with_range_gate`].
+    gate: f64,
+    robust: Option<Robust>,
 }
 
 impl SingleBeaconNavigator {
     /// A navigator at time `t0_s` with state `z0` = [x, y, psi, v, Omega, a] and
     /// covariance `p0`.
     pub fn new(aiding: Aiding, tuning: EkfTuning, filter: FilterKind, t0_s: f64, z0: State, p0: Cov) -> Self {
-        let model = UnicycleAccel { q_diag: tuning.q_diag };
-        let q = model.noise_covariance(&z0, 0.0);
+        Self::calibrated(aiding, tuning, filter, t0_s, (z0, p0), RangeCalibration::default())
+    }
+}
+
+/// What keeps the navigator on the vehicle besides its model: [`SingleBeaconNavigator::with_min_speed`],
+/// [`SingleBeaconNavigator::with_mirror_recovery`] and [`SingleBeaconNavigator::with_range_gate`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Guards {
+    pub min_speed_m_s: Option<f64>,
+    pub mirror: bool,
+    pub gate: f64,
+    pub robust: Option<Robust>,
+}
+
+/// The navigator of `calibration`'s states (6 to 9 of them), with its guards.
+pub fn boxed(
+    aiding: Aiding,
+    tuning: EkfTuning,
+    filter: FilterKind,
+    t0_s: f64,
+    start: (State, Cov),
+    calibration: RangeCalibration,
+    guards: Guards,
+) -> Box<dyn Navigator> {
+    fn make<const N: usize>(
+        a: Aiding,
+        t: EkfTuning,
+        f: FilterKind,
+        t0: f64,
+        s: (State, Cov),
+        c: RangeCalibration,
+        g: Guards,
+    ) -> Box<dyn Navigator> {
+        let nav = SingleBeaconNavigator::<N>::calibrated(a, t, f, t0, s, c);
+        Box::new(nav.with_mirror_recovery(g.mirror).with_min_speed(g.min_speed_m_s).with_range_gate(g.gate, g.robust))
+    }
+    let g = guards;
+    match calibration.states() {
+        0 => make::<6>(aiding, tuning, filter, t0_s, start, calibration, g),
+        1 => make::<7>(aiding, tuning, filter, t0_s, start, calibration, g),
+        2 => make::<8>(aiding, tuning, filter, t0_s, start, calibration, g),
+        _ => make::<9>(aiding, tuning, filter, t0_s, start, calibration, g),
+    }
+}
+
+impl<const N: usize> SingleBeaconNavigator<N> {
+    /// A navigator with the calibration states of `calibration` behind the pose
+    /// `start` = (z0, p0); `N` must be 6 + `calibration.states()`.
+    ///
+    /// # Panics
+    /// When `N` does not match the calibration.
+    pub fn calibrated(
+        aiding: Aiding,
+        tuning: EkfTuning,
+        filter: FilterKind,
+        t0_s: f64,
+        (z0, p0): (State, Cov),
+        calibration: RangeCalibration,
+    ) -> Self {
+        assert_eq!(N, DIM + calibration.states(), "state dimension against the calibration states");
+        let model = Calibrated {
+            inner: UnicycleAccel { q_diag: tuning.q_diag },
+            layout: calibration.layout(DIM),
+            offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
+        };
+        let (mut x, mut p) = (SVector::<f64, N>::zeros(), SMatrix::<f64, N, N>::zeros());
+        x.fixed_rows_mut::<DIM>(0).copy_from(&z0);
+        p.fixed_view_mut::<DIM, DIM>(0, 0).copy_from(&p0);
+        for (i, (value, sigma)) in calibration.prior().into_iter().enumerate() {
+            (x[DIM + i], p[(DIM + i, DIM + i)]) = (value, sigma * sigma);
+        }
         let inertial = [
             StateComponent::angle(idx::PSI, tuning.r_heading_rad2),
             StateComponent::value(idx::OMEGA, tuning.r_yaw_rate_rad2_s2),
             StateComponent::value(idx::ACCEL, tuning.r_accel_m2_s4),
         ];
-        let filter = AnyFilter::new(filter, z0, p0);
+        let filter = AnyFilter::new(filter, x, p);
         Self {
             aiding,
             tuning,
             model,
-            q,
             inertial,
             filter,
             t_s: t0_s,
@@ -114,7 +187,16 @@ impl SingleBeaconNavigator {
             beacon: None,
             unmirror: true,
             min_speed_m_s: None,
+            gate: f64::INFINITY,
+            robust: None,
         }
+    }
+
+    /// A range whose own NIS (at the prediction, with the nominal noise) exceeds `gate`
+    /// is left out of its frame's update; `robust` inflates the noise of the others.
+    pub fn with_range_gate(mut self, gate: f64, robust: Option<Robust>) -> Self {
+        (self.gate, self.robust) = (gate, robust);
+        self
     }
 
     /// The slowest the vehicle goes ahead, m/s: a speed estimate below it is projected
@@ -164,7 +246,9 @@ impl SingleBeaconNavigator {
         if !(v < -0.25 && v < -3.0 * p[(idx::V, idx::V)].max(0.0).sqrt()) {
             return;
         }
-        let j = Cov::from_diagonal(&SVector::from([-1.0, -1.0, 1.0, -1.0, 1.0, 1.0]));
+        let j = SMatrix::<f64, N, N>::from_diagonal(&SVector::from_fn(|i, _| {
+            if matches!(i, idx::X | idx::Y | idx::V) { -1.0 } else { 1.0 }
+        }));
         let p = j * p * j;
         let x = self.filter.mean_mut();
         x[idx::X] = 2.0 * b.x - x[idx::X];
@@ -182,8 +266,8 @@ impl SingleBeaconNavigator {
         Outcome::Applied
     }
 
-    /// The state estimate [x, y, psi, v, Omega, a].
-    pub fn state(&self) -> &State {
+    /// The state estimate [x, y, psi, v, Omega, a], then the calibration states.
+    pub fn state(&self) -> &SVector<f64, N> {
         self.filter.mean()
     }
 
@@ -192,27 +276,45 @@ impl SingleBeaconNavigator {
     fn tick(&mut self, t_s: f64, heading: f64, yaw_rate: f64, accel: f64) -> Result<Gated, FilterError> {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
-            self.filter.predict(&self.model, dt, &self.q);
+            let q = self.model.noise_covariance(self.filter.mean(), dt);
+            self.filter.predict(&self.model, dt, &q);
             self.t_s = t_s;
         }
         let (t, f) = (&self.tuning, &mut self.filter);
         let [heading_m, yaw_rate_m, accel_m] = &self.inertial;
         let Some(fr) = self.pending.take() else { return update(f, &self.inertial, [heading, yaw_rate, accel]) };
         self.beacon = Some(fr.beacon);
-        let range = Range2d { beacon: fr.beacon, var: t.r_range_m2 };
+        let layout = self.model.layout;
+        let range_model = |var: f64| CalibratedRange { range: Range2d { beacon: fr.beacon, var }, layout };
+        // the range's own NIS at the prediction: gated out above the gate, its noise
+        // inflated by a heavy-tailed update
+        let mut r_range = t.r_range_m2;
+        let mut range_m = fr.range_m;
+        if let Some(r) = range_m.filter(|_| self.gate.is_finite() || self.robust.is_some()) {
+            let (m, x) = (range_model(r_range), f.mean());
+            let h = ScalarModel::<N>::jacobian(&m, x);
+            let s = (h * f.covariance() * h.transpose())[(0, 0)] + r_range;
+            let nis = (r - ScalarModel::<N>::predict(&m, x)).powi(2) / s;
+            if nis > self.gate {
+                range_m = None;
+            } else if let Some(robust) = self.robust {
+                r_range *= robust.inflation(nis, 1);
+            }
+        }
+        let range = range_model(r_range);
         let doppler = RadialSpeed2d { beacon: fr.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
-        match (fr.range_m, fr.radial_speed_m_s) {
+        match (range_m, fr.radial_speed_m_s) {
             (None, None) => update(f, &self.inertial, [heading, yaw_rate, accel]),
             (Some(r), None) => {
-                let models: [&dyn ScalarModel<DIM>; 4] = [&range, heading_m, yaw_rate_m, accel_m];
+                let models: [&dyn ScalarModel<N>; 4] = [&range, heading_m, yaw_rate_m, accel_m];
                 update(f, &models, [r, heading, yaw_rate, accel])
             }
             (None, Some(v)) => {
-                let models: [&dyn ScalarModel<DIM>; 4] = [&doppler, heading_m, yaw_rate_m, accel_m];
+                let models: [&dyn ScalarModel<N>; 4] = [&doppler, heading_m, yaw_rate_m, accel_m];
                 update(f, &models, [v, heading, yaw_rate, accel])
             }
             (Some(r), Some(v)) => {
-                let models: [&dyn ScalarModel<DIM>; 5] = [&range, &doppler, heading_m, yaw_rate_m, accel_m]; // eq. 18, 20
+                let models: [&dyn ScalarModel<N>; 5] = [&range, &doppler, heading_m, yaw_rate_m, accel_m]; // eq. 18, 20
                 update(f, &models, [r, v, heading, yaw_rate, accel])
             }
         }
@@ -220,8 +322,8 @@ impl SingleBeaconNavigator {
 }
 
 /// One update of `filter` with the stacked `models` and their values `z`.
-fn update<const M: usize, H: MeasurementModel<DIM, M>>(
-    filter: &mut AnyFilter<DIM>,
+fn update<const N: usize, const M: usize, H: MeasurementModel<N, M>>(
+    filter: &mut AnyFilter<N>,
     models: &H,
     z: [f64; M],
 ) -> Result<Gated, FilterError> {
@@ -229,7 +331,7 @@ fn update<const M: usize, H: MeasurementModel<DIM, M>>(
     filter.update_gated(models, &SVector::from(z), &r, f64::INFINITY)
 }
 
-impl Navigator for SingleBeaconNavigator {
+impl<const N: usize> Navigator for SingleBeaconNavigator<N> {
     fn process(&mut self, m: &Measurement) -> Outcome {
         match m.kind {
             Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
@@ -264,8 +366,8 @@ impl Navigator for SingleBeaconNavigator {
             heading_var_rad2: p[(idx::PSI, idx::PSI)],
             roll_pitch_rad: [0.0; 2],
             speed_m_s: Some(x[idx::V]),
-            range_bias_m: 0.0,
-            range_scale: 0.0,
+            range_bias_m: self.model.layout.offset.map_or(0.0, |i| x[i]),
+            range_scale: self.model.layout.scale.map_or(0.0, |i| x[i]),
             distance_scale: 0.0,
             turn_scale: 0.0,
         }
