@@ -127,13 +127,7 @@ impl<const N: usize> Range6DofNavigator<N> {
         (eta0, p0): (State, Cov),
         calibration: RangeCalibration,
     ) -> Self {
-        assert_eq!(N, DIM + calibration.states(), "state dimension against the calibration states");
-        let (mut x, mut p) = (SVector::<f64, N>::zeros(), SMatrix::<f64, N, N>::zeros());
-        x.fixed_rows_mut::<DIM>(0).copy_from(&eta0);
-        p.fixed_view_mut::<DIM, DIM>(0, 0).copy_from(&p0);
-        for (i, (value, sigma)) in calibration.prior().into_iter().enumerate() {
-            (x[DIM + i], p[(DIM + i, DIM + i)]) = (value, sigma * sigma);
-        }
+        let (x, p) = calibration.initial(&eta0, &p0);
         Self {
             noise,
             depth_attitude: noise.depth_attitude_models(),

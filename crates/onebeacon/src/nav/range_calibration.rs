@@ -59,8 +59,28 @@ impl RangeCalibration {
         Layout { offset, drift, scale }
     }
 
+    /// The full state's mean and covariance: the pose's (`x0`, `p0`), then each
+    /// calibration state at its prior, uncorrelated.
+    ///
+    /// # Panics
+    /// When `N` is not `B` + [`Self::states`].
+    pub(crate) fn initial<const B: usize, const N: usize>(
+        &self,
+        x0: &SVector<f64, B>,
+        p0: &SMatrix<f64, B, B>,
+    ) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
+        assert_eq!(N, B + self.states(), "state dimension against the calibration states");
+        let (mut x, mut p) = (SVector::<f64, N>::zeros(), SMatrix::<f64, N, N>::zeros());
+        x.fixed_rows_mut::<B>(0).copy_from(x0);
+        p.fixed_view_mut::<B, B>(0, 0).copy_from(p0);
+        for (i, (value, sigma)) in self.prior().into_iter().enumerate() {
+            (x[B + i], p[(B + i, B + i)]) = (value, sigma * sigma);
+        }
+        (x, p)
+    }
+
     /// The appended states' initial values and standard deviations, in layout order.
-    pub(crate) fn prior(&self) -> Vec<(f64, f64)> {
+    fn prior(&self) -> Vec<(f64, f64)> {
         let mut prior = Vec::new();
         if let Some(o) = self.offset {
             prior.push((o.initial_m, o.sigma_m));

@@ -158,18 +158,12 @@ impl<const N: usize> SingleBeaconNavigator<N> {
         (z0, p0): (State, Cov),
         calibration: RangeCalibration,
     ) -> Self {
-        assert_eq!(N, DIM + calibration.states(), "state dimension against the calibration states");
         let model = Calibrated {
             inner: UnicycleAccel { q_diag: tuning.q_diag },
             layout: calibration.layout(DIM),
             offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
         };
-        let (mut x, mut p) = (SVector::<f64, N>::zeros(), SMatrix::<f64, N, N>::zeros());
-        x.fixed_rows_mut::<DIM>(0).copy_from(&z0);
-        p.fixed_view_mut::<DIM, DIM>(0, 0).copy_from(&p0);
-        for (i, (value, sigma)) in calibration.prior().into_iter().enumerate() {
-            (x[DIM + i], p[(DIM + i, DIM + i)]) = (value, sigma * sigma);
-        }
+        let (x, p) = calibration.initial(&z0, &p0);
         let inertial = [
             StateComponent::angle(idx::PSI, tuning.r_heading_rad2),
             StateComponent::value(idx::OMEGA, tuning.r_yaw_rate_rad2_s2),
