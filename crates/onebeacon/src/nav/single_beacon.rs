@@ -7,7 +7,7 @@
 //! (eq. 18 left, 22). [`Aiding::RANGE`] is the ROSB baseline: the same filter without
 //! the Doppler speed; [`Aiding::NONE`] is dead reckoning on the inertial sensors.
 
-use super::range_calibration::{Calibrated, CalibratedRange, RangeCalibration};
+use super::range_calibration::{Calibrated, CalibratedRange, Layout, RangeCalibration};
 use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::{AnyFilter, FilterError, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::measure::{RadialSpeed2d, Range2d, ScalarModel, StateComponent};
@@ -74,10 +74,18 @@ struct Frame {
 /// With a [`RangeCalibration`] the state has `N` = 6 + its states components (a range
 /// offset, its drift, a range scale), read by every range.
 #[derive(Debug, Clone)]
-pub struct SingleBeaconNavigator<const N: usize = DIM> {
+pub struct SingleBeaconNavigator<const N: usize = DIM, P = UnicycleAccel> {
     aiding: Aiding,
     tuning: EkfTuning,
-    model: Calibrated<UnicycleAccel, DIM>,
+    /// The unicycle model (eq. 7), wrapped with the calibration states' motion when
+    /// there are any (the plain model otherwise, at its own speed).
+    model: P,
+    /// Where the calibration states are, and the offset's walk, m / sqrt(s).
+    layout: Layout,
+    offset_walk_m_per_sqrt_s: f64,
+    /// The model's Q per step but the offset's walk (it depends on neither the state
+    /// nor dt).
+    q: SMatrix<f64, N, N>,
     /// The AHRS heading, gyro and accelerometer models, built once.
     inertial: [StateComponent; 3],
     filter: AnyFilter<N>,
@@ -99,7 +107,31 @@ impl SingleBeaconNavigator {
     /// A navigator at time `t0_s` with state `z0` = [x, y, psi, v, Omega, a] and
     /// covariance `p0`.
     pub fn new(aiding: Aiding, tuning: EkfTuning, filter: FilterKind, t0_s: f64, z0: State, p0: Cov) -> Self {
-        Self::calibrated(aiding, tuning, filter, t0_s, (z0, p0), RangeCalibration::default())
+        let model = UnicycleAccel { q_diag: tuning.q_diag };
+        Self::assemble(model, RangeCalibration::default(), aiding, tuning, filter, t0_s, (z0, p0))
+    }
+}
+
+impl<const N: usize> SingleBeaconNavigator<N, Calibrated<UnicycleAccel, DIM>> {
+    /// A navigator with the calibration states of `calibration` behind the pose
+    /// `start` = (z0, p0); `N` must be 6 + `calibration.states()`.
+    ///
+    /// # Panics
+    /// When `N` does not match the calibration.
+    pub(crate) fn calibrated(
+        aiding: Aiding,
+        tuning: EkfTuning,
+        filter: FilterKind,
+        t0_s: f64,
+        start: (State, Cov),
+        calibration: RangeCalibration,
+    ) -> Self {
+        let model = Calibrated {
+            inner: UnicycleAccel { q_diag: tuning.q_diag },
+            layout: calibration.layout(DIM),
+            offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
+        };
+        Self::assemble(model, calibration, aiding, tuning, filter, t0_s, start)
     }
 }
 
@@ -132,38 +164,36 @@ pub fn boxed(
         c: RangeCalibration,
         g: Guards,
     ) -> Box<dyn Navigator> {
-        let nav = SingleBeaconNavigator::<N>::calibrated(a, t, f, t0, s, c);
+        let nav = SingleBeaconNavigator::<N, _>::calibrated(a, t, f, t0, s, c);
         Box::new(nav.with_mirror_recovery(g.mirror).with_min_speed(g.min_speed_m_s).with_range_gate(g.gate, g.robust))
     }
     let g = guards;
     match calibration.states() {
-        0 => make::<6>(aiding, tuning, filter, t0_s, start, calibration, g),
+        0 => {
+            let nav = SingleBeaconNavigator::new(aiding, tuning, filter, t0_s, start.0, start.1);
+            Box::new(
+                nav.with_mirror_recovery(g.mirror).with_min_speed(g.min_speed_m_s).with_range_gate(g.gate, g.robust),
+            )
+        }
         1 => make::<7>(aiding, tuning, filter, t0_s, start, calibration, g),
         2 => make::<8>(aiding, tuning, filter, t0_s, start, calibration, g),
         _ => make::<9>(aiding, tuning, filter, t0_s, start, calibration, g),
     }
 }
 
-impl<const N: usize> SingleBeaconNavigator<N> {
-    /// A navigator with the calibration states of `calibration` behind the pose
-    /// `start` = (z0, p0); `N` must be 6 + `calibration.states()`.
-    ///
-    /// # Panics
-    /// When `N` does not match the calibration.
-    pub fn calibrated(
+impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
+    /// A navigator on `model` (the unicycle's, with `calibration`'s states if any).
+    fn assemble(
+        model: P,
+        calibration: RangeCalibration,
         aiding: Aiding,
         tuning: EkfTuning,
         filter: FilterKind,
         t0_s: f64,
         (z0, p0): (State, Cov),
-        calibration: RangeCalibration,
     ) -> Self {
-        let model = Calibrated {
-            inner: UnicycleAccel { q_diag: tuning.q_diag },
-            layout: calibration.layout(DIM),
-            offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
-        };
         let (x, p) = calibration.initial(&z0, &p0);
+        let q = model.noise_covariance(&x, 0.0);
         let inertial = [
             StateComponent::angle(idx::PSI, tuning.r_heading_rad2),
             StateComponent::value(idx::OMEGA, tuning.r_yaw_rate_rad2_s2),
@@ -174,6 +204,9 @@ impl<const N: usize> SingleBeaconNavigator<N> {
             aiding,
             tuning,
             model,
+            layout: calibration.layout(DIM),
+            offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
+            q,
             inertial,
             filter,
             t_s: t0_s,
@@ -270,15 +303,21 @@ impl<const N: usize> SingleBeaconNavigator<N> {
     fn tick(&mut self, t_s: f64, heading: f64, yaw_rate: f64, accel: f64) -> Result<Gated, FilterError> {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
-            let q = self.model.noise_covariance(self.filter.mean(), dt);
-            self.filter.predict(&self.model, dt, &q);
+            match self.layout.offset.filter(|_| self.offset_walk_m_per_sqrt_s > 0.0) {
+                None => self.filter.predict(&self.model, dt, &self.q),
+                Some(o) => {
+                    let mut q = self.q;
+                    q[(o, o)] = self.offset_walk_m_per_sqrt_s.powi(2) * dt;
+                    self.filter.predict(&self.model, dt, &q);
+                }
+            }
             self.t_s = t_s;
         }
         let (t, f) = (&self.tuning, &mut self.filter);
         let [heading_m, yaw_rate_m, accel_m] = &self.inertial;
         let Some(fr) = self.pending.take() else { return update(f, &self.inertial, [heading, yaw_rate, accel]) };
         self.beacon = Some(fr.beacon);
-        let layout = self.model.layout;
+        let layout = self.layout;
         let range_model = |var: f64| CalibratedRange { range: Range2d { beacon: fr.beacon, var }, layout };
         // the range's own NIS at the prediction: gated out above the gate, its noise
         // inflated by a heavy-tailed update
@@ -325,7 +364,7 @@ fn update<const N: usize, const M: usize, H: MeasurementModel<N, M>>(
     filter.update_gated(models, &SVector::from(z), &r, f64::INFINITY)
 }
 
-impl<const N: usize> Navigator for SingleBeaconNavigator<N> {
+impl<const N: usize, P: ProcessModel<N> + Send> Navigator for SingleBeaconNavigator<N, P> {
     fn process(&mut self, m: &Measurement) -> Outcome {
         match m.kind {
             Kind::Inertial { heading_rad, yaw_rate_rad_s, accel_m_s2 } => {
@@ -360,8 +399,8 @@ impl<const N: usize> Navigator for SingleBeaconNavigator<N> {
             heading_var_rad2: p[(idx::PSI, idx::PSI)],
             roll_pitch_rad: [0.0; 2],
             speed_m_s: Some(x[idx::V]),
-            range_bias_m: self.model.layout.offset.map_or(0.0, |i| x[i]),
-            range_scale: self.model.layout.scale.map_or(0.0, |i| x[i]),
+            range_bias_m: self.layout.offset.map_or(0.0, |i| x[i]),
+            range_scale: self.layout.scale.map_or(0.0, |i| x[i]),
             distance_scale: 0.0,
             turn_scale: 0.0,
         }
