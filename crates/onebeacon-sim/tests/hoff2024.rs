@@ -29,7 +29,7 @@ fn small(particles: usize, duration_s: f64, guidance: &[GuidanceKind]) -> Scenar
 fn the_planner_beats_a_static_asv_and_the_filter_is_consistent() {
     let s = small(20_000, 600.0, &[GuidanceKind::Determinant, GuidanceKind::Static]);
     let r = monte_carlo(&s, 2, 1, None, &|| {}).unwrap();
-    let pf = |cell: usize| r.cells[cell].estimators[0].1;
+    let pf = |cell: usize| &r.cells[cell].estimators[0].1;
     let (det, fixed) = (pf(0), pf(1));
     assert!(det.mean_error_m < 1.0, "det: {det:?}");
     assert!(

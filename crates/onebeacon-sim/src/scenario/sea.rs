@@ -85,14 +85,14 @@ impl SoundSpeed {
                 allowed: format!("one per depth ({}), each in {what}", d.len()),
             });
         }
-        if let Some(s) = self.salinity_ppt {
-            if !(25.0..=40.0).contains(&s) || speeds {
-                return Err(Violation {
-                    key: key("salinity_ppt"),
-                    value: format!("{s:?}"),
-                    allowed: "with temperature_c only, in Mackenzie's 25-40 ppt".into(),
-                });
-            }
+        if let Some(s) = self.salinity_ppt
+            && (!(25.0..=40.0).contains(&s) || speeds)
+        {
+            return Err(Violation {
+                key: key("salinity_ppt"),
+                value: format!("{s:?}"),
+                allowed: "with temperature_c only, in Mackenzie's 25-40 ppt".into(),
+            });
         }
         Ok(())
     }
