@@ -334,7 +334,7 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
     let not_a_dir = write("file.txt", "x");
     let escape = write("escape.toml", "name = \"../../x\"\n");
     let huge = write("huge.toml", "name = \"huge\"\n[mission]\nduration_s = 25000000\n");
-    let estimator = write("est.toml", "name = \"e\"\n[[estimators]]\nkind = \"rosb\"\nnis_gate = 3.0\n");
+    let estimator = write("est.toml", "name = \"e\"\n[[estimators]]\nkind = \"rosb\"\ndistance_sigma_frac = 0.1\n");
     let builtin = |name: &str| text(&run(&["scenarios", "--show", name]).stdout);
     let particles = write(
         "particles.toml",
@@ -405,10 +405,7 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["fly"], &["fly"]),
         (vec!["run", &escape], &["escape.toml", "name", "a name, not a path"]),
         (vec!["run", &huge, "--out", out], &["huge.toml", "100000000 steps", "GB"]),
-        (
-            vec!["run", &estimator, "--out", out],
-            &["est.toml", "estimators[0].nis_gate", "applies to: passive_usbl world, log"],
-        ),
+        (vec!["run", &estimator, "--out", out], &["est.toml", "estimators[0].distance_sigma_frac", "applies to: log"]),
         (vec!["run", "hoff2024", "--message", "0", "--out", out], &["--message 0", "messages 1 to 900"]),
     ];
     for (args, needles) in cases {
