@@ -3,7 +3,7 @@
 //! (eq. 3.3-3.6), and OWTT range updates to a beacon whose position travels with the
 //! measurement (eq. 3.7-3.10).
 
-use super::range_calibration::{Calibrated, CalibratedRange, Layout, RangeCalibration};
+use super::range_calibration::{Calibrated, CalibratedRange, RangeCalibration};
 use super::{Aiding, BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::measure::{Range3d, StateComponent};
@@ -62,8 +62,8 @@ pub struct Range6DofNavigator<const N: usize = DIM> {
     /// The depth sensor and AHRS models, built once.
     depth_attitude: [StateComponent; 4],
     aiding: Aiding,
-    calibration: Layout,
-    offset_walk_m_per_sqrt_s: f64,
+    /// Where the calibration states are and how they move.
+    calibration: Calibrated<(), DIM>,
     /// A range whose NIS exceeds it is rejected; a heavy-tailed range update.
     gate: f64,
     robust: Option<Robust>,
@@ -132,8 +132,7 @@ impl<const N: usize> Range6DofNavigator<N> {
             noise,
             depth_attitude: noise.depth_attitude_models(),
             aiding,
-            calibration: calibration.layout(DIM),
-            offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
+            calibration: calibration.motion(),
             gate: f64::INFINITY,
             robust: None,
             filter: AnyFilter::new(filter, x, p),
@@ -163,11 +162,7 @@ impl<const N: usize> Range6DofNavigator<N> {
     fn advance_to(&mut self, t_s: f64) {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
-            let model = Calibrated::<_, DIM> {
-                inner: self.noise.process_model(self.nu),
-                layout: self.calibration,
-                offset_walk_m_per_sqrt_s: self.offset_walk_m_per_sqrt_s,
-            };
+            let model = self.calibration.over(self.noise.process_model(self.nu));
             let q = model.noise_covariance(self.filter.mean(), dt);
             self.filter.predict(&model, dt, &q);
             self.t_s = t_s;
@@ -210,7 +205,7 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
             Kind::Range { beacon, range_m } | Kind::RangeDoppler { beacon, range_m, .. } if self.aiding.range => {
                 // range update (eq. 3.7-3.10) at the receive time
                 self.advance_to(m.t_s);
-                let model = CalibratedRange { range: self.noise.range_model(&beacon), layout: self.calibration };
+                let model = CalibratedRange { range: self.noise.range_model(&beacon), layout: self.calibration.layout };
                 super::gated_update(&mut self.filter, &[model], Vector1::new(range_m), self.gate, self.robust)
             }
             _ => Outcome::Skipped,
@@ -228,8 +223,8 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
             heading_var_rad2: p[(idx::YAW, idx::YAW)],
             roll_pitch_rad: [x[idx::ROLL], x[idx::PITCH]],
             speed_m_s: None,
-            range_bias_m: state(self.calibration.offset),
-            range_scale: state(self.calibration.scale),
+            range_bias_m: state(self.calibration.layout.offset),
+            range_scale: state(self.calibration.layout.scale),
             distance_scale: 0.0,
             turn_scale: 0.0,
         }

@@ -52,6 +52,16 @@ impl RangeCalibration {
         offset + if self.scale_sigma.is_some() { 1 } else { 0 }
     }
 
+    /// The calibration states' motion behind a pose of `B` components, over no pose
+    /// model yet ([`Calibrated::over`] puts one under it).
+    pub(crate) fn motion<const B: usize>(&self) -> Calibrated<(), B> {
+        Calibrated {
+            inner: (),
+            layout: self.layout(B),
+            offset_walk_m_per_sqrt_s: self.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
+        }
+    }
+
     pub(crate) fn layout(&self, base: usize) -> Layout {
         let offset = self.offset.map(|_| base);
         let drift = self.offset.and_then(|o| o.drift_sigma_m_s).map(|_| base + 1);
@@ -153,6 +163,13 @@ impl<P: ProcessModel<B>, const B: usize, const N: usize> ProcessModel<N> for Cal
 
     fn is_angle(&self, i: usize) -> bool {
         i < B && self.inner.is_angle(i)
+    }
+}
+
+impl<const B: usize> Calibrated<(), B> {
+    /// The same calibration states behind the pose model `inner`.
+    pub(crate) fn over<P>(self, inner: P) -> Calibrated<P, B> {
+        Calibrated { inner, layout: self.layout, offset_walk_m_per_sqrt_s: self.offset_walk_m_per_sqrt_s }
     }
 }
 

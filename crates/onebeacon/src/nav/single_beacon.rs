@@ -7,7 +7,7 @@
 //! (eq. 18 left, 22). [`Aiding::RANGE`] is the ROSB baseline: the same filter without
 //! the Doppler speed; [`Aiding::NONE`] is dead reckoning on the inertial sensors.
 
-use super::range_calibration::{Calibrated, CalibratedRange, Layout, RangeCalibration};
+use super::range_calibration::{Calibrated, CalibratedRange, RangeCalibration};
 use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::{AnyFilter, FilterError, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::measure::{RadialSpeed2d, Range2d, ScalarModel, StateComponent};
@@ -80,9 +80,8 @@ pub struct SingleBeaconNavigator<const N: usize = DIM, P = UnicycleAccel> {
     /// The unicycle model (eq. 7), wrapped with the calibration states' motion when
     /// there are any (the plain model otherwise, at its own speed).
     model: P,
-    /// Where the calibration states are, and the offset's walk, m / sqrt(s).
-    layout: Layout,
-    offset_walk_m_per_sqrt_s: f64,
+    /// Where the calibration states are and how they move.
+    calibration: Calibrated<(), DIM>,
     /// The model's Q per step but the offset's walk (it depends on neither the state
     /// nor dt).
     q: SMatrix<f64, N, N>,
@@ -126,11 +125,7 @@ impl<const N: usize> SingleBeaconNavigator<N, Calibrated<UnicycleAccel, DIM>> {
         start: (State, Cov),
         calibration: RangeCalibration,
     ) -> Self {
-        let model = Calibrated {
-            inner: UnicycleAccel { q_diag: tuning.q_diag },
-            layout: calibration.layout(DIM),
-            offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
-        };
+        let model = calibration.motion().over(UnicycleAccel { q_diag: tuning.q_diag });
         Self::assemble(model, calibration, aiding, tuning, filter, t0_s, start)
     }
 }
@@ -204,8 +199,7 @@ impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
             aiding,
             tuning,
             model,
-            layout: calibration.layout(DIM),
-            offset_walk_m_per_sqrt_s: calibration.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
+            calibration: calibration.motion(),
             q,
             inertial,
             filter,
@@ -303,11 +297,12 @@ impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
     fn tick(&mut self, t_s: f64, heading: f64, yaw_rate: f64, accel: f64) -> Result<Gated, FilterError> {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
-            match self.layout.offset.filter(|_| self.offset_walk_m_per_sqrt_s > 0.0) {
+            let c = &self.calibration;
+            match c.layout.offset.filter(|_| c.offset_walk_m_per_sqrt_s > 0.0) {
                 None => self.filter.predict(&self.model, dt, &self.q),
                 Some(o) => {
                     let mut q = self.q;
-                    q[(o, o)] = self.offset_walk_m_per_sqrt_s.powi(2) * dt;
+                    q[(o, o)] = c.offset_walk_m_per_sqrt_s.powi(2) * dt;
                     self.filter.predict(&self.model, dt, &q);
                 }
             }
@@ -317,7 +312,7 @@ impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
         let [heading_m, yaw_rate_m, accel_m] = &self.inertial;
         let Some(fr) = self.pending.take() else { return update(f, &self.inertial, [heading, yaw_rate, accel]) };
         self.beacon = Some(fr.beacon);
-        let layout = self.layout;
+        let layout = self.calibration.layout;
         let range_model = |var: f64| CalibratedRange { range: Range2d { beacon: fr.beacon, var }, layout };
         // the range's own NIS at the prediction: gated out above the gate, its noise
         // inflated by a heavy-tailed update
@@ -399,8 +394,8 @@ impl<const N: usize, P: ProcessModel<N> + Send> Navigator for SingleBeaconNaviga
             heading_var_rad2: p[(idx::PSI, idx::PSI)],
             roll_pitch_rad: [0.0; 2],
             speed_m_s: Some(x[idx::V]),
-            range_bias_m: self.layout.offset.map_or(0.0, |i| x[i]),
-            range_scale: self.layout.scale.map_or(0.0, |i| x[i]),
+            range_bias_m: self.calibration.layout.offset.map_or(0.0, |i| x[i]),
+            range_scale: self.calibration.layout.scale.map_or(0.0, |i| x[i]),
             distance_scale: 0.0,
             turn_scale: 0.0,
         }
