@@ -75,7 +75,7 @@ pub fn fleet(
     };
     let wall_s = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    let stats = statistics(f, &outputs);
+    let stats = statistics(f, seed, &outputs);
 
     let first = &outputs[0];
     let (vehicles, names) = (s.vehicle_names(), s.track_labels());

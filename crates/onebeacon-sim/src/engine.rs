@@ -193,6 +193,8 @@ pub(crate) fn run(
                 let outcome = t.navigator.process(m);
                 observers.iter_mut().for_each(|o| o.outcome(i, &outcome));
             }
+            // scored at the step's time, also when no message reached it
+            t.navigator.predict_to(world.t_s(k));
             estimates[i] = t.navigator.estimate();
             if t.restart.apply(&mut t.navigator, &mut estimates[i], world.t_s(k)) {
                 observers.iter_mut().for_each(|o| o.restarted(i));

@@ -5,6 +5,8 @@
 
 use crate::run::{RunOutput, StepRecord};
 use crate::scenario::fleet::{BehaviourName, Fleet};
+use crate::seed::{Stream, gauss, vehicle_rng};
+use nalgebra::Vector2;
 use onebeacon::nav::evaluation::quantile;
 use serde::Serialize;
 
@@ -185,16 +187,30 @@ fn coverage(s: &Fleet, traj: &[StepRecord]) -> Option<Coverage> {
 }
 
 /// The statistics of recorded runs of `s` (tracks in the order of
-/// [`crate::Scenario::tracks`]: each AUV's estimators in order).
-pub fn statistics(s: &Fleet, runs: &[RunOutput]) -> FleetStatistics {
+/// [`crate::Scenario::tracks`]: each AUV's estimators in order), run i of base seed
+/// `seed` at index i. With `[reference] sigma_m`, the errors are against a reference fix
+/// per step and AUV (the truth plus its own error, from a seeded stream of its own).
+pub fn statistics(s: &Fleet, seed: u64, runs: &[RunOutput]) -> FleetStatistics {
     let estimators: Vec<&str> = s.estimators.iter().map(|e| e.label()).collect();
     let ne = estimators.len();
     let mut per_track: Vec<Vec<f64>> = vec![Vec::new(); s.auvs.len() * ne];
-    for out in runs {
+    let sigma = s.reference.sigma_m;
+    for (run, out) in runs.iter().enumerate() {
+        let mut rngs: Vec<_> = (0..s.auvs.len()).map(|v| vehicle_rng(seed, run as u64, v, Stream::Reference)).collect();
         for r in &out.trajectory {
+            // every AUV's fix of this step, drawn whether it counts or not
+            let fixes: Vec<Vector2<f64>> = if sigma > 0.0 {
+                rngs.iter_mut()
+                    .zip(&r.truth)
+                    .map(|(rng, t)| t.pos.xy() + Vector2::new(gauss(rng, sigma), gauss(rng, sigma)))
+                    .collect()
+            } else {
+                Vec::new()
+            };
             for (i, e) in r.estimates.iter().enumerate() {
                 if counted(s, r, e.vehicle) {
-                    per_track[i].push(e.error_m);
+                    let error = fixes.get(e.vehicle).map_or(e.error_m, |f| (e.pos.xy() - f).norm());
+                    per_track[i].push(error);
                 }
             }
         }

@@ -34,6 +34,7 @@ pub mod replay;
 pub mod run;
 pub mod scenario;
 pub mod seed;
+pub mod sensor_errors;
 pub mod sensors;
 pub mod vehicles;
 mod world;

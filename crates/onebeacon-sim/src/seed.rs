@@ -23,6 +23,12 @@ pub enum Stream {
     BeaconClock = 8,
     /// A receiver's acoustic link: its losses and outliers.
     Link = 9,
+    /// A USBL head's sea (its carrier's waves) and attitude sensor.
+    Waves = 10,
+    /// A vehicle's drifting sensors (`[sea.sensors]`).
+    Sensors = 11,
+    /// A reference's own errors (a fleet's LBL fixes, `[reference]`).
+    Reference = 12,
 }
 
 /// SplitMix64 finaliser: a bijective mixing of 64 bits.

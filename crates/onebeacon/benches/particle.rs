@@ -30,7 +30,7 @@ fn bench(c: &mut Criterion) {
         sigma_depth_m: 0.15f64.sqrt(),
     };
     let usbl = Usbl::exact(Vector3::new(80.0, 30.0, 0.0), 0.0, 0.022f64.to_radians());
-    let bearing = UsblBearing { usbl, azimuth_rad: 0.78, elevation_rad: 0.8 };
+    let bearing = UsblBearing { usbl, azimuth_rad: 0.78, elevation_rad: 0.8, robust: None };
     let mut group = c.benchmark_group("hoff2024 particle filter cycle");
     group.sample_size(10);
     for n in [10_000usize, 100_000, 500_000, 1_000_000] {

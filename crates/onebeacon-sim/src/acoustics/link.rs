@@ -65,13 +65,12 @@ impl Link {
         Self { errors: *errors, enter, stay, lost: false, rng }
     }
 
-    /// The range a message carrying `range_m` arrives with, or None when it is lost.
-    /// Every message draws the same numbers, so that one's fate does not shift the
-    /// next's.
-    pub fn hear(&mut self, range_m: f64) -> Option<f64> {
+    /// How the next message arrives. Every message draws the same numbers, so that
+    /// one's fate does not shift the next's.
+    pub fn arrive(&mut self) -> Arrival {
         let e = &self.errors;
         if !e.any() {
-            return Some(range_m);
+            return Arrival::Direct;
         }
         let (u_loss, u_kind, u_false): (f64, f64, f64) = (self.rng.random(), self.rng.random(), self.rng.random());
         let excess = if e.multipath_excess_m > 0.0 {
@@ -81,15 +80,42 @@ impl Link {
         };
         self.lost = u_loss < if self.lost { self.stay } else { self.enter };
         if self.lost {
-            None
+            Arrival::Lost
         } else if u_kind < e.false_prob {
-            Some(u_false * e.false_max_range_m)
+            Arrival::False { u: u_false }
         } else if u_kind < e.false_prob + e.multipath_prob {
-            Some(range_m + excess)
+            Arrival::Multipath { excess_m: excess }
         } else {
-            Some(range_m)
+            Arrival::Direct
         }
     }
+
+    /// The range a message carrying `range_m` arrives with, or None when it is lost.
+    pub fn hear(&mut self, range_m: f64) -> Option<f64> {
+        match self.arrive() {
+            Arrival::Lost => None,
+            Arrival::Direct => Some(range_m),
+            Arrival::Multipath { excess_m } => Some(range_m + excess_m),
+            Arrival::False { u } => Some(u * self.errors.false_max_range_m),
+        }
+    }
+}
+
+/// How a message arrives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Arrival {
+    Lost,
+    /// On its direct path.
+    Direct,
+    /// On a reflected path, this much longer.
+    Multipath {
+        excess_m: f64,
+    },
+    /// A false detection; `u` is uniform on [0, 1) (its place in the false range's or
+    /// angle's span).
+    False {
+        u: f64,
+    },
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ pub mod clock;
 pub mod link;
 pub mod profile;
 pub mod propagation;
+pub mod usbl_head;
 pub mod wav;
 
 pub use propagation::Ping;

@@ -42,15 +42,29 @@ impl Profile {
     /// The travel time, s, along the direct eigenray from depth `z_s` to depth `z_r`
     /// over the horizontal distance `x` (m).
     pub fn travel_time(&self, x: f64, z_s: f64, z_r: f64) -> f64 {
+        self.eigenray(x, z_s, z_r).travel_time_s
+    }
+
+    /// The direct eigenray from depth `z_s` to depth `z_r` over the horizontal distance
+    /// `x` (m): its travel time and the angle it arrives at.
+    pub fn eigenray(&self, x: f64, z_s: f64, z_r: f64) -> Ray {
         let (top, bottom) = (z_s.min(z_r), z_s.max(z_r));
         let n = ((bottom - top) / LAYER_M).ceil() as usize;
+        // the angle from the vertical at the receiver, sin(theta) = p c(z_r) (Snell),
+        // measured from straight down when the source is below the receiver
+        let arriving = |sin_theta: f64| {
+            let theta = sin_theta.clamp(0.0, 1.0).asin();
+            if z_s >= z_r { theta } else { std::f64::consts::PI - theta }
+        };
         if n == 0 {
-            return x.hypot(bottom - top) / self.speed(top); // a horizontal ray
+            // a horizontal ray
+            return Ray { travel_time_s: x.hypot(bottom - top) / self.speed(top), arrival_rad: arriving(1.0) };
         }
         let h = (bottom - top) / n as f64;
         let layers: Vec<f64> = (0..n).map(|i| self.speed(top + (i as f64 + 0.5) * h)).collect();
         if x <= 0.0 {
-            return layers.iter().map(|c| h / c).sum(); // straight down
+            // straight down
+            return Ray { travel_time_s: layers.iter().map(|c| h / c).sum(), arrival_rad: arriving(0.0) };
         }
         let c_max = layers.iter().copied().fold(0.0, f64::max);
         let reach = |p: f64| -> f64 { layers.iter().map(|&c| h * p * c / (1.0 - (p * c).powi(2)).sqrt()).sum() };
@@ -68,22 +82,37 @@ impl Profile {
             }
         }
         let p = 0.5 * (lo + hi);
-        layers.iter().map(|&c| h / (c * (1.0 - (p * c).powi(2)).sqrt())).sum()
+        Ray {
+            travel_time_s: layers.iter().map(|&c| h / (c * (1.0 - (p * c).powi(2)).sqrt())).sum(),
+            arrival_rad: arriving(p * self.speed(z_r)),
+        }
     }
+}
+
+/// A direct eigenray: its travel time, and the angle it arrives at, rad from the vertical
+/// pointing down (0: from straight below, pi / 2: level, beyond: from above), as a
+/// receiver's array measures an elevation (hoff2024 eq. 2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    pub travel_time_s: f64,
+    pub arrival_rad: f64,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use std::f64::consts::PI;
 
     /// In water of one speed the eigenray is the straight line.
     #[test]
     fn one_speed_is_the_straight_line() {
         let p = Profile::new(vec![0.0], vec![1500.0]);
         for (x, zs, zr) in [(100.0, 0.0, 20.0), (3.0, 50.0, 1.0), (0.0, 0.0, 30.0), (80.0, 5.0, 5.0)] {
-            let t = p.travel_time(x, zs, zr);
-            assert_relative_eq!(t, f64::hypot(x, zr - zs) / 1500.0, max_relative = 1e-12);
+            let ray = p.eigenray(x, zs, zr);
+            assert_relative_eq!(ray.travel_time_s, f64::hypot(x, zr - zs) / 1500.0, max_relative = 1e-12);
+            // the geometric elevation (eq. 2) of the source seen from the receiver
+            assert!((ray.arrival_rad - x.atan2(zs - zr)).abs() < 1e-9, "({x}, {zs}, {zr})");
         }
     }
 
@@ -106,6 +135,10 @@ mod tests {
             assert_relative_eq!(p.travel_time(x, z1, z2), t, max_relative = 1e-7);
             // and the reverse path takes as long
             assert_relative_eq!(p.travel_time(x, z2, z1), t, max_relative = 1e-7);
+            // arriving at z2 from above at theta2, at z1 from below at theta1 (1e-6 rad,
+            // the bisection's p to the layers' O(h^2))
+            assert!((p.eigenray(x, z1, z2).arrival_rad - (PI - theta2)).abs() < 1e-6, "{theta1_deg}: at z2");
+            assert!((p.eigenray(x, z2, z1).arrival_rad - theta1).abs() < 1e-6, "{theta1_deg}: at z1");
         }
     }
 

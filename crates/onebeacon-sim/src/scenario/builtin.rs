@@ -20,8 +20,11 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "hoff2024-pair", toml: include_str!("../../../../scenarios/hoff2024-pair.toml") },
     Builtin { name: "hoff2024-consistency", toml: include_str!("../../../../scenarios/hoff2024-consistency.toml") },
     Builtin { name: "hoff2024-literal", toml: include_str!("../../../../scenarios/hoff2024-literal.toml") },
+    Builtin { name: "hoff2024-sea", toml: include_str!("../../../../scenarios/hoff2024-sea.toml") },
     Builtin { name: "rypkema-m1", toml: include_str!("../../../../scenarios/rypkema-m1.toml") },
     Builtin { name: "rypkema-m6", toml: include_str!("../../../../scenarios/rypkema-m6.toml") },
+    Builtin { name: "rypkema-m1-sea", toml: include_str!("../../../../scenarios/rypkema-m1-sea.toml") },
+    Builtin { name: "rypkema-m6-sea", toml: include_str!("../../../../scenarios/rypkema-m6-sea.toml") },
 ];
 
 /// The built-in scenario called `name`.

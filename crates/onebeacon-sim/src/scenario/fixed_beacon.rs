@@ -229,14 +229,7 @@ pub(super) fn validate_fixed(s: &FixedBeacon) -> Result<(), Violation> {
     use Rule::*;
     check_file_name("name", &s.name)?;
     check_count("runs", s.runs, 1, 1_000_000)?;
-    s.sea.check()?;
-    if s.sea.sound_speed.is_some() {
-        return Err(Violation {
-            key: "sea.sound_speed".into(),
-            value: "(set)".into(),
-            allowed: "applies to a moving_beacon world, whose pings travel between depths; this world is planar".into(),
-        });
-    }
+    s.sea.check(s.kind)?;
 
     let m = &s.mission;
     check_fields!("mission", m, {

@@ -45,6 +45,18 @@ pub enum World {
     Fleet,
 }
 
+impl World {
+    /// The world's `kind` as a scenario names it.
+    pub fn label(self) -> &'static str {
+        match self {
+            World::FixedBeacon => "fixed_beacon",
+            World::MovingBeacon => "moving_beacon",
+            World::PassiveUsbl => "passive_usbl",
+            World::Fleet => "fleet",
+        }
+    }
+}
+
 pub(crate) fn default_seed() -> u64 {
     1
 }

@@ -347,7 +347,7 @@ pub(super) fn validate_moving(s: &MovingBeacon) -> Result<(), Violation> {
     use Rule::*;
     check_file_name("name", &s.name)?;
     check_count("runs", s.runs, 1, 1_000_000)?;
-    s.sea.check()?;
+    s.sea.check(s.kind)?;
     check_fields!("mission", s.mission, {
         dt_s: Positive,
         duration_s: Positive,

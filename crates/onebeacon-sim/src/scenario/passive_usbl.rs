@@ -46,6 +46,10 @@ pub struct PassiveUsbl {
     pub estimators: Vec<EstimatorSpec>,
     #[serde(default)]
     pub sweep: Sweep,
+    /// `[sea]`: the link's losses and outliers, the USBL head's errors, a sound-speed
+    /// profile that bends the elevations (off by default).
+    #[serde(default)]
+    pub sea: super::sea::Sea,
 }
 
 fn default_estimators() -> Vec<EstimatorSpec> {
@@ -376,6 +380,7 @@ impl PassiveUsbl {
     pub fn tracker_noise(&self) -> onebeacon::nav::TrackerNoise {
         onebeacon::nav::TrackerNoise {
             usbl_sigma_rad_per_m: self.usbl.noise_deg_per_m.to_radians(),
+            usbl_floor_rad: 0.0,
             station_heading_sigma_rad: self.asv.compass_noise_deg.to_radians(),
             heading_sigma_rad: self.reports.heading_noise_deg.to_radians(),
             speed_sigma_m_s: self.reports.speed_noise_m_s,
@@ -428,6 +433,7 @@ fn check_auv(prefix: &str, a: &Auv) -> Result<(), Violation> {
 pub(super) fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
     check_file_name("name", &s.name)?;
     check_count("runs", s.runs, 1, 1_000_000)?;
+    s.sea.check(s.kind)?;
     check_fields!("mission", s.mission, {
         duration_s: Positive,
         message_period_s: Positive,

@@ -1,12 +1,16 @@
 //! The `[sea]` table: error sources of the real sea a world can switch on, all off by
-//! default (the reproductions run without them). So far the clocks of the one-way
-//! travel-time worlds (fixed_beacon, moving_beacon) and the sound-speed profile of the
-//! moving_beacon world.
+//! default (the reproductions run without them): clocks (worlds that time one-way
+//! travel), a sound-speed profile (worlds whose signals travel between depths), the
+//! acoustic link's losses and outliers (every world that hears messages), and a USBL
+//! head's misalignment, waves, floor and occluded sectors (worlds with a USBL).
 
 use super::validate::{Rule, Violation, check};
 use crate::acoustics::clock::ClockErrors;
 use crate::acoustics::link::LinkErrors;
 use crate::acoustics::profile::Profile;
+use crate::acoustics::usbl_head::UsblErrors;
+use crate::scenario::World;
+use crate::sensor_errors::SensorErrors;
 use onebeacon::dsp::sound_speed::mackenzie;
 use serde::{Deserialize, Serialize};
 
@@ -25,6 +29,11 @@ pub struct Sea {
     pub sound_speed: Option<SoundSpeed>,
     /// `[sea.link]`: lost messages, multipath and false ranges.
     pub link: LinkErrors,
+    /// `[sea.usbl]`: the USBL head's mounting, waves, attitude sensor, floor and
+    /// occluded sectors.
+    pub usbl: UsblErrors,
+    /// `[sea.sensors]`: the vehicles' heading bias, speed scale and speed dropouts.
+    pub sensors: SensorErrors,
 }
 
 /// `[sea.sound_speed]`: a cast, as speeds or as temperatures (Mackenzie 1981) at
@@ -131,9 +140,112 @@ fn check_link(l: &LinkErrors) -> Result<(), Violation> {
     Ok(())
 }
 
+fn check_usbl(u: &UsblErrors) -> Result<(), Violation> {
+    let bad = |key: &str, value: String, allowed: &str| {
+        Err(Violation { key: format!("sea.usbl.{key}"), value, allowed: allowed.into() })
+    };
+    if u.misalignment_deg.iter().any(|a| !(a.is_finite() && a.abs() <= 30.0)) {
+        return bad(
+            "misalignment_deg",
+            format!("{:?}", u.misalignment_deg),
+            "[roll, pitch, yaw], each a residual misalignment within +-30 deg",
+        );
+    }
+    for (key, v, most) in [
+        ("wave_roll_deg", u.wave_roll_deg, 30.0),
+        ("wave_pitch_deg", u.wave_pitch_deg, 30.0),
+        ("attitude_noise_deg", u.attitude_noise_deg, 10.0),
+        ("attitude_latency_s", u.attitude_latency_s, 10.0),
+        ("angle_floor_deg", u.angle_floor_deg, 30.0),
+    ] {
+        if !(0.0..=most).contains(&v) {
+            return bad(key, format!("{v:?}"), &format!("from 0 to {most}"));
+        }
+    }
+    if !(u.wave_period_s.is_finite() && (1.0..=30.0).contains(&u.wave_period_s)) {
+        return bad("wave_period_s", format!("{:?}", u.wave_period_s), "a wave period from 1 to 30 s");
+    }
+    let width = |[from, to]: [f64; 2]| (to - from).rem_euclid(360.0);
+    if let Some(s) =
+        u.occluded_deg.iter().find(|s| !s.iter().all(|a| a.is_finite() && a.abs() <= 360.0) || width(**s) == 0.0)
+    {
+        return bad(
+            "occluded_deg",
+            format!("{s:?}"),
+            "[from, to] pairs in deg from the bow (within +-360), from != to",
+        );
+    }
+    if u.occluded_deg.iter().map(|s| width(*s)).sum::<f64>() >= 360.0 {
+        return bad("occluded_deg", format!("{:?}", u.occluded_deg), "sectors that leave the head some of its circle");
+    }
+    Ok(())
+}
+
+fn check_sensors(e: &SensorErrors) -> Result<(), Violation> {
+    for (key, v, range, allowed) in [
+        ("heading_bias_sigma_deg", e.heading_bias_sigma_deg, 0.0..=30.0, "from 0 to 30"),
+        ("speed_scale_sigma", e.speed_scale_sigma, 0.0..=0.5, "from 0 to 0.5"),
+        ("speed_dropout_prob", e.speed_dropout_prob, 0.0..=0.99, "a share of time from 0 to 0.99"),
+        (
+            "heading_bias_time_constant_s",
+            e.heading_bias_time_constant_s,
+            1e-3..=1e7,
+            "a time constant > 0 s (up to 1e7)",
+        ),
+        ("speed_dropout_mean_s", e.speed_dropout_mean_s, 1e-3..=1e7, "a mean outage > 0 s (up to 1e7)"),
+    ] {
+        if !range.contains(&v) {
+            return Err(Violation {
+                key: format!("sea.sensors.{key}"),
+                value: format!("{v:?}"),
+                allowed: allowed.into(),
+            });
+        }
+    }
+    Ok(())
+}
+
 impl Sea {
-    pub(super) fn check(&self) -> Result<(), Violation> {
+    /// The checks of every table, and that each set table applies to a world of `kind`.
+    pub(super) fn check(&self, kind: World) -> Result<(), Violation> {
+        use World::*;
+        let set = [
+            (
+                "sea.clocks",
+                self.clocks != ClockErrors::default(),
+                &[FixedBeacon, MovingBeacon, Fleet][..],
+                "worlds that time one-way travel (fixed_beacon, moving_beacon, fleet)",
+            ),
+            (
+                "sea.sound_speed",
+                self.sound_speed.is_some(),
+                &[MovingBeacon, PassiveUsbl, Fleet][..],
+                "worlds whose signals travel between depths (moving_beacon, passive_usbl, fleet)",
+            ),
+            (
+                "sea.link",
+                self.link != LinkErrors::default(),
+                &[FixedBeacon, MovingBeacon, PassiveUsbl, Fleet][..],
+                "worlds that hear messages (fixed_beacon, moving_beacon, passive_usbl, fleet)",
+            ),
+            ("sea.usbl", self.usbl != UsblErrors::default(), &[PassiveUsbl][..], "worlds with a USBL (passive_usbl)"),
+            (
+                "sea.sensors",
+                self.sensors != SensorErrors::default(),
+                &[PassiveUsbl][..],
+                "the passive_usbl world so far (the AUVs' reports)",
+            ),
+        ];
+        if let Some((key, _, _, hosts)) = set.iter().find(|(_, on, kinds, _)| *on && !kinds.contains(&kind)) {
+            return Err(Violation {
+                key: (*key).into(),
+                value: "(set)".into(),
+                allowed: format!("applies to {hosts}, not to a {} world", kind.label()),
+            });
+        }
         check_link(&self.link)?;
+        check_usbl(&self.usbl)?;
+        check_sensors(&self.sensors)?;
         if let Some(s) = &self.sound_speed {
             s.check()?;
         }

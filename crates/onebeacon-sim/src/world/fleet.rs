@@ -7,6 +7,9 @@
 //! the navigators' receiver chains), or drawn as range, direction and mode (abstract).
 
 use crate::acoustics::channel::{Boundaries, Channel, simulate_ping};
+use crate::acoustics::clock::Clock;
+use crate::acoustics::link::{Arrival, Link};
+use crate::acoustics::profile::Profile;
 use crate::engine::{PilotRecord, VehicleTruth, World};
 use crate::scenario::fleet::{Fleet, SignalModel, Transmitter};
 use crate::seed::{Stream, gauss, vehicle_rng};
@@ -37,6 +40,9 @@ struct Auv {
     mode: Option<usize>,
     imu_rng: Pcg64Mcg,
     acoustic_rng: Pcg64Mcg,
+    /// Its clock and its link (`[sea]`).
+    clock: Clock,
+    link: Link,
 }
 
 /// A ping sent, waiting for the end of the capture window.
@@ -55,6 +61,10 @@ pub(crate) struct FleetWorld {
     elements: Vec<Vector3<f64>>,
     sent: Vec<Sent>,
     gps_rng: Pcg64Mcg,
+    /// The boat's and the dock's beacon clocks, and the sea's sound-speed profile
+    /// (`[sea]`).
+    beacon_clocks: [Clock; 2],
+    profile: Option<Profile>,
     /// The next transmit epoch.
     next_ping_s: f64,
     k: usize,
@@ -79,6 +89,8 @@ impl FleetWorld {
                     mode: None,
                     imu_rng,
                     acoustic_rng: vehicle_rng(seed, run, v, Stream::Acoustic),
+                    clock: Clock::new(&s.sea.clocks, vehicle_rng(seed, run, v, Stream::Clock)),
+                    link: Link::new(&s.sea.link, vehicle_rng(seed, run, v, Stream::Link)),
                 }
             })
             .collect();
@@ -89,6 +101,8 @@ impl FleetWorld {
             elements: pyramid_8cm(),
             sent: Vec::new(),
             gps_rng: crate::seed::rng(seed, run, Stream::BeaconGps),
+            beacon_clocks: [0, 1].map(|b| Clock::new(&s.sea.clocks, vehicle_rng(seed, run, b, Stream::BeaconClock))),
+            profile: s.sea.sound_speed.as_ref().map(|p| p.profile()),
             next_ping_s: 0.0,
             k: 0,
         }
@@ -106,8 +120,10 @@ impl FleetWorld {
         }
     }
 
-    /// What AUV `v` hears of ping `p`, if anything.
-    fn hear(&mut self, v: usize, p: &Sent, gps: Vector3<f64>) -> Option<Measurement> {
+    /// What AUV `v` hears of ping `p`, if anything: lost on the link, or heard with the
+    /// two clocks' difference (the AUV's at reception, the beacon's at transmission) on
+    /// its travel time.
+    fn hear(&mut self, v: usize, p: &Sent, gps: Vector3<f64>, tx_clock_s: f64) -> Option<Measurement> {
         let sig = &self.s.signal;
         let auv = &mut self.auvs[v];
         let at = auv.truth.position_ned_m;
@@ -119,6 +135,11 @@ impl FleetWorld {
         if r > sig.max_range_m {
             return None;
         }
+        let arrival = auv.link.arrive();
+        if arrival == Arrival::Lost {
+            return None;
+        }
+        let clock_s = auv.clock.error_s(p.t_tx + r / sig.sound_speed_m_s) - tx_clock_s;
         let beacon = BeaconFix {
             id: p.from as u32,
             position_ned_m: gps,
@@ -144,7 +165,7 @@ impl FleetWorld {
                         wall_east_m: None,
                         wall_coef: 0.0,
                     }),
-                    clock_offset_s: 0.0,
+                    clock_offset_s: clock_s,
                     clock_drift_ppm: 0.0,
                     radial_speed_m_s: velocity.dot(&(d / r.max(1e-9))),
                 };
@@ -156,10 +177,26 @@ impl FleetWorld {
                 if rng.random_bool(sig.mode_error_probability) {
                     mode = (mode + rng.random_range(1..4usize)) % 4;
                 }
-                let truth = att.transpose() * d / r;
+                // the direct path (its travel time along the profile's eigenray when the
+                // sea has one) or the surface-reflected one, from the source's image
+                let (d, excess_m) = match arrival {
+                    Arrival::Multipath { excess_m } => {
+                        (Vector3::new(p.source.x, p.source.y, -p.source.z) - at, excess_m)
+                    }
+                    _ => (d, 0.0),
+                };
+                let travelled = match (&self.profile, arrival) {
+                    (Some(c), Arrival::Direct) => sig.sound_speed_m_s * c.travel_time(d.xy().norm(), p.source.z, at.z),
+                    _ => d.norm(),
+                };
+                let late_m = sig.sound_speed_m_s * clock_s + excess_m;
+                let truth = att.transpose() * d / d.norm();
                 let (az, incl) = azimuth_inclination(&truth);
                 let sa = sig.angle_sigma_deg.to_radians();
-                let (range_m, azimuth_rad, inclination_rad) = if rng.random_bool(sig.outlier_probability) {
+                let (range_m, azimuth_rad, inclination_rad) = if let Arrival::False { u } = arrival {
+                    let z: f64 = rng.random_range(-1.0..=1.0);
+                    (u * self.s.sea.link.false_max_range_m, rng.random_range(0.0..std::f64::consts::TAU), z.acos())
+                } else if rng.random_bool(sig.outlier_probability) {
                     let z: f64 = rng.random_range(-1.0..=1.0);
                     (
                         r + rng.random_range(0.0..=sig.outlier_max_m),
@@ -168,7 +205,7 @@ impl FleetWorld {
                     )
                 } else {
                     (
-                        r + gauss(rng, sig.range_sigma_m),
+                        travelled + late_m + gauss(rng, sig.range_sigma_m),
                         az + gauss(rng, sa),
                         (incl + gauss(rng, sa)).clamp(0.0, std::f64::consts::PI),
                     )
@@ -250,6 +287,7 @@ impl World for FleetWorld {
         let due: Vec<Sent> = self.sent.iter().copied().filter(|p| p.t_tx + WINDOW_S <= t1).collect();
         self.sent.retain(|p| p.t_tx + WINDOW_S > t1);
         for p in &due {
+            let tx_clock_s = self.beacon_clocks[p.from as usize].error_s(p.t_tx);
             let gps = match p.from {
                 Transmitter::Boat => {
                     let s = self.s.dock.gps_sigma_m;
@@ -258,7 +296,7 @@ impl World for FleetWorld {
                 Transmitter::Dock => p.source,
             };
             for (v, h) in heard.iter_mut().enumerate() {
-                if let Some(m) = self.hear(v, p, gps) {
+                if let Some(m) = self.hear(v, p, gps, tx_clock_s) {
                     h.push(m);
                 }
             }

@@ -6,12 +6,21 @@
 //! it at `mission.dt_s`. Each vehicle is kinematic (an AUV on its circle in closed form,
 //! a unicycle ASV) or dynamic (REMUS 100 following its circle by ILOS, the Otter its
 //! legs, both under their autopilots by RK4 at 0.05 s or finer, in the water's current).
-//! Messages travel instantly (at 40 m the 27 ms of flight move the ASV 6 cm).
+//! Messages travel instantly (at 40 m the 27 ms of flight move the ASV 6 cm). In a
+//! `[sea]`, a message may be lost or arrive on the surface-reflected path or be a false
+//! detection (`[sea.link]`), the USBL head is misaligned, rolled and pitched by the waves
+//! and levelled by an attitude sensor, occluded astern and noisier by a floor
+//! (`[sea.usbl]`), and a sound-speed profile bends the direct ray's elevation
+//! (`[sea.sound_speed]`).
 
+use crate::acoustics::link::{Arrival, Link};
+use crate::acoustics::profile::Profile;
+use crate::acoustics::usbl_head::UsblHead;
 use crate::engine::{PilotRecord, VehicleTruth, World};
 use crate::scenario::PassiveUsbl;
 use crate::scenario::passive_usbl::{AsvVehicle, Auv, AuvVehicle, Current};
 use crate::seed::{Stream, gauss, vehicle_rng};
+use crate::sensor_errors::DriftingSensors;
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::autopilot::{Command, MAX_STEP_S, Piloted, step_over};
 use crate::vehicles::ilos::{self, CircleFollower, Ilos};
@@ -33,13 +42,16 @@ struct Circle {
     sense: f64,
 }
 
-/// One AUV: its circle, how it moves, and the random streams of its reports and
-/// bearings.
+/// One AUV: its circle, how it moves, the random streams of its reports and bearings,
+/// and the link its messages reach the ASV over.
 struct AuvTruth {
     circle: Circle,
     motion: AuvMotion,
     report_rng: Pcg64Mcg,
     usbl_rng: Pcg64Mcg,
+    link: Link,
+    /// Its INS's drifting errors (`[sea.sensors]`).
+    sensors: DriftingSensors,
 }
 
 /// How an AUV moves: on its circle in closed form, or REMUS 100's dynamics following it
@@ -50,7 +62,7 @@ enum AuvMotion {
 }
 
 impl AuvTruth {
-    fn new(spec: Auv, report_rng: Pcg64Mcg, usbl_rng: Pcg64Mcg) -> Self {
+    fn new(spec: Auv, report_rng: Pcg64Mcg, usbl_rng: Pcg64Mcg, link: Link, sensors: DriftingSensors) -> Self {
         let circle = Circle::new(spec);
         let motion = match circle.spec.vehicle {
             AuvVehicle::Kinematic => AuvMotion::Circle,
@@ -80,7 +92,7 @@ impl AuvTruth {
                 AuvMotion::Remus { pilot: Box::new(pilot), follower, command, distance_m: 0.0 }
             }
         };
-        Self { circle, motion, report_rng, usbl_rng }
+        Self { circle, motion, report_rng, usbl_rng, link, sensors }
     }
 
     /// Moves a dynamic AUV over `dt` s in `current_ned`, ILOS and the autopilots in steps
@@ -222,6 +234,10 @@ pub(crate) struct PassiveUsblWorld<'a> {
     asv_speed: f64,
     /// GPS and compass errors of the ASV.
     station_rng: Pcg64Mcg,
+    /// The USBL head (its misalignment, waves and attitude sensor) and the sea's
+    /// sound-speed profile, when there is one.
+    head: UsblHead,
+    profile: Option<Profile>,
     k: usize,
 }
 
@@ -232,7 +248,13 @@ impl<'a> PassiveUsblWorld<'a> {
             .into_iter()
             .enumerate()
             .map(|(v, spec)| {
-                AuvTruth::new(spec, vehicle_rng(seed, run, v, Stream::Imu), vehicle_rng(seed, run, v, Stream::Acoustic))
+                AuvTruth::new(
+                    spec,
+                    vehicle_rng(seed, run, v, Stream::Imu),
+                    vehicle_rng(seed, run, v, Stream::Acoustic),
+                    Link::new(&s.sea.link, vehicle_rng(seed, run, v, Stream::Link)),
+                    DriftingSensors::new(&s.sea.sensors, vehicle_rng(seed, run, v, Stream::Sensors)),
+                )
             })
             .collect();
         let start = auvs[0].circle.position(0.0).xy();
@@ -254,6 +276,8 @@ impl<'a> PassiveUsblWorld<'a> {
             water: Water::new(s.current.clone(), vehicle_rng(seed, run, 0, Stream::Current)),
             asv_speed: 0.0,
             station_rng: vehicle_rng(seed, run, 0, Stream::Heading),
+            head: UsblHead::new(&s.sea.usbl, vehicle_rng(seed, run, 0, Stream::Waves)),
+            profile: s.sea.sound_speed.as_ref().map(|p| p.profile()),
             k: 0,
         }
     }
@@ -377,7 +401,10 @@ impl World for PassiveUsblWorld<'_> {
         // each AUV's message at t1: its report, and its bearing on the USBL
         let s = self.s;
         let station = self.beacon_ned_m();
-        let usbl = Usbl::exact(station, self.asv.psi, s.usbl.noise_deg_per_m.to_radians());
+        let usbl = Usbl {
+            floor_rad: s.sea.usbl.angle_floor_deg.to_radians(),
+            ..Usbl::exact(station, self.asv.psi, s.usbl.noise_deg_per_m.to_radians())
+        };
         let gps = station
             + Vector3::new(
                 gauss(&mut self.station_rng, s.asv.gps_noise_m),
@@ -386,20 +413,47 @@ impl World for PassiveUsblWorld<'_> {
             );
         let compass = wrap_angle(self.asv.psi + gauss(&mut self.station_rng, s.asv.compass_noise_deg.to_radians()));
         let r = &s.reports;
+        let bends = s.sea.usbl.bends() || self.profile.is_some();
         for (auv, out) in self.auvs.iter_mut().zip(heard.iter_mut()) {
             let x = auv.state(t1);
             let rng = &mut auv.report_rng;
-            out.push(Measurement::new(
+            let heading = auv.sensors.heading(t1, x[idx::PSI]) + gauss(rng, r.heading_noise_deg.to_radians());
+            let speed = auv.sensors.speed(t1, x[idx::U] + gauss(rng, r.speed_noise_m_s));
+            let report = Measurement::new(
                 t1,
                 Kind::Report {
-                    heading_rad: wrap_angle(x[idx::PSI] + gauss(rng, r.heading_noise_deg.to_radians())),
-                    speed_m_s: x[idx::U] + gauss(rng, r.speed_noise_m_s),
+                    heading_rad: wrap_angle(heading),
+                    speed_m_s: speed,
                     depth_m: x[idx::Z] + gauss(rng, r.depth_noise_m),
                 },
-            ));
-            // the angles drawn from the USBL model (eq. 1-3) at the true station pose
-            let azimuth = usbl.model(UsblAngle::Azimuth).sample(&x, &mut auv.usbl_rng);
-            let elevation = usbl.model(UsblAngle::Elevation).sample(&x, &mut auv.usbl_rng);
+            );
+            // the angles the head reports before their noise: eq. 1-2 at the true
+            // station pose, or along the path the message arrived on
+            let p = x.fixed_rows::<3>(0).into_owned();
+            let clean = match auv.link.arrive() {
+                Arrival::Lost => continue,
+                Arrival::False { u } => Some(self.head.false_angles(u)),
+                Arrival::Direct if !bends => Some(usbl.angles(&p)).map(|(a, e, _)| (a, e)),
+                Arrival::Direct => {
+                    let d = p - station;
+                    let h = d.xy().norm();
+                    // a profile bends the direct ray in its vertical plane
+                    let e = self.profile.as_ref().map_or(h.atan2(d.z), |c| c.eigenray(h, p.z, station.z).arrival_rad);
+                    let toward = Vector3::new(e.sin() * d.x / h.max(1e-12), e.sin() * d.y / h.max(1e-12), e.cos());
+                    self.head.measure(&toward, self.asv.psi, t1)
+                }
+                // reflected off the surface: from the AUV's image above it
+                Arrival::Multipath { .. } => {
+                    self.head.measure(&(Vector3::new(p.x, p.y, -p.z) - station), self.asv.psi, t1)
+                }
+            };
+            // occluded: the message is not heard
+            let Some((a0, e0)) = clean else { continue };
+            out.push(report);
+            // eq. 3's noise (with the floor) at the true range
+            let (var_a, var_e) = usbl.variances(&p);
+            let azimuth = a0 + gauss(&mut auv.usbl_rng, var_a.sqrt());
+            let elevation = e0 + gauss(&mut auv.usbl_rng, var_e.sqrt());
             out.push(Measurement::new(
                 t1,
                 Kind::Bearing {
@@ -434,6 +488,8 @@ pub(crate) fn bearing_information(noise: TrackerNoise) -> impl FnMut(&Kind, &Veh
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::acoustics::link::LinkErrors;
+    use crate::acoustics::usbl_head::UsblErrors;
     use crate::scenario::{Scenario, builtin, parse};
 
     /// `asv.vehicle = "otter"`: the Otter's dynamics under its autopilots follow the same
@@ -587,5 +643,46 @@ mod tests {
         w.asv = AsvState { pos: Vector2::new(0.0, 10.0), psi: 0.0 };
         let (along, cross) = follow_legs(&mut w, step, 8);
         assert!(cross.abs() < 0.3 && along.abs() < 1.5, "along {along}, cross {cross}");
+    }
+
+    /// The world's `[sea]` as heard, over 3000 messages of the kinematic AUV to a static
+    /// ASV: a fifth lost (binomial standard error, 5 of them), a tenth of the rest on the
+    /// surface-reflected path (arriving from above: elevation beyond 90 deg), and the
+    /// direct ones turned by the head's yaw misalignment: the mean azimuth error is minus
+    /// it (to 5 standard errors of the 1 deg floor's noise). Planted: a misalignment
+    /// added instead of subtracted, or the loss ignored, fails it.
+    #[test]
+    fn the_sea_loses_reflects_and_turns_bearings() {
+        let mut s = builtin_scenario("hoff2024-kinematic");
+        s.sea.link = LinkErrors { loss_prob: 0.2, multipath_prob: 0.1, ..LinkErrors::default() };
+        s.sea.usbl = UsblErrors { misalignment_deg: [0.0, 0.0, 3.0], angle_floor_deg: 1.0, ..UsblErrors::default() };
+        s.usbl.noise_deg_per_m = 1e-6;
+        let mut w = PassiveUsblWorld::new(&s, 1, 0);
+        let n = 3000;
+        let (mut heard, mut reflected, mut errors) = (0usize, 0usize, Vec::new());
+        for k in 1..=n {
+            let mut out = vec![Vec::new()];
+            w.advance(k, &[None], &mut out);
+            let truth = w.auvs[0].state(w.t_s(k));
+            for m in &out[0] {
+                if let Kind::Bearing { azimuth_rad, elevation_rad, .. } = m.kind {
+                    heard += 1;
+                    if elevation_rad > FRAC_PI_2 {
+                        reflected += 1;
+                    } else {
+                        let station = w.beacon_ned_m();
+                        let (alpha, ..) = Usbl::exact(station, w.asv.psi, 0.0).angles(&truth.fixed_rows::<3>(0).into());
+                        errors.push(wrap_angle(azimuth_rad - alpha));
+                    }
+                }
+            }
+        }
+        let share =
+            |k: usize, m: usize, p: f64| (k as f64 / m as f64 - p).abs() < 5.0 * (p * (1.0 - p) / m as f64).sqrt();
+        assert!(share(heard, n, 0.8), "heard {heard} of {n}");
+        assert!(share(reflected, heard, 0.1), "reflected {reflected} of {heard}");
+        let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+        let se = 1f64.to_radians() / (errors.len() as f64).sqrt();
+        assert!((mean + 3f64.to_radians()).abs() < 5.0 * se, "mean azimuth error {} deg", mean.to_degrees());
     }
 }

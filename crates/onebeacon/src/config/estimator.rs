@@ -207,6 +207,9 @@ pub struct EstimatorSpec {
     pub heading_sigma_deg: Option<f64>,
     /// USBL bearings: sigma_USBL, deg per metre of range (passive_usbl).
     pub usbl_sigma_deg_per_m: Option<f64>,
+    /// USBL bearings: the angles' noise floor besides sigma_USBL's range-proportional
+    /// term, deg (passive_usbl; default 0, the paper's).
+    pub usbl_floor_deg: Option<f64>,
     /// Read hoff2024's eq. 6 as printed: sigma_USBL r (eq. 3) as the angles' variance
     /// instead of their standard deviation (passive_usbl; default false).
     pub usbl_as_printed: Option<bool>,
@@ -325,6 +328,7 @@ impl EstimatorSpec {
             doppler_sigma_m_s: None,
             heading_sigma_deg: None,
             usbl_sigma_deg_per_m: None,
+            usbl_floor_deg: None,
             usbl_as_printed: None,
             compass_sigma_deg: None,
             depth_sigma_m: None,
@@ -465,6 +469,7 @@ impl EstimatorSpec {
             },
             noise: TrackerNoise {
                 usbl_sigma_rad_per_m: self.usbl_sigma_deg_per_m.map_or(n.usbl_sigma_rad_per_m, f64::to_radians),
+                usbl_floor_rad: self.usbl_floor_deg.map_or(n.usbl_floor_rad, f64::to_radians),
                 station_heading_sigma_rad: self.compass_sigma_deg.map_or(n.station_heading_sigma_rad, f64::to_radians),
                 heading_sigma_rad: self.heading_sigma_deg.map_or(n.heading_sigma_rad, f64::to_radians),
                 speed_sigma_m_s: self.speed_sigma_m_s.unwrap_or(n.speed_sigma_m_s),
@@ -473,6 +478,7 @@ impl EstimatorSpec {
             },
             aiding: self.aiding(Host::PassiveUsbl),
             nis_gate: self.nis_gate.unwrap_or(d.nis_gate),
+            robust: self.range_gate().1,
         }
     }
 

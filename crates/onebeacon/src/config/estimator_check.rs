@@ -21,6 +21,7 @@ impl EstimatorSpec {
             ("doppler_sigma_m_s", self.doppler_sigma_m_s, Positive, FIXED_LOG),
             ("heading_sigma_deg", self.heading_sigma_deg, Positive, &[FixedBeacon, PassiveUsbl, Log]),
             ("usbl_sigma_deg_per_m", self.usbl_sigma_deg_per_m, Positive, USBL),
+            ("usbl_floor_deg", self.usbl_floor_deg, NonNegative, USBL),
             ("usbl_as_printed", flag(self.usbl_as_printed), Finite, USBL),
             ("compass_sigma_deg", self.compass_sigma_deg, NonNegative, USBL),
             ("depth_sigma_m", self.depth_sigma_m, Positive, USBL),
@@ -40,8 +41,8 @@ impl EstimatorSpec {
             ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
             ("nis_gate", self.nis_gate, Positive, &[FixedBeacon, MovingBeacon, PassiveUsbl, Log]),
-            ("huber_k", self.huber_k, Positive, RANGING),
-            ("student_t_dof", self.student_t_dof, Positive, RANGING),
+            ("huber_k", self.huber_k, Positive, &[FixedBeacon, MovingBeacon, PassiveUsbl, Log]),
+            ("student_t_dof", self.student_t_dof, Positive, &[FixedBeacon, MovingBeacon, PassiveUsbl, Log]),
             ("mirror_recovery", flag(self.mirror_recovery), Finite, &[FixedBeacon]),
             ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
             ("estimate_bias", flag(self.estimate_bias), Finite, CALIBRATING),
@@ -101,16 +102,6 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
                 key: key("estimate_beacon_offsets"),
                 value: "true".into(),
                 allowed: "replaces the shared offset of estimate_bias (give one of the two), and does not apply to the tracker (track_accel_sigma_m_s2)".into(),
-            });
-        }
-        if e.robust.is_some() && host == Host::PassiveUsbl {
-            return Err(Violation {
-                key: key("robust"),
-                value: format!("{:?}", e.robust),
-                allowed: format!(
-                    "does not apply to a {} (it applies to: fixed_beacon world, moving_beacon world, log)",
-                    host.label()
-                ),
             });
         }
         if e.iusbl.is_some() && !e.kind.iusbl() {
@@ -242,8 +233,8 @@ mod tests {
         assert_eq!(e.sensor_noise(sensors).velocity_m_s, 0.1);
 
         assert_eq!(
-            error("kind = \"pf\"\nhuber_k = 3.0", Host::PassiveUsbl),
-            "estimators[0].huber_k = 3.0: does not apply to a passive_usbl world (it applies to: fixed_beacon world, moving_beacon world, log)"
+            error("kind = \"pf\"\nrange_sigma_m = 3.0", Host::PassiveUsbl),
+            "estimators[0].range_sigma_m = 3.0: does not apply to a passive_usbl world (it applies to: fixed_beacon world, moving_beacon world, log)"
         );
         assert_eq!(
             error("kind = \"range+doppler\"", Host::MovingBeacon),

@@ -7,6 +7,7 @@ use crate::filter::lanes;
 use crate::filter::particle::ParticleLikelihood;
 use crate::geo::{wrap_angle, wrap_near};
 use crate::models::hoff::{BLOCK, DIM, idx};
+use crate::nav::Robust;
 
 /// The AUV's INS report (eq. 8): heading, speed and depth with the filter's assumed
 /// standard deviations.
@@ -42,12 +43,16 @@ impl ParticleLikelihood for InsReport {
 
 /// A USBL bearing (azimuth, elevation) measured by the surface vehicle (eq. 6-7). The
 /// noise grows with each particle's range (eq. 3), so the normalising term ln sigma^2
-/// differs between particles and is kept.
+/// differs between particles and is kept. With `robust`, each angle's Gaussian
+/// exponent is replaced by a heavy-tailed one ([`Robust::log_density`]), so that an
+/// outlier (a reflected path, a false detection) does not wipe out the particles near
+/// the truth.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UsblBearing {
     pub usbl: Usbl,
     pub azimuth_rad: f64,
     pub elevation_rad: f64,
+    pub robust: Option<Robust>,
 }
 
 impl ParticleLikelihood for UsblBearing {
@@ -89,9 +94,20 @@ impl ParticleLikelihood for UsblBearing {
             lanes::atan2(&cross_a[..m], &dot_a[..m], &mut da[..m]);
             lanes::atan2(&cross_e[..m], &dot_e[..m], &mut de[..m]);
             lanes::ln(&prod[..m], &mut ln_prod[..m]);
-            for (j, lw) in log_w[start..start + m].iter_mut().enumerate() {
-                // eq. 6, the two angles
-                *lw += -da[j] * da[j] / (2.0 * var_a[j]) - de[j] * de[j] / (2.0 * var_e[j]) - 0.5 * ln_prod[j];
+            let block = log_w[start..start + m].iter_mut().enumerate();
+            match self.robust {
+                None => {
+                    for (j, lw) in block {
+                        // eq. 6, the two angles
+                        *lw += -da[j] * da[j] / (2.0 * var_a[j]) - de[j] * de[j] / (2.0 * var_e[j]) - 0.5 * ln_prod[j];
+                    }
+                }
+                Some(r) => {
+                    for (j, lw) in block {
+                        let (d2a, d2e) = (da[j] * da[j] / var_a[j], de[j] * de[j] / var_e[j]);
+                        *lw += r.log_density(d2a) + r.log_density(d2e) - 0.5 * ln_prod[j];
+                    }
+                }
             }
         }
     }

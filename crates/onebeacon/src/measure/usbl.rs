@@ -10,8 +10,10 @@ use std::f64::consts::PI;
 /// The USBL on the surface vehicle: its NED position and heading when the message
 /// arrives, the baseline noise sigma_USBL in rad per metre of range (the paper's deg/m,
 /// converted), and how well the station knows its own position (GPS, m per horizontal
-/// axis) and heading (compass, rad): the paper takes both as exact (zero). `as_printed`
-/// reads eq. 6 as the paper prints it (see [`Usbl::base_variance`]).
+/// axis) and heading (compass, rad): the paper takes both as exact (zero). `floor_rad` is
+/// an angle noise floor (standard deviation) besides eq. 3's range-proportional term, as
+/// USBL datasheets state their accuracy (zero in the paper). `as_printed` reads eq. 6 as
+/// the paper prints it (see [`Usbl::base_variance`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Usbl {
     pub position_ned_m: Vector3<f64>,
@@ -19,6 +21,7 @@ pub struct Usbl {
     pub sigma_rad_per_m: f64,
     pub position_sigma_m: f64,
     pub heading_sigma_rad: f64,
+    pub floor_rad: f64,
     pub as_printed: bool,
 }
 
@@ -54,18 +57,21 @@ impl Usbl {
             sigma_rad_per_m,
             position_sigma_m: 0.0,
             heading_sigma_rad: 0.0,
+            floor_rad: 0.0,
             as_printed: false,
         }
     }
 
     /// The variance of each angle from eq. 3 at squared range `r2`: (sigma_USBL r)^2; as
     /// printed, eq. 6's covariance diag(sigma_alpha, sigma_phi) puts eq. 3's sigma where a
-    /// variance belongs: sigma_USBL r itself (rad taken as rad^2).
+    /// variance belongs: sigma_USBL r itself (rad taken as rad^2). The floor's variance
+    /// adds to either (independent errors).
     pub fn base_variance(&self, r2: f64) -> f64 {
+        let floor = self.floor_rad * self.floor_rad;
         if self.as_printed {
-            self.sigma_rad_per_m * r2.sqrt() // eq. 6 as printed
+            floor + self.sigma_rad_per_m * r2.sqrt() // eq. 6 as printed
         } else {
-            self.sigma_rad_per_m * self.sigma_rad_per_m * r2 // eq. 3, squared
+            floor + self.sigma_rad_per_m * self.sigma_rad_per_m * r2 // eq. 3, squared
         }
     }
 
@@ -183,6 +189,16 @@ mod tests {
         assert_abs_diff_eq!(var_az.sqrt().to_degrees(), 6.642, epsilon = 1e-3);
         let squared = Usbl { as_printed: false, ..literal };
         assert_abs_diff_eq!(squared.variances(&p).0.sqrt().to_degrees(), 0.77, epsilon = 1e-12);
+    }
+
+    /// A floor adds its variance to eq. 3's: 0.5 deg and 0.01 deg/m at 30 m give
+    /// sqrt(0.5^2 + 0.3^2) = 0.5831 deg on each angle.
+    #[test]
+    fn the_floor_adds_in_quadrature() {
+        let u = Usbl { floor_rad: 0.5f64.to_radians(), ..Usbl::exact(Vector3::zeros(), 0.0, 0.01f64.to_radians()) };
+        let (var_az, var_el) = u.variances(&Vector3::new(0.0, 18.0, 24.0));
+        assert_abs_diff_eq!(var_az.sqrt().to_degrees(), 0.583_095, epsilon = 1e-6);
+        assert_abs_diff_eq!(var_el.sqrt().to_degrees(), 0.583_095, epsilon = 1e-6);
     }
 
     /// The station's pose errors in the variances against the spread of the angles

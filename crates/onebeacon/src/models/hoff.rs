@@ -263,9 +263,10 @@ mod tests {
                 sigma_rad_per_m: 0.01f64.to_radians(),
                 position_sigma_m: gps,
                 heading_sigma_rad: compass,
+                floor_rad: 0.0,
                 as_printed,
             };
-            let bearing = UsblBearing { usbl, azimuth_rad: 0.2, elevation_rad: 0.9 };
+            let bearing = UsblBearing { usbl, azimuth_rad: 0.2, elevation_rad: 0.9, robust: None };
             let mut got = vec![0.0; n];
             bearing.add_log_likelihood(&view, &mut got);
             for (i, p) in pts.iter().enumerate() {
@@ -281,6 +282,35 @@ mod tests {
                     got[i]
                 );
             }
+        }
+    }
+
+    /// A heavy-tailed bearing weighs outliers by hand-computed densities: two particles
+    /// 10 and 20 standard deviations off in azimuth (a 1 deg floor, no range term) differ
+    /// in log-weight by 150 with eq. 6, by k (20 - 10) = 13.45 with Huber's k = 1.345, and
+    /// by (4 + 1) / 2 ln((1 + 400 / 4) / (1 + 100 / 4)) = 3.3925 with Student's t at 4
+    /// degrees of freedom (1e-3: the lanes' single-precision atan2).
+    #[test]
+    fn robust_bearings_weigh_outliers_by_their_tails() {
+        use crate::nav::Robust;
+        use nalgebra::Vector3;
+        let usbl = Usbl { floor_rad: 1f64.to_radians(), ..Usbl::exact(Vector3::zeros(), 0.0, 0.0) };
+        let at = |az_deg: f64| {
+            let (a, e) = (az_deg.to_radians(), 0.9f64);
+            [50.0 * e.sin() * a.cos(), 50.0 * e.sin() * a.sin(), 50.0 * e.cos()]
+        };
+        let pts = [at(10.0), at(20.0)];
+        let comps: Vec<Vec<f64>> =
+            (0..DIM).map(|k| pts.iter().map(|p| if k < 3 { p[k] } else { 0.0 }).collect()).collect();
+        let view: Vec<&[f64]> = comps.iter().map(|c| &c[..]).collect();
+        for (robust, expected) in [
+            (None, 150.0),
+            (Some(Robust::Huber { k: 1.345 }), 13.45),
+            (Some(Robust::StudentT { dof: 4.0 }), 2.5 * (101.0f64 / 26.0).ln()),
+        ] {
+            let mut w = vec![0.0; 2];
+            UsblBearing { usbl, azimuth_rad: 0.0, elevation_rad: 0.9, robust }.add_log_likelihood(&view, &mut w);
+            assert!(((w[0] - w[1]) / expected - 1.0).abs() < 1e-3, "{robust:?}: {} against {expected}", w[0] - w[1]);
         }
     }
 

@@ -58,6 +58,24 @@ impl Robust {
         };
         1.0 / w.min(1.0)
     }
+
+    /// The log-density, up to a constant, of a scalar residual whose square over its
+    /// nominal variance is `d2`, as a particle filter weighs it: Huber's (Gaussian within
+    /// k standard deviations, Laplace beyond: -d^2 / 2, then -(k d - k^2 / 2)) or
+    /// Student's t (-(dof + 1) / 2 ln(1 + d^2 / dof)); the normalising -ln sigma is the
+    /// caller's.
+    pub fn log_density(self, d2: f64) -> f64 {
+        match self {
+            Robust::Huber { k } => {
+                if d2 <= k * k {
+                    -0.5 * d2
+                } else {
+                    -(k * d2.sqrt() - 0.5 * k * k)
+                }
+            }
+            Robust::StudentT { dof } => -0.5 * (dof + 1.0) * (d2 / dof).ln_1p(),
+        }
+    }
 }
 
 /// One update of `filter` with the stacked `models` and their values `z`, gated at
@@ -203,6 +221,10 @@ pub trait Navigator: Send {
     fn process(&mut self, m: &Measurement) -> Outcome;
     /// The current estimate.
     fn estimate(&self) -> Estimate;
+    /// Moves the estimate on to `t_s` without a measurement: a step no message reached
+    /// a navigator that moves only on messages (the trackers). Navigators kept current by
+    /// their dead-reckoning inputs do nothing.
+    fn predict_to(&mut self, _t_s: f64) {}
     /// Up to `m` equally weighted samples of the position belief (NED), for a planner
     /// that scores a belief by its spread: a particle filter's particles, drawn in
     /// proportion to their weights; None for a Gaussian belief.

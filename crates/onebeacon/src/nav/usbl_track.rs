@@ -5,7 +5,7 @@
 //! or a UKF ([`GaussianTracker`]), both behind [`Navigator`], so that they run on the
 //! same measurements.
 
-use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, gated_update};
+use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, Robust, gated_update};
 use crate::filter::particle::{ParticleFilter, ParticleSettings};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::measure::hoff::{InsReport, UsblBearing};
@@ -22,6 +22,8 @@ pub type TrackState = SVector<f64, DIM>;
 pub struct TrackerNoise {
     /// sigma_USBL, rad per metre of range (eq. 3).
     pub usbl_sigma_rad_per_m: f64,
+    /// The angles' noise floor besides it, rad (zero in the paper).
+    pub usbl_floor_rad: f64,
     /// The station's compass error, rad (its GPS error comes with each bearing).
     pub station_heading_sigma_rad: f64,
     /// The vehicle's reported heading, speed and depth (eq. 8).
@@ -40,6 +42,7 @@ impl Default for TrackerNoise {
     fn default() -> Self {
         Self {
             usbl_sigma_rad_per_m: 0.022f64.to_radians(),
+            usbl_floor_rad: 0.0,
             station_heading_sigma_rad: 0.0,
             heading_sigma_rad: 0.15f64.sqrt(),
             speed_sigma_m_s: 0.06f64.sqrt(),
@@ -58,6 +61,9 @@ pub struct TrackerConfig {
     pub aiding: Aiding,
     /// Bearings whose NIS exceeds this are rejected (Gaussian trackers; infinite: none).
     pub nis_gate: f64,
+    /// A heavy-tailed bearing update: the Gaussian trackers inflate the noise of a far
+    /// bearing, the particle filter weighs it by a heavy-tailed density.
+    pub robust: Option<Robust>,
 }
 
 impl Default for TrackerConfig {
@@ -67,6 +73,7 @@ impl Default for TrackerConfig {
             noise: TrackerNoise::default(),
             aiding: Aiding::BEARING,
             nis_gate: f64::INFINITY,
+            robust: None,
         }
     }
 }
@@ -81,6 +88,7 @@ impl TrackerNoise {
             sigma_rad_per_m: self.usbl_sigma_rad_per_m,
             position_sigma_m: station.sigma_m,
             heading_sigma_rad: self.station_heading_sigma_rad,
+            floor_rad: self.usbl_floor_rad,
             as_printed: self.usbl_as_printed,
         }
     }
@@ -165,13 +173,20 @@ impl Navigator for ParticleTracker {
             {
                 self.advance_to(m.t_s);
                 let usbl = self.config.noise.usbl(&station, station_heading_rad);
-                self.pf.reweight(&UsblBearing { usbl, azimuth_rad, elevation_rad })
+                self.pf.reweight(&UsblBearing { usbl, azimuth_rad, elevation_rad, robust: self.config.robust })
             }
             _ => return Outcome::Skipped,
         };
         self.cache = OnceCell::new();
         // a particle filter has no innovation covariance: no NIS
         if ok { Outcome::Accepted(f64::NAN, f64::NAN) } else { Outcome::Rejected(f64::NAN, f64::NAN) }
+    }
+
+    fn predict_to(&mut self, t_s: f64) {
+        if t_s > self.t_s {
+            self.advance_to(t_s);
+            self.cache = OnceCell::new();
+        }
     }
 
     fn estimate(&self) -> Estimate {
@@ -234,10 +249,14 @@ impl Navigator for GaussianTracker {
                 let usbl = self.config.noise.usbl(&station, station_heading_rad);
                 let models = [usbl.model(UsblAngle::Azimuth), usbl.model(UsblAngle::Elevation)]; // eq. 1-3
                 let z = Vector2::new(azimuth_rad, elevation_rad);
-                gated_update(&mut self.filter, &models, z, self.config.nis_gate, None)
+                gated_update(&mut self.filter, &models, z, self.config.nis_gate, self.config.robust)
             }
             _ => Outcome::Skipped,
         }
+    }
+
+    fn predict_to(&mut self, t_s: f64) {
+        self.advance_to(t_s);
     }
 
     fn estimate(&self) -> Estimate {
@@ -252,6 +271,7 @@ mod tests {
     use crate::measure::ScalarModel;
     use crate::nav::BeaconFix;
     use rand::SeedableRng;
+    use std::f64::consts::FRAC_PI_2;
 
     /// A vehicle at rest 30 m down, heard from stations on a ring around it: the
     /// particle filter and the EKF both find it from a start 8 m off, within a few
@@ -300,5 +320,33 @@ mod tests {
         assert!((a - b).norm() < 1.0, "{a:?} against {b:?}");
         assert_eq!(pf.position_sample(100).map(|v| v.len()), Some(100));
         assert!(ekf.position_sample(100).is_none());
+    }
+
+    /// With no message for 12 s, both trackers move their estimate on along the believed
+    /// course: a vehicle believed at 1.5 m/s heading east (0.2 m/s spread) is 18 m east
+    /// of where it was, within 3 standard deviations of the particles' mean (0.2 x 12 /
+    /// sqrt(2e4)) for the particle filter, to 1e-9 for the EKF's mean step; its time
+    /// moves on too, and a time already reached changes nothing.
+    #[test]
+    fn trackers_predict_to_a_step_no_message_reached() {
+        let start = TrackState::from([0.0, 0.0, 30.0, 0.0, FRAC_PI_2, 1.5, 0.0, 0.0]);
+        let sigma = TrackState::from([0.1, 0.1, 0.1, 1e-4, 1e-4, 0.2, 1e-6, 1e-6]);
+        let config = TrackerConfig::default();
+        let mut pf = ParticleTracker::new(config, ParticleSettings::default(), 20_000, 0.0, &start, &sigma, 5);
+        let mut ekf = GaussianTracker::new(config, FilterKind::Ekf, 0.0, &start, &sigma);
+        for (nav, tol) in
+            [(&mut pf as &mut dyn Navigator, 3.0 * 0.2 * 12.0 / 20_000f64.sqrt() + 0.05), (&mut ekf, 1e-9)]
+        {
+            nav.predict_to(12.0);
+            let e = nav.estimate();
+            assert!(
+                (e.position_ned_m.y - 18.0).abs() < tol && e.position_ned_m.x.abs() < tol,
+                "{:?}",
+                e.position_ned_m
+            );
+            assert_eq!(e.t_s, 12.0);
+            nav.predict_to(12.0);
+            assert_eq!(nav.estimate().position_ned_m, e.position_ned_m);
+        }
     }
 }

@@ -1,0 +1,176 @@
+//! A vehicle's navigation sensors as they drift (`[sea.sensors]`): a heading bias that
+//! wanders as a first-order Gauss-Markov process, a speed scale factor (a DVL's or a
+//! speed log's calibration, drawn once a run) and dropouts of the speed sensor (bottom
+//! lock lost), during which the vehicle keeps the last speed it measured.
+
+use crate::seed::gauss;
+use rand::RngExt;
+use rand_pcg::Pcg64Mcg;
+use serde::{Deserialize, Serialize};
+
+/// `[sea.sensors]` (all zero: sensors with white noise only).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SensorErrors {
+    /// The heading bias's stationary standard deviation, deg, and its correlation
+    /// time, s.
+    pub heading_bias_sigma_deg: f64,
+    pub heading_bias_time_constant_s: f64,
+    /// The speed scale factor's standard deviation (0.01: 1 %), drawn once a run.
+    pub speed_scale_sigma: f64,
+    /// The share of time the speed sensor is out, and the mean length of an outage, s.
+    pub speed_dropout_prob: f64,
+    pub speed_dropout_mean_s: f64,
+}
+
+impl Default for SensorErrors {
+    fn default() -> Self {
+        Self {
+            heading_bias_sigma_deg: 0.0,
+            heading_bias_time_constant_s: 600.0,
+            speed_scale_sigma: 0.0,
+            speed_dropout_prob: 0.0,
+            speed_dropout_mean_s: 30.0,
+        }
+    }
+}
+
+/// One vehicle's sensors over a run, sampled at increasing times.
+#[derive(Debug, Clone)]
+pub struct DriftingSensors {
+    errors: SensorErrors,
+    heading_bias_rad: f64,
+    speed_scale: f64,
+    out: bool,
+    held_speed_m_s: Option<f64>,
+    last_t_s: Option<f64>,
+    rng: Pcg64Mcg,
+}
+
+impl DriftingSensors {
+    /// The sensors of `errors`, drawing from `rng` (a stream of their own): the bias
+    /// starts from its stationary distribution, the scale is drawn once.
+    pub fn new(errors: &SensorErrors, mut rng: Pcg64Mcg) -> Self {
+        let heading_bias_rad = gauss(&mut rng, errors.heading_bias_sigma_deg.to_radians());
+        let speed_scale = 1.0 + gauss(&mut rng, errors.speed_scale_sigma);
+        Self { errors: *errors, heading_bias_rad, speed_scale, out: false, held_speed_m_s: None, last_t_s: None, rng }
+    }
+
+    /// Moves the errors on to `t_s`: the bias by its exact discretisation, b <- a b +
+    /// sqrt(1 - a^2) sigma w with a = exp(-dt / tau); the outage state by a two-state
+    /// chain in continuous time (rates 1 / mean out of an outage, p / ((1 - p) mean)
+    /// into one), stepped exactly over dt.
+    fn advance(&mut self, t_s: f64) {
+        let dt = self.last_t_s.map_or(0.0, |t0| (t_s - t0).max(0.0));
+        self.last_t_s = Some(t_s);
+        if dt <= 0.0 {
+            return;
+        }
+        let e = &self.errors;
+        if e.heading_bias_sigma_deg > 0.0 {
+            let a = (-dt / e.heading_bias_time_constant_s).exp();
+            self.heading_bias_rad = a * self.heading_bias_rad
+                + gauss(&mut self.rng, (1.0 - a * a).sqrt() * e.heading_bias_sigma_deg.to_radians());
+        }
+        if e.speed_dropout_prob > 0.0 {
+            let leave = 1.0 / e.speed_dropout_mean_s;
+            let enter = e.speed_dropout_prob * leave / (1.0 - e.speed_dropout_prob);
+            // the probability of being out at t + dt given the state at t
+            let settle = (-(enter + leave) * dt).exp();
+            let stationary = e.speed_dropout_prob;
+            let p_out = if self.out { stationary + (1.0 - stationary) * settle } else { stationary * (1.0 - settle) };
+            self.out = self.rng.random::<f64>() < p_out;
+        }
+    }
+
+    /// The heading the sensor reads at `t_s` for a true `heading_rad` (before its white
+    /// noise).
+    pub fn heading(&mut self, t_s: f64, heading_rad: f64) -> f64 {
+        self.advance(t_s);
+        heading_rad + self.heading_bias_rad
+    }
+
+    /// The speed the sensor reads at `t_s` for a measured `speed_m_s` (the true speed
+    /// with its white noise): scaled, or the last one read while the sensor is out.
+    pub fn speed(&mut self, t_s: f64, speed_m_s: f64) -> f64 {
+        self.advance(t_s);
+        if self.out
+            && let Some(held) = self.held_speed_m_s
+        {
+            return held;
+        }
+        let v = self.speed_scale * speed_m_s;
+        self.held_speed_m_s = Some(v);
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    /// Over 2e5 samples 10 s apart: the bias's standard deviation and its correlation
+    /// at one time constant (exp(-1)) within 5 %; the share of time out and the mean
+    /// outage within 5 % (the chain's samples are correlated: 2e5 samples hold some
+    /// 2e4 outages); the scale's spread over 4000 runs within 5 %.
+    #[test]
+    fn drifts_and_outages_have_their_statistics() {
+        let errors = SensorErrors {
+            heading_bias_sigma_deg: 2.0,
+            heading_bias_time_constant_s: 600.0,
+            speed_scale_sigma: 0.01,
+            speed_dropout_prob: 0.2,
+            speed_dropout_mean_s: 30.0,
+        };
+        let mut s = DriftingSensors::new(&errors, Pcg64Mcg::seed_from_u64(9));
+        let n = 200_000;
+        let (mut bias, mut out) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for k in 0..n {
+            let t = 10.0 * k as f64;
+            bias.push(s.heading(t, 0.0).to_degrees());
+            out.push(s.out);
+        }
+        let var = bias.iter().map(|b| b * b).sum::<f64>() / n as f64;
+        let lag = 60;
+        let cov = bias.windows(lag + 1).map(|w| w[0] * w[lag]).sum::<f64>() / (n - lag) as f64;
+        assert!((var.sqrt() / 2.0 - 1.0).abs() < 0.05, "bias sigma {}", var.sqrt());
+        assert!((cov / var - (-1.0f64).exp()).abs() < 0.05, "correlation {}", cov / var);
+        let share = out.iter().filter(|o| **o).count() as f64 / n as f64;
+        assert!((share / 0.2 - 1.0).abs() < 0.05, "out {share}");
+        let outages = out.windows(2).filter(|w| !w[0] && w[1]).count() as f64;
+        let mean_s = share * n as f64 * 10.0 / outages;
+        // sampled every 10 s, an outage is seen as a run of samples out; the chain stays
+        // out from one sample to the next with p + (1 - p) exp(-(enter + leave) 10 s),
+        // leave = 1 / 30 s and enter + leave = leave / (1 - p): a mean run of 36.7 s
+        let stay = 0.2 + 0.8 * (-10.0 / (30.0 * 0.8f64)).exp();
+        let seen = 10.0 / (1.0 - stay);
+        assert!((mean_s / seen - 1.0).abs() < 0.05, "outage {mean_s} s against {seen}");
+        let scales: Vec<f64> = (0..4000)
+            .map(|k| DriftingSensors::new(&errors, Pcg64Mcg::seed_from_u64(k)).speed(0.0, 1.0) - 1.0)
+            .collect();
+        let sd = (scales.iter().map(|x| x * x).sum::<f64>() / 4000.0).sqrt();
+        assert!((sd / 0.01 - 1.0).abs() < 0.05, "scale sigma {sd}");
+    }
+
+    /// Out, the sensor holds the last speed it read; back, it reads again.
+    #[test]
+    fn an_outage_holds_the_last_speed() {
+        let errors = SensorErrors { speed_dropout_prob: 0.5, speed_dropout_mean_s: 20.0, ..SensorErrors::default() };
+        let mut s = DriftingSensors::new(&errors, Pcg64Mcg::seed_from_u64(1));
+        let mut last = None;
+        let mut held = 0;
+        for k in 0..2000 {
+            let truth = 1.0 + 0.001 * k as f64;
+            let read = s.speed(k as f64, truth);
+            if s.out && last.is_some() {
+                assert_eq!(Some(read), last);
+                held += 1;
+            } else {
+                assert_eq!(read, truth);
+            }
+            last = Some(read);
+        }
+        assert!(held > 500, "{held} held");
+    }
+}
