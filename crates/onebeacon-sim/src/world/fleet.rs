@@ -333,3 +333,55 @@ impl World for FleetWorld {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::acoustics::clock::ClockErrors;
+    use crate::acoustics::link::LinkErrors;
+    use crate::scenario::{Scenario, builtin, parse};
+
+    /// Abstract pings without noise in a sea of offset clocks and a lossy link: every
+    /// range heard reads the true one plus c times the AUV's clock less the beacon's
+    /// (1e-9 m), and 30 % of the pings a clean link hears on the same tracks are lost
+    /// (5 binomial standard errors).
+    #[test]
+    fn clocks_and_the_link_reach_the_abstract_pings() {
+        let text = builtin("rypkema-m1").unwrap().toml.replace("model = \"channel\"", "model = \"abstract\"");
+        let Scenario::Fleet(mut s) = parse(&text, "m1").unwrap() else { unreachable!() };
+        (s.signal.range_sigma_m, s.signal.outlier_probability, s.dock.gps_sigma_m) = (0.0, 0.0, 0.0);
+        s.sea.clocks = ClockErrors { offset_sigma_s: 1e-3, ..ClockErrors::default() };
+        let heard = |link: LinkErrors| {
+            let mut s = s.clone();
+            s.sea.link = link;
+            let mut w = FleetWorld::new(&s, 1, 0);
+            let c = s.signal.sound_speed_m_s;
+            let beacon_s = w.beacon_clocks[0].error_s(0.0);
+            let dive = Some(VehicleCommand::Setpoint {
+                setpoint: Setpoint { heading_rad: 0.0, speed_m_s: 1.0, depth_m: 2.5 },
+                mode: None,
+                phase: Phase::Waiting,
+            });
+            let commands = vec![dive; w.auvs.len()];
+            let mut heard = 0usize;
+            for k in 1..=6000 {
+                let before: Vec<Vector3<f64>> = w.auvs.iter().map(|a| a.truth.position_ned_m).collect();
+                let mut out = vec![Vec::new(); w.auvs.len()];
+                w.advance(k, &commands, &mut out);
+                for (v, ms) in out.iter().enumerate() {
+                    for m in ms {
+                        let Kind::ArrayFix { beacon, range_m, .. } = m.kind else { continue };
+                        heard += 1;
+                        let auv_s = w.auvs[v].clock.error_s(m.t_s);
+                        let r = (beacon.position_ned_m - before[v]).norm();
+                        assert!((range_m - r - c * (auv_s - beacon_s)).abs() < 1e-9, "{v} at {}", m.t_s);
+                    }
+                }
+            }
+            heard
+        };
+        let (all, kept) = (heard(LinkErrors::default()), heard(LinkErrors { loss_prob: 0.3, ..LinkErrors::default() }));
+        let p = kept as f64 / all as f64;
+        assert!(all > 500 && (p - 0.7).abs() < 5.0 * (0.21 / all as f64).sqrt(), "{kept} of {all}");
+    }
+}
