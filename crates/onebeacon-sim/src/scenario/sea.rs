@@ -228,7 +228,12 @@ impl Sea {
                 &[FixedBeacon, MovingBeacon, PassiveUsbl, Fleet][..],
                 "worlds that hear messages (fixed_beacon, moving_beacon, passive_usbl, fleet)",
             ),
-            ("sea.usbl", self.usbl != UsblErrors::default(), &[PassiveUsbl][..], "worlds with a USBL (passive_usbl)"),
+            (
+                "sea.usbl",
+                self.usbl != UsblErrors::default(),
+                &[PassiveUsbl, Fleet][..],
+                "worlds with a USBL (passive_usbl; fleet: misalignment_deg only)",
+            ),
             (
                 "sea.sensors",
                 self.sensors != SensorErrors::default(),
@@ -245,6 +250,16 @@ impl Sea {
         }
         check_link(&self.link)?;
         check_usbl(&self.usbl)?;
+        // an AUV's inverted USBL is under water, levelled by its own AHRS, heard all round
+        if kind == Fleet
+            && self.usbl != (UsblErrors { misalignment_deg: self.usbl.misalignment_deg, ..UsblErrors::default() })
+        {
+            return Err(Violation {
+                key: "sea.usbl".into(),
+                value: "(set)".into(),
+                allowed: "a fleet's inverted USBL takes misalignment_deg only (waves, attitude sensor, floor and occluded sectors are a surface vehicle's head's: passive_usbl)".into(),
+            });
+        }
         check_sensors(&self.sensors)?;
         if let Some(s) = &self.sound_speed {
             s.check()?;

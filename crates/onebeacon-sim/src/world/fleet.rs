@@ -15,7 +15,7 @@ use crate::scenario::fleet::{Fleet, SignalModel, Transmitter};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::autopilot::Command;
 use crate::vehicles::sandshark::{SandShark, SensorErrors};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Rotation3, Vector3};
 use onebeacon::dsp::beamform::{azimuth_inclination, pyramid_8cm};
 use onebeacon::dsp::waveform::{Lfm, rypkema_modes};
 use onebeacon::nav::{BeaconFix, Capture, Kind, Measurement};
@@ -65,6 +65,9 @@ pub(crate) struct FleetWorld {
     /// (`[sea]`).
     beacon_clocks: [Clock; 2],
     profile: Option<Profile>,
+    /// The arrays' mounting misalignment in the AUVs' bodies (`sea.usbl.misalignment_deg`),
+    /// when there is one.
+    mounting: Option<Matrix3<f64>>,
     /// The next transmit epoch.
     next_ping_s: f64,
     k: usize,
@@ -103,6 +106,10 @@ impl FleetWorld {
             gps_rng: crate::seed::rng(seed, run, Stream::BeaconGps),
             beacon_clocks: [0, 1].map(|b| Clock::new(&s.sea.clocks, vehicle_rng(seed, run, b, Stream::BeaconClock))),
             profile: s.sea.sound_speed.as_ref().map(|p| p.profile()),
+            mounting: s.sea.usbl.misalignment_deg.iter().any(|a| *a != 0.0).then(|| {
+                let [r, p, y] = s.sea.usbl.misalignment_deg.map(f64::to_radians);
+                Rotation3::from_euler_angles(r, p, y).into_inner()
+            }),
             next_ping_s: 0.0,
             k: 0,
         }
@@ -147,7 +154,9 @@ impl FleetWorld {
             t_tx_s: Some(p.t_tx),
         };
         let t = p.t_tx + WINDOW_S;
-        let att = auv.truth.attitude();
+        // the array's axes: the body's, turned by its mounting (the navigator levels
+        // with the body's attitude, taking the array as aligned)
+        let att = self.mounting.map_or(auv.truth.attitude(), |m| auv.truth.attitude() * m);
         let rng = &mut auv.acoustic_rng;
         let kind = match sig.model {
             SignalModel::Channel => {
@@ -344,16 +353,18 @@ mod tests {
     /// Abstract pings without noise in a sea of offset clocks and a lossy link: every
     /// range heard reads the true one plus c times the AUV's clock less the beacon's
     /// (1e-9 m), and 30 % of the pings a clean link hears on the same tracks are lost
-    /// (5 binomial standard errors).
+    /// (5 binomial standard errors). An array mounted 2 deg off in yaw reads every
+    /// azimuth 2 deg less, its inclination unchanged (1e-9 rad).
     #[test]
-    fn clocks_and_the_link_reach_the_abstract_pings() {
+    fn clocks_the_link_and_a_misaligned_array_reach_the_abstract_pings() {
         let text = builtin("rypkema-m1").unwrap().toml.replace("model = \"channel\"", "model = \"abstract\"");
         let Scenario::Fleet(mut s) = parse(&text, "m1").unwrap() else { unreachable!() };
         (s.signal.range_sigma_m, s.signal.outlier_probability, s.dock.gps_sigma_m) = (0.0, 0.0, 0.0);
         s.sea.clocks = ClockErrors { offset_sigma_s: 1e-3, ..ClockErrors::default() };
-        let heard = |link: LinkErrors| {
+        let heard = |link: LinkErrors, yaw_deg: f64| {
             let mut s = s.clone();
             s.sea.link = link;
+            s.sea.usbl.misalignment_deg = [0.0, 0.0, yaw_deg];
             let mut w = FleetWorld::new(&s, 1, 0);
             let c = s.signal.sound_speed_m_s;
             let beacon_s = w.beacon_clocks[0].error_s(0.0);
@@ -363,15 +374,17 @@ mod tests {
                 phase: Phase::Waiting,
             });
             let commands = vec![dive; w.auvs.len()];
-            let mut heard = 0usize;
+            let mut heard = Vec::new();
             for k in 1..=6000 {
                 let before: Vec<Vector3<f64>> = w.auvs.iter().map(|a| a.truth.position_ned_m).collect();
                 let mut out = vec![Vec::new(); w.auvs.len()];
                 w.advance(k, &commands, &mut out);
                 for (v, ms) in out.iter().enumerate() {
                     for m in ms {
-                        let Kind::ArrayFix { beacon, range_m, .. } = m.kind else { continue };
-                        heard += 1;
+                        let Kind::ArrayFix { beacon, range_m, azimuth_rad, inclination_rad, .. } = m.kind else {
+                            continue;
+                        };
+                        heard.push((azimuth_rad, inclination_rad));
                         let auv_s = w.auvs[v].clock.error_s(m.t_s);
                         let r = (beacon.position_ned_m - before[v]).norm();
                         assert!((range_m - r - c * (auv_s - beacon_s)).abs() < 1e-9, "{v} at {}", m.t_s);
@@ -380,7 +393,12 @@ mod tests {
             }
             heard
         };
-        let (all, kept) = (heard(LinkErrors::default()), heard(LinkErrors { loss_prob: 0.3, ..LinkErrors::default() }));
+        let all = heard(LinkErrors::default(), 0.0);
+        let kept = heard(LinkErrors { loss_prob: 0.3, ..LinkErrors::default() }, 0.0).len();
+        for ((a0, i0), (a, i)) in all.iter().zip(&heard(LinkErrors::default(), 2.0)) {
+            assert!((onebeacon::geo::wrap_angle(a - a0) + 2f64.to_radians()).abs() < 1e-9 && (i - i0).abs() < 1e-9);
+        }
+        let all = all.len();
         let p = kept as f64 / all as f64;
         assert!(all > 500 && (p - 0.7).abs() < 5.0 * (0.21 / all as f64).sqrt(), "{kept} of {all}");
     }
