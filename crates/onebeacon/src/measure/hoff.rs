@@ -2,12 +2,12 @@
 //! INS report (eq. 8) and the USBL bearing heard at the surface vehicle (eq. 6-7),
 //! computed over the particles' columns in lanes.
 
+use super::Robust;
 use super::Usbl;
 use crate::filter::lanes;
 use crate::filter::particle::ParticleLikelihood;
 use crate::geo::{wrap_angle, wrap_near};
 use crate::models::hoff::{BLOCK, DIM, idx};
-use crate::nav::Robust;
 
 /// The AUV's INS report (eq. 8): heading, speed and depth with the filter's assumed
 /// standard deviations.

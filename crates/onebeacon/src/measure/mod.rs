@@ -14,11 +14,13 @@
 pub mod doppler;
 pub mod hoff;
 pub mod range;
+pub mod robust;
 pub mod state;
 pub mod usbl;
 
 pub use doppler::RadialSpeed2d;
 pub use range::{Range2d, Range3d, SlantRange};
+pub use robust::Robust;
 pub use state::StateComponent;
 pub use usbl::{Usbl, UsblAngle, UsblModel};
 
