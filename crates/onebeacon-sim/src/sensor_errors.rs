@@ -1,7 +1,7 @@
 //! A vehicle's navigation sensors as they drift (`[sea.sensors]`): a heading bias that
 //! wanders as a first-order Gauss-Markov process, a speed scale factor (a DVL's or a
 //! speed log's calibration, drawn once a run) and dropouts of the speed sensor (bottom
-//! lock lost), during which the vehicle keeps the last speed it measured.
+//! lock lost), during which the vehicle keeps the last velocity it measured.
 
 use crate::seed::gauss;
 use rand::RngExt;
@@ -42,7 +42,7 @@ pub struct DriftingSensors {
     heading_bias_rad: f64,
     speed_scale: f64,
     out: bool,
-    held_speed_m_s: Option<f64>,
+    held: Option<[f64; 3]>,
     last_t_s: Option<f64>,
     rng: Pcg64Mcg,
 }
@@ -53,7 +53,7 @@ impl DriftingSensors {
     pub fn new(errors: &SensorErrors, mut rng: Pcg64Mcg) -> Self {
         let heading_bias_rad = gauss(&mut rng, errors.heading_bias_sigma_deg.to_radians());
         let speed_scale = 1.0 + gauss(&mut rng, errors.speed_scale_sigma);
-        Self { errors: *errors, heading_bias_rad, speed_scale, out: false, held_speed_m_s: None, last_t_s: None, rng }
+        Self { errors: *errors, heading_bias_rad, speed_scale, out: false, held: None, last_t_s: None, rng }
     }
 
     /// Moves the errors on to `t_s`: the bias by its exact discretisation, b <- a b +
@@ -93,15 +93,21 @@ impl DriftingSensors {
     /// The speed the sensor reads at `t_s` for a measured `speed_m_s` (the true speed
     /// with its white noise): scaled, or the last one read while the sensor is out.
     pub fn speed(&mut self, t_s: f64, speed_m_s: f64) -> f64 {
+        self.velocity(t_s, [speed_m_s, 0.0, 0.0])[0]
+    }
+
+    /// The same for a velocity sensor's three linear components (a DVL's u, v, w): one
+    /// scale on all, all held while it is out.
+    pub fn velocity(&mut self, t_s: f64, v: [f64; 3]) -> [f64; 3] {
         self.advance(t_s);
         if self.out
-            && let Some(held) = self.held_speed_m_s
+            && let Some(held) = self.held
         {
             return held;
         }
-        let v = self.speed_scale * speed_m_s;
-        self.held_speed_m_s = Some(v);
-        v
+        let read = v.map(|c| self.speed_scale * c);
+        self.held = Some(read);
+        read
     }
 }
 

@@ -237,8 +237,8 @@ impl Sea {
             (
                 "sea.sensors",
                 self.sensors != SensorErrors::default(),
-                &[PassiveUsbl][..],
-                "the passive_usbl world so far (the AUVs' reports)",
+                &[MovingBeacon, PassiveUsbl][..],
+                "moving_beacon (the vehicles' DVL and heading) and passive_usbl (the AUVs' reports) so far",
             ),
         ];
         if let Some((key, _, _, hosts)) = set.iter().find(|(_, on, kinds, _)| *on && !kinds.contains(&kind)) {
@@ -273,5 +273,48 @@ impl Sea {
             check(key, v, Rule::NonNegative)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn refused(sea: &Sea, kind: World) -> Option<String> {
+        sea.check(kind).err().map(|v| format!("{}: {}", v.key, v.allowed))
+    }
+
+    /// Each table is checked against the worlds it applies to: refused by its name
+    /// elsewhere, accepted where it applies; a fleet's inverted USBL takes the
+    /// misalignment alone.
+    #[test]
+    fn each_table_applies_to_its_worlds() {
+        use World::*;
+        let clocks = Sea { clocks: ClockErrors { drift_sigma_ppm: 1.0, ..ClockErrors::default() }, ..Sea::default() };
+        let usbl =
+            Sea { usbl: UsblErrors { misalignment_deg: [0.0, 0.0, 1.0], ..UsblErrors::default() }, ..Sea::default() };
+        let sensors =
+            Sea { sensors: SensorErrors { speed_scale_sigma: 0.01, ..SensorErrors::default() }, ..Sea::default() };
+        let profile = Sea {
+            sound_speed: Some(SoundSpeed { depth_m: vec![0.0], speed_m_s: vec![1500.0], ..SoundSpeed::default() }),
+            ..Sea::default()
+        };
+        for (sea, key, allowed) in [
+            (&clocks, "sea.clocks", [true, true, false, true]),
+            (&usbl, "sea.usbl", [false, false, true, true]),
+            (&sensors, "sea.sensors", [false, true, true, false]),
+            (&profile, "sea.sound_speed", [false, true, true, true]),
+        ] {
+            for (kind, ok) in [FixedBeacon, MovingBeacon, PassiveUsbl, Fleet].into_iter().zip(allowed) {
+                let got = refused(sea, kind);
+                assert_eq!(got.is_none(), ok, "{key} in {kind:?}: {got:?}");
+                if let Some(e) = got {
+                    assert!(e.starts_with(key) && e.contains(kind.label()), "{e}");
+                }
+            }
+        }
+        let waves = Sea { usbl: UsblErrors { wave_roll_deg: 3.0, ..UsblErrors::default() }, ..Sea::default() };
+        assert!(refused(&waves, Fleet).unwrap().contains("misalignment_deg only"));
+        assert!(refused(&waves, PassiveUsbl).is_none());
     }
 }

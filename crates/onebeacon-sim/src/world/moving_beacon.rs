@@ -12,6 +12,7 @@ use crate::scenario::moving_beacon::Vehicle;
 use crate::scenario::passive_usbl::AsvVehicle;
 use crate::scenario::{MovingBeacon, MovingBeaconCell};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
+use crate::sensor_errors::DriftingSensors;
 use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::autopilot::{Command, MAX_STEP_S, step_over};
 use crate::vehicles::otter::OtterPilot;
@@ -78,6 +79,8 @@ struct Underwater {
     clock: Clock,
     /// Its acoustic link: losses and outliers.
     link: Link,
+    /// Its DVL's and heading sensor's drifting errors (`[sea.sensors]`).
+    sensors: DriftingSensors,
     nu_meas: BodyVelocity,
     distance_m: f64,
 }
@@ -123,6 +126,7 @@ impl<'a> MovingBeaconWorld<'a> {
                 range_rng: (v > 0).then(|| vehicle_rng(seed, run, v, Stream::Acoustic)),
                 clock: Clock::new(&s.sea.clocks, vehicle_rng(seed, run, v, Stream::Clock)),
                 link: Link::new(&s.sea.link, vehicle_rng(seed, run, v, Stream::Link)),
+                sensors: DriftingSensors::new(&s.sea.sensors, vehicle_rng(seed, run, v, Stream::Sensors)),
                 nu_meas: BodyVelocity::zeros(),
                 distance_m: 0.0,
             })
@@ -246,6 +250,9 @@ impl World for MovingBeaconWorld<'_> {
             veh.nu_meas = noise
                 .process_model(body_velocity(&veh.spec.body_path(), t0 + dt / 2.0))
                 .sample_input(&mut veh.velocity_rng);
+            // the DVL's scale and outages (`[sea.sensors]`) on its linear part
+            let [u, v_, w] = veh.sensors.velocity(t0, [veh.nu_meas[0], veh.nu_meas[1], veh.nu_meas[2]]);
+            (veh.nu_meas[0], veh.nu_meas[1], veh.nu_meas[2]) = (u, v_, w);
             let p0 = veh.truth.state().fixed_rows::<3>(0).into_owned();
             veh.truth.step();
             let x = *veh.truth.state();
@@ -295,7 +302,7 @@ impl World for MovingBeaconWorld<'_> {
                 Kind::Attitude {
                     roll_rad: x[idx::ROLL] + roll_m.noise(x, rng),
                     pitch_rad: x[idx::PITCH] + pitch_m.noise(x, rng),
-                    heading_rad: onebeacon::geo::wrap_angle(x[idx::YAW] + yaw_m.noise(x, rng)),
+                    heading_rad: onebeacon::geo::wrap_angle(veh.sensors.heading(t1, x[idx::YAW]) + yaw_m.noise(x, rng)),
                 },
             ));
         }
@@ -312,5 +319,62 @@ pub(crate) fn range_information(noise: SensorNoise) -> impl FnMut(&Kind, &Vehicl
         let h = ScalarModel::<6>::jacobian(&model, &truth.eta);
         let info = h.transpose() * h / model.variance(&truth.eta);
         Some(DMatrix::from_column_slice(6, 6, info.as_slice()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{Scenario, builtin, parse};
+    use crate::sensor_errors::SensorErrors;
+
+    /// The sousa world's DVL and heading with `[sea.sensors]` against the same run
+    /// without: every forward speed read is the clean one times one scale (1e-12), not
+    /// 1; the heading differs by a bias that barely moves with a 1e7 s time constant
+    /// (under 0.01 rad over 200 s); with outages half the time, some steps repeat the
+    /// last velocity exactly while the clean one moves on.
+    #[test]
+    fn drifting_sensors_reach_the_vehicle() {
+        let Scenario::MovingBeacon(clean) = parse(builtin("sousa").unwrap().toml, "sousa").unwrap() else {
+            unreachable!()
+        };
+        let read = |sensors: SensorErrors| {
+            let mut s = clean.clone();
+            s.sea.sensors = sensors;
+            let cell = s.base_cell();
+            let mut w = MovingBeaconWorld::new(&s, &cell, Vector2::new(30.0, 0.0), 1, 0);
+            let mut out = Vec::new();
+            for k in 1..=2000 {
+                let mut heard = vec![Vec::new(); w.vehicles.len()];
+                w.advance(k, &[None], &mut heard);
+                let (mut u, mut psi) = (f64::NAN, f64::NAN);
+                for m in &heard[0] {
+                    match m.kind {
+                        Kind::BodyVelocity { nu } => u = nu[0],
+                        Kind::Attitude { heading_rad, .. } => psi = heading_rad,
+                        _ => {}
+                    }
+                }
+                out.push((u, psi));
+            }
+            out
+        };
+        let base = read(SensorErrors::default());
+        let scaled = read(SensorErrors {
+            speed_scale_sigma: 0.05,
+            heading_bias_sigma_deg: 2.0,
+            heading_bias_time_constant_s: 1e7,
+            ..SensorErrors::default()
+        });
+        let scale = scaled[0].0 / base[0].0;
+        let bias = onebeacon::geo::wrap_angle(scaled[0].1 - base[0].1);
+        assert!((scale - 1.0).abs() > 1e-4 && bias.abs() > 1e-4, "scale {scale}, bias {bias}");
+        for ((u0, p0), (u, p)) in base.iter().zip(&scaled) {
+            assert!((u / u0 - scale).abs() < 1e-12 || u0.abs() < 1e-9, "{u} against {u0}");
+            assert!((onebeacon::geo::wrap_angle(p - p0) - bias).abs() < 0.01);
+        }
+        let out = read(SensorErrors { speed_dropout_prob: 0.5, speed_dropout_mean_s: 5.0, ..SensorErrors::default() });
+        let held = out.windows(2).zip(base.windows(2)).filter(|(o, b)| o[1].0 == o[0].0 && b[1].0 != b[0].0).count();
+        assert!(held > 100, "{held} steps held");
     }
 }
