@@ -42,7 +42,7 @@ def is_source(header):
 
 
 def variant(parts, keep):
-    """The file with only the sources in `keep`, its sweep dropped and its name suffixed."""
+    """The file with only the sources in `keep` and its sweep dropped."""
     text = ""
     for header, lines in parts:
         if header == "sweep" or (is_source(header) and header not in keep):

@@ -42,7 +42,7 @@ pub(crate) fn fixed_beacon(s: &FixedBeacon, z_true: State, seed: u64, run: u64) 
         .iter()
         .map(|e| {
             let (aiding, tuning, filter) = (e.aiding(Host::FixedBeacon), e.ekf_tuning(), e.filter_kind());
-            let (gate, robust) = e.range_gate();
+            let (gate, robust) = e.gate();
             let guards = single_beacon::Guards {
                 min_speed_m_s: e.min_speed_m_s,
                 mirror: e.mirror_recovery.unwrap_or(true),
@@ -75,7 +75,7 @@ pub(crate) fn moving_beacon(s: &MovingBeacon, truth0: &[Eta], seed: u64, run: u6
         tracks.extend(s.estimators.iter().map(|e| {
             let (noise, aiding, filter) =
                 (e.sensor_noise(s.sensor_noise()), e.aiding(Host::MovingBeacon), e.filter_kind());
-            let (calibration, gate) = (e.range_calibration(), e.range_gate());
+            let (calibration, gate) = (e.range_calibration(), e.gate());
             let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
                 let mut eta = eta0;
                 (eta[0], eta[1], eta[5]) = (north, east, heading);

@@ -197,16 +197,14 @@ pub fn statistics(s: &Fleet, seed: u64, runs: &[RunOutput]) -> FleetStatistics {
     let sigma = s.reference.sigma_m;
     for (run, out) in runs.iter().enumerate() {
         let mut rngs: Vec<_> = (0..s.auvs.len()).map(|v| vehicle_rng(seed, run as u64, v, Stream::Reference)).collect();
+        let mut fixes: Vec<Vector2<f64>> = Vec::with_capacity(s.auvs.len());
         for r in &out.trajectory {
             // every AUV's fix of this step, drawn whether it counts or not
-            let fixes: Vec<Vector2<f64>> = if sigma > 0.0 {
-                rngs.iter_mut()
-                    .zip(&r.truth)
-                    .map(|(rng, t)| t.pos.xy() + Vector2::new(gauss(rng, sigma), gauss(rng, sigma)))
-                    .collect()
-            } else {
-                Vec::new()
-            };
+            fixes.clear();
+            if sigma > 0.0 {
+                let drawn = rngs.iter_mut().zip(&r.truth);
+                fixes.extend(drawn.map(|(rng, t)| t.pos.xy() + Vector2::new(gauss(rng, sigma), gauss(rng, sigma))));
+            }
             for (i, e) in r.estimates.iter().enumerate() {
                 if counted(s, r, e.vehicle) {
                     let error = fixes.get(e.vehicle).map_or(e.error_m, |f| (e.pos.xy() - f).norm());

@@ -194,12 +194,13 @@ impl FleetWorld {
                     }
                     _ => (d, 0.0),
                 };
+                let path_m = d.norm();
                 let travelled = match (&self.profile, arrival) {
                     (Some(c), Arrival::Direct) => sig.sound_speed_m_s * c.travel_time(d.xy().norm(), p.source.z, at.z),
-                    _ => d.norm(),
+                    _ => path_m,
                 };
                 let late_m = sig.sound_speed_m_s * clock_s + excess_m;
-                let truth = att.transpose() * d / d.norm();
+                let truth = att.transpose() * d / path_m;
                 let (az, incl) = azimuth_inclination(&truth);
                 let sa = sig.angle_sigma_deg.to_radians();
                 let (range_m, azimuth_rad, inclination_rad) = if let Arrival::False { u } = arrival {

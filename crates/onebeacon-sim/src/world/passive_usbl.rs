@@ -433,7 +433,10 @@ impl World for PassiveUsblWorld<'_> {
             let clean = match auv.link.arrive() {
                 Arrival::Lost => continue,
                 Arrival::False { u } => Some(self.head.false_angles(u)),
-                Arrival::Direct if !bends => Some(usbl.angles(&p)).map(|(a, e, _)| (a, e)),
+                Arrival::Direct if !bends => {
+                    let (a, e, _) = usbl.angles(&p);
+                    Some((a, e))
+                }
                 Arrival::Direct => {
                     let d = p - station;
                     let h = d.xy().norm();

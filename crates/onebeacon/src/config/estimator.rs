@@ -448,8 +448,9 @@ impl EstimatorSpec {
         RangeCalibration { offset, scale_sigma }
     }
 
-    /// The range gate and heavy-tailed update asked for (`nis_gate`, `robust`).
-    pub fn range_gate(&self) -> (f64, Option<Robust>) {
+    /// The gate (a NIS; infinity: none) and heavy-tailed update asked for (`nis_gate`,
+    /// `robust`), of ranges, Doppler speeds, heading fixes and bearings alike.
+    pub fn gate(&self) -> (f64, Option<Robust>) {
         let robust = self.robust.map(|r| match r {
             RobustName::Huber => Robust::Huber { k: self.huber_k.unwrap_or(1.345) },
             RobustName::StudentT => Robust::StudentT { dof: self.student_t_dof.unwrap_or(4.0) },
@@ -462,6 +463,7 @@ impl EstimatorSpec {
     pub fn tracker_config(&self, n: TrackerNoise) -> TrackerConfig {
         let d = TrackerConfig::default();
         let scale = self.process_noise_scale.unwrap_or(1.0);
+        let (nis_gate, robust) = self.gate();
         TrackerConfig {
             process: HoffProcess {
                 sigma: self.process_sigma.unwrap_or(d.process.sigma).map(|s| s * scale),
@@ -477,8 +479,8 @@ impl EstimatorSpec {
                 usbl_as_printed: self.usbl_as_printed.unwrap_or(n.usbl_as_printed),
             },
             aiding: self.aiding(Host::PassiveUsbl),
-            nis_gate: self.nis_gate.unwrap_or(d.nis_gate),
-            robust: self.range_gate().1,
+            nis_gate,
+            robust,
         }
     }
 
@@ -532,7 +534,7 @@ impl EstimatorSpec {
             estimate_turn_scale: self.estimate_turn_scale.unwrap_or(c.estimate_turn_scale),
             turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
             nis_gate: self.nis_gate,
-            robust: self.range_gate().1,
+            robust: self.gate().1,
             noise,
             track_accel_sigma_m_s2: self.track_accel_sigma_m_s2,
         }

@@ -15,6 +15,7 @@ impl EstimatorSpec {
         const USBL: &[Host] = &[PassiveUsbl, Log];
         const CALIBRATING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const CLOCKED: &[Host] = &[FixedBeacon, MovingBeacon];
+        const GATED: &[Host] = &[FixedBeacon, MovingBeacon, PassiveUsbl, Log];
         let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
         let mut keys = vec![
             ("range_sigma_m", self.range_sigma_m, Positive, RANGING),
@@ -40,9 +41,9 @@ impl EstimatorSpec {
             ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, CALIBRATING),
             ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
-            ("nis_gate", self.nis_gate, Positive, &[FixedBeacon, MovingBeacon, PassiveUsbl, Log]),
-            ("huber_k", self.huber_k, Positive, &[FixedBeacon, MovingBeacon, PassiveUsbl, Log]),
-            ("student_t_dof", self.student_t_dof, Positive, &[FixedBeacon, MovingBeacon, PassiveUsbl, Log]),
+            ("nis_gate", self.nis_gate, Positive, GATED),
+            ("huber_k", self.huber_k, Positive, GATED),
+            ("student_t_dof", self.student_t_dof, Positive, GATED),
             ("mirror_recovery", flag(self.mirror_recovery), Finite, &[FixedBeacon]),
             ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
             ("estimate_bias", flag(self.estimate_bias), Finite, CALIBRATING),
