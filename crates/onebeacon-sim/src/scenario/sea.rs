@@ -237,8 +237,8 @@ impl Sea {
             (
                 "sea.sensors",
                 self.sensors != SensorErrors::default(),
-                &[MovingBeacon, PassiveUsbl][..],
-                "moving_beacon (the vehicles' DVL and heading) and passive_usbl (the AUVs' reports) so far",
+                &[FixedBeacon, MovingBeacon, PassiveUsbl][..],
+                "fixed_beacon (the AHRS heading), moving_beacon (the vehicles' DVL and heading) and passive_usbl (the AUVs' reports) so far",
             ),
         ];
         if let Some((key, _, _, hosts)) = set.iter().find(|(_, on, kinds, _)| *on && !kinds.contains(&kind)) {
@@ -261,6 +261,21 @@ impl Sea {
             });
         }
         check_sensors(&self.sensors)?;
+        // garin2024's AUV measures no speed: it integrates its accelerometer
+        if kind == FixedBeacon
+            && self.sensors
+                != (SensorErrors {
+                    heading_bias_sigma_deg: self.sensors.heading_bias_sigma_deg,
+                    heading_bias_time_constant_s: self.sensors.heading_bias_time_constant_s,
+                    ..SensorErrors::default()
+                })
+        {
+            return Err(Violation {
+                key: "sea.sensors".into(),
+                value: "(set)".into(),
+                allowed: "a fixed_beacon world's AUV has no speed sensor: heading_bias_sigma_deg and heading_bias_time_constant_s only".into(),
+            });
+        }
         if let Some(s) = &self.sound_speed {
             s.check()?;
         }
@@ -295,6 +310,8 @@ mod tests {
             Sea { usbl: UsblErrors { misalignment_deg: [0.0, 0.0, 1.0], ..UsblErrors::default() }, ..Sea::default() };
         let sensors =
             Sea { sensors: SensorErrors { speed_scale_sigma: 0.01, ..SensorErrors::default() }, ..Sea::default() };
+        let heading =
+            Sea { sensors: SensorErrors { heading_bias_sigma_deg: 1.0, ..SensorErrors::default() }, ..Sea::default() };
         let profile = Sea {
             sound_speed: Some(SoundSpeed { depth_m: vec![0.0], speed_m_s: vec![1500.0], ..SoundSpeed::default() }),
             ..Sea::default()
@@ -303,6 +320,7 @@ mod tests {
             (&clocks, "sea.clocks", [true, true, false, true]),
             (&usbl, "sea.usbl", [false, false, true, true]),
             (&sensors, "sea.sensors", [false, true, true, false]),
+            (&heading, "sea.sensors", [true, true, true, false]),
             (&profile, "sea.sound_speed", [false, true, true, true]),
         ] {
             for (kind, ok) in [FixedBeacon, MovingBeacon, PassiveUsbl, Fleet].into_iter().zip(allowed) {

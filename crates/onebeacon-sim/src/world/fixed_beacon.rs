@@ -7,9 +7,11 @@ use crate::engine::{VehicleTruth, World};
 use crate::scenario::sea::FIXED_BEACON_SOUND_SPEED_M_S;
 use crate::scenario::{FixedBeacon, FixedBeaconCell};
 use crate::seed::{Stream, rng};
+use crate::sensor_errors::{DriftingSensors, SensorErrors};
 use crate::sensors::SensorSuite;
 use crate::vehicles::{Path, TruthState, feedback_linearising_control};
 use nalgebra::{Vector2, Vector3, Vector6};
+use onebeacon::geo::wrap_angle;
 use onebeacon::models::unicycle::State;
 use onebeacon::nav::{Kind, Measurement};
 use onebeacon::vehicle::Command;
@@ -30,6 +32,9 @@ pub(crate) struct FixedBeaconWorld {
     clocks: [Clock; 2],
     /// The AUV's acoustic link: losses and outliers.
     link: Link,
+    /// The AHRS heading's wandering bias (`[sea.sensors]`; None: off, so that the
+    /// heading is not wrapped twice).
+    drift: Option<DriftingSensors>,
     /// Frames sent so far.
     frame_index: u64,
     distance_m: f64,
@@ -55,6 +60,8 @@ impl FixedBeaconWorld {
             sensors: SensorSuite::new(&s.sensors, s.comms.frame_loss_prob, seed, run),
             clocks: [Stream::Clock, Stream::BeaconClock].map(|c| Clock::new(&s.sea.clocks, rng(seed, run, c))),
             link: Link::new(&s.sea.link, rng(seed, run, Stream::Link)),
+            drift: (s.sea.sensors != SensorErrors::default())
+                .then(|| DriftingSensors::new(&s.sea.sensors, rng(seed, run, Stream::Sensors))),
             frame_index: 0,
             distance_m: 0.0,
         }
@@ -101,7 +108,10 @@ impl World for FixedBeaconWorld {
         self.distance_m += self.truth.v.abs() * self.dt;
         (self.omega, self.accel) = feedback_linearising_control(&self.truth, &self.path.at_time(t, self.speed));
 
-        let sample = self.sensors.proprioceptive(t, &self.truth, self.omega, self.accel);
+        let mut sample = self.sensors.proprioceptive(t, &self.truth, self.omega, self.accel);
+        if let (Some(drift), Kind::Inertial { heading_rad, .. }) = (&mut self.drift, &mut sample) {
+            *heading_rad = wrap_angle(drift.heading(t, *heading_rad));
+        }
         // a frame every T_com seconds, at the first step at or after each multiple; a
         // frame decoded during the step is fused with the step's inertial sample
         let due = ((t + 1e-9) / self.t_com_s).floor() as u64;
@@ -155,6 +165,40 @@ mod tests {
         assert_ne!(a.metrics, other.metrics);
         assert_eq!(a.trajectory.len(), 481);
         assert_eq!(a.frames_decoded, 40);
+    }
+
+    /// `[sea.sensors]`'s heading bias on the AHRS against the same run without: each
+    /// heading read differs from the clean one by the bias (a 1e7 s time constant: it
+    /// moves by under 0.01 rad over 300 s), which is not zero.
+    #[test]
+    fn the_heading_bias_reaches_the_ahrs() {
+        let headings = |sensors: SensorErrors| {
+            let mut s = garin();
+            s.sea.sensors = sensors;
+            let mut world = FixedBeaconWorld::new(&s, &s.base_cell(), 1, 0);
+            let mut out = Vec::new();
+            for k in 1..=1200 {
+                let mut heard = vec![Vec::new()];
+                world.advance(k, &[], &mut heard);
+                out.extend(heard[0].iter().filter_map(|m| match m.kind {
+                    Kind::Inertial { heading_rad, .. } => Some(heading_rad),
+                    _ => None,
+                }));
+            }
+            out
+        };
+        let base = headings(SensorErrors::default());
+        let biased = headings(SensorErrors {
+            heading_bias_sigma_deg: 2.0,
+            heading_bias_time_constant_s: 1e7,
+            ..SensorErrors::default()
+        });
+        assert_eq!(base.len(), 1200);
+        let bias = wrap_angle(biased[0] - base[0]);
+        assert!(bias.abs() > 1e-4, "bias {bias}");
+        for (b, h) in base.iter().zip(&biased) {
+            assert!((wrap_angle(h - b) - bias).abs() < 0.01, "{h} against {b}");
+        }
     }
 
     /// Clocks that drift apart: with noise-free sensors a range's error is c times what

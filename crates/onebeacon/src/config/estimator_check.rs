@@ -24,6 +24,8 @@ impl EstimatorSpec {
             ("usbl_sigma_deg_per_m", self.usbl_sigma_deg_per_m, Positive, USBL),
             ("usbl_floor_deg", self.usbl_floor_deg, NonNegative, USBL),
             ("usbl_as_printed", flag(self.usbl_as_printed), Finite, USBL),
+            ("usbl_misalignment_sigma_deg", self.usbl_misalignment_sigma_deg, Positive, USBL),
+            ("usbl_misalignment_walk_deg_per_sqrt_s", self.usbl_misalignment_walk_deg_per_sqrt_s, NonNegative, USBL),
             ("compass_sigma_deg", self.compass_sigma_deg, NonNegative, USBL),
             ("depth_sigma_m", self.depth_sigma_m, Positive, USBL),
             ("seed", self.seed.map(|s| s as f64), Finite, &[Log]),
@@ -141,12 +143,21 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
             ("ess_fraction", e.ess_fraction.is_some()),
             ("roughening_k", e.roughening_k.is_some()),
             ("min_effective_particles", e.min_effective_particles.is_some()),
+            ("usbl_misalignment_sigma_deg", e.usbl_misalignment_sigma_deg.is_some()),
+            ("usbl_misalignment_walk_deg_per_sqrt_s", e.usbl_misalignment_walk_deg_per_sqrt_s.is_some()),
         ];
         if let Some((name, _)) = pf_only.iter().find(|(_, set)| *set).filter(|_| !particle) {
             return Err(Violation {
                 key: key(name),
                 value: "(set)".into(),
                 allowed: format!("applies to a particle filter (kind = \"pf\") only, not to kind {:?}", e.kind.label()),
+            });
+        }
+        if e.usbl_misalignment_walk_deg_per_sqrt_s.is_some() && e.usbl_misalignment_sigma_deg.is_none() {
+            return Err(Violation {
+                key: key("usbl_misalignment_walk_deg_per_sqrt_s"),
+                value: "(set)".into(),
+                allowed: "walks the misalignment state that usbl_misalignment_sigma_deg turns on (give it too)".into(),
             });
         }
         if particle {
@@ -251,6 +262,17 @@ mod tests {
             ""
         );
         assert!(error("kind = \"rosb\"\nrange_sigma_m = 0.0", Host::Log).contains("> 0"));
+        // the misalignment state: a particle filter's, its walk only with it
+        assert_eq!(error("kind = \"pf\"\nusbl_misalignment_sigma_deg = 2.0", Host::PassiveUsbl), "");
+        assert_eq!(
+            error("kind = \"bearing\"\nusbl_misalignment_sigma_deg = 2.0", Host::PassiveUsbl),
+            "estimators[0].usbl_misalignment_sigma_deg = (set): applies to a particle filter (kind = \"pf\") only, not to kind \"bearing\""
+        );
+        assert!(
+            error("kind = \"pf\"\nusbl_misalignment_walk_deg_per_sqrt_s = 0.1", Host::PassiveUsbl)
+                .contains("usbl_misalignment_sigma_deg turns on")
+        );
+        assert!(error("kind = \"pf\"\nusbl_misalignment_sigma_deg = -1.0", Host::PassiveUsbl).contains("> 0"));
     }
 
     /// The drift implies the offset; the states follow the pose in the order offset,

@@ -61,7 +61,9 @@ impl ParticleLikelihood for UsblBearing {
     /// unit vector at the measured world bearing alpha + psi_ASV and the particle's
     /// (dx, dy); for the elevation, of (cos phi, sin phi) and (dz, h). It equals the
     /// wrapped difference of the angles (eq. 6), with no wrap and no atan2 of the
-    /// particle's own angles.
+    /// particle's own angles. A state that carries the head's yaw misalignment m
+    /// ([`crate::models::hoff::MisalignedProcess`]) reads the azimuth as measured plus
+    /// its particle's m (a head turned by m reads azimuths m less).
     fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
         let u = &self.usbl;
         let (sb, cb) = (self.azimuth_rad + u.heading_rad).sin_cos();
@@ -70,6 +72,7 @@ impl ParticleLikelihood for UsblBearing {
         let o = u.position_ned_m;
         let [px, py, pz, ..] = x else { panic!("hoff2024's state has {DIM} components") };
         let n = log_w.len();
+        let misalignment = x.get(idx::MISALIGNMENT);
         let (mut cross_a, mut dot_a, mut cross_e, mut dot_e) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
         let (mut var_a, mut var_e, mut prod) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
         let (mut da, mut de, mut ln_prod) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
@@ -92,6 +95,11 @@ impl ParticleLikelihood for UsblBearing {
                 prod[j] = var_a[j] * var_e[j];
             }
             lanes::atan2(&cross_a[..m], &dot_a[..m], &mut da[..m]);
+            if let Some(mis) = misalignment {
+                for (d, yaw) in da[..m].iter_mut().zip(&mis[start..start + m]) {
+                    *d = wrap_near(*d + yaw);
+                }
+            }
             lanes::atan2(&cross_e[..m], &dot_e[..m], &mut de[..m]);
             lanes::ln(&prod[..m], &mut ln_prod[..m]);
             let block = log_w[start..start + m].iter_mut().enumerate();

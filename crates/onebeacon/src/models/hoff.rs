@@ -16,6 +16,10 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 /// State dimension.
 pub const DIM: usize = 8;
 
+/// The tracker's state with the USBL head's yaw misalignment as a ninth component
+/// ([`MisalignedProcess`]).
+pub const DIM_MISALIGNED: usize = DIM + 1;
+
 /// Index of each state component.
 pub mod idx {
     pub const X: usize = 0;
@@ -26,6 +30,8 @@ pub mod idx {
     pub const U: usize = 5;
     pub const B_THETA: usize = 6;
     pub const B_PSI: usize = 7;
+    /// The USBL head's yaw misalignment, rad, in a tracker that estimates it.
+    pub const MISALIGNMENT: usize = 8;
 }
 
 /// The process model (eq. 4) with its noise: standard deviations per second of each
@@ -144,6 +150,32 @@ impl ParticleProcess for HoffProcess {
                     let mean = u[j] - s[idx::U] * e[idx::U][j];
                     u[j] = truncated_normal(rng, mean, s[idx::U], 0.0, f64::INFINITY);
                 }
+            }
+        }
+    }
+}
+
+/// Eq. 4 for a tracker whose state carries the USBL head's yaw misalignment as a ninth
+/// component: the vehicle's eight as [`HoffProcess`] moves them, the misalignment a
+/// random walk (a mounting is constant; the walk keeps the particles' values diverse
+/// after resampling).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MisalignedProcess {
+    pub process: HoffProcess,
+    /// The misalignment's walk, rad per sqrt(s).
+    pub walk_rad_per_sqrt_s: f64,
+}
+
+impl ParticleProcess for MisalignedProcess {
+    fn propagate(&self, x: &mut [&mut [f64]], dt: f64, rng: &mut Pcg64) {
+        ParticleProcess::propagate(&self.process, &mut x[..DIM], dt, rng);
+        let [misalignment] = &mut x[DIM..] else { panic!("the misaligned state has {DIM_MISALIGNED} components") };
+        let s = self.walk_rad_per_sqrt_s * dt.sqrt();
+        let mut noise = [0.0; BLOCK];
+        for block in misalignment.chunks_mut(BLOCK) {
+            lanes::standard_normals(rng, &mut noise[..block.len()]);
+            for (m, e) in block.iter_mut().zip(&noise) {
+                *m += s * e;
             }
         }
     }

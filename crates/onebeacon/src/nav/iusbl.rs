@@ -414,6 +414,7 @@ impl Navigator for IusblNavigator {
             range_scale: 0.0,
             distance_scale: 0.0,
             turn_scale: 0.0,
+            usbl_misalignment_rad: 0.0,
         }
     }
 

@@ -28,7 +28,7 @@ pub use range_6dof::{Range6DofNavigator, SensorNoise};
 pub use range_calibration::{OffsetPrior, RangeCalibration};
 pub use single_beacon::{EkfTuning, SingleBeaconNavigator};
 pub use tracking::TrackingNavigator;
-pub use usbl_track::{GaussianTracker, ParticleTracker, TrackerConfig, TrackerNoise};
+pub use usbl_track::{GaussianTracker, MisalignmentPrior, ParticleTracker, TrackerConfig, TrackerNoise};
 
 pub use crate::measure::Robust;
 
@@ -133,6 +133,8 @@ pub struct Estimate {
     pub range_scale: f64,
     pub distance_scale: f64,
     pub turn_scale: f64,
+    /// The USBL head's yaw misalignment, rad, where it is a state.
+    pub usbl_misalignment_rad: f64,
 }
 
 impl Estimate {
@@ -155,13 +157,14 @@ impl Estimate {
     pub fn sigma_heading_rad(&self) -> f64 {
         self.heading_var_rad2.max(0.0).sqrt()
     }
-    /// The range and odometry calibration states, as output keys.
-    pub fn calibration(&self) -> [(&'static str, f64); 4] {
+    /// The range, odometry and USBL calibration states, as output keys.
+    pub fn calibration(&self) -> [(&'static str, f64); 5] {
         [
             ("range_bias_m", self.range_bias_m),
             ("range_scale", self.range_scale),
             ("distance_scale", self.distance_scale),
             ("turn_scale", self.turn_scale),
+            ("usbl_misalignment_rad", self.usbl_misalignment_rad),
         ]
     }
     /// Body-to-NED rotation of the estimated attitude (roll and pitch zero where they

@@ -510,6 +510,7 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
             range_scale: x[idx::RANGE_SCALE],
             distance_scale: x[idx::DISTANCE_SCALE],
             turn_scale: x[idx::TURN_SCALE],
+            usbl_misalignment_rad: 0.0,
         }
     }
 }

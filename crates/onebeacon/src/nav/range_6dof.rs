@@ -227,6 +227,7 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
             range_scale: state(self.calibration.layout.scale),
             distance_scale: 0.0,
             turn_scale: 0.0,
+            usbl_misalignment_rad: 0.0,
         }
     }
 }

@@ -398,6 +398,7 @@ impl<const N: usize, P: ProcessModel<N> + Send> Navigator for SingleBeaconNaviga
             range_scale: self.calibration.layout.scale.map_or(0.0, |i| x[i]),
             distance_scale: 0.0,
             turn_scale: 0.0,
+            usbl_misalignment_rad: 0.0,
         }
     }
 }

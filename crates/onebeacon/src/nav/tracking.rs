@@ -165,6 +165,7 @@ impl Navigator for TrackingNavigator {
             range_scale: x[idx::RANGE_SCALE],
             distance_scale: 0.0,
             turn_scale: 0.0,
+            usbl_misalignment_rad: 0.0,
         }
     }
 }

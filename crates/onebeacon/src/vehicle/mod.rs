@@ -220,6 +220,7 @@ mod tests {
                 range_scale: 0.0,
                 distance_scale: 0.0,
                 turn_scale: 0.0,
+                usbl_misalignment_rad: 0.0,
             }
         }
         fn command_mode(&self) -> Option<usize> {
