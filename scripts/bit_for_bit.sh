@@ -40,7 +40,15 @@ done
 $NEW replay "$REPO/data/plaza/plaza1.toml" --print-stream > plaza1.jsonl
 $OLD stream "$REPO/data/plaza/plaza1.toml" < plaza1.jsonl > old-stream.jsonl 2>/dev/null
 $NEW stream "$REPO/data/plaza/plaza1.toml" < plaza1.jsonl > new-stream.jsonl 2>/dev/null
-echo "stream plaza1 ($(wc -l < new-stream.jsonl) lines): $(cmp -s old-stream.jsonl new-stream.jsonl && echo identical || echo DIFFERENT)"
+# line by line, with the keys a later issue added left out as in cmp_json
+echo "stream plaza1 ($(wc -l < new-stream.jsonl) lines): $(python3 -c "
+import json,sys
+def strip(v):
+    if isinstance(v, dict): return {k: strip(x) for k, x in v.items() if k not in ('wall_s', 'usbl_misalignment_rad')}
+    if isinstance(v, list): return [strip(x) for x in v]
+    return v
+a, b = ([strip(json.loads(l)) for l in open(f)] for f in sys.argv[1:3])
+print('identical' if a == b else 'DIFFERENT')" old-stream.jsonl new-stream.jsonl)"
 for s in garin2024 sousa hoff2024-kinematic; do
   $OLD run $s --out old-run-$s > /dev/null 2>&1; $NEW run $s --out new-run-$s > /dev/null 2>&1
   echo "run $s trajectory.csv: $(cmp -s old-run-$s/trajectory.csv new-run-$s/trajectory.csv && echo identical || echo DIFFERENT)"

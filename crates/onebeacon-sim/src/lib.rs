@@ -37,6 +37,7 @@ pub mod seed;
 pub mod sensor_errors;
 pub mod sensors;
 pub mod vehicles;
+pub mod water;
 mod world;
 
 pub use scenario::{Scenario, ScenarioError};

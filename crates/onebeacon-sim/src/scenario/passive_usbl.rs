@@ -6,6 +6,7 @@
 use super::estimator::Host;
 use super::validate::*;
 use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
+use crate::water::Current;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -108,41 +109,6 @@ pub enum AuvVehicle {
     /// REMUS 100's 6-DOF dynamics (`vehicles::remus100`) under its heading, depth and
     /// speed autopilots, steered by ILOS on the circle.
     Remus100,
-}
-
-/// A current constant in the water column, or slowly varying: its speed and direction
-/// each a first-order Gauss-Markov process about their means (drawn once per message
-/// period).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Current {
-    pub speed_m_s: f64,
-    /// The direction it flows toward, deg from north.
-    pub toward_deg: f64,
-    /// Stationary standard deviations of the speed and the direction about their means,
-    /// and their correlation time.
-    pub speed_sigma_m_s: f64,
-    pub direction_sigma_deg: f64,
-    pub time_constant_s: f64,
-}
-
-impl Default for Current {
-    fn default() -> Self {
-        Self {
-            speed_m_s: 0.0,
-            toward_deg: 0.0,
-            speed_sigma_m_s: 0.0,
-            direction_sigma_deg: 0.0,
-            time_constant_s: 1800.0,
-        }
-    }
-}
-
-impl Current {
-    /// Whether there is any.
-    pub fn flows(&self) -> bool {
-        self.speed_m_s > 0.0 || self.speed_sigma_m_s > 0.0
-    }
 }
 
 impl Default for Auv {
@@ -481,13 +447,7 @@ pub(super) fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
         start_distance_m: NonNegative,
         start_bearing_deg: Finite,
     });
-    check_fields!("current", s.current, {
-        speed_m_s: NonNegative,
-        toward_deg: Finite,
-        speed_sigma_m_s: NonNegative,
-        direction_sigma_deg: NonNegative,
-        time_constant_s: Positive,
-    });
+    super::sea::check_current("current", &s.current)?;
     let dynamic = s.asv.vehicle == AsvVehicle::Otter || s.auvs().iter().any(|a| a.vehicle == AuvVehicle::Remus100);
     if s.current.flows() && !dynamic {
         return Err(Violation {

@@ -2,7 +2,8 @@
 //! default (the reproductions run without them): clocks (worlds that time one-way
 //! travel), a sound-speed profile (worlds whose signals travel between depths), the
 //! acoustic link's losses and outliers (every world that hears messages), and a USBL
-//! head's misalignment, waves, floor and occluded sectors (worlds with a USBL).
+//! head's misalignment, waves, floor and occluded sectors (worlds with a USBL), the
+//! vehicles' drifting sensors and the water's current.
 
 use super::validate::{Rule, Violation, check};
 use crate::acoustics::clock::ClockErrors;
@@ -11,6 +12,7 @@ use crate::acoustics::profile::Profile;
 use crate::acoustics::usbl_head::UsblErrors;
 use crate::scenario::World;
 use crate::sensor_errors::SensorErrors;
+use crate::water::Current;
 use onebeacon::dsp::sound_speed::mackenzie;
 use serde::{Deserialize, Serialize};
 
@@ -34,6 +36,8 @@ pub struct Sea {
     pub usbl: UsblErrors,
     /// `[sea.sensors]`: the vehicles' heading bias, speed scale and speed dropouts.
     pub sensors: SensorErrors,
+    /// `[sea.current]`: the water's current, which carries the vehicles over ground.
+    pub current: Current,
 }
 
 /// `[sea.sound_speed]`: a cast, as speeds or as temperatures (Mackenzie 1981) at
@@ -181,6 +185,20 @@ fn check_usbl(u: &UsblErrors) -> Result<(), Violation> {
     Ok(())
 }
 
+/// A current's keys under `table` (`current`, `sea.current`).
+pub(super) fn check_current(table: &str, c: &Current) -> Result<(), Violation> {
+    for (key, v, rule) in [
+        ("speed_m_s", c.speed_m_s, Rule::NonNegative),
+        ("toward_deg", c.toward_deg, Rule::Finite),
+        ("speed_sigma_m_s", c.speed_sigma_m_s, Rule::NonNegative),
+        ("direction_sigma_deg", c.direction_sigma_deg, Rule::NonNegative),
+        ("time_constant_s", c.time_constant_s, Rule::Positive),
+    ] {
+        check(&format!("{table}.{key}"), v, rule)?;
+    }
+    Ok(())
+}
+
 fn check_sensors(e: &SensorErrors) -> Result<(), Violation> {
     for (key, v, range, allowed) in [
         ("heading_bias_sigma_deg", e.heading_bias_sigma_deg, 0.0..=30.0, "from 0 to 30"),
@@ -240,6 +258,12 @@ impl Sea {
                 &[FixedBeacon, MovingBeacon, PassiveUsbl][..],
                 "fixed_beacon (the AHRS heading), moving_beacon (the vehicles' DVL and heading) and passive_usbl (the AUVs' reports) so far",
             ),
+            (
+                "sea.current",
+                self.current != Current::default(),
+                &[FixedBeacon, Fleet][..],
+                "worlds whose vehicles measure their speed through the water (fixed_beacon, fleet); a passive_usbl world's current is its own [current] table, and a moving_beacon world's DVL locks on the bottom",
+            ),
         ];
         if let Some((key, _, _, hosts)) = set.iter().find(|(_, on, kinds, _)| *on && !kinds.contains(&kind)) {
             return Err(Violation {
@@ -261,6 +285,7 @@ impl Sea {
             });
         }
         check_sensors(&self.sensors)?;
+        check_current("sea.current", &self.current)?;
         // garin2024's AUV measures no speed: it integrates its accelerometer
         if kind == FixedBeacon
             && self.sensors
@@ -312,6 +337,7 @@ mod tests {
             Sea { sensors: SensorErrors { speed_scale_sigma: 0.01, ..SensorErrors::default() }, ..Sea::default() };
         let heading =
             Sea { sensors: SensorErrors { heading_bias_sigma_deg: 1.0, ..SensorErrors::default() }, ..Sea::default() };
+        let current = Sea { current: Current { speed_m_s: 0.1, ..Current::default() }, ..Sea::default() };
         let profile = Sea {
             sound_speed: Some(SoundSpeed { depth_m: vec![0.0], speed_m_s: vec![1500.0], ..SoundSpeed::default() }),
             ..Sea::default()
@@ -321,6 +347,7 @@ mod tests {
             (&usbl, "sea.usbl", [false, false, true, true]),
             (&sensors, "sea.sensors", [false, true, true, false]),
             (&heading, "sea.sensors", [true, true, true, false]),
+            (&current, "sea.current", [true, false, false, true]),
             (&profile, "sea.sound_speed", [false, true, true, true]),
         ] {
             for (kind, ok) in [FixedBeacon, MovingBeacon, PassiveUsbl, Fleet].into_iter().zip(allowed) {

@@ -10,6 +10,7 @@ use crate::seed::{Stream, rng};
 use crate::sensor_errors::{DriftingSensors, SensorErrors};
 use crate::sensors::SensorSuite;
 use crate::vehicles::{Path, TruthState, feedback_linearising_control};
+use crate::water::Water;
 use nalgebra::{Vector2, Vector3, Vector6};
 use onebeacon::geo::wrap_angle;
 use onebeacon::models::unicycle::State;
@@ -35,6 +36,9 @@ pub(crate) struct FixedBeaconWorld {
     /// The AHRS heading's wandering bias (`[sea.sensors]`; None: off, so that the
     /// heading is not wrapped twice).
     drift: Option<DriftingSensors>,
+    /// The water's current (`[sea.current]`), when it flows: it carries the AUV over
+    /// ground, where its accelerometer and gyro see only its motion through the water.
+    water: Option<Water>,
     /// Frames sent so far.
     frame_index: u64,
     distance_m: f64,
@@ -62,6 +66,7 @@ impl FixedBeaconWorld {
             link: Link::new(&s.sea.link, rng(seed, run, Stream::Link)),
             drift: (s.sea.sensors != SensorErrors::default())
                 .then(|| DriftingSensors::new(&s.sea.sensors, rng(seed, run, Stream::Sensors))),
+            water: s.sea.current.flows().then(|| Water::new(s.sea.current.clone(), rng(seed, run, Stream::Current))),
             frame_index: 0,
             distance_m: 0.0,
         }
@@ -105,6 +110,14 @@ impl World for FixedBeaconWorld {
         // truth moves under the command of the previous step (eq. 3-4), then a new
         // command is computed from the reference (eq. 2)
         self.truth = self.truth.step(self.omega, self.accel, self.dt);
+        let current = self.water.as_mut().map(|w| {
+            let c = w.ned().xy();
+            w.drift(self.dt);
+            c
+        });
+        if let Some(c) = current {
+            self.truth.pos += c * self.dt;
+        }
         self.distance_m += self.truth.v.abs() * self.dt;
         (self.omega, self.accel) = feedback_linearising_control(&self.truth, &self.path.at_time(t, self.speed));
 
@@ -125,8 +138,13 @@ impl World for FixedBeaconWorld {
             let clock_m = c * (auv.error_s(t) - beacon.error_s(t_tx));
             // lost, or heard on another path
             let frame = self.sensors.comm_frame(&self.truth, self.beacon, clock_m).and_then(|mut frame| {
-                if let Kind::RangeDoppler { range_m, .. } = &mut frame {
+                if let Kind::RangeDoppler { range_m, radial_speed_m_s, .. } = &mut frame {
                     *range_m = self.link.hear(*range_m)?;
+                    // the Doppler shift is of the speed over ground: the current's share
+                    // toward the beacon (eq. 13 has the speed through the water)
+                    if let Some(c) = current {
+                        *radial_speed_m_s += c.dot(&(self.beacon - self.truth.pos).normalize());
+                    }
                 }
                 Some(frame)
             });
@@ -145,6 +163,7 @@ mod tests {
     use crate::scenario::Cell;
     use crate::scenario::fixed_beacon::Sensors;
     use crate::scenario::{Scenario, builtin, parse};
+    use crate::water::Current;
 
     fn garin() -> FixedBeacon {
         match parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap() {
@@ -165,6 +184,43 @@ mod tests {
         assert_ne!(a.metrics, other.metrics);
         assert_eq!(a.trajectory.len(), 481);
         assert_eq!(a.frames_decoded, 40);
+    }
+
+    /// A current of 0.3 m/s toward the north (noise-free sensors): every Doppler speed is
+    /// the speed over ground toward the beacon, the AUV's own v along its heading plus the
+    /// current (1e-9 m/s), and the AUV is carried off the still-water track (by 0.6 m
+    /// at most in 300 s, 0.3 m/s for 2 s: its controller sees the truth and steers back,
+    /// crabbing into the current; asserted above 0.3 m, none in still water).
+    #[test]
+    fn a_current_carries_the_auv_and_shows_in_the_doppler() {
+        let track = |current: Current| {
+            let mut s = garin();
+            s.sensors = Sensors::noise_free();
+            let flows = current.flows();
+            s.sea.current = current;
+            let mut world = FixedBeaconWorld::new(&s, &s.base_cell(), 1, 0);
+            let mut out = Vec::new();
+            for k in 1..=1200 {
+                let mut heard = vec![Vec::new()];
+                world.advance(k, &[], &mut heard);
+                for m in &heard[0] {
+                    if let Kind::RangeDoppler { radial_speed_m_s, .. } = m.kind {
+                        let t = &world.truth;
+                        let ground = Vector2::new(t.psi.cos(), t.psi.sin()) * t.v + Vector2::new(0.3, 0.0);
+                        let toward = (world.beacon - t.pos).normalize();
+                        if flows {
+                            assert!((radial_speed_m_s - ground.dot(&toward)).abs() < 1e-9, "at {} s", m.t_s);
+                        }
+                    }
+                }
+                out.push(world.truth.pos);
+            }
+            out
+        };
+        let still = track(Current::default());
+        let carried = track(Current { speed_m_s: 0.3, ..Current::default() });
+        let off = still.iter().zip(&carried).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        assert!(off > 0.3, "{off} m");
     }
 
     /// `[sea.sensors]`'s heading bias on the AHRS against the same run without: each

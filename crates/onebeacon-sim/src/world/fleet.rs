@@ -15,6 +15,7 @@ use crate::scenario::fleet::{Fleet, SignalModel, Transmitter};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::vehicles::autopilot::Command;
 use crate::vehicles::sandshark::{SandShark, SensorErrors};
+use crate::water::Water;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use onebeacon::dsp::beamform::{azimuth_inclination, pyramid_8cm};
 use onebeacon::dsp::waveform::{Lfm, rypkema_modes};
@@ -68,6 +69,9 @@ pub(crate) struct FleetWorld {
     /// The arrays' mounting misalignment in the AUVs' bodies (`sea.usbl.misalignment_deg`),
     /// when there is one.
     mounting: Option<Matrix3<f64>>,
+    /// The water's current (`[sea.current]`), when it flows: it carries every AUV over
+    /// ground, while their speed comes from the propeller's RPM (through the water).
+    water: Option<Water>,
     /// The next transmit epoch.
     next_ping_s: f64,
     k: usize,
@@ -110,6 +114,11 @@ impl FleetWorld {
                 let [r, p, y] = s.sea.usbl.misalignment_deg.map(f64::to_radians);
                 Rotation3::from_euler_angles(r, p, y).into_inner()
             }),
+            water: s
+                .sea
+                .current
+                .flows()
+                .then(|| Water::new(s.sea.current.clone(), crate::seed::rng(seed, run, Stream::Current))),
             next_ping_s: 0.0,
             k: 0,
         }
@@ -312,6 +321,11 @@ impl World for FleetWorld {
             }
         }
         let params = self.s.sandshark.clone();
+        let current = self.water.as_mut().map(|w| {
+            let c = w.ned();
+            w.drift(dt);
+            c
+        });
         for (v, a) in self.auvs.iter_mut().enumerate() {
             if t1 < a.launch_s {
                 continue; // not in the water yet
@@ -320,6 +334,9 @@ impl World for FleetWorld {
                 (a.setpoint, a.mode, a.phase) = (*setpoint, *mode, *phase);
             }
             a.truth.step(&params, &a.setpoint, dt);
+            if let Some(c) = current {
+                a.truth.position_ned_m += c * dt;
+            }
             a.distance_m += a.truth.speed_m_s * dt;
             a.errors.advance(&params, dt, &mut a.imu_rng);
             let rng = &mut a.imu_rng;
@@ -350,6 +367,7 @@ mod tests {
     use crate::acoustics::clock::ClockErrors;
     use crate::acoustics::link::LinkErrors;
     use crate::scenario::{Scenario, builtin, parse};
+    use crate::water::Current;
 
     /// Abstract pings without noise in a sea of offset clocks and a lossy link: every
     /// range heard reads the true one plus c times the AUV's clock less the beacon's
@@ -402,5 +420,44 @@ mod tests {
         let all = all.len();
         let p = kept as f64 / all as f64;
         assert!(all > 500 && (p - 0.7).abs() < 5.0 * (0.21 / all as f64).sqrt(), "{kept} of {all}");
+    }
+
+    /// A current of 0.1 m/s toward the east carries every AUV over ground: after 300 s
+    /// under the same commands, each is 0.1 m/s times its time in the water further east
+    /// than in still water, and no further north (1e-9 m); AUVs not yet launched stay.
+    #[test]
+    fn a_current_carries_the_auvs() {
+        let Scenario::Fleet(s) = parse(builtin("rypkema-m1").unwrap().toml, "m1").unwrap() else { unreachable!() };
+        let end = |current: Current| {
+            let mut s = s.clone();
+            s.sea.current = current;
+            let mut w = FleetWorld::new(&s, 1, 0);
+            let dive = Some(VehicleCommand::Setpoint {
+                setpoint: Setpoint { heading_rad: 0.5, speed_m_s: 1.0, depth_m: 2.5 },
+                mode: None,
+                phase: Phase::Waiting,
+            });
+            let commands = vec![dive; w.auvs.len()];
+            // an AUV moves on every step from its launch on
+            let mut in_water = vec![0.0; w.auvs.len()];
+            for k in 1..=(300.0 / w.dt()).round() as usize {
+                let mut out = vec![Vec::new(); w.auvs.len()];
+                w.advance(k, &commands, &mut out);
+                for (t, a) in in_water.iter_mut().zip(&w.auvs) {
+                    *t += if w.t_s(k) >= a.launch_s { w.dt() } else { 0.0 };
+                }
+            }
+            w.auvs.iter().zip(in_water).map(|(a, t)| (a.truth.position_ned_m, t)).collect::<Vec<_>>()
+        };
+        let still = end(Current::default());
+        let carried = end(Current { speed_m_s: 0.1, toward_deg: 90.0, ..Current::default() });
+        for ((p0, in_water), (p, _)) in still.iter().zip(&carried) {
+            let d = p - p0;
+            assert!(
+                d.x.abs() < 1e-9 && (d.y - 0.1 * in_water).abs() < 1e-9 && d.z.abs() < 1e-9,
+                "{d:?} after {in_water} s"
+            );
+        }
+        assert!(carried.iter().any(|(_, t)| *t > 100.0));
     }
 }

@@ -18,7 +18,7 @@ use crate::acoustics::profile::Profile;
 use crate::acoustics::usbl_head::UsblHead;
 use crate::engine::{PilotRecord, VehicleTruth, World};
 use crate::scenario::PassiveUsbl;
-use crate::scenario::passive_usbl::{AsvVehicle, Auv, AuvVehicle, Current};
+use crate::scenario::passive_usbl::{AsvVehicle, Auv, AuvVehicle};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use crate::sensor_errors::DriftingSensors;
 use crate::vehicles::asv::{AsvLimits, AsvState};
@@ -26,6 +26,7 @@ use crate::vehicles::autopilot::{Command, MAX_STEP_S, Piloted, step_over};
 use crate::vehicles::ilos::{self, CircleFollower, Ilos};
 use crate::vehicles::otter::OtterPilot;
 use crate::vehicles::remus100::{Remus100, Remus100Pilot};
+use crate::water::Water;
 use nalgebra::{DMatrix, SMatrix, SVector, Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
 use onebeacon::measure::{ScalarModel, Usbl, UsblAngle};
@@ -154,38 +155,6 @@ impl AuvTruth {
     fn pilot_record(&self, v: usize) -> Option<PilotRecord> {
         let AuvMotion::Remus { pilot, command, .. } = &self.motion else { return None };
         Some(PilotRecord::of(Some(v), *command, &pilot.state))
-    }
-}
-
-/// The current the dynamic vehicles feel: its speed and direction, each drifting as a
-/// first-order Gauss-Markov process about its mean.
-struct Water {
-    spec: Current,
-    speed_dev: f64,
-    direction_dev: f64,
-    rng: Pcg64Mcg,
-}
-
-impl Water {
-    fn new(spec: Current, mut rng: Pcg64Mcg) -> Self {
-        let speed_dev = gauss(&mut rng, spec.speed_sigma_m_s);
-        let direction_dev = gauss(&mut rng, spec.direction_sigma_deg.to_radians());
-        Self { spec, speed_dev, direction_dev, rng }
-    }
-
-    fn ned(&self) -> Vector3<f64> {
-        let dir = self.spec.toward_deg.to_radians() + self.direction_dev;
-        let speed = (self.spec.speed_m_s + self.speed_dev).max(0.0);
-        Vector3::new(dir.cos(), dir.sin(), 0.0) * speed
-    }
-
-    /// Drifts over `dt` s (exact discretisation of the first-order process).
-    fn drift(&mut self, dt: f64) {
-        let a = (-dt / self.spec.time_constant_s).exp();
-        let b = (1.0 - a * a).sqrt();
-        self.speed_dev = a * self.speed_dev + gauss(&mut self.rng, b * self.spec.speed_sigma_m_s);
-        self.direction_dev =
-            a * self.direction_dev + gauss(&mut self.rng, b * self.spec.direction_sigma_deg.to_radians());
     }
 }
 
@@ -553,33 +522,6 @@ mod tests {
         assert!((auv.depth_m - 30.0).abs() < 0.3 && (auv.speed_m_s - 1.5).abs() < 0.1, "{auv:?}");
         assert_eq!(auv.command.depth_m, Some(30.0));
         assert!(asv.command.depth_m.is_none() && (last.beacon - start).xy().norm() < 2.0, "{asv:?}");
-    }
-
-    /// The current's slow variation: the speed's deviation from its mean, sampled every
-    /// 4 s over 4e5 s, has the stationary standard deviation asked for (within 5 %) and
-    /// the first-order process's autocorrelation exp(-lag / T) at one correlation time
-    /// (within 0.05).
-    #[test]
-    fn the_current_varies_as_a_gauss_markov_process() {
-        let spec = Current {
-            speed_m_s: 0.3,
-            speed_sigma_m_s: 0.1,
-            direction_sigma_deg: 10.0,
-            time_constant_s: 400.0,
-            ..Default::default()
-        };
-        let mut w = Water::new(spec, vehicle_rng(1, 0, 0, Stream::Current));
-        let x: Vec<f64> = (0..100_000)
-            .map(|_| {
-                w.drift(4.0);
-                w.speed_dev
-            })
-            .collect();
-        let var = x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64;
-        let lag = 100; // 400 s
-        let cov = x.windows(lag + 1).map(|p| p[0] * p[lag]).sum::<f64>() / (x.len() - lag) as f64;
-        assert!((var.sqrt() / 0.1 - 1.0).abs() < 0.05, "{}", var.sqrt());
-        assert!((cov / var - (-1.0f64).exp()).abs() < 0.05, "{}", cov / var);
     }
 
     /// The Otter on straight legs north at 2 m/s (lookahead 20 m) in a 0.3 m/s current
