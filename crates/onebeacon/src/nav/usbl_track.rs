@@ -324,6 +324,30 @@ mod tests {
     use rand::SeedableRng;
     use std::f64::consts::FRAC_PI_2;
 
+    /// The k-th bearing (every 4 s) of `truth` from a station stepping 0.5 rad round a
+    /// 20 m ring about (40, -20) m, heading 1 rad off its angle, sigma_USBL as given; the
+    /// head turned by `misaligned` reads the azimuth that much less.
+    fn ring_bearing(
+        k: u32,
+        truth: &TrackState,
+        sigma_rad_per_m: f64,
+        misaligned: f64,
+        rng: &mut rand_pcg::Pcg64Mcg,
+    ) -> (f64, Kind) {
+        let a = 0.5 * f64::from(k);
+        let station = Vector3::new(40.0 + 20.0 * a.cos(), -20.0 + 20.0 * a.sin(), 0.0);
+        let usbl = Usbl::exact(station, a + 1.0, sigma_rad_per_m);
+        let az = usbl.model(UsblAngle::Azimuth).sample(truth, rng) - misaligned;
+        let el = usbl.model(UsblAngle::Elevation).sample(truth, rng);
+        let bearing = Kind::Bearing {
+            station: BeaconFix::fixed(0, station),
+            station_heading_rad: a + 1.0,
+            azimuth_rad: crate::geo::wrap_angle(az),
+            elevation_rad: el,
+        };
+        (4.0 * f64::from(k), bearing)
+    }
+
     /// A vehicle at rest 30 m down, heard from stations on a ring around it: the
     /// particle filter and the EKF both find it from a start 8 m off, within a few
     /// standard deviations of what they report, and agree with each other.
@@ -338,19 +362,8 @@ mod tests {
         let true_usbl = 0.01f64.to_radians();
         let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(9);
         for k in 1..=40 {
-            let t = 4.0 * k as f64;
-            let a = 0.5 * k as f64;
-            let station = Vector3::new(40.0 + 20.0 * a.cos(), -20.0 + 20.0 * a.sin(), 0.0);
-            let usbl = Usbl::exact(station, a + 1.0, true_usbl);
+            let (t, bearing) = ring_bearing(k, &truth, true_usbl, 0.0, &mut rng);
             let p = truth.fixed_rows::<3>(0).into_owned();
-            let az = usbl.model(UsblAngle::Azimuth).sample(&truth, &mut rng);
-            let el = usbl.model(UsblAngle::Elevation).sample(&truth, &mut rng);
-            let bearing = Kind::Bearing {
-                station: BeaconFix::fixed(0, station),
-                station_heading_rad: a + 1.0,
-                azimuth_rad: crate::geo::wrap_angle(az),
-                elevation_rad: el,
-            };
             let report = Kind::Report {
                 heading_rad: 0.7 + crate::filter::gauss(&mut rng, 0.3),
                 speed_m_s: crate::filter::gauss(&mut rng, 0.2f64).abs(),
@@ -401,18 +414,7 @@ mod tests {
         let mut aligned = ParticleTracker::new(still, settings, 20_000, 0.0, &start, &sigma, 5);
         let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(4);
         for k in 1..=40 {
-            let t = 4.0 * k as f64;
-            let a = 0.5 * k as f64;
-            let station = Vector3::new(40.0 + 20.0 * a.cos(), -20.0 + 20.0 * a.sin(), 0.0);
-            let usbl = Usbl::exact(station, a + 1.0, 0.01f64.to_radians());
-            let az = usbl.model(UsblAngle::Azimuth).sample(&truth, &mut rng) - misaligned;
-            let el = usbl.model(UsblAngle::Elevation).sample(&truth, &mut rng);
-            let bearing = Kind::Bearing {
-                station: BeaconFix::fixed(0, station),
-                station_heading_rad: a + 1.0,
-                azimuth_rad: crate::geo::wrap_angle(az),
-                elevation_rad: el,
-            };
+            let (t, bearing) = ring_bearing(k, &truth, 0.01f64.to_radians(), misaligned, &mut rng);
             let report = Kind::Report { heading_rad: 0.7, speed_m_s: 0.0, depth_m: 30.0 };
             for nav in [&mut pf, &mut aligned] {
                 nav.process(&Measurement::new(t, report.clone()));
