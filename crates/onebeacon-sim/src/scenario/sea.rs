@@ -255,8 +255,8 @@ impl Sea {
             (
                 "sea.sensors",
                 self.sensors != SensorErrors::default(),
-                &[FixedBeacon, MovingBeacon, PassiveUsbl][..],
-                "fixed_beacon (the AHRS heading), moving_beacon (the vehicles' DVL and heading) and passive_usbl (the AUVs' reports) so far",
+                &[FixedBeacon, MovingBeacon, PassiveUsbl, Fleet][..],
+                "every world: fixed_beacon (the AHRS heading), moving_beacon (the vehicles' DVL and heading), passive_usbl (the AUVs' reports), fleet (the AUVs' AHRS heading and propeller speed)",
             ),
             (
                 "sea.current",
@@ -345,8 +345,8 @@ mod tests {
         for (sea, key, allowed) in [
             (&clocks, "sea.clocks", [true, true, false, true]),
             (&usbl, "sea.usbl", [false, false, true, true]),
-            (&sensors, "sea.sensors", [false, true, true, false]),
-            (&heading, "sea.sensors", [true, true, true, false]),
+            (&sensors, "sea.sensors", [false, true, true, true]),
+            (&heading, "sea.sensors", [true, true, true, true]),
             (&current, "sea.current", [true, false, false, true]),
             (&profile, "sea.sound_speed", [false, true, true, true]),
         ] {

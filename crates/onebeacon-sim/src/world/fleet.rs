@@ -13,6 +13,7 @@ use crate::acoustics::profile::Profile;
 use crate::engine::{PilotRecord, VehicleTruth, World};
 use crate::scenario::fleet::{Fleet, SignalModel, Transmitter};
 use crate::seed::{Stream, gauss, vehicle_rng};
+use crate::sensor_errors::{DriftingSensors, SensorErrors as DriftErrors};
 use crate::vehicles::autopilot::Command;
 use crate::vehicles::sandshark::{SandShark, SensorErrors};
 use crate::water::Water;
@@ -44,6 +45,9 @@ struct Auv {
     /// Its clock and its link (`[sea]`).
     clock: Clock,
     link: Link,
+    /// Its AHRS's and speed's drifting errors on top of the `[sandshark]` ones
+    /// (`[sea.sensors]`; None: off, so that the heading is not wrapped twice).
+    drift: Option<DriftingSensors>,
 }
 
 /// A ping sent, waiting for the end of the capture window.
@@ -98,6 +102,8 @@ impl FleetWorld {
                     acoustic_rng: vehicle_rng(seed, run, v, Stream::Acoustic),
                     clock: Clock::new(&s.sea.clocks, vehicle_rng(seed, run, v, Stream::Clock)),
                     link: Link::new(&s.sea.link, vehicle_rng(seed, run, v, Stream::Link)),
+                    drift: (s.sea.sensors != DriftErrors::default())
+                        .then(|| DriftingSensors::new(&s.sea.sensors, vehicle_rng(seed, run, v, Stream::Sensors))),
                 }
             })
             .collect();
@@ -342,9 +348,12 @@ impl World for FleetWorld {
             let rng = &mut a.imu_rng;
             let white = params.attitude_white_deg.to_radians();
             let sog = a.truth.speed_m_s * (1.0 + a.errors.speed_scale) * a.truth.pitch_rad.cos(); // eq. 1
-            let speed = if a.truth.thrusting { (sog + gauss(rng, params.speed_white_m_s)).max(0.0) } else { 0.0 };
-            let heading =
+            let mut speed = if a.truth.thrusting { (sog + gauss(rng, params.speed_white_m_s)).max(0.0) } else { 0.0 };
+            let mut heading =
                 a.truth.heading_rad + a.errors.heading_rad + gauss(rng, params.heading_white_deg.to_radians());
+            if let Some(d) = &mut a.drift {
+                (speed, heading) = (d.speed(t1, speed), d.heading(t1, heading));
+            }
             let h = &mut heard[v];
             h.push(Measurement::new(t1, Kind::Speed { speed_m_s: speed }));
             h.push(Measurement::new(
@@ -459,5 +468,63 @@ mod tests {
             );
         }
         assert!(carried.iter().any(|(_, t)| *t > 100.0));
+    }
+
+    /// `[sea.sensors]` on the AUVs against the same run without: every speed read is the
+    /// clean one times one scale per AUV (1e-12), not 1; every heading differs from the
+    /// clean one by a bias that barely moves with a 1e7 s time constant (under 0.01 rad
+    /// over 300 s).
+    #[test]
+    fn drifting_sensors_reach_the_auvs() {
+        let Scenario::Fleet(s) = parse(builtin("rypkema-m1").unwrap().toml, "m1").unwrap() else { unreachable!() };
+        let read = |sensors: DriftErrors| {
+            let mut s = s.clone();
+            s.sea.sensors = sensors;
+            let mut w = FleetWorld::new(&s, 1, 0);
+            let dive = Some(VehicleCommand::Setpoint {
+                setpoint: Setpoint { heading_rad: 0.5, speed_m_s: 1.0, depth_m: 2.5 },
+                mode: None,
+                phase: Phase::Waiting,
+            });
+            let commands = vec![dive; w.auvs.len()];
+            let mut out = Vec::new();
+            for k in 1..=(300.0 / w.dt()).round() as usize {
+                let mut heard = vec![Vec::new(); w.auvs.len()];
+                w.advance(k, &commands, &mut heard);
+                for (v, ms) in heard.iter().enumerate() {
+                    let (mut u, mut psi) = (None, None);
+                    for m in ms {
+                        match m.kind {
+                            Kind::Speed { speed_m_s } => u = Some(speed_m_s),
+                            Kind::Attitude { heading_rad, .. } => psi = Some(heading_rad),
+                            _ => {}
+                        }
+                    }
+                    if let (Some(u), Some(psi)) = (u, psi) {
+                        out.push((v, u, psi));
+                    }
+                }
+            }
+            out
+        };
+        let base = read(DriftErrors::default());
+        let drifted = read(DriftErrors {
+            speed_scale_sigma: 0.05,
+            heading_bias_sigma_deg: 2.0,
+            heading_bias_time_constant_s: 1e7,
+            ..DriftErrors::default()
+        });
+        assert_eq!(base.len(), drifted.len());
+        let mut first: Vec<Option<(f64, f64)>> = vec![None; s.auvs.len()];
+        for ((v, u0, p0), (_, u, p)) in base.iter().zip(&drifted) {
+            if *u0 <= 1e-6 {
+                continue;
+            }
+            let (scale, bias) = *first[*v].get_or_insert((u / u0, onebeacon::geo::wrap_angle(p - p0)));
+            assert!((scale - 1.0).abs() > 1e-4 && bias.abs() > 1e-4, "{v}: scale {scale}, bias {bias}");
+            assert!((u / u0 - scale).abs() < 1e-12, "{v}: {u} against {u0}");
+            assert!((onebeacon::geo::wrap_angle(p - p0) - bias).abs() < 0.01, "{v}");
+        }
+        assert!(first.iter().all(Option::is_some));
     }
 }
