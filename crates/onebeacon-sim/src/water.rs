@@ -65,6 +65,13 @@ impl Water {
         Vector3::new(dir.cos(), dir.sin(), 0.0) * speed
     }
 
+    /// The current now, then drifted over the step of `dt` s that it acts on.
+    pub fn step(&mut self, dt: f64) -> Vector3<f64> {
+        let now = self.ned();
+        self.drift(dt);
+        now
+    }
+
     /// Drifts over `dt` s (exact discretisation of the first-order process).
     pub fn drift(&mut self, dt: f64) {
         let a = (-dt / self.spec.time_constant_s).exp();

@@ -110,11 +110,7 @@ impl World for FixedBeaconWorld {
         // truth moves under the command of the previous step (eq. 3-4), then a new
         // command is computed from the reference (eq. 2)
         self.truth = self.truth.step(self.omega, self.accel, self.dt);
-        let current = self.water.as_mut().map(|w| {
-            let c = w.ned().xy();
-            w.drift(self.dt);
-            c
-        });
+        let current = self.water.as_mut().map(|w| w.step(self.dt).xy());
         if let Some(c) = current {
             self.truth.pos += c * self.dt;
         }

@@ -327,11 +327,7 @@ impl World for FleetWorld {
             }
         }
         let params = self.s.sandshark.clone();
-        let current = self.water.as_mut().map(|w| {
-            let c = w.ned();
-            w.drift(dt);
-            c
-        });
+        let current = self.water.as_mut().map(|w| w.step(dt));
         for (v, a) in self.auvs.iter_mut().enumerate() {
             if t1 < a.launch_s {
                 continue; // not in the water yet
@@ -378,6 +374,18 @@ mod tests {
     use crate::scenario::{Scenario, builtin, parse};
     use crate::water::Current;
 
+    /// rypkema-m1 as built in.
+    fn m1() -> Fleet {
+        let Scenario::Fleet(s) = parse(builtin("rypkema-m1").unwrap().toml, "m1").unwrap() else { unreachable!() };
+        s
+    }
+
+    /// Every one of `auvs` AUVs told to dive to 2.5 m and hold `heading_rad` at 1 m/s.
+    fn dive(heading_rad: f64, auvs: usize) -> Vec<Option<VehicleCommand>> {
+        let setpoint = Setpoint { heading_rad, speed_m_s: 1.0, depth_m: 2.5 };
+        vec![Some(VehicleCommand::Setpoint { setpoint, mode: None, phase: Phase::Waiting }); auvs]
+    }
+
     /// Abstract pings without noise in a sea of offset clocks and a lossy link: every
     /// range heard reads the true one plus c times the AUV's clock less the beacon's
     /// (1e-9 m), and 30 % of the pings a clean link hears on the same tracks are lost
@@ -396,12 +404,7 @@ mod tests {
             let mut w = FleetWorld::new(&s, 1, 0);
             let c = s.signal.sound_speed_m_s;
             let beacon_s = w.beacon_clocks[0].error_s(0.0);
-            let dive = Some(VehicleCommand::Setpoint {
-                setpoint: Setpoint { heading_rad: 0.0, speed_m_s: 1.0, depth_m: 2.5 },
-                mode: None,
-                phase: Phase::Waiting,
-            });
-            let commands = vec![dive; w.auvs.len()];
+            let commands = dive(0.0, w.auvs.len());
             let mut heard = Vec::new();
             for k in 1..=6000 {
                 let before: Vec<Vector3<f64>> = w.auvs.iter().map(|a| a.truth.position_ned_m).collect();
@@ -436,17 +439,12 @@ mod tests {
     /// than in still water, and no further north (1e-9 m); AUVs not yet launched stay.
     #[test]
     fn a_current_carries_the_auvs() {
-        let Scenario::Fleet(s) = parse(builtin("rypkema-m1").unwrap().toml, "m1").unwrap() else { unreachable!() };
+        let s = m1();
         let end = |current: Current| {
             let mut s = s.clone();
             s.sea.current = current;
             let mut w = FleetWorld::new(&s, 1, 0);
-            let dive = Some(VehicleCommand::Setpoint {
-                setpoint: Setpoint { heading_rad: 0.5, speed_m_s: 1.0, depth_m: 2.5 },
-                mode: None,
-                phase: Phase::Waiting,
-            });
-            let commands = vec![dive; w.auvs.len()];
+            let commands = dive(0.5, w.auvs.len());
             // an AUV moves on every step from its launch on
             let mut in_water = vec![0.0; w.auvs.len()];
             for k in 1..=(300.0 / w.dt()).round() as usize {
@@ -476,17 +474,12 @@ mod tests {
     /// over 300 s).
     #[test]
     fn drifting_sensors_reach_the_auvs() {
-        let Scenario::Fleet(s) = parse(builtin("rypkema-m1").unwrap().toml, "m1").unwrap() else { unreachable!() };
+        let s = m1();
         let read = |sensors: DriftErrors| {
             let mut s = s.clone();
             s.sea.sensors = sensors;
             let mut w = FleetWorld::new(&s, 1, 0);
-            let dive = Some(VehicleCommand::Setpoint {
-                setpoint: Setpoint { heading_rad: 0.5, speed_m_s: 1.0, depth_m: 2.5 },
-                mode: None,
-                phase: Phase::Waiting,
-            });
-            let commands = vec![dive; w.auvs.len()];
+            let commands = dive(0.5, w.auvs.len());
             let mut out = Vec::new();
             for k in 1..=(300.0 / w.dt()).round() as usize {
                 let mut heard = vec![Vec::new(); w.auvs.len()];
