@@ -108,9 +108,22 @@ pub fn fleet(
 fn table(name: &str, seed: u64, wall_s: f64, st: &FleetStatistics) -> String {
     let mut t = String::new();
     let _ = writeln!(t, "{name}: {} runs from seed {seed} in {wall_s:.0} s", st.runs);
-    let _ = writeln!(t, "2-norm error while submerged (m)   {:>8} {:>8} {:>8} {:>9}", "68 %", "95 %", "mean", "steps");
+    let _ = writeln!(
+        t,
+        "2-norm error while submerged (m)   {:>8} {:>8} {:>8} {:>9} {:>8} {:>13}",
+        "68 %", "95 %", "mean", "steps", "nees", "nees_band95"
+    );
     for e in st.tracks.iter().chain(&st.fleet) {
-        let _ = writeln!(t, "  {:<32} {:>8.2} {:>8.2} {:>8.2} {:>9}", e.label, e.p68_m, e.p95_m, e.mean_m, e.samples);
+        let (nees, band) = if e.nees_mean.is_nan() {
+            ("-".to_string(), "-".to_string())
+        } else {
+            (format!("{:.2}", e.nees_mean), format!("{:.2}-{:.2}", e.nees_band[0], e.nees_band[1]))
+        };
+        let _ = writeln!(
+            t,
+            "  {:<32} {:>8.2} {:>8.2} {:>8.2} {:>9} {nees:>8} {band:>13}",
+            e.label, e.p68_m, e.p95_m, e.mean_m, e.samples
+        );
     }
     let _ =
         writeln!(t, "  {:<32} {PAPER_P68_M:>8.2} {PAPER_P95_M:>8.2}   (rypkema Table 3, real data)", "paper, all AUVs");

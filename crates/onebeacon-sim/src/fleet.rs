@@ -7,7 +7,7 @@ use crate::run::{RunOutput, StepRecord};
 use crate::scenario::fleet::{BehaviourName, Fleet};
 use crate::seed::{Stream, gauss, vehicle_rng};
 use nalgebra::Vector2;
-use onebeacon::nav::evaluation::quantile;
+use onebeacon::nav::evaluation::{chi_square_band, quantile};
 use serde::Serialize;
 
 /// Errors of one (vehicle, estimator) or one estimator pooled over the fleet.
@@ -19,6 +19,12 @@ pub struct ErrorPercentiles {
     pub mean_m: f64,
     /// Steps counted (submerged, after launch).
     pub samples: usize,
+    /// The horizontal position's NEES against the truth (never the reference), averaged
+    /// over the counted steps of each run and then over the runs (NaN for an estimator
+    /// without a covariance); 2 is consistent.
+    pub nees_mean: f64,
+    /// The 95 % band of that mean for as many runs (tracks pooled: runs x AUVs).
+    pub nees_band: [f64; 2],
 }
 
 /// When one AUV confirmed one command.
@@ -68,11 +74,20 @@ pub struct FleetStatistics {
     pub coverage: Option<Coverage>,
 }
 
-fn percentiles(label: String, mut e: Vec<f64>) -> ErrorPercentiles {
+/// Errors `e` and each run's mean NEES `nees` (one per run and track) summarised.
+fn percentiles(label: String, mut e: Vec<f64>, nees: &[f64]) -> ErrorPercentiles {
     e.retain(|v| v.is_finite());
     e.sort_by(f64::total_cmp);
     let mean = e.iter().sum::<f64>() / e.len().max(1) as f64;
-    ErrorPercentiles { label, p68_m: quantile(&e, 0.68), p95_m: quantile(&e, 0.95), mean_m: mean, samples: e.len() }
+    ErrorPercentiles {
+        label,
+        p68_m: quantile(&e, 0.68),
+        p95_m: quantile(&e, 0.95),
+        mean_m: mean,
+        samples: e.len(),
+        nees_mean: nees.iter().sum::<f64>() / nees.len() as f64,
+        nees_band: chi_square_band(nees.len(), 2),
+    }
 }
 
 /// Whether vehicle `v` is submerged and launched at record `r` (the steps the error
@@ -194,10 +209,13 @@ pub fn statistics(s: &Fleet, seed: u64, runs: &[RunOutput]) -> FleetStatistics {
     let estimators: Vec<&str> = s.estimators.iter().map(|e| e.label()).collect();
     let ne = estimators.len();
     let mut per_track: Vec<Vec<f64>> = vec![Vec::new(); s.auvs.len() * ne];
+    // each run's mean NEES per track over its counted steps
+    let mut nees: Vec<Vec<f64>> = vec![Vec::with_capacity(runs.len()); s.auvs.len() * ne];
     let sigma = s.reference.sigma_m;
     for (run, out) in runs.iter().enumerate() {
         let mut rngs: Vec<_> = (0..s.auvs.len()).map(|v| vehicle_rng(seed, run as u64, v, Stream::Reference)).collect();
         let mut fixes: Vec<Vector2<f64>> = Vec::with_capacity(s.auvs.len());
+        let mut run_nees = vec![(0.0, 0usize); per_track.len()]; // (sum, steps)
         for r in &out.trajectory {
             // every AUV's fix of this step, drawn whether it counts or not
             fixes.clear();
@@ -209,19 +227,24 @@ pub fn statistics(s: &Fleet, seed: u64, runs: &[RunOutput]) -> FleetStatistics {
                 if counted(s, r, e.vehicle) {
                     let error = fixes.get(e.vehicle).map_or(e.error_m, |f| (e.pos.xy() - f).norm());
                     per_track[i].push(error);
+                    run_nees[i] = (run_nees[i].0 + e.nees, run_nees[i].1 + 1);
                 }
             }
+        }
+        for (all, (sum, n)) in nees.iter_mut().zip(run_nees) {
+            all.push(sum / n as f64);
         }
     }
     let tracks = per_track
         .iter()
         .enumerate()
-        .map(|(i, e)| percentiles(format!("{}/{}", s.auvs[i / ne].name, estimators[i % ne]), e.clone()))
+        .map(|(i, e)| percentiles(format!("{}/{}", s.auvs[i / ne].name, estimators[i % ne]), e.clone(), &nees[i]))
         .collect();
     let fleet = (0..ne)
         .map(|j| {
             let all = per_track.iter().skip(j).step_by(ne).flatten().copied().collect();
-            percentiles(format!("fleet/{}", estimators[j]), all)
+            let all_nees: Vec<f64> = nees.iter().skip(j).step_by(ne).flatten().copied().collect();
+            percentiles(format!("fleet/{}", estimators[j]), all, &all_nees)
         })
         .collect();
     let mut all_confirmed = true;

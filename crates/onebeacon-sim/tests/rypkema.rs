@@ -4,6 +4,7 @@
 
 use nalgebra::{Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
+use onebeacon::nav::evaluation::chi_square_band;
 use onebeacon::vehicle::Phase;
 use onebeacon::vehicle::autonomy::{Autonomy, AutonomySettings, Behaviour};
 use onebeacon_sim::Scenario;
@@ -120,12 +121,17 @@ fn a_short_mission_confirms_its_mode_and_navigates() {
     // (within 5 %: some 4500 samples, correlated only through the navigation)
     let mut far = f.clone();
     far.reference.sigma_m = 100.0;
-    let st = statistics(&far, 1, &[out]);
-    let iusbl = st.fleet.iter().find(|e| e.label == "fleet/iusbl").unwrap();
-    for (got, q) in [(iusbl.p68_m, 0.68f64), (iusbl.p95_m, 0.95)] {
+    let far_st = statistics(&far, 1, &[out]);
+    let far_iusbl = far_st.fleet.iter().find(|e| e.label == "fleet/iusbl").unwrap();
+    for (got, q) in [(far_iusbl.p68_m, 0.68f64), (far_iusbl.p95_m, 0.95)] {
         let rayleigh = 100.0 * (-2.0 * (1.0 - q).ln()).sqrt();
         assert!((got / rayleigh - 1.0).abs() < 0.05, "{q}: {got} against {rayleigh}");
     }
+    // the NEES is the filter's against the truth, whatever the reference: the same bits,
+    // pooled over one run of each AUV (its band that of as many chi-square(2) draws)
+    assert!(iusbl.nees_mean.is_finite() && iusbl.nees_mean > 0.0, "{iusbl:?}");
+    assert_eq!(far_iusbl.nees_mean.to_bits(), iusbl.nees_mean.to_bits());
+    assert_eq!(iusbl.nees_band, chi_square_band(f.auvs.len(), 2));
 }
 
 /// Bad fleet keys are one-line errors naming the key and what is allowed.
