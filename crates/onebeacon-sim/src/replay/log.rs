@@ -611,6 +611,53 @@ y = "y"
         assert_abs_diff_eq!(heading_change_rad, -PI / 6.0, epsilon = 1e-12);
     }
 
+    /// `increment_frame = "start"`: factor-graph edges (a translation in the start pose's
+    /// frame, then the turn) with turns of 80-150 deg. Dead reckoning lands on the
+    /// closed-form SE(2) composition p += R(psi) (d, l), psi += dpsi at every step (1e-9
+    /// m), in a NED and an ENU log, from body_odometry and from odometry; the same rows
+    /// read at the mid-step heading (the default) end metres off.
+    #[test]
+    fn start_frame_increments_compose_as_factor_graph_edges() {
+        for frame in ["ned", "enu"] {
+            for (kind, columns) in
+                [("body_odometry", "forward = \"d\"\nlateral = \"l\""), ("odometry", "distance = \"d\"")]
+            {
+                let (mut odometry, mut truth) = ("t,d,l,dh\n".to_string(), "t,x,y\n".to_string());
+                let (mut x, mut y, mut psi) = (0.0f64, 0.0f64, 0.0f64);
+                for k in 0..40 {
+                    let d = 1.0 + (k % 5) as f64;
+                    let l = if kind == "odometry" { 0.0 } else { 0.4 * ((k % 3) as f64 - 1.0) };
+                    let turn =
+                        (80.0 + 70.0 * ((k * 7) % 11) as f64 / 10.0).to_radians() * if k % 2 == 0 { 1.0 } else { -1.0 };
+                    x += d * psi.cos() - l * psi.sin();
+                    y += d * psi.sin() + l * psi.cos();
+                    psi += turn;
+                    odometry += &format!("{k}.0,{d},{l},{turn}\n");
+                    truth += &format!("{k}.5,{x},{y}\n");
+                }
+                let run = |increment: &str| {
+                    let body = format!(
+                        "frame = \"{frame}\"\n[[source]]\nkind = \"{kind}\"\nfile = \"o.csv\"\ntime = \"t\"\n{columns}\n\
+                         heading_change = \"dh\"\n{increment}\n[[source]]\nkind = \"ground_truth\"\nfile = \"g.csv\"\n\
+                         time = \"t\"\nx = \"x\"\ny = \"y\"\n"
+                    );
+                    let log = load(&format!("start-{frame}-{kind}"), &body, &[("o.csv", &odometry), ("g.csv", &truth)])
+                        .unwrap();
+                    let mut worst: f64 = 0.0;
+                    let r = crate::replay::replay(&log, None, |row| {
+                        worst = worst.max(row.estimates[0].error_m);
+                        Ok::<_, LogError>(())
+                    });
+                    assert_eq!(r.unwrap().session.stats[0].count, 40);
+                    worst
+                };
+                let (start, mid) = (run("increment_frame = \"start\""), run(""));
+                assert!(start < 1e-9, "{frame} {kind}: {start} m off the composition");
+                assert!(mid > 1.0, "{frame} {kind}: the mid-step reading is {mid} m off");
+            }
+        }
+    }
+
     /// Without `[initial]`, a log starts at its first ground-truth pose and heading (the
     /// documented defaults), with the default sigmas.
     #[test]
@@ -846,6 +893,12 @@ heading_clockwise = true
             "[[source]]\nkind = \"speed\"\nfile = \"s.csv\"\ntime = \"t\"\nspeed = \"v\"\nheading_clockwise = true\n",
         );
         assert!(e.contains("source[0].heading_clockwise"), "{e}");
+        let e = parse(
+            "[[source]]\nkind = \"speed\"\nfile = \"s.csv\"\ntime = \"t\"\nspeed = \"v\"\nincrement_frame = \"start\"\n",
+        );
+        assert!(e.contains("source[0].increment_frame") && e.contains("odometry and body_odometry"), "{e}");
+        let e = parse(&format!("{truth}x = \"x\"\ny = \"y\"\nincrement_frame = \"end\"\n"));
+        assert!(e.contains("increment_frame") && e.contains("start"), "{e}");
         let e = parse("[[beacon]]\nid = 1\nx_m = 1.0\n");
         assert!(e.contains("beacon[0].x_m"), "{e}");
         let e = parse("[origin]\nlat_deg = 95.0\nlon_deg = 0.0\n");

@@ -4,7 +4,7 @@
 use super::csv::Table;
 use super::geodesy::Geodetic;
 use super::log::{Log, LogError};
-use super::schema::{COLUMN_KEYS, Source, SourceKind, TimeOrder};
+use super::schema::{COLUMN_KEYS, IncrementFrame, Source, SourceKind, TimeOrder};
 use nalgebra::Vector3;
 use onebeacon::geo::Frame;
 use onebeacon::nav::Kind;
@@ -238,15 +238,23 @@ impl<'a> SourceRows<'a> {
         let measurement = |m: Kind| Item { t_s: t, input: Input::Measurement(m) };
         let mut second = None;
         let item = match s.kind {
+            SourceKind::Odometry if s.increment_frame == IncrementFrame::Start => {
+                measurement(at_mid_heading(num("distance")? * len, 0.0, turn("heading_change")?))
+            }
             SourceKind::Odometry => measurement(Kind::Odometry {
                 distance_m: num("distance")? * len,
                 heading_change_rad: turn("heading_change")?,
             }),
-            SourceKind::BodyOdometry => measurement(Kind::BodyOdometry {
-                forward_m: num("forward")? * len,
-                lateral_m: sense * num("lateral")? * len,
-                heading_change_rad: turn("heading_change")?,
-            }),
+            SourceKind::BodyOdometry => {
+                let (forward, lateral) = (num("forward")? * len, sense * num("lateral")? * len);
+                let dpsi = turn("heading_change")?;
+                measurement(match s.increment_frame {
+                    IncrementFrame::Mid => {
+                        Kind::BodyOdometry { forward_m: forward, lateral_m: lateral, heading_change_rad: dpsi }
+                    }
+                    IncrementFrame::Start => at_mid_heading(forward, lateral, dpsi),
+                })
+            }
             SourceKind::BodyVelocity => {
                 let r = cols.contains_key("yaw_rate").then(|| turn("yaw_rate")).transpose()?.unwrap_or(0.0);
                 let (u, v) = (num("forward_speed")? * len, sense * num("lateral_speed")? * len);
@@ -277,5 +285,19 @@ impl<'a> SourceRows<'a> {
         };
         self.previous = Some(t);
         Ok(Some((item, second)))
+    }
+}
+
+/// A start-frame increment (`increment_frame = "start"`: the translation (d, l) at the
+/// heading before the turn dpsi) as the body_odometry the navigators compose at the
+/// mid-step heading: the same translation turned back by dpsi / 2,
+/// (d', l') = R(-dpsi / 2) (d, l), so that R(psi + dpsi / 2) (d', l') = R(psi) (d, l)
+/// exactly. In either frame's sense: l and dpsi turn the same way.
+fn at_mid_heading(forward_m: f64, lateral_m: f64, heading_change_rad: f64) -> Kind {
+    let (s, c) = (heading_change_rad / 2.0).sin_cos();
+    Kind::BodyOdometry {
+        forward_m: c * forward_m + s * lateral_m,
+        lateral_m: -s * forward_m + c * lateral_m,
+        heading_change_rad,
     }
 }

@@ -126,6 +126,20 @@ pub enum TimeOrder {
     Drop,
 }
 
+/// Which heading an odometry increment's translation is expressed at
+/// (`increment_frame`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IncrementFrame {
+    /// The heading halfway through the turn (the default): the chord of an arc sampled
+    /// by wheel odometry or an INS, p' = p + R(psi + dpsi / 2) (d, l).
+    #[default]
+    Mid,
+    /// The heading at the start of the increment, then the turn: a factor-graph edge
+    /// (GTSAM's `BetweenFactor`, g2o's `EDGE_SE2`), p' = p + R(psi) (d, l).
+    Start,
+}
+
 /// One CSV file: its kind, the time column and the column of each quantity.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -166,6 +180,9 @@ pub struct Source {
     pub heading_clockwise: Option<bool>,
     #[serde(default)]
     pub latlon_unit: LatLonUnit,
+    /// odometry and body_odometry: the heading each increment's translation is at.
+    #[serde(default)]
+    pub increment_frame: IncrementFrame,
     pub distance: Option<String>,
     pub heading_change: Option<String>,
     pub forward: Option<String>,

@@ -3,7 +3,7 @@
 //! are checked by [`onebeacon::config::stream::StreamConfig::check`]). The first
 //! violation is reported with its key.
 
-use super::log::{COLUMN_KEYS, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
+use super::log::{COLUMN_KEYS, IncrementFrame, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
 use crate::scenario::validate::{Rule, Violation, check};
 
 /// A position given as exactly one pair: `x`/`y` or `lat`/`lon` (the keys named by
@@ -116,6 +116,15 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
                 | SourceKind::SpeedHeading
                 | SourceKind::GroundTruth
         );
+        if s.increment_frame != IncrementFrame::Mid
+            && !matches!(s.kind, SourceKind::Odometry | SourceKind::BodyOdometry)
+        {
+            return Err(Violation {
+                key: format!("source[{i}].increment_frame"),
+                value: "\"start\"".into(),
+                allowed: format!("applies to odometry and body_odometry sources, not to a {:?} source", s.kind),
+            });
+        }
         if !turns && (s.heading_offset_deg != 0.0 || s.heading_clockwise.is_some()) {
             return Err(Violation {
                 key: format!("source[{i}].heading_clockwise"),
