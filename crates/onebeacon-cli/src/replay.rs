@@ -111,6 +111,19 @@ pub fn replay(
             .collect();
         outln!("{:<20}{cells}", e["name"].as_str().unwrap_or(""));
     }
+    // per-beacon range offsets (`estimate_beacon_offsets`), one line per estimator
+    for e in summary["estimators"].as_array().into_iter().flatten() {
+        let Some(offsets) = e["beacon_offsets"].as_object() else { continue };
+        let cells: Vec<String> = offsets
+            .iter()
+            .map(|(b, o)| {
+                let (v, sigma) =
+                    (o["offset_m"].as_f64().unwrap_or(f64::NAN), o["sigma_m"].as_f64().unwrap_or(f64::NAN));
+                format!("beacon {b} {v:+.3} (sigma {sigma:.3})")
+            })
+            .collect();
+        outln!("{}: range offsets, m: {}", e["name"].as_str().unwrap_or(""), cells.join(", "));
+    }
     outln!("wrote:");
     for f in files {
         outln!("  {}", f.display());

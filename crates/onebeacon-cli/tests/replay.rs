@@ -63,6 +63,31 @@ fn rmse(estimators: &[Value], name: &str) -> f64 {
     estimators.iter().find(|e| e["name"] == name).unwrap()["rmse_m"].as_f64().unwrap()
 }
 
+/// Per-beacon range offsets (`estimate_beacon_offsets`) are in the console table's
+/// lines as in `--json`, one line per estimator that has them, every beacon heard.
+#[test]
+fn beacon_offsets_are_printed_as_in_the_json() {
+    let dir = scratch("offsets");
+    let est = dir.join("est.toml");
+    std::fs::write(&est, "[[estimators]]\nname = \"offsets\"\nkind = \"range-ekf\"\nestimate_beacon_offsets = true\n")
+        .unwrap();
+    let (out, est) = (dir.join("out").display().to_string(), est.display().to_string());
+    let o = run(&["replay", &plaza(1), "--estimators", &est, "--out", &out, "--json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let offsets = v["estimators"][0]["beacon_offsets"].as_object().unwrap().clone();
+    let o = run(&["replay", &plaza(1), "--estimators", &est, "--out", &out]);
+    let table = text(&o.stdout);
+    let line =
+        table.lines().find(|l| l.starts_with("offsets: range offsets, m: ")).unwrap_or_else(|| panic!("{table}"));
+    assert_eq!(offsets.len(), 4, "{offsets:?}");
+    for (b, e) in &offsets {
+        let want =
+            format!("beacon {b} {:+.3} (sigma {:.3})", e["offset_m"].as_f64().unwrap(), e["sigma_m"].as_f64().unwrap());
+        assert!(line.contains(&want), "{want} not in {line}");
+    }
+}
+
 /// The targets that the data allow (see the closing note for the table): all
 /// four beacons within 1.5 m RMSE on both logs, with the bias estimated and with the
 /// calibration states; on plaza2, where dead reckoning drifts (32 m RMSE), each single

@@ -59,9 +59,19 @@ impl Table {
     }
 
     pub(super) fn index(&self, column: &str) -> Result<usize, LogError> {
-        self.header.iter().position(|h| h == column).ok_or_else(|| LogError::File {
+        // a first line of numbers is data: the file has no header row to name columns by
+        let headless = !self.header.is_empty() && self.header.iter().all(|h| h.parse::<f64>().is_ok());
+        self.header.iter().position(|h| h == column && !headless).ok_or_else(|| LogError::File {
             file: self.file.clone(),
-            message: format!("no column `{column}` (columns: {})", self.header.join(", ")),
+            message: if headless {
+                format!(
+                    "no header row: its first line ({}) is numbers; a CSV file of a log starts with a line \
+                     naming its columns, which the source's keys refer to by name (docs/logs.md)",
+                    self.header.join(", ")
+                )
+            } else {
+                format!("no column `{column}` (columns: {})", self.header.join(", "))
+            },
         })
     }
 

@@ -658,6 +658,17 @@ y = "y"
         }
     }
 
+    /// A CSV file without a header row (its first line is data) is refused by that
+    /// name, even when a key names a column by a number the first line holds.
+    #[test]
+    fn a_file_without_a_header_row_is_named_so() {
+        let body = "[[source]]\nkind = \"speed\"\nfile = \"s.csv\"\ntime = \"0\"\nspeed = \"1.5\"\n";
+        let e = load("headless", body, &[("s.csv", "0,1.5\n1,1.4\n")])
+            .and_then(|l| l.items()?.collect::<Result<Vec<_>, _>>());
+        let e = e.unwrap_err().to_string();
+        assert!(e.contains("s.csv") && e.contains("no header row") && e.contains("(0, 1.5)"), "{e}");
+    }
+
     /// Without `[initial]`, a log starts at its first ground-truth pose and heading (the
     /// documented defaults), with the default sigmas.
     #[test]
