@@ -84,6 +84,17 @@ pub fn replay(
         return Ok(());
     }
     outln!("{title}: {} measurements, replayed in {:.1} ms", r.items, wall_s * 1e3);
+    let st = &summary["start"];
+    let f = |k: &str| st[k].as_f64().unwrap_or(f64::NAN);
+    outln!(
+        "start ([initial] from = \"{}\"): t {:.3} s, x {:.2} m, y {:.2} m, heading {:.1} deg, position sigma {:.2} m",
+        st["from"].as_str().unwrap_or(""),
+        f("t_s"),
+        f("x_m"),
+        f("y_m"),
+        f("heading_rad").to_degrees(),
+        f("position_sigma_m")
+    );
     for d in r.dropped.iter().filter(|d| d.dropped > 0) {
         outln!("{}: {} rows out of time order dropped (time_order = \"drop\")", d.file, d.dropped);
     }

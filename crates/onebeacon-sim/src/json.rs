@@ -8,6 +8,7 @@ use crate::montecarlo::McResult;
 use crate::replay::{Log, Replay};
 use crate::run::RunOutput;
 use crate::scenario::{Cell, SweepValue};
+use onebeacon::config::stream::InitialFrom;
 use serde_json::{Value, json};
 
 /// JSON number, or null when not finite (JSON has no NaN or infinity).
@@ -133,9 +134,23 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
             v
         })
         .collect();
+    let (north, east, psi) = r.start.pose;
+    let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(north, east, 0.0));
     json!({
         "log": log.description.name,
         "beacons": used,
+        "start": {
+            "from": match log.description.initial.from {
+                InitialFrom::GroundTruth => "ground_truth",
+                InitialFrom::Given => "given",
+                InitialFrom::Ranges => "ranges",
+            },
+            "t_s": r.start.t0_s,
+            "x_m": x,
+            "y_m": y,
+            "heading_rad": log.frame.heading_from_ned(psi),
+            "position_sigma_m": r.start.position_sigma_m,
+        },
         "items": r.items,
         "skipped_before_start": s.before_start,
         "left_out": s.left_out,

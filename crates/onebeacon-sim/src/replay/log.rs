@@ -960,6 +960,13 @@ heading_clockwise = true
         assert_abs_diff_eq!(e, p.1, epsilon = 0.01);
         assert_abs_diff_eq!(psi, FRAC_PI_2, epsilon = 1e-12);
         assert_eq!(sigma, 1.0); // the fix is exact: position_sigma_m's default
+        // the replay starts there and says so in its summary (in the log's frame)
+        let r = crate::replay::replay(&log, None, |_| Ok::<_, LogError>(())).unwrap();
+        assert_eq!(r.start, log.initial_start().unwrap());
+        let v = crate::json::replay_summary(&log, &[0, 1, 2], &r, 0.0);
+        let at = |k: &str| v["start"][k].as_f64().unwrap();
+        assert_eq!((v["start"]["from"].as_str(), at("t_s"), at("position_sigma_m")), (Some("ranges"), 11.0, 1.0));
+        assert_eq!((at("x_m"), at("y_m"), at("heading_rad")), (n, e, psi));
         let two = csv.lines().filter(|l| !l.contains(",2,")).collect::<Vec<_>>().join("\n");
         let mut log = load("ranges-two", body, &[("r.csv", &two)]).unwrap();
         log.description.initial.from = InitialFrom::Ranges;

@@ -12,7 +12,7 @@ pub(crate) mod schema;
 pub mod tune;
 pub(crate) mod validate;
 
-pub use log::{Log, LogDescription, LogError};
+pub use log::{InitialStart, Log, LogDescription, LogError};
 pub use rows::Dropped;
 
 use onebeacon::config::stream::Beacon;
@@ -31,6 +31,9 @@ pub struct Replay {
     pub items: usize,
     /// Rows dropped and kept by sources with `time_order = "drop"`.
     pub dropped: Vec<Dropped>,
+    /// Where and when the estimators started (`[initial]`: given, the ground truth or a
+    /// fix of the first ranges).
+    pub start: InitialStart,
 }
 
 /// Fewer ground-truth rows than this make a score that says little (a NEES band of a
@@ -70,6 +73,11 @@ impl Replay {
 
 /// The session a log describes, started at its initial pose.
 pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
+    session_and_start(log, beacons).map(|(session, _)| session)
+}
+
+/// [`session_for`] with the start it was given.
+fn session_and_start(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<(Session, InitialStart), LogError> {
     if !log.description.tracked.is_empty() {
         return Err(LogError::File {
             file: log.description.name.clone(),
@@ -80,7 +88,7 @@ pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session,
     let d = &log.description;
     let at = Start::At { t0_s: Some(start.t0_s), pose: start.pose };
     let session = d.stream_config(Vec::new()).session(&d.initial, at, beacons);
-    Ok(session.with_position_sigma(start.position_sigma_m))
+    Ok((session.with_position_sigma(start.position_sigma_m), start))
 }
 
 /// Beacon ids asked for (all when `None`) checked against the log's: the set to use, or
@@ -115,7 +123,7 @@ pub fn replay<E: From<LogError>>(
     beacons: Option<BTreeSet<u32>>,
     mut record: impl FnMut(StepRecord) -> Result<(), E>,
 ) -> Result<Replay, E> {
-    let mut session = session_for(log, beacons)?;
+    let (mut session, start) = session_and_start(log, beacons)?;
     let has_truth = log.has_truth();
     let mut heard = false;
     let mut items = 0;
@@ -132,7 +140,7 @@ pub fn replay<E: From<LogError>>(
         record(to_record(&step, session.last_beacon, heard))?;
         heard = false;
     }
-    Ok(Replay { session, items, dropped: stream.dropped() })
+    Ok(Replay { session, items, dropped: stream.dropped(), start })
 }
 
 /// A trajectory row (NED) from a step.
