@@ -647,13 +647,20 @@ y = "y"
                     let r = crate::replay::replay(&log, None, |row| {
                         worst = worst.max(row.estimates[0].error_m);
                         Ok::<_, LogError>(())
-                    });
-                    assert_eq!(r.unwrap().session.stats[0].count, 40);
-                    worst
+                    })
+                    .unwrap();
+                    assert_eq!(r.session.stats[0].count, 40);
+                    (worst, r.warnings(true))
                 };
-                let (start, mid) = (run("increment_frame = \"start\""), run(""));
+                let ((start, quiet), (mid, warned)) = (run("increment_frame = \"start\""), run(""));
                 assert!(start < 1e-9, "{frame} {kind}: {start} m off the composition");
                 assert!(mid > 1.0, "{frame} {kind}: the mid-step reading is {mid} m off");
+                // every turn is wider than the warning's 23 deg: read at mid-step, it is said
+                assert!(quiet.is_empty(), "{quiet:?}");
+                assert!(
+                    warned.iter().any(|w| w.starts_with("40 of 40 odometry rows") && w.contains("increment_frame")),
+                    "{warned:?}"
+                );
             }
         }
     }

@@ -15,7 +15,9 @@ pub(crate) mod validate;
 pub use log::{InitialStart, Log, LogDescription, LogError};
 pub use rows::Dropped;
 
+use log::IncrementFrame;
 use onebeacon::config::stream::Beacon;
+use onebeacon::nav::Kind;
 use onebeacon::nav::session::{Input, Session, Start, Step};
 use onebeacon::vehicle::unit::Unit;
 
@@ -34,7 +36,16 @@ pub struct Replay {
     /// Where and when the estimators started (`[initial]`: given, the ground truth or a
     /// fix of the first ranges).
     pub start: InitialStart,
+    /// Odometry rows read at the mid-step heading that turn more than
+    /// [`WIDE_TURN_DEG`] in one row, and all odometry rows.
+    pub wide_turns: (usize, usize),
 }
+
+/// A turn per odometry row beyond which the two increment conventions (mid-step and
+/// start heading) put the row's end apart by more than a fifth of its distance (2
+/// sin(dpsi / 4) = 0.2 at 23 deg); a sampled arc rarely turns so far in one row, a
+/// pose-graph edge often does: worth a warning when the log reads them at mid-step.
+pub const WIDE_TURN_DEG: f64 = 23.0;
 
 /// Fewer ground-truth rows than this make a score that says little (a NEES band of a
 /// handful of rows holds almost anything): the replay flags it.
@@ -66,6 +77,14 @@ impl Replay {
                     ));
                 }
             }
+        }
+        let (wide, rows) = self.wide_turns;
+        if wide > 0 {
+            w.push(format!(
+                "{wide} of {rows} odometry rows turn more than {WIDE_TURN_DEG} deg in one row, read at the \
+                 mid-step heading: if they are factor-graph edges (the translation, then the turn), set the \
+                 source's increment_frame = \"start\" (docs/logs.md, \"Motion models\")"
+            ));
         }
         w
     }
@@ -128,9 +147,19 @@ pub fn replay<E: From<LogError>>(
     let mut heard = false;
     let mut items = 0;
     let mut stream = log.items()?;
+    let start_frame = log.description.sources.iter().any(|s| s.increment_frame == IncrementFrame::Start);
+    let mut wide_turns = (0, 0);
     for item in &mut stream {
         let item = item?;
         items += 1;
+        if let Input::Measurement(
+            Kind::Odometry { heading_change_rad: dpsi, .. } | Kind::BodyOdometry { heading_change_rad: dpsi, .. },
+        ) = item.input
+            && !start_frame
+        {
+            wide_turns.0 += usize::from(dpsi.abs() > WIDE_TURN_DEG.to_radians());
+            wide_turns.1 += 1;
+        }
         // a screened item is counted and logged by the session; the replay goes on
         let Ok(Some(step)) = session.push(&item) else { continue };
         heard |= step.outcomes.iter().any(|o| matches!(o, Some(onebeacon::nav::Outcome::Accepted(..))));
@@ -140,7 +169,7 @@ pub fn replay<E: From<LogError>>(
         record(to_record(&step, session.last_beacon, heard))?;
         heard = false;
     }
-    Ok(Replay { session, items, dropped: stream.dropped(), start })
+    Ok(Replay { session, items, dropped: stream.dropped(), start, wide_turns })
 }
 
 /// A trajectory row (NED) from a step.
