@@ -347,8 +347,9 @@ impl StreamConfig {
     /// The vehicle's computer: one session per vehicle it estimates (its own from
     /// `[initial]`, or each of `[[tracked]]`), each started at its given pose or at the
     /// first ground-truth line, and the `[controller]` when there is one; no rejection
-    /// log (a stream reports each line as it comes). A start a stream cannot make (from
-    /// ranges, a heading from the track) is refused by its key.
+    /// log (a stream reports each line as it comes). A heading from the track starts
+    /// where the track is `track_m` long (a stream cannot look ahead); a start from
+    /// ranges, which needs a window of the log, is refused by its key.
     pub fn unit(&self) -> Result<Unit, Violation> {
         let frame = Frame::from(self.frame);
         let vehicles: Vec<(String, &Initial)> = if self.tracked.is_empty() {
@@ -367,13 +368,8 @@ impl StreamConfig {
                         allowed: "needs a window of the log; a stream starts from the first ground_truth line or a given pose".into(),
                     });
                 }
-                None if init.heading_from == HeadingFrom::Track => {
-                    return Err(Violation {
-                        key: format!("{section}.heading_from"),
-                        value: "\"track\"".into(),
-                        allowed: "needs the whole log; a stream starts from the first ground_truth line's heading (\"column\") or a given pose".into(),
-                    });
-                }
+                // a stream cannot look ahead: it starts where the track is track_m long
+                None if init.heading_from == HeadingFrom::Track => Start::Track { track_m: init.track_m, from: None },
                 None => Start::FirstTruth,
             };
             let session = self.session(init, start, None);

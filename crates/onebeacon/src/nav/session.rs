@@ -135,6 +135,10 @@ pub enum Start {
     At { t0_s: Option<f64>, pose: (f64, f64, f64) },
     /// At the first ground-truth item that carries a heading.
     FirstTruth,
+    /// A ground truth without heading, in a stream (which cannot look ahead): at the
+    /// first ground-truth item `track_m` from the first one (`from`, once seen), there,
+    /// heading along the chord between the two.
+    Track { track_m: f64, from: Option<(f64, f64)> },
 }
 
 /// A measurement an estimator's gate rejected, or an item screened out for every
@@ -438,6 +442,7 @@ impl Session {
             Start::At { t0_s: Some(t0), .. } => format!("the start time {t0} s"),
             Start::At { t0_s: None, .. } => "the first item".into(),
             Start::FirstTruth => "the first ground_truth item with a heading".into(),
+            Start::Track { track_m, .. } => format!("a ground-truth track {track_m} m long"),
         }
     }
 
@@ -550,6 +555,15 @@ impl Session {
                 (Start::FirstTruth, Input::Truth(TruthPose { north_m, east_m, heading_rad: Some(h) })) => {
                     self.begin(t, (*north_m, *east_m, *h))
                 }
+                (Start::Track { track_m, from }, Input::Truth(TruthPose { north_m, east_m, .. })) => {
+                    let (n0, e0) = from.unwrap_or((*north_m, *east_m));
+                    if (north_m - n0).hypot(east_m - e0) < track_m {
+                        self.start = Start::Track { track_m, from: Some((n0, e0)) };
+                        self.before_start += 1;
+                        return Ok(None);
+                    }
+                    self.begin(t, (*north_m, *east_m, (east_m - e0).atan2(north_m - n0)))
+                }
                 _ => {
                     self.before_start += 1;
                     return Ok(None);
@@ -659,6 +673,30 @@ mod tests {
         let after: Vec<bool> = [10_000.0, 10_001.0, 10_002.0, 10_003.0].map(|t| s.push(&item(t)).is_ok()).to_vec();
         assert_eq!(after, [false, false, true, true]);
         assert_eq!(s.screened, 3);
+    }
+
+    /// A stream whose ground truth has no heading (`heading_from = "track"`) starts at
+    /// the first truth item 2 m from the first one, heading along the chord: a truth
+    /// walking north-east 0.5 m a row starts at its fifth row (2.0 m), at that point,
+    /// at 45 deg; the four rows before are counted before the start.
+    #[test]
+    fn a_track_start_begins_where_the_track_is_long_enough() {
+        let est = vec![("dr".to_string(), PlanarConfig::default(), FilterKind::Ekf)];
+        let start = Start::Track { track_m: 2.0, from: None };
+        let mut s = Session::new(Frame::Ned, planar(est), start, (1.0, 0.1), None);
+        let step = 0.5 / 2f64.sqrt();
+        for k in 0..6 {
+            let (n, e) = (10.0 + step * k as f64, -5.0 + step * k as f64);
+            let item =
+                Item { t_s: k as f64, input: Input::Truth(TruthPose { north_m: n, east_m: e, heading_rad: None }) };
+            assert_eq!(s.push(&item).unwrap().is_some(), k >= 4, "row {k}");
+            if k == 4 {
+                let e0 = &s.final_estimates()[0];
+                assert!((e0.north_m() - n).abs() < 1e-12 && (e0.east_m() - e).abs() < 1e-12);
+                assert!((e0.heading_rad() - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
+            }
+        }
+        assert_eq!(s.before_start, 4);
     }
 
     /// Every plausible item passes the default limits; the implausible ones are refused
