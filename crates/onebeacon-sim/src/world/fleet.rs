@@ -386,6 +386,19 @@ mod tests {
         vec![Some(VehicleCommand::Setpoint { setpoint, mode: None, phase: Phase::Waiting }); auvs]
     }
 
+    /// Run 0 of `s` for 300 s, every AUV diving on heading 0.5 rad, `each` shown the world
+    /// and what every AUV heard after each step; the world at the end.
+    fn dive_300_s(s: &Fleet, mut each: impl FnMut(&FleetWorld, usize, &[Vec<Measurement>])) -> FleetWorld {
+        let mut w = FleetWorld::new(s, 1, 0);
+        let commands = dive(0.5, w.auvs.len());
+        for k in 1..=(300.0 / w.dt()).round() as usize {
+            let mut heard = vec![Vec::new(); w.auvs.len()];
+            w.advance(k, &commands, &mut heard);
+            each(&w, k, &heard);
+        }
+        w
+    }
+
     /// Abstract pings without noise in a sea of offset clocks and a lossy link: every
     /// range heard reads the true one plus c times the AUV's clock less the beacon's
     /// (1e-9 m), and 30 % of the pings a clean link hears on the same tracks are lost
@@ -443,17 +456,13 @@ mod tests {
         let end = |current: Current| {
             let mut s = s.clone();
             s.sea.current = current;
-            let mut w = FleetWorld::new(&s, 1, 0);
-            let commands = dive(0.5, w.auvs.len());
             // an AUV moves on every step from its launch on
-            let mut in_water = vec![0.0; w.auvs.len()];
-            for k in 1..=(300.0 / w.dt()).round() as usize {
-                let mut out = vec![Vec::new(); w.auvs.len()];
-                w.advance(k, &commands, &mut out);
+            let mut in_water = vec![0.0; s.auvs.len()];
+            let w = dive_300_s(&s, |w, k, _| {
                 for (t, a) in in_water.iter_mut().zip(&w.auvs) {
                     *t += if w.t_s(k) >= a.launch_s { w.dt() } else { 0.0 };
                 }
-            }
+            });
             w.auvs.iter().zip(in_water).map(|(a, t)| (a.truth.position_ned_m, t)).collect::<Vec<_>>()
         };
         let still = end(Current::default());
@@ -478,12 +487,8 @@ mod tests {
         let read = |sensors: DriftErrors| {
             let mut s = s.clone();
             s.sea.sensors = sensors;
-            let mut w = FleetWorld::new(&s, 1, 0);
-            let commands = dive(0.5, w.auvs.len());
             let mut out = Vec::new();
-            for k in 1..=(300.0 / w.dt()).round() as usize {
-                let mut heard = vec![Vec::new(); w.auvs.len()];
-                w.advance(k, &commands, &mut heard);
+            dive_300_s(&s, |_, _, heard| {
                 for (v, ms) in heard.iter().enumerate() {
                     let (mut u, mut psi) = (None, None);
                     for m in ms {
@@ -497,7 +502,7 @@ mod tests {
                         out.push((v, u, psi));
                     }
                 }
-            }
+            });
             out
         };
         let base = read(DriftErrors::default());
