@@ -23,6 +23,7 @@ mod output;
 mod plot;
 mod replay;
 mod report;
+mod smooth;
 mod tune;
 
 use clap::{Parser, Subcommand};
@@ -209,6 +210,38 @@ enum Command {
         /// writes).
         #[arg(long, value_name = "FILE")]
         estimators: Option<PathBuf>,
+    },
+    /// Smooth a log after the dive: every pose at once (sparse nonlinear least squares
+    /// over the motion, heading, range, Doppler and USBL measurements, with calibration
+    /// variables and a heavy-tailed kernel; docs/smooth.md), beside the log's filters:
+    /// trajectory.csv (a `smoother` column), summary.json, top_view.png and error.png in
+    /// DIR, and the replay's table with a `smoother` line (or --json).
+    Smooth {
+        /// The log description (TOML; see docs/logs.md).
+        log: PathBuf,
+        /// Output directory (default: out/<log>-smooth[-beacons-...]).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Use only these beacons (ids, comma-separated).
+        #[arg(long, value_delimiter = ',', value_name = "IDS")]
+        beacons: Option<Vec<u32>>,
+        /// Weigh the measurements as this estimator of the log does (its noise, kernel,
+        /// gate and calibration); default: the filters' default noise, a Huber kernel and
+        /// the calibration variables range_scale, turn_scale, offsets, clock_drift.
+        #[arg(long, value_name = "ESTIMATOR")]
+        like: Option<String>,
+        /// The calibration variables (comma-separated): none, all, range_scale,
+        /// turn_scale, distance_scale, offsets (one per beacon), shared_offset,
+        /// clock_drift.
+        #[arg(long, value_delimiter = ',', value_name = "VARS")]
+        calibrate: Option<Vec<String>>,
+        /// The kernel of ranges, Doppler speeds, bearings and heading fixes: none,
+        /// huber (k 1.345), cauchy (k 2.3849), student_t (4 dof).
+        #[arg(long, value_name = "KERNEL")]
+        kernel: Option<String>,
+        /// Print one JSON object (the summary) instead of the table.
+        #[arg(long)]
+        json: bool,
     },
     /// Fit estimators' noise keys to a log: the values that maximise the likelihood of
     /// their innovations (no ground truth needed). Writes estimators.toml (the log's
@@ -435,6 +468,9 @@ fn main() -> ExitCode {
         }
         Command::Replay { log, out, beacons, json, print_stream, estimators } => {
             replay::replay(&log, out, beacons, json, print_stream, estimators.as_deref())
+        }
+        Command::Smooth { log, out, beacons, like, calibrate, kernel, json } => {
+            smooth::smooth(&log, smooth::SmoothArgs { out, beacons, json, like, calibrate, kernel })
         }
         Command::Tune { log, estimators, keys, beacons, each_beacon, out, json } => {
             tune::tune(&log, tune::TuneArgs { estimators, keys, beacons, each_beacon, out, json })

@@ -84,6 +84,17 @@ pub fn replay(
         return Ok(());
     }
     outln!("{title}: {} measurements, replayed in {:.1} ms", r.items, wall_s * 1e3);
+    print_table(&summary, &r.dropped)?;
+    outln!("wrote:");
+    for f in files {
+        outln!("  {}", f.display());
+    }
+    Ok(())
+}
+
+/// The replay's table: its start, rows dropped, one line per estimator of `summary`
+/// (and the per-beacon range offsets).
+pub(crate) fn print_table(summary: &serde_json::Value, dropped: &[onebeacon_sim::replay::Dropped]) -> Result<()> {
     let st = &summary["start"];
     let f = |k: &str| st[k].as_f64().unwrap_or(f64::NAN);
     outln!(
@@ -95,7 +106,7 @@ pub fn replay(
         f("heading_rad").to_degrees(),
         f("position_sigma_m")
     );
-    for d in r.dropped.iter().filter(|d| d.dropped > 0) {
+    for d in dropped.iter().filter(|d| d.dropped > 0) {
         outln!("{}: {} rows out of time order dropped (time_order = \"drop\")", d.file, d.dropped);
     }
     // (header, summary key, decimals)
@@ -134,10 +145,6 @@ pub fn replay(
             })
             .collect();
         outln!("{}: range offsets, m: {}", e["name"].as_str().unwrap_or(""), cells.join(", "));
-    }
-    outln!("wrote:");
-    for f in files {
-        outln!("  {}", f.display());
     }
     Ok(())
 }

@@ -95,6 +95,47 @@ pub fn run_summary(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutp
     v
 }
 
+/// The smoother's line of a replay summary (the keys of the estimators' lines: errors,
+/// NEES, calibration as errors from nominal, per-beacon offsets) and its solve.
+pub fn smoother_summary(name: &str, s: &crate::smooth::Smoothed) -> Value {
+    let (st, dr) = s.score();
+    let scored = st.count > 0;
+    let mut v = json!({
+        "name": name,
+        "rmse_m": num(st.rmse_m()),
+        "mean_error_m": num(st.mean_m()),
+        "final_error_m": if scored { num(st.final_m) } else { Value::Null },
+        "max_error_m": if scored { num(st.max_m) } else { Value::Null },
+        "rejected": s.gated,
+        "nees_mean": num(st.nees_mean()),
+        "nees_band": onebeacon::nav::evaluation::chi_square_band(st.nees_count, 2).map(num),
+        "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
+        "dead_reckoning_rmse_m": num(dr.rmse_m()),
+        "iterations": s.iterations,
+        "cost": {"initial": num(s.cost0), "final": num(s.cost)},
+        "solve_s": s.solve_s,
+        "measurements": s.used,
+        "ignored": s.ignored,
+    });
+    let mut offsets = serde_json::Map::new();
+    for (k, x, sigma) in &s.calibration {
+        let cal = json!({"value": num(*x), "sigma": num(*sigma)});
+        match k.strip_prefix("range_offset_m[").and_then(|b| b.strip_suffix(']')) {
+            Some(b) => {
+                offsets.insert(b.to_string(), json!({"offset_m": num(*x), "sigma_m": num(*sigma)}));
+            }
+            None if k.ends_with("scale") => v[k.as_str()] = num(x - 1.0),
+            None if k == "range_offset_m" => v["range_bias_m"] = num(*x),
+            None => v[k.as_str()] = num(*x),
+        }
+        v["calibration"][k.as_str()] = cal;
+    }
+    if !offsets.is_empty() {
+        v["beacon_offsets"] = Value::Object(offsets);
+    }
+    v
+}
+
 /// `replay --json`, the replay's summary.json.
 pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
     let s = &r.session;

@@ -36,6 +36,7 @@ pub mod scenario;
 pub mod seed;
 pub mod sensor_errors;
 pub mod sensors;
+pub mod smooth;
 pub mod vehicles;
 pub mod water;
 mod world;

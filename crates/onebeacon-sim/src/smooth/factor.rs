@@ -1,0 +1,334 @@
+//! The smoother's factors: what each measurement says about the poses and calibration
+//! variables it touches, as a whitened residual (residual over its standard deviation)
+//! and its Jacobian. Poses are (north, east, heading) at the graph's nodes, the
+//! heading kept continuous (unwrapped) along the trajectory.
+
+use onebeacon::geo::wrap_angle;
+
+/// Most variables one factor touches: two poses and four calibration variables.
+pub(crate) const MAX_VARS: usize = 10;
+
+/// A factor's whitened linearisation: `m` residuals over `n` variables (global indices
+/// `vars`), row-major Jacobian.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Linear {
+    pub m: usize,
+    pub n: usize,
+    pub vars: [usize; MAX_VARS],
+    pub r: [f64; 3],
+    pub j: [[f64; MAX_VARS]; 3],
+}
+
+/// Which calibration variables a factor reads (global indices), `None` where the
+/// smoother does not estimate that one (its nominal value is used: scale 1, offset 0).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct CalVars {
+    pub scale: Option<usize>,
+    pub offset: Option<usize>,
+    pub drift: Option<usize>,
+}
+
+/// Where an acoustic measurement sits between two nodes: the position at its time is
+/// (1 - alpha) p_k + alpha p_(k+1) (alpha 0 with no later node).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct At {
+    pub k: usize,
+    pub alpha: f64,
+    /// The node after k exists (alpha and the interval's velocity apply).
+    pub next: bool,
+    /// Seconds between nodes k and k + 1.
+    pub dt_s: f64,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) enum Factor {
+    /// A Gaussian prior on pose k (the start).
+    PosePrior { k: usize, mean: [f64; 3], sigma: [f64; 3] },
+    /// A Gaussian prior on one calibration variable.
+    Prior { var: usize, mean: f64, sigma: f64 },
+    /// Motion from node k to k + 1: body-frame forward and lateral distance along the
+    /// mid-step heading (psi_k + psi_(k+1)) / 2, and the heading change (times the turn
+    /// scale); `turn` None: no turn measured (a weak zero-mean turn, `sigma[2]`).
+    Motion {
+        k: usize,
+        forward_m: f64,
+        lateral_m: f64,
+        turn_rad: Option<f64>,
+        sigma: [f64; 3],
+        turn_scale: Option<usize>,
+        distance_scale: Option<usize>,
+    },
+    /// An absolute heading (compass, AHRS) at node k.
+    Heading { k: usize, heading_rad: f64, sigma: f64 },
+    /// A range: z = s |p(t) - b| + offset + drift (t - t0), the distance slant with the
+    /// vertical offset `dz_m` between vehicle and beacon.
+    Range { at: At, beacon: [f64; 2], dz_m: f64, range_m: f64, sigma: f64, cal: CalVars, t_rel_s: f64 },
+    /// A Doppler radial speed, positive when closing (garin2024 eq. 13): -u . v, u the
+    /// unit vector from the beacon to p(t), v the velocity over the node interval.
+    Doppler { at: At, beacon: [f64; 2], dz_m: f64, speed_m_s: f64, sigma: f64 },
+    /// A USBL bearing on a station (hoff2024 eq. 1-2): azimuth from the station's
+    /// heading and elevation from the vertical.
+    Bearing { at: At, station: [f64; 3], station_heading_rad: f64, depth_m: f64, az_el: [f64; 2], sigma: f64 },
+}
+
+impl Factor {
+    /// Whether a heavy-tailed kernel and a gate apply (the acoustic measurements and
+    /// heading fixes; motion and priors are Gaussian).
+    pub(crate) fn is_measurement(&self) -> bool {
+        matches!(self, Factor::Heading { .. } | Factor::Range { .. } | Factor::Doppler { .. } | Factor::Bearing { .. })
+    }
+
+    /// The variables this factor reads, in the order of its local vector.
+    pub(crate) fn vars(&self) -> ([usize; MAX_VARS], usize) {
+        let mut v = [0; MAX_VARS];
+        let mut n = 0;
+        let mut push = |i: usize| {
+            v[n] = i;
+            n += 1;
+        };
+        let pose = |push: &mut dyn FnMut(usize), k: usize| (0..3).for_each(|i| push(3 * k + i));
+        match self {
+            Factor::PosePrior { k, .. } | Factor::Heading { k, .. } => pose(&mut push, *k),
+            Factor::Prior { var, .. } => push(*var),
+            Factor::Motion { k, turn_scale, distance_scale, .. } => {
+                pose(&mut push, *k);
+                pose(&mut push, k + 1);
+                turn_scale.iter().chain(distance_scale).for_each(|&i| push(i));
+            }
+            Factor::Range { at, cal, .. } => {
+                pose(&mut push, at.k);
+                if at.next {
+                    pose(&mut push, at.k + 1);
+                }
+                cal.scale.iter().chain(&cal.offset).chain(&cal.drift).for_each(|&i| push(i));
+            }
+            Factor::Doppler { at, .. } | Factor::Bearing { at, .. } => {
+                pose(&mut push, at.k);
+                if at.next {
+                    pose(&mut push, at.k + 1);
+                }
+            }
+        }
+        (v, n)
+    }
+
+    /// The whitened residuals at the local values `x` (in the order of [`Factor::vars`]).
+    pub(crate) fn residual(&self, x: &[f64]) -> ([f64; 3], usize) {
+        match self {
+            Factor::PosePrior { mean, sigma, .. } => {
+                ([(x[0] - mean[0]) / sigma[0], (x[1] - mean[1]) / sigma[1], wrap_angle(x[2] - mean[2]) / sigma[2]], 3)
+            }
+            Factor::Prior { mean, sigma, .. } => ([(x[0] - mean) / sigma, 0.0, 0.0], 1),
+            Factor::Heading { heading_rad, sigma, .. } => ([wrap_angle(x[2] - heading_rad) / sigma, 0.0, 0.0], 1),
+            Factor::Motion { forward_m, lateral_m, turn_rad, sigma, turn_scale, distance_scale, .. } => {
+                let mut i = 6;
+                let mut next = |on: bool| {
+                    if on {
+                        i += 1;
+                        x[i - 1]
+                    } else {
+                        1.0
+                    }
+                };
+                let (kt, kd) = (next(turn_scale.is_some()), next(distance_scale.is_some()));
+                let (f, l, dpsi) = body_motion(x);
+                (
+                    [
+                        (f - kd * forward_m) / sigma[0],
+                        (l - kd * lateral_m) / sigma[1],
+                        (dpsi - kt * turn_rad.unwrap_or(0.0)) / sigma[2],
+                    ],
+                    3,
+                )
+            }
+            Factor::Range { at, beacon, dz_m, range_m, sigma, cal, t_rel_s } => {
+                let p = position(at, x);
+                let slant = slant(p, *beacon, *dz_m);
+                let mut i = if at.next { 6 } else { 3 };
+                let mut take = |on: bool, nominal: f64| {
+                    if on {
+                        i += 1;
+                        x[i - 1]
+                    } else {
+                        nominal
+                    }
+                };
+                let s = take(cal.scale.is_some(), 1.0);
+                let b = take(cal.offset.is_some(), 0.0);
+                let d = take(cal.drift.is_some(), 0.0);
+                ([(s * slant + b + d * t_rel_s - range_m) / sigma, 0.0, 0.0], 1)
+            }
+            Factor::Doppler { at, beacon, dz_m, speed_m_s, sigma } => {
+                if !at.next {
+                    return ([0.0; 3], 1);
+                }
+                let p = position(at, x);
+                let v = [(x[3] - x[0]) / at.dt_s, (x[4] - x[1]) / at.dt_s];
+                let r = slant(p, *beacon, *dz_m);
+                // garin2024 eq. 13: the radial speed, closing positive
+                let radial = -((p[0] - beacon[0]) * v[0] + (p[1] - beacon[1]) * v[1]) / r;
+                ([(radial - speed_m_s) / sigma, 0.0, 0.0], 1)
+            }
+            Factor::Bearing { at, station, station_heading_rad, depth_m, az_el, sigma } => {
+                let p = position(at, x);
+                let (dn, de) = (p[0] - station[0], p[1] - station[1]);
+                // hoff2024 eq. 1: azimuth from the station's heading
+                let az = de.atan2(dn) - station_heading_rad;
+                // hoff2024 eq. 2: elevation from the vertical
+                let el = dn.hypot(de).atan2(depth_m - station[2]);
+                ([wrap_angle(az - az_el[0]) / sigma, (el - az_el[1]) / sigma, 0.0], 2)
+            }
+        }
+    }
+
+    /// The whitened residuals and Jacobian at the global state `x`: analytic for the
+    /// priors, motion and ranges (all but a few factors of a log), central differences
+    /// for Doppler speeds and bearings.
+    pub(crate) fn linearize(&self, x: &[f64]) -> Linear {
+        let (vars, n) = self.vars();
+        let mut local = [0.0; MAX_VARS];
+        for (l, &v) in local.iter_mut().zip(&vars[..n]) {
+            *l = x[v];
+        }
+        let (r, m) = self.residual(&local[..n]);
+        let mut lin = Linear { m, n, vars, r, j: [[0.0; MAX_VARS]; 3] };
+        if !self.jacobian(&local[..n], &mut lin.j) {
+            numeric_jacobian(self, &mut local, n, &mut lin.j);
+        }
+        lin
+    }
+
+    /// Writes the analytic Jacobian where this factor has one (false: none).
+    fn jacobian(&self, x: &[f64], j: &mut [[f64; MAX_VARS]; 3]) -> bool {
+        match self {
+            Factor::PosePrior { sigma, .. } => (0..3).for_each(|i| j[i][i] = 1.0 / sigma[i]),
+            Factor::Prior { sigma, .. } => j[0][0] = 1.0 / sigma,
+            Factor::Heading { sigma, .. } => j[0][2] = 1.0 / sigma,
+            Factor::Motion { forward_m, lateral_m, turn_rad, sigma, turn_scale, distance_scale, .. } => {
+                let (f, l, _) = body_motion(x);
+                let psi_m = 0.5 * (x[2] + x[5]);
+                let (c, s) = (psi_m.cos(), psi_m.sin());
+                // forward f = c dn + s de, lateral l = -s dn + c de; d f / d psi_m = l, d l / d psi_m = -f
+                let rows = [[c, s, 0.5 * l], [-s, c, -0.5 * f]];
+                for (row, r) in rows.iter().enumerate() {
+                    j[row][..3].copy_from_slice(&[-r[0] / sigma[row], -r[1] / sigma[row], r[2] / sigma[row]]);
+                    j[row][3..6].copy_from_slice(&[r[0] / sigma[row], r[1] / sigma[row], r[2] / sigma[row]]);
+                }
+                j[2][2] = -1.0 / sigma[2];
+                j[2][5] = 1.0 / sigma[2];
+                let mut i = 6;
+                if turn_scale.is_some() {
+                    j[2][i] = -turn_rad.unwrap_or(0.0) / sigma[2];
+                    i += 1;
+                }
+                if distance_scale.is_some() {
+                    j[0][i] = -forward_m / sigma[0];
+                    j[1][i] = -lateral_m / sigma[1];
+                }
+            }
+            Factor::Range { at, beacon, dz_m, sigma, cal, t_rel_s, .. } => {
+                let p = position(at, x);
+                let slant = slant(p, *beacon, *dz_m);
+                let mut i = if at.next { 6 } else { 3 };
+                let s = if cal.scale.is_some() { x[i] } else { 1.0 };
+                let u = [(p[0] - beacon[0]) / slant, (p[1] - beacon[1]) / slant];
+                let w = [1.0 - at.alpha, at.alpha];
+                for (node, wn) in w.iter().enumerate().take(if at.next { 2 } else { 1 }) {
+                    j[0][3 * node] = s * wn * u[0] / sigma;
+                    j[0][3 * node + 1] = s * wn * u[1] / sigma;
+                }
+                for (on, d) in
+                    [(cal.scale.is_some(), slant), (cal.offset.is_some(), 1.0), (cal.drift.is_some(), *t_rel_s)]
+                {
+                    if on {
+                        j[0][i] = d / sigma;
+                        i += 1;
+                    }
+                }
+            }
+            Factor::Doppler { .. } | Factor::Bearing { .. } => return false,
+        }
+        true
+    }
+}
+
+/// Central differences of the whitened residual (step 1e-6 of each variable's scale).
+fn numeric_jacobian(f: &Factor, x: &mut [f64; MAX_VARS], n: usize, j: &mut [[f64; MAX_VARS]; 3]) {
+    for c in 0..n {
+        let x0 = x[c];
+        let h = 1e-6 * x0.abs().max(1.0);
+        x[c] = x0 + h;
+        let (up, m) = f.residual(&x[..n]);
+        x[c] = x0 - h;
+        let (down, _) = f.residual(&x[..n]);
+        x[c] = x0;
+        for row in 0..m {
+            j[row][c] = (up[row] - down[row]) / (2.0 * h);
+        }
+    }
+}
+
+/// The motion between two poses (local x = pose k, pose k + 1) in the frame of the
+/// mid-step heading: forward, lateral, heading change.
+fn body_motion(x: &[f64]) -> (f64, f64, f64) {
+    let (dn, de) = (x[3] - x[0], x[4] - x[1]);
+    let psi_m = 0.5 * (x[2] + x[5]);
+    let (c, s) = (psi_m.cos(), psi_m.sin());
+    (c * dn + s * de, -s * dn + c * de, x[5] - x[2])
+}
+
+/// The horizontal position at a measurement's time, interpolated between its nodes.
+fn position(at: &At, x: &[f64]) -> [f64; 2] {
+    if !at.next {
+        return [x[0], x[1]];
+    }
+    let a = at.alpha;
+    [(1.0 - a) * x[0] + a * x[3], (1.0 - a) * x[1] + a * x[4]]
+}
+
+fn slant(p: [f64; 2], b: [f64; 2], dz_m: f64) -> f64 {
+    ((p[0] - b[0]).powi(2) + (p[1] - b[1]).powi(2) + dz_m * dz_m).sqrt().max(1e-6)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every analytic Jacobian against central differences, at a generic state with
+    /// every calibration variable on.
+    #[test]
+    fn analytic_jacobians_match_central_differences() {
+        let at = At { k: 0, alpha: 0.3, next: true, dt_s: 2.0 };
+        let cal = CalVars { scale: Some(6), offset: Some(7), drift: Some(8) };
+        let factors = [
+            Factor::PosePrior { k: 0, mean: [1.0, 2.0, 0.3], sigma: [0.5, 0.4, 0.1] },
+            Factor::Heading { k: 0, heading_rad: 0.2, sigma: 0.05 },
+            Factor::Motion {
+                k: 0,
+                forward_m: 1.1,
+                lateral_m: 0.2,
+                turn_rad: Some(0.4),
+                sigma: [0.1, 0.2, 0.03],
+                turn_scale: Some(6),
+                distance_scale: Some(7),
+            },
+            Factor::Range { at, beacon: [10.0, -4.0], dz_m: 3.0, range_m: 12.0, sigma: 1.5, cal, t_rel_s: 40.0 },
+        ];
+        let x = [1.2, 2.1, 0.35, 2.0, 2.9, 0.8, 1.05, 0.7, 0.01, 0.0];
+        for f in &factors {
+            let lin = f.linearize(&x);
+            let (_, n) = f.vars();
+            let mut local = [0.0; MAX_VARS];
+            let mut j = [[0.0; MAX_VARS]; 3];
+            for (i, &v) in f.vars().0[..n].iter().enumerate() {
+                local[i] = x[v];
+            }
+            numeric_jacobian(f, &mut local, n, &mut j);
+            for (row, (a, b)) in lin.j.iter().zip(&j).take(lin.m).enumerate() {
+                for (c, (x, y)) in a.iter().zip(b).take(n).enumerate() {
+                    assert!((x - y).abs() < 1e-6, "{f:?}: row {row} col {c}: {x} vs {y}");
+                }
+            }
+        }
+    }
+}

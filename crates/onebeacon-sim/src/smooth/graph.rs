@@ -1,0 +1,304 @@
+//! From a log's time-ordered items to the smoother's graph: a node (pose) at the start
+//! and at every motion increment (odometry rows; speed or body-velocity samples, the
+//! held velocity integrated since the node before), a motion factor between each two
+//! nodes, heading fixes at their nearest node, acoustic measurements between the two
+//! nodes around them, calibration variables after the poses with their priors.
+
+use super::factor::{At, CalVars, Factor};
+use super::{Calibrate, Offsets, SmoothConfig, SmoothError};
+use crate::replay::Log;
+use nalgebra::Vector3;
+use onebeacon::geo::wrap_angle;
+use onebeacon::nav::Kind;
+use onebeacon::nav::session::Input;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Standard deviation of the heading change between two nodes when nothing measures
+/// it (speed and compass logs: the compass holds the heading), rad.
+const UNMEASURED_TURN_SIGMA_RAD: f64 = 1.0;
+/// Floors of a motion factor's standard deviations (a zero-length increment), m and rad.
+const MIN_STEP_SIGMA_M: f64 = 1e-3;
+const MIN_TURN_SIGMA_RAD: f64 = 1e-4;
+
+#[derive(Debug)]
+pub(crate) struct Graph {
+    pub t_s: Vec<f64>,
+    pub factors: Vec<Factor>,
+    /// Dead reckoning from the start (the initial values of the poses), then the
+    /// calibration variables' nominal values.
+    pub x0: Vec<f64>,
+    /// Calibration variables: name and index.
+    pub calibration: Vec<(String, usize)>,
+    /// Ground-truth (t, north, east) rows.
+    pub truth: Vec<(f64, f64, f64)>,
+    /// Measurements used per kind, and items the smoother has no factor for, per kind.
+    pub used: BTreeMap<&'static str, usize>,
+    pub ignored: BTreeMap<&'static str, usize>,
+}
+
+/// An acoustic measurement waiting for its nodes.
+struct Heard {
+    t_s: f64,
+    kind: Kind,
+    beacon: Vector3<f64>,
+    depth_m: f64,
+}
+
+pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) -> Result<Graph, SmoothError> {
+    let start = log.initial_start()?;
+    let noise = &cfg.noise;
+    let mut g = Graph {
+        t_s: vec![start.t0_s],
+        factors: Vec::new(),
+        x0: Vec::new(),
+        calibration: Vec::new(),
+        truth: Vec::new(),
+        used: BTreeMap::new(),
+        ignored: BTreeMap::new(),
+    };
+    // motion between nodes: (forward, lateral, turn, sigmas), applied once the
+    // calibration variables have their indices
+    let mut motion: Vec<(f64, f64, Option<f64>, [f64; 3])> = Vec::new();
+    let mut headings: Vec<(f64, f64)> = Vec::new();
+    let mut heard: Vec<Heard> = Vec::new();
+    let mut tracked: BTreeMap<u32, Vector3<f64>> = BTreeMap::new();
+    let mut depth_m = 0.0;
+    let mut held: Option<(f64, f64, Option<f64>)> = None; // forward, lateral speed, yaw rate
+    let mut odometry = false;
+    let step_sigma = |d: f64, turn: f64| {
+        let s = (noise.distance_sigma_frac * d).max(MIN_STEP_SIGMA_M);
+        let turn_var = (noise.heading_change_sigma_frac * turn).powi(2) + noise.heading_walk_rad_per_sqrt_m.powi(2) * d;
+        [s, s, turn_var.sqrt().max(MIN_TURN_SIGMA_RAD)]
+    };
+    for item in log.items()? {
+        let item = item?;
+        let t = item.t_s;
+        match item.input.to_ned(log.frame) {
+            Input::Truth(p) => g.truth.push((t, p.north_m, p.east_m)),
+            Input::BeaconPosition { beacon_id, position } => {
+                tracked.insert(beacon_id, position);
+            }
+            _ if t < start.t0_s => {}
+            Input::Measurement(m) => match m {
+                Kind::Odometry { distance_m: d, heading_change_rad: turn } => {
+                    odometry = true;
+                    g.t_s.push(t);
+                    motion.push((d, 0.0, Some(turn), step_sigma(d.abs(), turn)));
+                    count(&mut g.used, "odometry");
+                }
+                Kind::BodyOdometry { forward_m: f, lateral_m: l, heading_change_rad: turn } => {
+                    odometry = true;
+                    g.t_s.push(t);
+                    motion.push((f, l, Some(turn), step_sigma(f.hypot(l), turn)));
+                    count(&mut g.used, "body_odometry");
+                }
+                Kind::Speed { .. } | Kind::BodyVelocity { .. } if odometry => count(&mut g.ignored, m.name()),
+                Kind::Speed { speed_m_s } | Kind::BodyVelocity { nu: [speed_m_s, ..] } => {
+                    let last = *g.t_s.last().unwrap_or(&start.t0_s);
+                    if let Some((u, v, r)) = held
+                        && t > last
+                    {
+                        let dt = t - last;
+                        let (f, l) = (u * dt, v * dt);
+                        let mut sigma = step_sigma(f.hypot(l), r.map_or(0.0, |r| r * dt));
+                        let speed_sigma = noise.speed_sigma_m_s * dt;
+                        sigma[0] = sigma[0].hypot(speed_sigma);
+                        sigma[1] = sigma[1].hypot(speed_sigma);
+                        if r.is_none() {
+                            sigma[2] = UNMEASURED_TURN_SIGMA_RAD;
+                        }
+                        g.t_s.push(t);
+                        motion.push((f, l, r.map(|r| r * dt), sigma));
+                    }
+                    held = Some(match m {
+                        Kind::BodyVelocity { nu } => (nu[0], nu[1], Some(nu[5])),
+                        _ => (speed_m_s, 0.0, None),
+                    });
+                    count(&mut g.used, m.name());
+                }
+                Kind::Heading { heading_rad } | Kind::Attitude { heading_rad, .. } => {
+                    headings.push((t, heading_rad));
+                    count(&mut g.used, m.name());
+                }
+                Kind::Depth { depth_m: d } => depth_m = d,
+                Kind::Range { beacon, .. }
+                | Kind::Doppler { beacon, .. }
+                | Kind::RangeDoppler { beacon, .. }
+                | Kind::Bearing { station: beacon, .. } => {
+                    if beacons.is_some_and(|b| !b.contains(&beacon.id)) {
+                        continue;
+                    }
+                    let position = if beacon.position_ned_m.iter().all(|v| v.is_finite()) {
+                        beacon.position_ned_m
+                    } else if let Some(p) = tracked.get(&beacon.id) {
+                        *p
+                    } else {
+                        count(&mut g.ignored, "range before its beacon's position");
+                        continue;
+                    };
+                    heard.push(Heard { t_s: t, kind: m, beacon: position, depth_m });
+                }
+                other => count(&mut g.ignored, other.name()),
+            },
+        }
+    }
+    if motion.is_empty() {
+        return Err(SmoothError::NoMotion);
+    }
+    let n = g.t_s.len();
+    // calibration variables after the poses
+    let mut next = 3 * n;
+    let mut var = |g: &mut Graph, on: bool, name: String, mean: f64, sigma: f64| {
+        on.then(|| {
+            let i = next;
+            next += 1;
+            g.calibration.push((name, i));
+            g.factors.push(Factor::Prior { var: i, mean, sigma });
+            i
+        })
+    };
+    let Calibrate { range_scale, turn_scale, distance_scale, offsets, clock_drift } = cfg.calibrate;
+    let p = &cfg.priors;
+    let turn_var = var(&mut g, turn_scale, "turn_scale".into(), 1.0, p.turn_scale_sigma);
+    let dist_var = var(&mut g, distance_scale, "distance_scale".into(), 1.0, p.distance_scale_sigma);
+    let ranged = heard.iter().any(|h| matches!(h.kind, Kind::Range { .. } | Kind::RangeDoppler { .. }));
+    let scale_var = var(&mut g, range_scale && ranged, "range_scale".into(), 1.0, p.range_scale_sigma);
+    let drift_var = var(&mut g, clock_drift && ranged, "range_drift_m_per_s".into(), 0.0, p.drift_sigma_m_per_s);
+    let ids: BTreeSet<u32> = heard
+        .iter()
+        .filter(|h| matches!(h.kind, Kind::Range { .. } | Kind::RangeDoppler { .. }))
+        .filter_map(|h| h.kind.beacon().map(|b| b.id))
+        .collect();
+    let offset_vars: BTreeMap<u32, usize> = match offsets {
+        Offsets::None => BTreeMap::new(),
+        Offsets::Shared => var(&mut g, ranged, "range_offset_m".into(), p.offset_m, p.offset_sigma_m)
+            .map(|i| ids.iter().map(|&id| (id, i)).collect())
+            .unwrap_or_default(),
+        Offsets::PerBeacon => ids
+            .iter()
+            .filter_map(|&id| {
+                var(&mut g, true, format!("range_offset_m[{id}]"), p.offset_m, p.offset_sigma_m).map(|i| (id, i))
+            })
+            .collect(),
+    };
+    let (n0, e0, psi0) = start.pose;
+    let heading_sigma = log.description.initial.heading_sigma_deg.to_radians();
+    let ps = start.position_sigma_m;
+    g.factors.push(Factor::PosePrior { k: 0, mean: [n0, e0, psi0], sigma: [ps, ps, heading_sigma] });
+    for (k, &(f, l, turn, sigma)) in motion.iter().enumerate() {
+        g.factors.push(Factor::Motion {
+            k,
+            forward_m: f,
+            lateral_m: l,
+            turn_rad: turn,
+            sigma,
+            turn_scale: turn.and(turn_var),
+            distance_scale: dist_var,
+        });
+    }
+    // heading fixes at their nearest node
+    let mut fixed_heading: BTreeMap<usize, f64> = BTreeMap::new();
+    for &(t, h) in &headings {
+        let k = nearest(&g.t_s, t);
+        fixed_heading.insert(k, h);
+        g.factors.push(Factor::Heading { k, heading_rad: h, sigma: noise.heading_sigma_rad });
+    }
+    let t0 = start.t0_s;
+    for h in heard {
+        let at = between(&g.t_s, h.t_s);
+        let (b, dz) = ([h.beacon.x, h.beacon.y], h.depth_m - h.beacon.z);
+        let id = h.kind.beacon().map_or(0, |b| b.id);
+        let cal = CalVars { scale: scale_var, offset: offset_vars.get(&id).copied(), drift: drift_var };
+        let range = |g: &mut Graph, range_m: f64| {
+            g.factors.push(Factor::Range {
+                at,
+                beacon: b,
+                dz_m: dz,
+                range_m,
+                sigma: noise.range_sigma_m,
+                cal,
+                t_rel_s: h.t_s - t0,
+            });
+            count(&mut g.used, "range");
+        };
+        let doppler = |g: &mut Graph, speed_m_s: f64| {
+            if at.next && at.dt_s > 0.0 {
+                g.factors.push(Factor::Doppler { at, beacon: b, dz_m: dz, speed_m_s, sigma: noise.doppler_sigma_m_s });
+                count(&mut g.used, "doppler");
+            }
+        };
+        match h.kind {
+            Kind::Range { range_m, .. } => range(&mut g, range_m),
+            Kind::Doppler { radial_speed_m_s, .. } => doppler(&mut g, radial_speed_m_s),
+            Kind::RangeDoppler { range_m, radial_speed_m_s, .. } => {
+                range(&mut g, range_m);
+                doppler(&mut g, radial_speed_m_s);
+            }
+            Kind::Bearing { station_heading_rad, azimuth_rad, elevation_rad, .. } => {
+                g.factors.push(Factor::Bearing {
+                    at,
+                    station: [h.beacon.x, h.beacon.y, h.beacon.z],
+                    station_heading_rad,
+                    depth_m: h.depth_m,
+                    az_el: [azimuth_rad, elevation_rad],
+                    sigma: cfg.usbl_sigma_rad,
+                });
+                count(&mut g.used, "bearing");
+            }
+            _ => {}
+        }
+    }
+    // initial values: dead reckoning from the start, nominal calibration
+    g.x0 = vec![0.0; next];
+    g.x0[..3].copy_from_slice(&[n0, e0, psi0]);
+    for (k, &(f, l, turn, _)) in motion.iter().enumerate() {
+        let psi = g.x0[3 * k + 2];
+        let next_psi = match (turn, fixed_heading.get(&(k + 1))) {
+            (Some(turn), _) => psi + turn,
+            (None, Some(&h)) => psi + wrap_angle(h - psi),
+            (None, None) => psi,
+        };
+        let mid = 0.5 * (psi + next_psi);
+        let (s, c) = mid.sin_cos();
+        g.x0[3 * k + 3] = g.x0[3 * k] + c * f - s * l;
+        g.x0[3 * k + 4] = g.x0[3 * k + 1] + s * f + c * l;
+        g.x0[3 * k + 5] = next_psi;
+    }
+    for (name, i) in &g.calibration {
+        g.x0[*i] = if name.ends_with("scale") {
+            1.0
+        } else if name.starts_with("range_offset") {
+            p.offset_m
+        } else {
+            0.0
+        };
+    }
+    Ok(g)
+}
+
+fn count(map: &mut BTreeMap<&'static str, usize>, kind: &'static str) {
+    *map.entry(kind).or_default() += 1;
+}
+
+/// The node nearest in time to `t`.
+fn nearest(t_s: &[f64], t: f64) -> usize {
+    let k = t_s.partition_point(|&x| x < t);
+    if k == 0 {
+        0
+    } else if k == t_s.len() || t - t_s[k - 1] <= t_s[k] - t {
+        k - 1
+    } else {
+        k
+    }
+}
+
+/// Where time `t` falls between nodes (clamped to the first and last).
+pub(crate) fn between(t_s: &[f64], t: f64) -> At {
+    let k = t_s.partition_point(|&x| x <= t).saturating_sub(1);
+    if k + 1 >= t_s.len() {
+        return At { k: t_s.len() - 1, alpha: 0.0, next: false, dt_s: 0.0 };
+    }
+    let dt_s = t_s[k + 1] - t_s[k];
+    let alpha = if dt_s > 0.0 { ((t - t_s[k]) / dt_s).clamp(0.0, 1.0) } else { 0.0 };
+    At { k, alpha, next: true, dt_s }
+}

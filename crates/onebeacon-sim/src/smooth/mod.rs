@@ -1,0 +1,242 @@
+//! After the dive: fixed-interval smoothing of a log as sparse nonlinear least squares
+//! over every pose ([`graph`]: motion, heading, range, Doppler and USBL factors;
+//! calibration variables: range scale, turn and distance scale, range offsets, a clock
+//! drift), solved by Levenberg-Marquardt over a sparse Cholesky factorisation with
+//! Huber, Student-t or Cauchy kernels ([`solve`]), with the marginal covariance of
+//! every pose. The noise is the filters' ([`PlanarNoise`]): the smoother reads what an
+//! estimator of the log reads.
+
+mod factor;
+mod graph;
+mod solve;
+
+pub use solve::SolveError;
+
+use crate::replay::{Log, LogError};
+use nalgebra::{Matrix2, Vector2};
+use onebeacon::filter::consistency::nees;
+use onebeacon::nav::evaluation::ErrorStats;
+use onebeacon::nav::{PlanarConfig, PlanarNoise, Robust};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Range offsets as variables: none, one shared by every beacon (a clock offset), or
+/// one per beacon.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Offsets {
+    None,
+    Shared,
+    PerBeacon,
+}
+
+/// Which calibration variables the smoother estimates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Calibrate {
+    pub range_scale: bool,
+    pub turn_scale: bool,
+    pub distance_scale: bool,
+    pub offsets: Offsets,
+    /// A range error growing linearly in time (a one-way travel time's clock drift
+    /// times the sound speed), m/s.
+    pub clock_drift: bool,
+}
+
+impl Calibrate {
+    pub const NONE: Calibrate = Calibrate {
+        range_scale: false,
+        turn_scale: false,
+        distance_scale: false,
+        offsets: Offsets::None,
+        clock_drift: false,
+    };
+    pub const ALL: Calibrate = Calibrate {
+        range_scale: true,
+        turn_scale: true,
+        distance_scale: true,
+        offsets: Offsets::PerBeacon,
+        clock_drift: true,
+    };
+}
+
+/// The calibration variables' priors (means 1 for scales, `offset_m` for offsets, 0
+/// for the drift).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Priors {
+    pub range_scale_sigma: f64,
+    pub turn_scale_sigma: f64,
+    pub distance_scale_sigma: f64,
+    pub offset_m: f64,
+    pub offset_sigma_m: f64,
+    pub drift_sigma_m_per_s: f64,
+}
+
+/// What the smoother weighs and estimates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SmoothConfig {
+    pub noise: PlanarNoise,
+    pub calibrate: Calibrate,
+    pub priors: Priors,
+    /// The heavy-tailed kernel of the acoustic measurements and heading fixes.
+    pub kernel: Option<Robust>,
+    /// After the solve, measurements whose squared whitened residual exceeds this are
+    /// dropped and the problem solved again (chi-square: 10.83 is 99.9 % at 1 dof).
+    pub nis_gate: Option<f64>,
+    /// USBL azimuth and elevation standard deviation, rad.
+    pub usbl_sigma_rad: f64,
+    pub max_iterations: usize,
+}
+
+impl Default for SmoothConfig {
+    /// The filters' default noise, every calibration variable but the distance scale
+    /// (with one beacon, the range and distance scales trade against each other), a
+    /// Huber kernel (k = 1.345).
+    fn default() -> Self {
+        Self::from_planar(&PlanarConfig::default(), Calibrate { distance_scale: false, ..Calibrate::ALL })
+            .with_kernel(Some(Robust::Huber { k: 1.345 }))
+    }
+}
+
+impl SmoothConfig {
+    /// The smoother an estimator of the log describes: its noise, kernel, gate and
+    /// calibration priors, with the variables `calibrate`.
+    pub fn from_planar(c: &PlanarConfig, calibrate: Calibrate) -> Self {
+        Self {
+            noise: c.noise,
+            calibrate,
+            priors: Priors {
+                range_scale_sigma: c.range_scale_sigma,
+                turn_scale_sigma: c.turn_scale_sigma,
+                distance_scale_sigma: c.distance_scale_sigma,
+                offset_m: c.bias_m,
+                offset_sigma_m: c.bias_sigma_m,
+                drift_sigma_m_per_s: DRIFT_SIGMA_M_PER_S,
+            },
+            kernel: c.robust,
+            nis_gate: c.nis_gate,
+            usbl_sigma_rad: 1f64.to_radians(),
+            max_iterations: 100,
+        }
+    }
+
+    pub fn with_kernel(self, kernel: Option<Robust>) -> Self {
+        Self { kernel, ..self }
+    }
+}
+
+/// The prior on a range drift: 1 mm/s, a clock drift of 0.7 us/s at 1500 m/s.
+pub const DRIFT_SIGMA_M_PER_S: f64 = 1e-3;
+
+#[derive(Debug, thiserror::Error)]
+pub enum SmoothError {
+    #[error(transparent)]
+    Log(#[from] LogError),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    #[error("no motion to smooth: the log has no odometry, body_odometry, speed or body_velocity rows after its start")]
+    NoMotion,
+}
+
+/// A smoothed log: a pose and its marginal covariance per node, the calibration
+/// variables, and how the solve went.
+#[derive(Debug, Clone)]
+pub struct Smoothed {
+    pub t_s: Vec<f64>,
+    /// North, east (m), heading (rad, continuous along the trajectory).
+    pub poses: Vec<[f64; 3]>,
+    /// Dead reckoning from the same start (the solver's initial values).
+    pub dead_reckoning: Vec<[f64; 3]>,
+    /// Marginal covariance of (north, east, heading) per pose.
+    pub covariances: Vec<[[f64; 3]; 3]>,
+    /// Calibration variables: name, value, standard deviation.
+    pub calibration: Vec<(String, f64, f64)>,
+    pub iterations: usize,
+    pub cost0: f64,
+    pub cost: f64,
+    /// Measurements used per kind, dropped by the gate, and items without a factor.
+    pub used: BTreeMap<&'static str, usize>,
+    pub gated: usize,
+    pub ignored: BTreeMap<&'static str, usize>,
+    /// Ground-truth rows: (t, north, east).
+    pub truth: Vec<(f64, f64, f64)>,
+    pub solve_s: f64,
+}
+
+/// Smooths `log` (its beacons `beacons`, all when `None`).
+pub fn smooth(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) -> Result<Smoothed, SmoothError> {
+    let started = std::time::Instant::now();
+    let g = graph::build(log, beacons, cfg)?;
+    let options = solve::SolveOptions { kernel: cfg.kernel, max_iterations: cfg.max_iterations };
+    let mut active = vec![true; g.factors.len()];
+    let mut sol = solve::solve(&g.factors, &active, g.x0.clone(), options)?;
+    let mut gated = 0;
+    if let Some(gate) = cfg.nis_gate {
+        for (f, on) in g.factors.iter().zip(&mut active) {
+            let lin = f.linearize(&sol.x);
+            if f.is_measurement() && lin.r[..lin.m].iter().map(|r| r * r).sum::<f64>() > gate {
+                *on = false;
+                gated += 1;
+            }
+        }
+        if gated > 0 {
+            let iterations = sol.iterations;
+            sol = solve::solve(&g.factors, &active, sol.x, options)?;
+            sol.iterations += iterations;
+        }
+    }
+    let l = sol.chol.l();
+    let z = solve::selected_inverse(l);
+    let n = g.t_s.len();
+    let covariances = solve::marginal_blocks(l, &z, (0..n).map(|k| 3 * k));
+    let variance = |i: usize| {
+        let s = l.col_offsets()[i];
+        z[s]
+    };
+    let pose = |x: &[f64], k: usize| [x[3 * k], x[3 * k + 1], x[3 * k + 2]];
+    Ok(Smoothed {
+        poses: (0..n).map(|k| pose(&sol.x, k)).collect(),
+        dead_reckoning: (0..n).map(|k| pose(&g.x0, k)).collect(),
+        covariances,
+        calibration: g.calibration.iter().map(|(name, i)| (name.clone(), sol.x[*i], variance(*i).sqrt())).collect(),
+        iterations: sol.iterations,
+        cost0: sol.cost0,
+        cost: sol.cost,
+        used: g.used,
+        gated,
+        ignored: g.ignored,
+        truth: g.truth,
+        t_s: g.t_s,
+        solve_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+impl Smoothed {
+    /// The pose at time `t` (linear between nodes, heading included) and the
+    /// horizontal covariance of the nearer node.
+    pub fn at(&self, t: f64) -> ([f64; 3], Matrix2<f64>) {
+        let (p, k) = self.interpolate(&self.poses, t);
+        let c = &self.covariances[k];
+        (p, Matrix2::new(c[0][0], c[0][1], c[1][0], c[1][1]))
+    }
+
+    /// A track of this smoother's nodes (the poses, dead reckoning) at time `t`, and
+    /// the node nearer to it.
+    fn interpolate(&self, track: &[[f64; 3]], t: f64) -> ([f64; 3], usize) {
+        let at = graph::between(&self.t_s, t);
+        let (p, q) = (track[at.k], track[if at.next { at.k + 1 } else { at.k }]);
+        let a = at.alpha;
+        (std::array::from_fn(|i| (1.0 - a) * p[i] + a * q[i]), if a > 0.5 { at.k + 1 } else { at.k })
+    }
+
+    /// The smoothed trajectory's errors and NEES against the ground truth, and dead
+    /// reckoning's errors.
+    pub fn score(&self) -> (ErrorStats, ErrorStats) {
+        let (mut s, mut dr) = (ErrorStats::default(), ErrorStats::default());
+        for &(t, n, e) in &self.truth {
+            let (p, cov) = self.at(t);
+            let d = Vector2::new(p[0] - n, p[1] - e);
+            s.push(d.norm(), nees(&d, &cov));
+            let (q, _) = self.interpolate(&self.dead_reckoning, t);
+            dr.push((q[0] - n).hypot(q[1] - e), None);
+        }
+        (s, dr)
+    }
+}
