@@ -227,9 +227,13 @@ enum Command {
         beacons: Option<Vec<u32>>,
         /// Weigh the measurements as this estimator of the log does (its noise, kernel,
         /// gate and calibration); default: the filters' default noise, a Huber kernel and
-        /// the calibration variables range_scale, turn_scale, offsets, clock_drift.
+        /// the calibration variables range_scale and turn_scale.
         #[arg(long, value_name = "ESTIMATOR")]
         like: Option<String>,
+        /// Read the `[[estimators]]` of this TOML file instead of the log's (for the
+        /// filters beside the smoother and for --like).
+        #[arg(long, value_name = "FILE")]
+        estimators: Option<PathBuf>,
         /// The calibration variables (comma-separated): none, all, range_scale,
         /// turn_scale, distance_scale, offsets (one per beacon), shared_offset,
         /// clock_drift.
@@ -469,8 +473,8 @@ fn main() -> ExitCode {
         Command::Replay { log, out, beacons, json, print_stream, estimators } => {
             replay::replay(&log, out, beacons, json, print_stream, estimators.as_deref())
         }
-        Command::Smooth { log, out, beacons, like, calibrate, kernel, json } => {
-            smooth::smooth(&log, smooth::SmoothArgs { out, beacons, json, like, calibrate, kernel })
+        Command::Smooth { log, out, beacons, like, estimators, calibrate, kernel, json } => {
+            smooth::smooth(&log, smooth::SmoothArgs { out, beacons, json, like, estimators, calibrate, kernel })
         }
         Command::Tune { log, estimators, keys, beacons, each_beacon, out, json } => {
             tune::tune(&log, tune::TuneArgs { estimators, keys, beacons, each_beacon, out, json })

@@ -7,10 +7,9 @@ use crate::replay::{beacon_filter, print_table};
 use crate::{plot, report};
 use anyhow::{Context, Result};
 use nalgebra::{Vector2, Vector3};
-use onebeacon::nav::Robust;
 use onebeacon_sim::replay::{Log, replay as run_replay};
 use onebeacon_sim::run::Estimate;
-use onebeacon_sim::smooth::{Calibrate, Offsets, SmoothConfig, Smoothed, smooth as run_smooth};
+use onebeacon_sim::smooth::{Smoothed, smooth as run_smooth};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -20,93 +19,22 @@ pub struct SmoothArgs {
     pub beacons: Option<Vec<u32>>,
     pub json: bool,
     pub like: Option<String>,
+    pub estimators: Option<PathBuf>,
     pub calibrate: Option<Vec<String>>,
     pub kernel: Option<String>,
-}
-
-/// The calibration variables `--calibrate` names (or the default's).
-const CALIBRATION_NAMES: &str =
-    "none, all, range_scale, turn_scale, distance_scale, offsets, shared_offset, clock_drift";
-
-fn calibrate(names: &[String]) -> Result<Calibrate> {
-    let mut c = Calibrate::NONE;
-    for n in names {
-        match n.as_str() {
-            "none" => c = Calibrate::NONE,
-            "all" => c = Calibrate::ALL,
-            "range_scale" => c.range_scale = true,
-            "turn_scale" => c.turn_scale = true,
-            "distance_scale" => c.distance_scale = true,
-            "offsets" => c.offsets = Offsets::PerBeacon,
-            "shared_offset" => c.offsets = Offsets::Shared,
-            "clock_drift" => c.clock_drift = true,
-            other => {
-                return Err(BadInput(format!(
-                    "--calibrate {other}: not a calibration variable (allowed: {CALIBRATION_NAMES})"
-                ))
-                .into());
-            }
-        }
-    }
-    Ok(c)
-}
-
-fn kernel(name: &str) -> Result<Option<Robust>> {
-    Ok(match name {
-        "none" | "gaussian" => None,
-        "huber" => Some(Robust::Huber { k: 1.345 }),
-        "cauchy" => Some(Robust::Cauchy { k: 2.3849 }),
-        "student_t" => Some(Robust::StudentT { dof: 4.0 }),
-        other => {
-            return Err(
-                BadInput(format!("--kernel {other}: not a kernel (allowed: none, huber, cauchy, student_t)")).into()
-            );
-        }
-    })
-}
-
-/// The smoother's configuration: the defaults, or what the log's estimator `like`
-/// reads, with `--calibrate` and `--kernel` over them.
-fn config(log: &Log, a: &SmoothArgs) -> Result<SmoothConfig> {
-    let mut cfg = SmoothConfig::default();
-    if let Some(name) = &a.like {
-        let estimators = &log.description.estimators;
-        let e = estimators.iter().find(|e| &e.name() == name).ok_or_else(|| {
-            let names: Vec<String> = estimators.iter().map(|e| e.name()).collect();
-            BadInput(format!("--like {name}: not an estimator of the log (estimators: {})", names.join(", ")))
-        })?;
-        let p = e.planar_config();
-        let c = Calibrate {
-            range_scale: p.estimate_range_scale,
-            turn_scale: p.estimate_turn_scale,
-            distance_scale: p.estimate_distance_scale,
-            offsets: if p.estimate_beacon_offsets {
-                Offsets::PerBeacon
-            } else if p.estimate_bias {
-                Offsets::Shared
-            } else {
-                Offsets::None
-            },
-            clock_drift: false,
-        };
-        cfg = SmoothConfig::from_planar(&p, c);
-    }
-    if let Some(names) = &a.calibrate {
-        cfg.calibrate = calibrate(names)?;
-    }
-    if let Some(k) = &a.kernel {
-        cfg.kernel = kernel(k)?;
-    }
-    Ok(cfg)
 }
 
 /// `onebeacon smooth LOG.toml [--out DIR] [--beacons 0,5] [--like NAME] [--calibrate ...]
 /// [--kernel ...] [--json]`
 pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
-    let log = Log::load(path)?;
+    let mut log = Log::load(path)?;
+    if let Some(file) = &a.estimators {
+        log.description.estimators = onebeacon_sim::replay::log::load_estimators(file)?;
+    }
     let known = log.beacon_ids();
     let filter = beacon_filter(a.beacons.clone(), &known)?;
-    let cfg = config(&log, &a)?;
+    let cfg = onebeacon_sim::smooth::config(&log, a.like.as_deref(), a.calibrate.as_deref(), a.kernel.as_deref())
+        .map_err(|e| BadInput(format!("--{e}")))?;
     let used: Vec<u32> = filter.clone().map_or_else(|| known.iter().copied().collect(), |f| f.into_iter().collect());
     let suffix =
         filter.as_ref().map(|f| format!("-beacons-{}", f.iter().map(u32::to_string).collect::<Vec<_>>().join("-")));
@@ -123,7 +51,7 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
     eprintln!(
         "smoothed {} poses in {:.3} s ({} iterations); replaying the filters ...",
         smoothed.poses.len(),
-        smoothed.solve_s,
+        smoothed.build_s + smoothed.solve_s,
         smoothed.iterations
     );
     let started = std::time::Instant::now();
@@ -164,9 +92,10 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
     }
     let s = &smoothed;
     outln!(
-        "{title}: {} poses, {} factors' worth of measurements, smoothed in {:.3} s ({} iterations, cost {:.1} -> {:.1}, {} gated)",
+        "{title}: {} poses, {} measurements, read in {:.3} s, smoothed in {:.3} s ({} iterations, cost {:.1} -> {:.1}, {} gated)",
         s.poses.len(),
         s.used.values().sum::<usize>(),
+        s.build_s,
         s.solve_s,
         s.iterations,
         s.cost0,

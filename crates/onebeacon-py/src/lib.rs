@@ -476,6 +476,47 @@ fn replay<'py>(
     PyTuple::new(py, [columns.into_any(), to_py(py, &summary)?])
 }
 
+/// A log smoothed over every pose after the dive (`onebeacon smooth`): `(poses,
+/// summary)`, poses a dict of arrays per node (t_s, north_m, east_m, heading_rad,
+/// sigma_north_m, sigma_east_m, and dead reckoning's dr_north_m, dr_east_m), the
+/// summary the smoother's line of `smooth --json` (errors, NEES, calibration, solve).
+/// `like`: weigh as this estimator of the log; `calibrate`: calibration variables by
+/// name; `kernel`: none, huber, cauchy or student_t.
+#[pyfunction]
+#[pyo3(signature = (log, beacons = None, like = None, calibrate = None, kernel = None))]
+fn smooth<'py>(
+    py: Python<'py>,
+    log: PathBuf,
+    beacons: Option<Vec<u32>>,
+    like: Option<String>,
+    calibrate: Option<Vec<String>>,
+    kernel: Option<String>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let l = Log::load(&log).map_err(input_error)?;
+    let filter = beacon_filter(beacons, &l.beacon_ids()).map_err(|e| input_error(format!("beacons {e}")))?;
+    let cfg = onebeacon_sim::smooth::config(&l, like.as_deref(), calibrate.as_deref(), kernel.as_deref())
+        .map_err(input_error)?;
+    Budget::resolve(None).map_err(input_error)?.check_replay(&l, true).map_err(input_error)?;
+    let s = py.detach(|| onebeacon_sim::smooth::smooth(&l, filter.as_ref(), &cfg)).map_err(input_error)?;
+    let d = PyDict::new(py);
+    let column = |f: &dyn Fn(usize) -> f64| (0..s.t_s.len()).map(f).collect::<Vec<f64>>();
+    let columns: [(&str, Vec<f64>); 8] = [
+        ("t_s", s.t_s.clone()),
+        ("north_m", column(&|k| s.poses[k][0])),
+        ("east_m", column(&|k| s.poses[k][1])),
+        ("heading_rad", column(&|k| onebeacon::geo::wrap_angle(s.poses[k][2]))),
+        ("sigma_north_m", column(&|k| s.covariances[k][0][0].sqrt())),
+        ("sigma_east_m", column(&|k| s.covariances[k][1][1].sqrt())),
+        ("dr_north_m", column(&|k| s.dead_reckoning[k][0])),
+        ("dr_east_m", column(&|k| s.dead_reckoning[k][1])),
+    ];
+    for (name, c) in columns {
+        d.set_item(name, PyArray1::from_vec(py, c))?;
+    }
+    let summary = onebeacon_sim::json::smoother_summary("smoother", &s);
+    PyTuple::new(py, [d.into_any(), to_py(py, &summary)?])
+}
+
 /// The estimators of a stream configuration, step by step: what `onebeacon stream`
 /// runs, for a Python backseat node (ROS 2, MOOS). `feed` takes one measurement (a dict
 /// or a JSON line, docs/logs.md) and returns the estimates line `stream` would print
@@ -653,6 +694,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(mc, m)?)?;
     m.add_function(wrap_pyfunction!(replay, m)?)?;
+    m.add_function(wrap_pyfunction!(smooth, m)?)?;
     m.add_function(wrap_pyfunction!(dsp_process, m)?)?;
     Ok(())
 }

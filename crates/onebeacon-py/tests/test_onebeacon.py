@@ -205,6 +205,20 @@ def test_replay_summary_is_the_cli_json(cli, tmp_path):
     assert all(c.shape == traj["t_s"].shape for c in traj.values())
 
 
+def test_smooth_is_the_cli_smoother(cli, tmp_path):
+    poses, summary = onebeacon.smooth(PLAZA, beacons=[5])
+    out = json.loads(cli("smooth", PLAZA, "--beacons", "5", "--json", "--out", tmp_path / "s").stdout)
+    line = next(e for e in out["estimators"] if e["name"] == "smoother")
+    for d in (summary, line):
+        for k in ("build_s", "solve_s"):
+            d.pop(k)
+    assert summary == line
+    assert poses["t_s"].shape == poses["north_m"].shape and poses["t_s"].size > 9000
+    assert np.all(poses["sigma_north_m"] > 0)
+    with pytest.raises(onebeacon.InputError, match="kernel nope: not a kernel"):
+        onebeacon.smooth(PLAZA, kernel="nope")
+
+
 def test_navigator_step_by_step_equals_the_cli_replay(cli, tmp_path):
     items = cli("replay", PLAZA, "--print-stream").stdout.splitlines()
     summary = json.loads(cli("replay", PLAZA, "--json", "--out", tmp_path / "r").stdout)

@@ -113,6 +113,7 @@ pub fn smoother_summary(name: &str, s: &crate::smooth::Smoothed) -> Value {
         "dead_reckoning_rmse_m": num(dr.rmse_m()),
         "iterations": s.iterations,
         "cost": {"initial": num(s.cost0), "final": num(s.cost)},
+        "build_s": s.build_s,
         "solve_s": s.solve_s,
         "measurements": s.used,
         "ignored": s.ignored,

@@ -8,6 +8,7 @@ The same engine as the ``onebeacon`` command line, from Python, with numpy array
 - ``run(scenario)``: one recorded run, ``(trajectory, summary)``;
 - ``mc(scenario)``: Monte Carlo over the sweep, the cells of ``onebeacon mc --json``;
 - ``replay(log)``: a real log through its estimators, ``(trajectory, summary)``;
+- ``smooth(log)``: a log smoothed over every pose after the dive, ``(poses, summary)``;
 - ``Navigator(config)``: the estimators step by step, for a backseat node;
 - ``dsp.process(samples, fs)``: the acoustic receiver chain on one capture.
 
@@ -23,6 +24,7 @@ from ._native import (
     replay,
     run,
     scenarios,
+    smooth,
 )
 from . import dsp
 
@@ -36,4 +38,5 @@ __all__ = [
     "replay",
     "run",
     "scenarios",
+    "smooth",
 ]

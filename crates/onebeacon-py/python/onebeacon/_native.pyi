@@ -60,6 +60,14 @@ def replay(
     estimators: Optional[Union[str, "os.PathLike[str]"]] = None,
 ) -> Tuple[Trajectory, Dict[str, Any]]: ...
 
+def smooth(
+    log: Union[str, "os.PathLike[str]"],
+    beacons: Optional[Sequence[int]] = None,
+    like: Optional[str] = None,
+    calibrate: Optional[Sequence[str]] = None,
+    kernel: Optional[str] = None,
+) -> Tuple[Dict[str, npt.NDArray[np.float64]], Dict[str, Any]]: ...
+
 class Navigator:
     """The estimators of a stream configuration, fed one measurement at a time."""
 

@@ -3,17 +3,23 @@
 //! reweighted least squares, and the marginal covariances of the poses by selected
 //! inversion of the factor at the optimum.
 //!
-//! The variables are ordered poses first, in time, calibration variables last: the
-//! normal matrix is a band (each factor touches neighbouring nodes) with a dense border,
-//! whose Cholesky factor fills in nothing outside them, so no fill-reducing ordering is
-//! needed.
+//! The poses come first, in time: their normal matrix A is a band (each factor touches
+//! neighbouring nodes) whose Cholesky factor fills in nothing outside it, so no
+//! fill-reducing ordering is needed. The few calibration variables, which every range
+//! or motion factor touches, are a dense border [A B; B^T C] taken out by their Schur
+//! complement S = C - B^T A^-1 B (a sparse factorisation of the whole would be
+//! quadratic in the poses in nalgebra-sparse's symbolic analysis).
 
-use super::factor::{Factor, Linear};
-use nalgebra::DVector;
+use super::factor::{Factor, Linear, MAX_VARS};
+use nalgebra::{DMatrix, DVector};
 use nalgebra_sparse::CscMatrix;
-use nalgebra_sparse::factorization::CscCholesky;
+use nalgebra_sparse::factorization::{CscCholesky, CscSymbolicCholesky};
 use nalgebra_sparse::pattern::SparsityPattern;
 use onebeacon::nav::Robust;
+
+/// The solver stops when a step lowers the cost by less than this fraction (GTSAM's
+/// relative error tolerance, as `../shared/bench/gtsam_smooth.py` sets it).
+const RELATIVE_TOLERANCE: f64 = 1e-6;
 
 /// How the solver weighs and stops.
 #[derive(Debug, Clone, Copy)]
@@ -22,15 +28,17 @@ pub(crate) struct SolveOptions {
     pub max_iterations: usize,
 }
 
-/// The optimum and how it was reached.
+/// The optimum, how it was reached, and the marginal covariances there.
 #[derive(Debug, Clone)]
 pub(crate) struct Solution {
     pub x: Vec<f64>,
     pub iterations: usize,
     pub cost0: f64,
     pub cost: f64,
-    /// The normal matrix's Cholesky factor at the optimum (for the marginals).
-    pub chol: CscCholesky<f64>,
+    /// (north, east, heading) covariance per pose.
+    pub poses: Vec<[[f64; 3]; 3]>,
+    /// Covariance of the calibration variables.
+    pub calibration: DMatrix<f64>,
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -41,51 +49,47 @@ pub enum SolveError {
     Singular,
 }
 
-/// The normal equations' pattern: the full symmetric matrix (the symbolic factorisation
-/// reads its upper half, the numeric one its lower), with each factor's slots.
-struct Normal {
+/// The pose block's pattern: every factor touches at most two consecutive nodes, so
+/// with a motion factor between each two it is block tridiagonal (3 x 3 blocks), kept
+/// as the full symmetric matrix (the symbolic factorisation reads its upper half, the
+/// numeric one its lower).
+struct Pattern {
     pattern: SparsityPattern,
-    /// Per factor, the value index of each (row, col) of its variables, row-major.
-    slots: Vec<Vec<usize>>,
-    diag: Vec<usize>,
+    nodes: usize,
 }
 
-impl Normal {
-    fn new(dim: usize, factors: &[Factor]) -> Self {
-        let mut cols: Vec<Vec<usize>> = (0..dim).map(|i| vec![i]).collect();
-        for f in factors {
-            let (v, n) = f.vars();
-            for &a in &v[..n] {
-                cols[a].extend_from_slice(&v[..n]);
-            }
-        }
-        let mut offsets = Vec::with_capacity(dim + 1);
-        let mut rows = Vec::new();
+impl Pattern {
+    fn new(poses: usize) -> Self {
+        let nodes = poses / 3;
+        let mut offsets = Vec::with_capacity(poses + 1);
+        let mut rows = Vec::with_capacity(9 * poses);
         offsets.push(0);
-        for c in &mut cols {
-            c.sort_unstable();
-            c.dedup();
-            rows.extend_from_slice(c);
+        for c in 0..poses {
+            let k = c / 3;
+            rows.extend(3 * k.saturating_sub(1)..3 * (k + 2).min(nodes));
             offsets.push(rows.len());
         }
-        let find = |col: usize, row: usize| {
-            offsets[col]
-                + rows[offsets[col]..offsets[col + 1]]
-                    .binary_search(&row)
-                    .unwrap_or_else(|_| unreachable!("pattern holds every pair"))
-        };
-        let slots = factors
-            .iter()
-            .map(|f| {
-                let (v, n) = f.vars();
-                v[..n].iter().flat_map(|&a| v[..n].iter().map(move |&b| (a, b))).map(|(a, b)| find(b, a)).collect()
-            })
-            .collect();
-        let diag = (0..dim).map(|i| find(i, i)).collect();
-        let pattern = SparsityPattern::try_from_offsets_and_indices(dim, dim, offsets, rows)
-            .unwrap_or_else(|_| unreachable!("sorted, deduplicated, in range"));
-        Self { pattern, slots, diag }
+        let pattern = SparsityPattern::try_from_offsets_and_indices(poses, poses, offsets, rows)
+            .unwrap_or_else(|_| unreachable!("sorted, in range"));
+        Self { pattern, nodes }
     }
+
+    /// The value index of (row, col), both poses of neighbouring (or the same) nodes.
+    fn slot(&self, row: usize, col: usize) -> usize {
+        let first = 3 * (col / 3).saturating_sub(1);
+        debug_assert!(row >= first && row < 3 * (col / 3 + 2).min(self.nodes));
+        self.pattern.major_offsets()[col] + row - first
+    }
+}
+
+/// The normal equations at one point: the pose block A (values on the pattern), the
+/// border B (poses x calibration) and C, the gradient g = J^T r.
+#[derive(Clone)]
+struct Normal {
+    a: Vec<f64>,
+    b: DMatrix<f64>,
+    c: DMatrix<f64>,
+    g: DVector<f64>,
 }
 
 /// The factor's weight under the kernel at its whitened residual (1 for Gaussian
@@ -104,74 +108,139 @@ fn total_cost(factors: &[Factor], active: &[bool], x: &[f64], kernel: Option<Rob
         .zip(active)
         .filter(|(_, on)| **on)
         .map(|(f, _)| {
-            let lin_r = local_residual(f, x);
-            weigh(f, &lin_r.0[..lin_r.1], kernel).1
+            let (v, n) = f.vars();
+            let mut local = [0.0; MAX_VARS];
+            for (l, &i) in local.iter_mut().zip(&v[..n]) {
+                *l = x[i];
+            }
+            let (r, m) = f.residual(&local[..n]);
+            weigh(f, &r[..m], kernel).1
         })
         .sum()
 }
 
-fn local_residual(f: &Factor, x: &[f64]) -> ([f64; 3], usize) {
-    let (v, n) = f.vars();
-    let mut local = [0.0; super::factor::MAX_VARS];
-    for (l, &i) in local.iter_mut().zip(&v[..n]) {
-        *l = x[i];
-    }
-    f.residual(&local[..n])
+/// The problem: factors, which are active, the pose block's pattern.
+struct Problem<'a> {
+    factors: &'a [Factor],
+    active: &'a [bool],
+    pattern: Pattern,
+    poses: usize,
+    dim: usize,
+    kernel: Option<Robust>,
 }
 
-/// Minimises the sum of the factors' costs (those `active`) from `x0`.
-pub(crate) fn solve(
-    factors: &[Factor],
-    active: &[bool],
-    x0: Vec<f64>,
-    opt: SolveOptions,
-) -> Result<Solution, SolveError> {
-    let dim = x0.len();
-    let normal = Normal::new(dim, factors);
-    let nnz = normal.pattern.nnz();
-    let mut values = vec![0.0; nnz];
-    let mut g = DVector::zeros(dim);
-    let mut x = x0;
-    let build = |x: &[f64], values: &mut Vec<f64>, g: &mut DVector<f64>| {
-        values.iter_mut().for_each(|v| *v = 0.0);
-        g.fill(0.0);
-        for ((f, slots), _) in factors.iter().zip(&normal.slots).zip(active).filter(|(_, on)| **on) {
+impl Problem<'_> {
+    /// The reweighted normal equations at `x`.
+    fn normal(&self, x: &[f64]) -> Normal {
+        let (p, k) = (self.poses, self.dim - self.poses);
+        let mut ne = Normal {
+            a: vec![0.0; self.pattern.pattern.nnz()],
+            b: DMatrix::zeros(p, k),
+            c: DMatrix::zeros(k, k),
+            g: DVector::zeros(self.dim),
+        };
+        for (f, _) in self.factors.iter().zip(self.active).filter(|(_, on)| **on) {
             let Linear { m, n, vars, mut r, mut j } = f.linearize(x);
-            let (w, _) = weigh(f, &r[..m], opt.kernel);
-            let sw = w.sqrt();
+            let sw = weigh(f, &r[..m], self.kernel).0.sqrt();
             for row in 0..m {
                 r[row] *= sw;
                 j[row][..n].iter_mut().for_each(|v| *v *= sw);
             }
             for a in 0..n {
-                g[vars[a]] += (0..m).map(|row| j[row][a] * r[row]).sum::<f64>();
+                ne.g[vars[a]] += (0..m).map(|row| j[row][a] * r[row]).sum::<f64>();
                 for b in 0..n {
-                    values[slots[a * n + b]] += (0..m).map(|row| j[row][a] * j[row][b]).sum::<f64>();
+                    let h: f64 = (0..m).map(|row| j[row][a] * j[row][b]).sum();
+                    match (vars[a] < p, vars[b] < p) {
+                        (true, true) => ne.a[self.pattern.slot(vars[a], vars[b])] += h,
+                        (true, false) => ne.b[(vars[a], vars[b] - p)] += h,
+                        (false, true) => {}
+                        (false, false) => ne.c[(vars[a] - p, vars[b] - p)] += h,
+                    }
                 }
             }
         }
-    };
+        ne
+    }
+
+    /// Factors A + lambda diag(A) (a fresh factor the first time).
+    fn factor(&self, chol: &mut Option<CscCholesky<f64>>, ne: &Normal, lambda: f64) -> bool {
+        let mut a = ne.a.clone();
+        for i in 0..self.poses {
+            let d = self.pattern.slot(i, i);
+            a[d] += lambda * ne.a[d].max(1e-9);
+        }
+        match chol {
+            Some(c) => c.refactor(&a).is_ok(),
+            None => {
+                match CscCholesky::factor_numerical(CscSymbolicCholesky::factor(self.pattern.pattern.clone()), &a) {
+                    Ok(c) => {
+                        *chol = Some(c);
+                        true
+                    }
+                    Err(_) => false,
+                }
+            }
+        }
+    }
+
+    /// The Schur complement's pieces at a factored A: W = A^-1 B and the factored
+    /// S = C + lambda diag(C) - B^T W.
+    fn schur(
+        &self,
+        chol: &CscCholesky<f64>,
+        ne: &Normal,
+        lambda: f64,
+    ) -> Option<(DMatrix<f64>, nalgebra::Cholesky<f64, nalgebra::Dyn>)> {
+        let w = if ne.b.ncols() > 0 { chol.solve(&ne.b) } else { DMatrix::zeros(self.poses, 0) };
+        let mut s = &ne.c - ne.b.transpose() * &w;
+        for i in 0..s.nrows() {
+            s[(i, i)] += lambda * ne.c[(i, i)].max(1e-9);
+        }
+        s.cholesky().map(|s| (w, s))
+    }
+
+    /// The LM step: [A B; B^T C] (damped) d = -g by the Schur complement.
+    fn step(&self, ne: &Normal, lambda: f64, chol: &mut Option<CscCholesky<f64>>) -> Option<DVector<f64>> {
+        if !self.factor(chol, ne, lambda) {
+            return None;
+        }
+        let chol = chol.as_ref()?;
+        let (w, s) = self.schur(chol, ne, lambda)?;
+        let p = self.poses;
+        let y = chol.solve(&ne.g.rows(0, p));
+        let rhs = ne.b.transpose() * &y - ne.g.rows(p, self.dim - p);
+        let dc = s.solve(&rhs);
+        let da = -(&y + &w * &dc);
+        let mut d = DVector::zeros(self.dim);
+        d.rows_mut(0, p).copy_from(&da.column(0));
+        d.rows_mut(p, self.dim - p).copy_from(&dc.column(0));
+        Some(d)
+    }
+}
+
+/// Minimises the sum of the factors' costs (those `active`) from `x0`, whose first
+/// `poses` variables are the poses.
+pub(crate) fn solve(
+    factors: &[Factor],
+    active: &[bool],
+    x0: Vec<f64>,
+    poses: usize,
+    opt: SolveOptions,
+) -> Result<Solution, SolveError> {
+    let problem = Problem { factors, active, pattern: Pattern::new(poses), poses, dim: x0.len(), kernel: opt.kernel };
+    let mut x = x0;
     let cost0 = total_cost(factors, active, &x, opt.kernel);
     let mut cost = cost0;
     let mut lambda = 1e-6;
     let mut iterations = 0;
-    let symbolic_matrix = |v: Vec<f64>| {
-        CscMatrix::try_from_pattern_and_values(normal.pattern.clone(), v)
-            .unwrap_or_else(|_| unreachable!("one value per slot"))
-    };
-    build(&x, &mut values, &mut g);
-    let mut chol = CscCholesky::factor(&symbolic_matrix(values.clone())).map_err(|_| SolveError::Singular)?;
-    while iterations < opt.max_iterations {
+    let mut chol = None;
+    let mut ne = problem.normal(&x);
+    while iterations < opt.max_iterations && lambda < 1e12 {
         iterations += 1;
-        let mut damped = values.clone();
-        for &d in &normal.diag {
-            damped[d] += lambda * values[d].max(1e-9);
-        }
-        if chol.refactor(&damped).is_err() {
+        let Some(step) = problem.step(&ne, lambda, &mut chol) else {
             lambda *= 10.0;
             continue;
-        }
-        let step = chol.solve(&(-&g));
+        };
         let trial: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
         let trial_cost = total_cost(factors, active, &trial, opt.kernel);
         if trial_cost.is_finite() && trial_cost <= cost {
@@ -179,19 +248,36 @@ pub(crate) fn solve(
             x = trial;
             cost = trial_cost;
             lambda = (lambda / 10.0).max(1e-12);
-            build(&x, &mut values, &mut g);
-            if gain <= 1e-10 * cost.max(1.0) || step.amax() < 1e-9 {
+            ne = problem.normal(&x);
+            if gain <= RELATIVE_TOLERANCE * cost || step.amax() < 1e-9 {
                 break;
             }
         } else {
             lambda *= 10.0;
-            if lambda > 1e12 {
-                break;
+        }
+    }
+    // the marginals at the optimum: Cov(poses) = A^-1 + W S^-1 W^T, Cov(calibration) = S^-1
+    if !problem.factor(&mut chol, &ne, 0.0) {
+        return Err(SolveError::Singular);
+    }
+    let chol = chol.ok_or(SolveError::Singular)?;
+    let (w, s) = problem.schur(&chol, &ne, 0.0).ok_or(SolveError::Singular)?;
+    let s_inv = s.inverse();
+    let l = chol.l();
+    let z = selected_inverse(l);
+    let mut blocks = marginal_blocks(l, &z, (0..poses / 3).map(|k| 3 * k));
+    if s_inv.nrows() > 0 {
+        for (k, block) in blocks.iter_mut().enumerate() {
+            let wk = w.rows(3 * k, 3);
+            let extra = wk * &s_inv * wk.transpose();
+            for (a, row) in block.iter_mut().enumerate() {
+                for (b, v) in row.iter_mut().enumerate() {
+                    *v += extra[(a, b)];
+                }
             }
         }
     }
-    chol.refactor(&values).map_err(|_| SolveError::Singular)?;
-    Ok(Solution { x, iterations, cost0, cost, chol })
+    Ok(Solution { x, iterations, cost0, cost, poses: blocks, calibration: s_inv })
 }
 
 /// The entries of the inverse of L L^T on the pattern of L (Takahashi, Fagan and Chen's
