@@ -449,3 +449,32 @@ lon = "lon"
     let warnings = v["warnings"].as_array().unwrap();
     assert_eq!(warnings.len(), 1 + v["estimators"].as_array().unwrap().len(), "{warnings:?}");
 }
+
+/// `onebeacon smooth` on plaza2 with the range scale as a variable lands within 10 % of
+/// GTSAM's LM on the same graph (0.266 m: `../shared/bench/gtsam_smooth.py plaza2 --scale
+/// est`, docs/smooth.md), writes replay's files with a smoother column, and its table
+/// line is the JSON's; a bad flag exits 2 with one line and writes nothing.
+#[test]
+fn smooth_matches_gtsam_on_plaza2_and_refuses_bad_flags() {
+    let dir = scratch("smooth");
+    let out = dir.join("s");
+    let args = ["smooth", &plaza(2), "--calibrate", "range_scale", "--kernel", "none", "--out"];
+    let o = run(&[&args[..], &[out.to_str().unwrap(), "--json"]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let estimators = summary["estimators"].as_array().unwrap();
+    let smoother = rmse(estimators, "smoother");
+    assert!(smoother < 1.1 * 0.266, "smoother RMSE {smoother} m");
+    let header = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    assert!(header.lines().next().unwrap().contains("smoother_sigma_north_m"));
+    for f in ["summary.json", "top_view.png", "error.png"] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    let bad = dir.join("bad");
+    let o = run(&["smooth", &plaza(2), "--kernel", "gauss", "--out", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("--kernel gauss: not a kernel (allowed: none, huber, cauchy, student_t)"), "{err}");
+    assert!(!bad.exists());
+}

@@ -21,6 +21,9 @@ use onebeacon::nav::Robust;
 /// relative error tolerance, as `../shared/bench/gtsam_smooth.py` sets it).
 const RELATIVE_TOLERANCE: f64 = 1e-6;
 
+/// The least damping (relative to the normal matrix's diagonal) after a rejected step.
+const REJECTED_LAMBDA: f64 = 1e-5;
+
 /// How the solver weighs and stops.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SolveOptions {
@@ -162,12 +165,16 @@ impl Problem<'_> {
         ne
     }
 
+    /// The damping's scale of variable i: its diagonal of the normal matrix.
+    fn diagonal(&self, ne: &Normal, i: usize) -> f64 {
+        if i < self.poses { ne.a[self.pattern.slot(i, i)] } else { ne.c[(i - self.poses, i - self.poses)] }.max(1e-9)
+    }
+
     /// Factors A + lambda diag(A) (a fresh factor the first time).
     fn factor(&self, chol: &mut Option<CscCholesky<f64>>, ne: &Normal, lambda: f64) -> bool {
         let mut a = ne.a.clone();
         for i in 0..self.poses {
-            let d = self.pattern.slot(i, i);
-            a[d] += lambda * ne.a[d].max(1e-9);
+            a[self.pattern.slot(i, i)] += lambda * self.diagonal(ne, i);
         }
         match chol {
             Some(c) => c.refactor(&a).is_ok(),
@@ -194,7 +201,7 @@ impl Problem<'_> {
         let w = if ne.b.ncols() > 0 { chol.solve(&ne.b) } else { DMatrix::zeros(self.poses, 0) };
         let mut s = &ne.c - ne.b.transpose() * &w;
         for i in 0..s.nrows() {
-            s[(i, i)] += lambda * ne.c[(i, i)].max(1e-9);
+            s[(i, i)] += lambda * self.diagonal(ne, self.poses + i);
         }
         s.cholesky().map(|s| (w, s))
     }
@@ -231,29 +238,38 @@ pub(crate) fn solve(
     let mut x = x0;
     let cost0 = total_cost(factors, active, &x, opt.kernel);
     let mut cost = cost0;
-    let mut lambda = 1e-6;
+    // nearly Gauss-Newton first (the problem is nearly linear near dead reckoning with
+    // good odometry); damping from REJECTED_LAMBDA on once a step fails
+    let mut lambda = 1e-9;
+    let mut nu = 2.0;
     let mut iterations = 0;
     let mut chol = None;
     let mut ne = problem.normal(&x);
     while iterations < opt.max_iterations && lambda < 1e12 {
         iterations += 1;
         let Some(step) = problem.step(&ne, lambda, &mut chol) else {
-            lambda *= 10.0;
+            (lambda, nu) = ((lambda * nu).max(REJECTED_LAMBDA), 2.0 * nu);
             continue;
         };
         let trial: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
         let trial_cost = total_cost(factors, active, &trial, opt.kernel);
+        // the decrease the quadratic model predicts, (lambda h^T D h - h^T g) / 2
+        let damped: f64 = (0..problem.dim).map(|i| problem.diagonal(&ne, i) * step[i] * step[i]).sum();
+        let predicted = 0.5 * (lambda * damped - step.dot(&ne.g));
+        let rho = (cost - trial_cost) / predicted.max(f64::MIN_POSITIVE);
         if trial_cost.is_finite() && trial_cost <= cost {
             let gain = cost - trial_cost;
             x = trial;
             cost = trial_cost;
-            lambda = (lambda / 10.0).max(1e-12);
+            // Nielsen's update: less damping the better the model predicted the step
+            lambda = (lambda * (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0)).max(1e-12);
+            nu = 2.0;
             ne = problem.normal(&x);
             if gain <= RELATIVE_TOLERANCE * cost || step.amax() < 1e-9 {
                 break;
             }
         } else {
-            lambda *= 10.0;
+            (lambda, nu) = ((lambda * nu).max(REJECTED_LAMBDA), 2.0 * nu);
         }
     }
     // the marginals at the optimum: Cov(poses) = A^-1 + W S^-1 W^T, Cov(calibration) = S^-1

@@ -372,6 +372,9 @@ pub struct Session {
     pub before_start: usize,
     pub left_out: usize,
     pub screened: usize,
+    /// A ground-truth row without heading was screened while the session waits for one
+    /// (said once: the rows after it wait silently).
+    told_no_heading: bool,
     /// The position of the last beacon heard.
     pub last_beacon: Option<Vector3<f64>>,
     limits: Limits,
@@ -412,6 +415,7 @@ impl Session {
             before_start: 0,
             left_out: 0,
             screened: 0,
+            told_no_heading: false,
             last_beacon: None,
             limits: Limits::default(),
             last_t: None,
@@ -564,6 +568,14 @@ impl Session {
                     }
                     self.begin(t, (*north_m, *east_m, (east_m - e0).atan2(north_m - n0)))
                 }
+                (Start::FirstTruth, Input::Truth(TruthPose { heading_rad: None, .. })) if !self.told_no_heading => {
+                    self.told_no_heading = true;
+                    self.before_start += 1;
+                    let reason = "a ground-truth row without heading: the estimators start at the first one with a \
+                                  heading ([initial] heading_from = \"column\"); for a truth without heading set \
+                                  heading_from = \"track\" (said once)";
+                    return Err(self.screen(item, reason.into()));
+                }
                 _ => {
                     self.before_start += 1;
                     return Ok(None);
@@ -697,6 +709,23 @@ mod tests {
             }
         }
         assert_eq!(s.before_start, 4);
+    }
+
+    /// A stream that starts at the first ground-truth heading says, once, that a truth
+    /// row has none (instead of waiting in silence), and starts at the first that has.
+    #[test]
+    fn a_truth_without_heading_is_named_once() {
+        let est = vec![("dr".to_string(), PlanarConfig::default(), FilterKind::Ekf)];
+        let mut s = Session::new(Frame::Ned, planar(est), Start::FirstTruth, (1.0, 0.1), None);
+        let truth = |t: f64, heading_rad| Item {
+            t_s: t,
+            input: Input::Truth(TruthPose { north_m: t, east_m: 0.0, heading_rad }),
+        };
+        let first = s.push(&truth(0.0, None)).unwrap_err();
+        assert!(first.reason.contains("heading_from = \"track\""), "{first}");
+        assert_eq!(s.push(&truth(1.0, None)), Ok(None));
+        assert!(s.push(&truth(2.0, Some(0.5))).unwrap().is_some());
+        assert_eq!((s.screened, s.before_start), (1, 2));
     }
 
     /// Every plausible item passes the default limits; the implausible ones are refused
