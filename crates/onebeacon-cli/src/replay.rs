@@ -7,7 +7,8 @@ use crate::{plot, report};
 use anyhow::{Context, Result};
 use onebeacon::io::jsonl;
 use onebeacon::nav::session::Session;
-use onebeacon_sim::replay::{Log, replay as run_replay, stream_setup};
+use onebeacon_sim::replay::{Log, Replay, replay as run_replay, stream_setup};
+use onebeacon_sim::run::StepRecord;
 use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -15,6 +16,83 @@ use std::path::{Path, PathBuf};
 /// `--beacons` checked against the log's beacons.
 pub(crate) fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Option<BTreeSet<u32>>> {
     onebeacon_sim::replay::beacon_filter(ids, known).map_err(|e| BadInput(format!("--beacons {e}")).into())
+}
+
+/// A log made ready for `replay` or `smooth`: its beacons, its output directory
+/// (`out/<log>-<command>[-beacons-...]` by default), the memory budget checked.
+pub(crate) struct Prepared {
+    pub log: Log,
+    pub filter: Option<BTreeSet<u32>>,
+    pub used: Vec<u32>,
+    pub staging: Staging,
+}
+
+impl Prepared {
+    pub(crate) fn new(log: Log, out: Option<PathBuf>, beacons: Option<Vec<u32>>, command: &str) -> Result<Self> {
+        let known = log.beacon_ids();
+        let filter = beacon_filter(beacons, &known)?;
+        let used: Vec<u32> =
+            filter.clone().map_or_else(|| known.iter().copied().collect(), |f| f.into_iter().collect());
+        let suffix =
+            filter.as_ref().map(|f| format!("-beacons-{}", f.iter().map(u32::to_string).collect::<Vec<_>>().join("-")));
+        let name = &log.description.name;
+        let dir =
+            out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-{command}{}", suffix.unwrap_or_default())));
+        crate::budget().check_replay(&log, false).map_err(|e| BadInput(e.to_string()))?;
+        let staging = Staging::new(&dir)?;
+        Ok(Self { log, filter, used, staging })
+    }
+
+    /// Replays the log's estimators, each record given to `extra` first (to add the
+    /// estimates named `extra_names`), writing trajectory.csv as it goes (the plots get
+    /// at most 20 000 evenly spaced rows), then summary.json as `summary` makes it,
+    /// rejected.csv, top_view.png and error.png titled "<log><label>, beacons ...".
+    /// Returns the replay, the summary and the title.
+    pub(crate) fn replay(
+        &self,
+        label: &str,
+        extra_names: &[String],
+        mut extra: impl FnMut(&mut StepRecord),
+        summary: impl FnOnce(&mut serde_json::Value, &Replay) -> Result<()>,
+    ) -> Result<(Replay, serde_json::Value, String)> {
+        let (log, staging) = (&self.log, &self.staging);
+        let vehicles = ["auv".to_string()];
+        let mut names: Vec<String> = log.description.estimators.iter().map(|e| e.name()).collect();
+        names.extend_from_slice(extra_names);
+        let file = std::fs::File::create(staging.file("trajectory.csv")).context("cannot write trajectory.csv")?;
+        let mut trajectory = report::TrajectoryWriter::new(std::io::BufWriter::new(file), &vehicles, &names)?;
+        let mut plotted = plot::Thinned::new(10_000);
+        let r = run_replay(log, self.filter.clone(), |mut record| -> Result<()> {
+            extra(&mut record);
+            trajectory.write(&record)?;
+            plotted.push(record);
+            Ok(())
+        })?;
+        trajectory.finish()?.flush().context("cannot write trajectory.csv")?;
+        let mut s = serde_json::Value::Null;
+        summary(&mut s, &r)?;
+        staging.write("summary.json", serde_json::to_string_pretty(&s)?.as_bytes())?;
+        staging.write("rejected.csv", &rejected_csv(&r.session)?)?;
+        let used = &self.used;
+        let fixed: Vec<_> =
+            used.iter().filter_map(|b| log.beacons.get(b).map(|p| (*b, log.frame.to_ned(p.x, p.y, p.z)))).collect();
+        let beacons = used.iter().map(u32::to_string).collect::<Vec<_>>().join(", ");
+        let title = format!("{}{label}, beacons {beacons}", log.description.name);
+        plot::top_view(&staging.file("top_view.png"), &vehicles, &names, &title, plotted.records(), Some(&fixed))
+            .context("cannot draw top_view.png")?;
+        plot::error_vs_time(&staging.file("error.png"), &names, &title, plotted.records())
+            .context("cannot draw error.png")?;
+        Ok((r, s, title))
+    }
+
+    /// Moves the files into place and prints the replay's warnings; the files written.
+    pub(crate) fn finish(self, r: &Replay) -> Result<Vec<PathBuf>> {
+        let files = self.staging.commit()?;
+        for w in r.warnings(self.log.has_truth()) {
+            eprintln!("warning: {w}");
+        }
+        Ok(files)
+    }
 }
 
 /// `onebeacon replay LOG.toml [--out DIR] [--beacons 0,5] [--json] [--print-stream]`
@@ -38,47 +116,19 @@ pub fn replay(
         stdout.flush()?;
         return Ok(());
     }
-    let known = log.beacon_ids();
-    let filter = beacon_filter(beacons, &known)?;
-    let used: Vec<u32> = filter.clone().map_or_else(|| known.iter().copied().collect(), |f| f.into_iter().collect());
-    let suffix =
-        filter.as_ref().map(|f| format!("-beacons-{}", f.iter().map(u32::to_string).collect::<Vec<_>>().join("-")));
-    let name = &log.description.name;
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-replay{}", suffix.unwrap_or_default())));
-    crate::budget().check_replay(&log, false).map_err(|e| BadInput(e.to_string()))?;
-    let staging = Staging::new(&dir)?;
-
+    let p = Prepared::new(log, out, beacons, "replay")?;
     let started = std::time::Instant::now();
-    let vehicles = ["auv".to_string()];
-    let names: Vec<String> = log.description.estimators.iter().map(|e| e.name()).collect();
-    let file = std::fs::File::create(staging.file("trajectory.csv")).context("cannot write trajectory.csv")?;
-    let mut trajectory = report::TrajectoryWriter::new(std::io::BufWriter::new(file), &vehicles, &names)?;
-    // the trajectory is written as it comes; the plots get at most 20 000 evenly spaced rows
-    let mut plotted = plot::Thinned::new(10_000);
-    let r = run_replay(&log, filter, |record| -> Result<()> {
-        trajectory.write(&record)?;
-        plotted.push(record);
-        Ok(())
-    })?;
-    trajectory.finish()?.flush().context("cannot write trajectory.csv")?;
-    let wall_s = started.elapsed().as_secs_f64();
-    let s = &r.session;
-    let summary = onebeacon_sim::json::replay_summary(&log, &used, &r, wall_s);
-
-    staging.write("summary.json", serde_json::to_string_pretty(&summary)?.as_bytes())?;
-    staging.write("rejected.csv", &rejected_csv(s)?)?;
-    let fixed: Vec<_> =
-        used.iter().filter_map(|b| log.beacons.get(b).map(|p| (*b, log.frame.to_ned(p.x, p.y, p.z)))).collect();
-    let title = format!("{name}, beacons {}", used.iter().map(u32::to_string).collect::<Vec<_>>().join(", "));
-    plot::top_view(&staging.file("top_view.png"), &vehicles, &s.names, &title, plotted.records(), Some(&fixed))
-        .context("cannot draw top_view.png")?;
-    plot::error_vs_time(&staging.file("error.png"), &s.names, &title, plotted.records())
-        .context("cannot draw error.png")?;
-    let files = staging.commit()?;
-    for w in r.warnings(log.has_truth()) {
-        eprintln!("warning: {w}");
-    }
-
+    let (r, summary, title) = p.replay(
+        "",
+        &[],
+        |_| {},
+        |summary, r| {
+            *summary = onebeacon_sim::json::replay_summary(&p.log, &p.used, r, started.elapsed().as_secs_f64());
+            Ok(())
+        },
+    )?;
+    let wall_s = summary["wall_s"].as_f64().unwrap_or(f64::NAN);
+    let files = p.finish(&r)?;
     if as_json {
         outln!("{summary}");
         return Ok(());
