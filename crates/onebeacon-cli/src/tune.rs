@@ -7,7 +7,7 @@ use crate::output::Staging;
 use anyhow::Result;
 use onebeacon::nav::evaluation::ErrorStats;
 use onebeacon_sim::replay::Log;
-use onebeacon_sim::replay::tune::{DEFAULT_KEYS, TUNABLE, Tuned, tune as fit};
+use onebeacon_sim::replay::tune::{BOUND_FACTOR, DEFAULT_KEYS, TUNABLE, Tuned, tune as fit};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 
@@ -124,7 +124,15 @@ pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
             t.evaluations
         );
         for (k, from, to) in &t.keys {
-            outln!("  {k:<30} {from:>10.4} -> {to:.4}");
+            let bound = if at_bound(*from, *to) {
+                format!(" (at its bound, a factor of {BOUND_FACTOR} from the start: the fit wants it further)")
+            } else {
+                String::new()
+            };
+            outln!("  {k:<30} {from:>10.4} -> {to:.4}{bound}");
+        }
+        if a.rejected > 0 {
+            outln!("  {} of {} corrections gated out after the fit", a.rejected, a.nis_count);
         }
         outln!(
             "  rmse {:.3} -> {:.3} m, nees {:.1} -> {:.1} (2 when consistent), nis {:.2} -> {:.2} (1)",
@@ -148,14 +156,23 @@ fn stats_json(s: &ErrorStats) -> Value {
     json!({"rmse_m": num(s.rmse_m()), "nees_mean": num(s.nees_mean()), "nis_mean": num(s.nis_mean())})
 }
 
+/// Whether a key tuned from `from` to `to` stopped at its bound.
+fn at_bound(from: f64, to: f64) -> bool {
+    (to / from).ln().abs() >= BOUND_FACTOR.ln() * 0.999
+}
+
 fn tuned_json(name: &str, t: &Tuned) -> Value {
-    let keys: serde_json::Map<String, Value> =
-        t.keys.iter().map(|(k, a, b)| (k.clone(), json!({"before": a, "after": b}))).collect();
+    let keys: serde_json::Map<String, Value> = t
+        .keys
+        .iter()
+        .map(|(k, a, b)| (k.clone(), json!({"before": a, "after": b, "at_bound": at_bound(*a, *b)})))
+        .collect();
     json!({
         "name": name,
         "keys": keys,
         "neg_log_likelihood": {"before": t.nll_before, "after": t.nll_after},
         "corrections": t.after.nis_count,
+        "gated": t.after.rejected,
         "replays": t.evaluations,
         "before": stats_json(&t.before),
         "after": stats_json(&t.after),

@@ -341,7 +341,12 @@ impl StreamConfig {
     pub fn session(&self, initial: &Initial, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
         let estimators = self.estimators.iter().map(|e| (e.name(), e.builder(initial.tracker_start()))).collect();
         let sigmas = (initial.position_sigma_m, initial.heading_sigma_deg.to_radians());
-        Session::new(self.frame.into(), estimators, start, sigmas, beacons).with_limits(self.limits)
+        let mut session = Session::new(self.frame.into(), estimators, start, sigmas, beacons).with_limits(self.limits);
+        for (stats, e) in session.stats.iter_mut().zip(&self.estimators) {
+            let (gate, kernel) = e.gate();
+            *stats = stats.weighed_as(Some(gate), kernel);
+        }
+        session
     }
 
     /// The vehicle's computer: one session per vehicle it estimates (its own from

@@ -3,7 +3,7 @@
 //! 95 % chi-square bands and quantiles. One module for the simulator's runs, the replay
 //! of a log, the stream and the fleet's percentiles.
 
-use super::{Estimate, Outcome};
+use super::{Estimate, Outcome, Robust};
 use crate::filter::consistency::nees;
 use nalgebra::Vector2;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -53,9 +53,20 @@ pub struct ErrorStats {
     pub nis_within_95: usize,
     /// Sum of ln det S of the same corrections: with the NIS, their Gaussian likelihood.
     pub ln_det_s_sum: f64,
+    /// How the estimator weighs a correction ([`ErrorStats::weighed_as`]): its gate and
+    /// heavy-tailed kernel, and the sum of each correction's cost under them.
+    pub gate: Option<f64>,
+    pub kernel: Option<Robust>,
+    pub own_cost_sum: f64,
 }
 
 impl ErrorStats {
+    /// Statistics that score each correction as an estimator with this gate (NIS beyond
+    /// it: an outlier, its cost the gate's) and kernel weighs it.
+    pub fn weighed_as(self, gate: Option<f64>, kernel: Option<Robust>) -> Self {
+        Self { gate: gate.filter(|g| g.is_finite()), kernel, ..self }
+    }
+
     /// Statistics whose first `half` errors are also summed apart (a run of 2 half steps).
     pub fn with_half(half: usize) -> Self {
         Self { half, ..Self::default() }
@@ -103,6 +114,8 @@ impl ErrorStats {
             self.nis_count += 1;
             self.nis_within_95 += usize::from(nis <= NIS_95_1DOF);
             self.ln_det_s_sum += det_s.ln();
+            let d2 = self.gate.map_or(nis, |g| nis.min(g));
+            self.own_cost_sum += self.kernel.map_or(0.5 * d2, |k| -k.log_density(d2));
         }
     }
 
@@ -133,6 +146,14 @@ impl ErrorStats {
     /// NIS) / 2 over them (the innovations' Gaussian density, what `tune` minimises).
     pub fn neg_log_likelihood(&self) -> f64 {
         0.5 * (self.ln_det_s_sum + self.nis_count as f64 * std::f64::consts::TAU.ln() + self.nis_sum)
+    }
+
+    /// The same corrections' negative log-likelihood as the estimator weighs them: its
+    /// kernel's cost rho of each NIS (Huber's, Student's t, Cauchy's; NIS / 2 without
+    /// one), a gated-out correction costing the gate's value (an outlier's flat tail),
+    /// plus ln det(2 pi S) / 2. Without gate and kernel, [`Self::neg_log_likelihood`].
+    pub fn own_neg_log_likelihood(&self) -> f64 {
+        0.5 * (self.ln_det_s_sum + self.nis_count as f64 * std::f64::consts::TAU.ln()) + self.own_cost_sum
     }
 }
 
@@ -179,6 +200,27 @@ mod tests {
         assert_eq!((s.first_half_sum_m, s.max_m, s.final_m, s.nees_within_95), (4.0, 6.0, 6.0, 2));
         s.push(f64::NAN, None);
         assert!(s.diverged && s.count == 2);
+    }
+
+    /// A correction's cost as the estimator weighs it, by hand: NIS 1 and 25 with det S
+    /// 1; Gaussian 13, gated at 10.83 (1 + 10.83) / 2, Huber k = 1 (1 / 2 and 5 - 1 / 2),
+    /// Cauchy k = 1 (ln 2 / 2 and ln 26 / 2); ungated and Gaussian equals the likelihood.
+    #[test]
+    fn own_likelihood_of_gated_and_robust_corrections() {
+        let cost = |gate, kernel| {
+            let mut s = ErrorStats::default().weighed_as(gate, kernel);
+            s.push_outcome(&Outcome::Accepted(1.0, 1.0), true);
+            s.push_outcome(&Outcome::Rejected(25.0, 1.0), true);
+            s.own_neg_log_likelihood() - std::f64::consts::TAU.ln()
+        };
+        assert_relative_eq!(cost(None, None), 13.0);
+        assert_relative_eq!(cost(Some(f64::INFINITY), None), 13.0);
+        assert_relative_eq!(cost(Some(10.83), None), 0.5 * (1.0 + 10.83));
+        assert_relative_eq!(cost(None, Some(Robust::Huber { k: 1.0 })), 0.5 + 4.5);
+        assert_relative_eq!(cost(None, Some(Robust::Cauchy { k: 1.0 })), 0.5 * (2f64.ln() + 26f64.ln()));
+        let mut g = ErrorStats::default();
+        g.push_outcome(&Outcome::Accepted(1.0, 1.0), true);
+        assert_relative_eq!(g.own_neg_log_likelihood(), g.neg_log_likelihood());
     }
 
     #[test]
