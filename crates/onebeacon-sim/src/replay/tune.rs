@@ -281,8 +281,8 @@ mod tests {
     }
 
     /// The sigma that maximises a likelihood of the ranges' errors alone, cost rho(d^2)
-    /// + ln sigma per range, by brute force over 1 mm steps (the filter adds its state's
-    /// uncertainty to each S: small here, exact odometry and three beacons).
+    /// plus ln sigma per range, by brute force over 1 mm steps (the filter adds its
+    /// state's uncertainty to each S: small here, exact odometry and three beacons).
     fn brute_force_sigma(errors: &[f64], rho: impl Fn(f64) -> f64) -> f64 {
         let cost = |s: f64| errors.iter().map(|e| rho((e / s).powi(2)) + s.ln()).sum::<f64>();
         (100..20_000)
@@ -302,7 +302,8 @@ mod tests {
         let wide = range_sigma(&gauss).unwrap().keys[0].2;
         assert!(wide > 5.0 * drawn, "a Gaussian fit covers the outliers: {wide} m");
         let student = Robust::StudentT { dof: 4.0 };
-        let cases: [(&str, &str, &dyn Fn(f64) -> f64); 2] = [
+        type Rho<'a> = &'a dyn Fn(f64) -> f64;
+        let cases: [(&str, &str, Rho); 2] = [
             ("student", "robust = \"student_t\"\n", &|d2| -student.log_density(d2)),
             ("gated", "nis_gate = 10.83\n", &|d2: f64| 0.5 * d2.min(10.83)),
         ];
