@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use nalgebra::{Vector2, Vector3};
 use onebeacon_sim::replay::Log;
 use onebeacon_sim::run::{Estimate, StepRecord};
-use onebeacon_sim::smooth::{Smoothed, smooth as run_smooth};
+use onebeacon_sim::smooth::{SmoothError, Smoothed, smooth as run_smooth};
 use std::path::PathBuf;
 
 /// `smooth`'s options besides the log.
@@ -31,8 +31,11 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
     let cfg = onebeacon_sim::smooth::config(&log, a.like.as_deref(), a.calibrate.as_deref(), a.kernel.as_deref())
         .map_err(|e| BadInput(format!("--{e}")))?;
     let p = Prepared::new(log, a.out.clone(), a.beacons.clone(), "smooth")?;
-    eprintln!("smoothing {} ...", p.log.description.name);
-    let smoothed = run_smooth(&p.log, p.filter.as_ref(), &cfg)?;
+    // a log that cannot be read or has nothing to smooth is bad input (exit 2)
+    let smoothed = run_smooth(&p.log, p.filter.as_ref(), &cfg).map_err(|e| match e {
+        SmoothError::Log(e) => anyhow::Error::from(e),
+        other => BadInput(other.to_string()).into(),
+    })?;
     eprintln!(
         "smoothed {} poses in {:.3} s ({} iterations); replaying the filters ...",
         smoothed.poses.len(),

@@ -477,4 +477,11 @@ fn smooth_matches_gtsam_on_plaza2_and_refuses_bad_flags() {
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("--kernel gauss: not a kernel (allowed: none, huber, cauchy, student_t)"), "{err}");
     assert!(!bad.exists());
+    // a log with a bad cell past its first row (read by the smoother): one line naming file, line and column, exit 2, nothing written
+    let log = bad_log(&dir, "smooth-cell", "t,id,r\n1.0,0,5.0\n2.0,0,abc\n", "");
+    let o = run(&["smooth", &log, "--out", bad.to_str().unwrap()]);
+    let err = text(&o.stderr);
+    assert_eq!((o.status.code(), err.lines().count()), (Some(2), 1), "{err}");
+    assert!(err.contains("line 3, column `r`"), "{err}");
+    assert!(!bad.exists());
 }
