@@ -70,9 +70,18 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
         let turn_var = (noise.heading_change_sigma_frac * turn).powi(2) + noise.heading_walk_rad_per_sqrt_m.powi(2) * d;
         [s, s, turn_var.sqrt().max(MIN_TURN_SIGMA_RAD)]
     };
+    // the physical limits every item must respect before an estimator sees it (the
+    // session's screen, `[limits]`)
+    let limits = log.description.limits;
+    let mut last_t: Option<f64> = None;
     for item in log.items()? {
         let item = item?;
         let t = item.t_s;
+        if limits.check(&item.input, last_t.map(|l| t - l)).is_err() {
+            count(&mut g.ignored, "screened by [limits]");
+            continue;
+        }
+        last_t = Some(t);
         match item.input.to_ned(log.frame) {
             Input::Truth(p) => g.truth.push((t, p.north_m, p.east_m)),
             Input::BeaconPosition { beacon_id, position } => {

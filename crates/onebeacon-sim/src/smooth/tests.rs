@@ -42,6 +42,8 @@ fn synthetic(name: &str, steps: usize, scale: f64, offsets: [f64; 2], noisy: Opt
             }
         }
     }
+    // a negative range, which the limits screen out (used, it would pull the fit)
+    writeln!(ranges, "{}.5,1,-50", steps).unwrap();
     let beacons: String = BEACONS.iter().map(|(id, x, y)| format!("{id},{x},{y}\n")).collect();
     let dir = std::env::temp_dir().join(format!("onebeacon-smooth-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -114,6 +116,7 @@ fn exact_data_give_back_the_truth_and_the_calibration() {
     assert!((cal["range_scale"] - 1.05).abs() < 1e-4, "{cal:?}");
     assert!((cal["range_offset_m[1]"] - 0.8).abs() < 1e-2, "{cal:?}");
     assert!((cal["range_offset_m[2]"] + 0.5).abs() < 1e-2, "{cal:?}");
+    assert_eq!(s.ignored.get("screened by [limits]"), Some(&1));
 }
 
 /// Data drawn from the smoother's own noise model: the final pose's NEES (2 dof) over
