@@ -45,16 +45,18 @@ impl Prepared {
 
     /// Replays the log's estimators, each record given to `extra` first (to add the
     /// estimates named `extra_names`), writing trajectory.csv as it goes (the plots get
-    /// at most 20 000 evenly spaced rows), then summary.json as `summary` makes it,
-    /// rejected.csv, top_view.png and error.png titled "<log><label>, beacons ...".
-    /// Returns the replay, the summary and the title.
+    /// at most 20 000 evenly spaced rows), then summary.json (the replay's summary, to
+    /// which `extend` adds), rejected.csv, top_view.png and error.png titled
+    /// "<log><label>, beacons ...". Returns the replay, the summary, the title and the
+    /// replay's wall time, s.
     pub(crate) fn replay(
         &self,
         label: &str,
         extra_names: &[String],
         mut extra: impl FnMut(&mut StepRecord),
-        summary: impl FnOnce(&mut serde_json::Value, &Replay) -> Result<()>,
-    ) -> Result<(Replay, serde_json::Value, String)> {
+        extend: impl FnOnce(&mut serde_json::Value) -> Result<()>,
+    ) -> Result<(Replay, serde_json::Value, String, f64)> {
+        let started = std::time::Instant::now();
         let (log, staging) = (&self.log, &self.staging);
         let vehicles = ["auv".to_string()];
         let mut names: Vec<String> = log.description.estimators.iter().map(|e| e.name()).collect();
@@ -69,8 +71,9 @@ impl Prepared {
             Ok(())
         })?;
         trajectory.finish()?.flush().context("cannot write trajectory.csv")?;
-        let mut s = serde_json::Value::Null;
-        summary(&mut s, &r)?;
+        let wall_s = started.elapsed().as_secs_f64();
+        let mut s = onebeacon_sim::json::replay_summary(log, &self.used, &r, wall_s);
+        extend(&mut s)?;
         staging.write("summary.json", serde_json::to_string_pretty(&s)?.as_bytes())?;
         staging.write("rejected.csv", &rejected_csv(&r.session)?)?;
         let used = &self.used;
@@ -82,7 +85,7 @@ impl Prepared {
             .context("cannot draw top_view.png")?;
         plot::error_vs_time(&staging.file("error.png"), &names, &title, plotted.records())
             .context("cannot draw error.png")?;
-        Ok((r, s, title))
+        Ok((r, s, title, wall_s))
     }
 
     /// Moves the files into place and prints the replay's warnings; the files written.
@@ -117,17 +120,7 @@ pub fn replay(
         return Ok(());
     }
     let p = Prepared::new(log, out, beacons, "replay")?;
-    let started = std::time::Instant::now();
-    let (r, summary, title) = p.replay(
-        "",
-        &[],
-        |_| {},
-        |summary, r| {
-            *summary = onebeacon_sim::json::replay_summary(&p.log, &p.used, r, started.elapsed().as_secs_f64());
-            Ok(())
-        },
-    )?;
-    let wall_s = summary["wall_s"].as_f64().unwrap_or(f64::NAN);
+    let (r, summary, title, wall_s) = p.replay("", &[], |_| {}, |_| Ok(()))?;
     let files = p.finish(&r)?;
     if as_json {
         outln!("{summary}");

@@ -42,10 +42,8 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
         smoothed.build_s + smoothed.solve_s,
         smoothed.iterations
     );
-    let started = std::time::Instant::now();
     let extra = |record: &mut StepRecord| record.estimates.push(estimate(&smoothed, record.t_s, record.truth[0].pos));
-    let (r, summary, title) = p.replay(" smoothed", &["smoother".into()], extra, |summary, r| {
-        *summary = onebeacon_sim::json::replay_summary(&p.log, &p.used, r, started.elapsed().as_secs_f64());
+    let (r, summary, title, _) = p.replay(" smoothed", &["smoother".into()], extra, |summary| {
         summary["estimators"]
             .as_array_mut()
             .context("the summary lists its estimators")?
@@ -88,14 +86,14 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
 /// The smoother's row at time `t`, scored against the truth `truth` (NaN: none).
 fn estimate(s: &Smoothed, t: f64, truth: Vector3<f64>) -> Estimate {
     let (p, cov) = s.at(t);
-    let e = Vector2::new(p[0] - truth.x, p[1] - truth.y);
+    let (error_m, nees) = s.error(t, truth.x, truth.y);
     Estimate {
         vehicle: 0,
         pos: Vector3::new(p[0], p[1], 0.0),
         psi: onebeacon::geo::wrap_angle(p[2]),
         speed: None,
         sigma_pos: Vector2::new(cov[(0, 0)].sqrt(), cov[(1, 1)].sqrt()),
-        error_m: e.norm(),
-        nees: onebeacon::filter::consistency::nees(&e, &cov).unwrap_or(f64::NAN),
+        error_m,
+        nees: nees.unwrap_or(f64::NAN),
     }
 }

@@ -404,17 +404,11 @@ mod tests {
     /// A log description (`body`, then a dead-reckoning estimator) and its CSV files in
     /// a directory of their own, loaded.
     fn load(name: &str, body: &str, files: &[(&str, &str)]) -> Result<Log, LogError> {
-        let dir = std::env::temp_dir().join(format!("onebeacon-log-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        for (file, text) in files {
-            std::fs::write(dir.join(file), text).unwrap();
-        }
         let toml = format!(
             "name = \"{name}\"\n{body}\n[initial]\nfrom = \"given\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n\
              [[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n"
         );
-        std::fs::write(dir.join("log.toml"), toml).unwrap();
-        Log::load(&dir.join("log.toml"))
+        crate::replay::write_log("log", name, &toml, files)
     }
 
     fn items(log: &Log) -> Vec<Item> {

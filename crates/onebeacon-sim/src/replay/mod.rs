@@ -90,6 +90,19 @@ impl Replay {
     }
 }
 
+/// A log description `toml` and its `files` written to a directory of their own
+/// (`onebeacon-<prefix>-<pid>-<name>` in the temporary directory), loaded: the tests' logs.
+#[cfg(test)]
+pub(crate) fn write_log(prefix: &str, name: &str, toml: &str, files: &[(&str, &str)]) -> Result<Log, LogError> {
+    let dir = std::env::temp_dir().join(format!("onebeacon-{prefix}-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (file, text) in files {
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    std::fs::write(dir.join("log.toml"), toml).unwrap();
+    Log::load(&dir.join("log.toml"))
+}
+
 /// The session a log describes, started at its initial pose.
 pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
     session_and_start(log, beacons).map(|(session, _)| session)

@@ -126,7 +126,7 @@ pub fn tune(
         let r = replay(&one, set.clone(), |_| Ok::<(), LogError>(()))?;
         let st = r.session.stats[0];
         // a filter that weighs nothing, or diverges to non-finite, is the worst there is
-        let nll = st.own_neg_log_likelihood();
+        let nll = st.neg_log_likelihood();
         Ok((if st.nis_count > 0 && nll.is_finite() { nll } else { f64::INFINITY }, st))
     };
     let evaluate = |x: &[f64]| -> Result<(f64, ErrorStats), LogError> {
@@ -213,8 +213,6 @@ mod tests {
     /// with the estimator `estimator` (TOML keys after name and kind): the log, the
     /// standard deviation of the Gaussian noise drawn and every range's error.
     fn circle_log(name: &str, outlier_every: usize, estimator: &str) -> (Log, f64, Vec<f64>) {
-        let dir = std::env::temp_dir().join(format!("onebeacon-tune-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
         let beacons = [(0, 60.0, 0.0), (1, -30.0, 50.0), (2, -30.0, -50.0)];
         let noise = Normal::new(0.0, 0.8).unwrap();
         let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
@@ -243,14 +241,7 @@ mod tests {
             }
         }
         let beacon_rows: String = beacons.iter().map(|(id, n, e)| format!("{id},{n},{e}\n")).collect();
-        for (f, text) in [
-            ("odo.csv", odo),
-            ("ranges.csv", ranges),
-            ("truth.csv", truth),
-            ("b.csv", format!("id,x,y\n{beacon_rows}")),
-        ] {
-            std::fs::write(dir.join(f), text).unwrap();
-        }
+        let beacon_rows = format!("id,x,y\n{beacon_rows}");
         let toml = format!(
             "name = \"circle\"\n\
             [[source]]\nkind = \"odometry\"\nfile = \"odo.csv\"\ntime = \"t\"\ndistance = \"d\"\nheading_change = \"dh\"\n\
@@ -260,8 +251,9 @@ mod tests {
             [[estimators]]\nname = \"ekf\"\nkind = \"range-ekf\"\nrange_sigma_m = 2.0\ndistance_sigma_frac = 0.001\n\
             heading_change_sigma_frac = 0.001\nheading_walk_deg_per_sqrt_m = 0.001\n{estimator}"
         );
-        std::fs::write(dir.join("log.toml"), toml).unwrap();
-        (Log::load(&dir.join("log.toml")).unwrap(), (drawn_sq / drawn_n as f64).sqrt(), errors)
+        let files = [("odo.csv", &odo), ("ranges.csv", &ranges), ("truth.csv", &truth), ("b.csv", &beacon_rows)];
+        let log = crate::replay::write_log("tune", name, &toml, &files.map(|(f, t)| (f, t.as_str()))).unwrap();
+        (log, (drawn_sq / drawn_n as f64).sqrt(), errors)
     }
 
     fn range_sigma(log: &Log) -> Result<Tuned, LogError> {

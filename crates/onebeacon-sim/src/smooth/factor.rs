@@ -185,17 +185,37 @@ impl Factor {
     /// priors, motion and ranges (all but a few factors of a log), central differences
     /// for Doppler speeds and bearings.
     pub(crate) fn linearize(&self, x: &[f64]) -> Linear {
-        let (vars, n) = self.vars();
-        let mut local = [0.0; MAX_VARS];
-        for (l, &v) in local.iter_mut().zip(&vars[..n]) {
-            *l = x[v];
-        }
+        let (vars, n, mut local) = self.local(x);
         let (r, m) = self.residual(&local[..n]);
         let mut lin = Linear { m, n, vars, r, j: [[0.0; MAX_VARS]; 3] };
         if !self.jacobian(&local[..n], &mut lin.j) {
             numeric_jacobian(self, &mut local, n, &mut lin.j);
         }
         lin
+    }
+
+    /// The whitened residuals at the global state `x`, and how many.
+    pub(crate) fn whitened(&self, x: &[f64]) -> ([f64; 3], usize) {
+        let (_, n, local) = self.local(x);
+        self.residual(&local[..n])
+    }
+
+    /// A range's slant distance at the global state `x` (its scale, offset and drift
+    /// aside), with the range and its sigma; None for other factors.
+    pub(crate) fn range_slant(&self, x: &[f64]) -> Option<(f64, f64, f64)> {
+        let Factor::Range { at, beacon, dz_m, range_m, sigma, .. } = self else { return None };
+        let (_, _, local) = self.local(x);
+        Some((slant(position(at, &local), *beacon, *dz_m), *range_m, *sigma))
+    }
+
+    /// This factor's variables and their values gathered from the global state.
+    fn local(&self, x: &[f64]) -> ([usize; MAX_VARS], usize, [f64; MAX_VARS]) {
+        let (vars, n) = self.vars();
+        let mut local = [0.0; MAX_VARS];
+        for (l, &v) in local.iter_mut().zip(&vars[..n]) {
+            *l = x[v];
+        }
+        (vars, n, local)
     }
 
     /// Writes the analytic Jacobian where this factor has one (false: none).

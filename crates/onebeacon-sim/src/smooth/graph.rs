@@ -260,7 +260,7 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
     // initial values: dead reckoning from the start with the turn scale that best
     // explains the ranges, nominal calibration
     let kappa = match turn_var {
-        Some(_) => best_turn_scale(&g.factors, &motion, [n0, e0, psi0], &fixed_heading, p.turn_scale_sigma),
+        Some(_) => best_turn_scale(&g.factors, &motion, [n0, e0, psi0], &fixed_heading, p.turn_scale_sigma, next),
         None => 1.0,
     };
     g.x0 = dead_reckoning(&motion, [n0, e0, psi0], &fixed_heading, kappa);
@@ -313,32 +313,19 @@ fn best_turn_scale(
     start: [f64; 3],
     fixed: &BTreeMap<usize, f64>,
     sigma: f64,
+    dim: usize,
 ) -> f64 {
-    let ranges: Vec<_> = factors
-        .iter()
-        .filter_map(|f| match f {
-            Factor::Range { at, beacon, dz_m, range_m, sigma, .. } => Some((*at, *beacon, *dz_m, *range_m, *sigma)),
-            _ => None,
-        })
-        .collect();
-    if ranges.is_empty() {
+    if !factors.iter().any(|f| matches!(f, Factor::Range { .. })) {
         return 1.0;
     }
     let huber = onebeacon::nav::Robust::Huber { k: 1.345 };
     let cost = |kappa: f64| {
-        let x = dead_reckoning(motion, start, fixed, kappa);
-        let slants: Vec<f64> = ranges
-            .iter()
-            .map(|(at, b, dz, _, _)| {
-                let q = if at.next { 3 * (at.k + 1) } else { 3 * at.k };
-                let (a, p) = (at.alpha, 3 * at.k);
-                let (n, e) = ((1.0 - a) * x[p] + a * x[q], (1.0 - a) * x[p + 1] + a * x[q + 1]);
-                ((n - b[0]).powi(2) + (e - b[1]).powi(2) + dz * dz).sqrt()
-            })
-            .collect();
-        let scale =
-            ranges.iter().zip(&slants).map(|(r, d)| r.3 * d).sum::<f64>() / slants.iter().map(|d| d * d).sum::<f64>();
-        ranges.iter().zip(&slants).map(|(r, d)| -huber.log_density(((scale * d - r.3) / r.4).powi(2))).sum::<f64>()
+        let mut x = dead_reckoning(motion, start, fixed, kappa);
+        x.resize(dim, 0.0); // the calibration variables, which a slant does not read
+        // (slant, range, sigma) per range
+        let ranges: Vec<(f64, f64, f64)> = factors.iter().filter_map(|f| f.range_slant(&x)).collect();
+        let scale = ranges.iter().map(|(d, z, _)| z * d).sum::<f64>() / ranges.iter().map(|(d, ..)| d * d).sum::<f64>();
+        ranges.iter().map(|(d, z, sigma)| -huber.log_density(((scale * d - z) / sigma).powi(2))).sum::<f64>()
     };
     let span = TURN_SEARCH_SIGMAS * sigma;
     (0..=TURN_SEARCH_STEPS)

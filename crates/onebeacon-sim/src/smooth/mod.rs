@@ -96,7 +96,7 @@ impl Default for SmoothConfig {
     /// scale), a Huber kernel (k = 1.345).
     fn default() -> Self {
         let calibrate = Calibrate { range_scale: true, turn_scale: true, ..Calibrate::NONE };
-        Self::from_planar(&PlanarConfig::default(), calibrate).with_kernel(Some(Robust::Huber { k: 1.345 }))
+        Self { kernel: Some(Robust::Huber { k: 1.345 }), ..Self::from_planar(&PlanarConfig::default(), calibrate) }
     }
 }
 
@@ -120,10 +120,6 @@ impl SmoothConfig {
             usbl_sigma_rad: 1f64.to_radians(),
             max_iterations: 100,
         }
-    }
-
-    pub fn with_kernel(self, kernel: Option<Robust>) -> Self {
-        Self { kernel, ..self }
     }
 }
 
@@ -179,8 +175,8 @@ pub fn smooth(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) ->
     let mut gated = 0;
     if let Some(gate) = cfg.nis_gate {
         for (f, on) in g.factors.iter().zip(&mut active) {
-            let lin = f.linearize(&sol.x);
-            if f.is_measurement() && lin.r[..lin.m].iter().map(|r| r * r).sum::<f64>() > gate {
+            let (r, m) = f.whitened(&sol.x);
+            if f.is_measurement() && r[..m].iter().map(|r| r * r).sum::<f64>() > gate {
                 *on = false;
                 gated += 1;
             }
@@ -233,14 +229,20 @@ impl Smoothed {
         (std::array::from_fn(|i| (1.0 - a) * p[i] + a * q[i]), if a > 0.5 { at.k + 1 } else { at.k })
     }
 
+    /// The horizontal error at time `t` against a true (north, east), m, and its NEES.
+    pub fn error(&self, t: f64, north_m: f64, east_m: f64) -> (f64, Option<f64>) {
+        let (p, cov) = self.at(t);
+        let d = Vector2::new(p[0] - north_m, p[1] - east_m);
+        (d.norm(), nees(&d, &cov))
+    }
+
     /// The smoothed trajectory's errors and NEES against the ground truth, and dead
     /// reckoning's errors.
     pub fn score(&self) -> (ErrorStats, ErrorStats) {
         let (mut s, mut dr) = (ErrorStats::default(), ErrorStats::default());
         for &(t, n, e) in &self.truth {
-            let (p, cov) = self.at(t);
-            let d = Vector2::new(p[0] - n, p[1] - e);
-            s.push(d.norm(), nees(&d, &cov));
+            let (error_m, nees) = self.error(t, n, e);
+            s.push(error_m, nees);
             let (q, _) = self.interpolate(&self.dead_reckoning, t);
             dr.push((q[0] - n).hypot(q[1] - e), None);
         }

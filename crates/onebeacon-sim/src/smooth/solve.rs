@@ -10,7 +10,7 @@
 //! complement S = C - B^T A^-1 B (a sparse factorisation of the whole would be
 //! quadratic in the poses in nalgebra-sparse's symbolic analysis).
 
-use super::factor::{Factor, Linear, MAX_VARS};
+use super::factor::{Factor, Linear};
 use nalgebra::{DMatrix, DVector};
 use nalgebra_sparse::CscMatrix;
 use nalgebra_sparse::factorization::{CscCholesky, CscSymbolicCholesky};
@@ -111,12 +111,7 @@ fn total_cost(factors: &[Factor], active: &[bool], x: &[f64], kernel: Option<Rob
         .zip(active)
         .filter(|(_, on)| **on)
         .map(|(f, _)| {
-            let (v, n) = f.vars();
-            let mut local = [0.0; MAX_VARS];
-            for (l, &i) in local.iter_mut().zip(&v[..n]) {
-                *l = x[i];
-            }
-            let (r, m) = f.residual(&local[..n]);
+            let (r, m) = f.whitened(x);
             weigh(f, &r[..m], kernel).1
         })
         .sum()

@@ -45,13 +45,6 @@ fn synthetic(name: &str, steps: usize, scale: f64, offsets: [f64; 2], noisy: Opt
     // a negative range, which the limits screen out (used, it would pull the fit)
     writeln!(ranges, "{}.5,1,-50", steps).unwrap();
     let beacons: String = BEACONS.iter().map(|(id, x, y)| format!("{id},{x},{y}\n")).collect();
-    let dir = std::env::temp_dir().join(format!("onebeacon-smooth-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    for (file, text) in
-        [("odo.csv", odo), ("ranges.csv", ranges), ("truth.csv", truth), ("beacons.csv", format!("id,x,y\n{beacons}"))]
-    {
-        std::fs::write(dir.join(file), text).unwrap();
-    }
     let toml = format!(
         r#"name = "{name}"
 frame = "ned"
@@ -94,8 +87,9 @@ kind = "dead-reckoning"
         given[1],
         given[2].to_degrees()
     );
-    std::fs::write(dir.join("log.toml"), toml).unwrap();
-    Log::load(&dir.join("log.toml")).unwrap()
+    let beacons = format!("id,x,y\n{beacons}");
+    let files = [("odo.csv", &odo), ("ranges.csv", &ranges), ("truth.csv", &truth), ("beacons.csv", &beacons)];
+    crate::replay::write_log("smooth", name, &toml, &files.map(|(f, t)| (f, t.as_str()))).unwrap()
 }
 
 /// Exact odometry and ranges read 5 % long with an offset per beacon: the smoother,

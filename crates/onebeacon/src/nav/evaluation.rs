@@ -57,7 +57,7 @@ pub struct ErrorStats {
     /// heavy-tailed kernel, and the sum of each correction's cost under them.
     pub gate: Option<f64>,
     pub kernel: Option<Robust>,
-    pub own_cost_sum: f64,
+    pub cost_sum: f64,
 }
 
 impl ErrorStats {
@@ -115,7 +115,7 @@ impl ErrorStats {
             self.nis_within_95 += usize::from(nis <= NIS_95_1DOF);
             self.ln_det_s_sum += det_s.ln();
             let d2 = self.gate.map_or(nis, |g| nis.min(g));
-            self.own_cost_sum += self.kernel.map_or(0.5 * d2, |k| -k.log_density(d2));
+            self.cost_sum += self.kernel.map_or(0.5 * d2, |k| -k.log_density(d2));
         }
     }
 
@@ -142,18 +142,13 @@ impl ErrorStats {
         self.nis_within_95 as f64 / self.nis_count as f64
     }
 
-    /// The negative log-likelihood of the corrections weighed, sum of (ln det(2 pi S) +
-    /// NIS) / 2 over them (the innovations' Gaussian density, what `tune` minimises).
+    /// The negative log-likelihood of the corrections weighed, as the estimator weighs
+    /// them (what `tune` minimises): sum of ln det(2 pi S) / 2 + rho(NIS), rho its
+    /// kernel's cost (Huber's, Student's t, Cauchy's; NIS / 2 without one, the
+    /// innovations' Gaussian density), a gated-out correction costing the gate's value
+    /// (an outlier's flat tail).
     pub fn neg_log_likelihood(&self) -> f64 {
-        0.5 * (self.ln_det_s_sum + self.nis_count as f64 * std::f64::consts::TAU.ln() + self.nis_sum)
-    }
-
-    /// The same corrections' negative log-likelihood as the estimator weighs them: its
-    /// kernel's cost rho of each NIS (Huber's, Student's t, Cauchy's; NIS / 2 without
-    /// one), a gated-out correction costing the gate's value (an outlier's flat tail),
-    /// plus ln det(2 pi S) / 2. Without gate and kernel, [`Self::neg_log_likelihood`].
-    pub fn own_neg_log_likelihood(&self) -> f64 {
-        0.5 * (self.ln_det_s_sum + self.nis_count as f64 * std::f64::consts::TAU.ln()) + self.own_cost_sum
+        0.5 * (self.ln_det_s_sum + self.nis_count as f64 * std::f64::consts::TAU.ln()) + self.cost_sum
     }
 }
 
@@ -204,14 +199,14 @@ mod tests {
 
     /// A correction's cost as the estimator weighs it, by hand: NIS 1 and 25 with det S
     /// 1; Gaussian 13, gated at 10.83 (1 + 10.83) / 2, Huber k = 1 (1 / 2 and 5 - 1 / 2),
-    /// Cauchy k = 1 (ln 2 / 2 and ln 26 / 2); ungated and Gaussian equals the likelihood.
+    /// Cauchy k = 1 (ln 2 / 2 and ln 26 / 2); ungated and Gaussian, (ln 2 pi + NIS) / 2.
     #[test]
     fn own_likelihood_of_gated_and_robust_corrections() {
         let cost = |gate, kernel| {
             let mut s = ErrorStats::default().weighed_as(gate, kernel);
             s.push_outcome(&Outcome::Accepted(1.0, 1.0), true);
             s.push_outcome(&Outcome::Rejected(25.0, 1.0), true);
-            s.own_neg_log_likelihood() - std::f64::consts::TAU.ln()
+            s.neg_log_likelihood() - std::f64::consts::TAU.ln()
         };
         assert_relative_eq!(cost(None, None), 13.0);
         assert_relative_eq!(cost(Some(f64::INFINITY), None), 13.0);
@@ -220,7 +215,7 @@ mod tests {
         assert_relative_eq!(cost(None, Some(Robust::Cauchy { k: 1.0 })), 0.5 * (2f64.ln() + 26f64.ln()));
         let mut g = ErrorStats::default();
         g.push_outcome(&Outcome::Accepted(1.0, 1.0), true);
-        assert_relative_eq!(g.own_neg_log_likelihood(), g.neg_log_likelihood());
+        assert_relative_eq!(g.neg_log_likelihood(), 0.5 * (std::f64::consts::TAU.ln() + 1.0));
     }
 
     #[test]
