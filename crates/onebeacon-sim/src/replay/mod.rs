@@ -12,6 +12,9 @@ pub(crate) mod schema;
 pub mod tune;
 pub(crate) mod validate;
 
+#[cfg(test)]
+mod burst_tests;
+
 pub use log::{InitialStart, Log, LogDescription, LogError};
 pub use rows::Dropped;
 

@@ -18,6 +18,8 @@ pub enum Rule {
     NonNegative,
     Probability,
     Finite,
+    /// A threshold: > 0, infinity (`inf` in TOML) meaning none.
+    Threshold,
 }
 
 pub fn check(key: &str, value: f64, rule: Rule) -> Result<(), Violation> {
@@ -26,8 +28,9 @@ pub fn check(key: &str, value: f64, rule: Rule) -> Result<(), Violation> {
         Rule::NonNegative => (value >= 0.0, "must be a finite number >= 0"),
         Rule::Probability => ((0.0..=1.0).contains(&value), "must be a probability in [0, 1]"),
         Rule::Finite => (true, "must be a finite number"),
+        Rule::Threshold => (value > 0.0, "must be a number > 0, or inf for none"),
     };
-    if ok && value.is_finite() {
+    if ok && (value.is_finite() || rule == Rule::Threshold) {
         Ok(())
     } else {
         Err(Violation { key: key.to_string(), value: format!("{value:?}"), allowed: allowed.to_string() })

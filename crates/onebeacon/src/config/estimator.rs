@@ -307,6 +307,13 @@ pub const DEFAULT_BIAS_DRIFT_SIGMA_M_S: f64 = 4.5e-3;
 /// values apart after resampling; at 0.005 the 2e4 particles of the tracker's test
 /// collapse onto values 1 deg off, at 0.05 they find the misalignment within 0.1 deg.
 pub const DEFAULT_MISALIGNMENT_WALK_DEG_PER_SQRT_S: f64 = 0.05;
+/// The NIS gate of a log's or a stream's range, ROSB and Doppler estimators when
+/// `nis_gate` is not given: 10 standard deviations of a scalar measurement, a gross
+/// error that no Gaussian tail explains (real logs have them: false ranges, a wrong
+/// beacon). It rejects nothing on plaza1 or plaza2; with the rule that opens a gate after
+/// [`crate::nav::LOST_AFTER_REJECTIONS`] rejections in a row, a burst of false ranges to
+/// one beacon cannot capture a filter that hears other beacons meanwhile.
+pub const LOG_NIS_GATE: f64 = 100.0;
 /// A `pf` estimator's `min_effective_particles` when not given.
 pub const DEFAULT_MIN_EFFECTIVE: f64 = 20.0;
 
@@ -461,6 +468,15 @@ impl EstimatorSpec {
         RangeCalibration { offset, scale_sigma }
     }
 
+    /// The gate and heavy-tailed update of the navigator [`EstimatorSpec::builder`]
+    /// builds on a log or a stream: [`EstimatorSpec::gate`], with the planar family's
+    /// ranges and Doppler speeds gated at [`LOG_NIS_GATE`] where `nis_gate` is not given.
+    pub fn log_gate(&self) -> (f64, Option<Robust>) {
+        let (gate, robust) = self.gate();
+        let planar = !self.kind.tracks_bearings() && !self.kind.iusbl();
+        (if planar && self.nis_gate.is_none() { LOG_NIS_GATE } else { gate }, robust)
+    }
+
     /// The gate (a NIS; infinity: none) and heavy-tailed update asked for (`nis_gate`,
     /// `robust`), of ranges, Doppler speeds, heading fixes and bearings alike.
     pub fn gate(&self) -> (f64, Option<Robust>) {
@@ -553,7 +569,7 @@ impl EstimatorSpec {
             distance_scale_sigma: self.distance_scale_sigma.unwrap_or(c.distance_scale_sigma),
             estimate_turn_scale: self.estimate_turn_scale.unwrap_or(c.estimate_turn_scale),
             turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
-            nis_gate: self.nis_gate,
+            nis_gate: Some(self.log_gate().0),
             robust: self.gate().1,
             noise,
             track_accel_sigma_m_s2: self.track_accel_sigma_m_s2,

@@ -43,7 +43,7 @@ impl EstimatorSpec {
             ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, CALIBRATING),
             ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
             ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
-            ("nis_gate", self.nis_gate, Positive, GATED),
+            ("nis_gate", self.nis_gate, Threshold, GATED),
             ("huber_k", self.huber_k, Positive, GATED),
             ("student_t_dof", self.student_t_dof, Positive, GATED),
             ("mirror_recovery", flag(self.mirror_recovery), Finite, &[FixedBeacon]),

@@ -343,7 +343,7 @@ impl StreamConfig {
         let sigmas = (initial.position_sigma_m, initial.heading_sigma_deg.to_radians());
         let mut session = Session::new(self.frame.into(), estimators, start, sigmas, beacons).with_limits(self.limits);
         for (stats, e) in session.stats.iter_mut().zip(&self.estimators) {
-            let (gate, kernel) = e.gate();
+            let (gate, kernel) = e.log_gate();
             *stats = stats.weighed_as(Some(gate), kernel);
         }
         session

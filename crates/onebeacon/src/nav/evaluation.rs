@@ -99,22 +99,27 @@ impl ErrorStats {
     pub fn push_outcome(&mut self, outcome: &Outcome, rejections: bool) {
         match *outcome {
             Outcome::Failed(_) => self.failed += 1,
-            Outcome::Accepted(nis, det_s) => self.push_nis(nis, det_s),
+            Outcome::Accepted(nis, det_s) => self.push_nis(nis, det_s, false),
             Outcome::Rejected(nis, det_s) => {
-                self.push_nis(nis, det_s);
+                self.push_nis(nis, det_s, true);
                 self.rejected += usize::from(rejections);
             }
             Outcome::Applied | Outcome::Skipped => {}
         }
     }
 
-    fn push_nis(&mut self, nis: f64, det_s: f64) {
+    /// A correction's NIS, costing the gate's value when `rejected` (a correction a lost
+    /// navigator's open gate let through costs its own).
+    fn push_nis(&mut self, nis: f64, det_s: f64, rejected: bool) {
         if nis.is_finite() && det_s > 0.0 && det_s.is_finite() {
             self.nis_sum += nis;
             self.nis_count += 1;
             self.nis_within_95 += usize::from(nis <= NIS_95_1DOF);
             self.ln_det_s_sum += det_s.ln();
-            let d2 = self.gate.map_or(nis, |g| nis.min(g));
+            let d2 = match (rejected, self.gate) {
+                (true, Some(g)) => nis.min(g),
+                _ => nis,
+            };
             self.cost_sum += self.kernel.map_or(0.5 * d2, |k| -k.log_density(d2));
         }
     }

@@ -67,6 +67,44 @@ pub(crate) fn gated_update<const N: usize, const M: usize, H: MeasurementModel<N
     }
 }
 
+/// Consecutive rejections after which a gate takes its navigator for lost: a burst of
+/// false measurements shorter than this cannot capture a gated navigator, and a
+/// navigator whose error has outgrown its covariance is not shut out for good.
+pub const LOST_AFTER_REJECTIONS: u32 = 30;
+
+/// A navigator's NIS gate (infinity: none) with the one rule that keeps it from
+/// locking the navigator out: after [`LOST_AFTER_REJECTIONS`] rejections in a row the
+/// gate opens, and stays open until a correction falls within it again.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Gate {
+    nis: f64,
+    rejected_in_row: u32,
+}
+
+impl Gate {
+    pub(crate) fn new(nis: f64) -> Self {
+        Self { nis, rejected_in_row: 0 }
+    }
+
+    /// [`gated_update`] at this gate (none while it is open), counting the rejections.
+    pub(crate) fn update<const N: usize, const M: usize, H: MeasurementModel<N, M>>(
+        &mut self,
+        filter: &mut AnyFilter<N>,
+        models: &H,
+        z: SVector<f64, M>,
+        robust: Option<Robust>,
+    ) -> Outcome {
+        let open = self.rejected_in_row >= LOST_AFTER_REJECTIONS;
+        let outcome = gated_update(filter, models, z, if open { f64::INFINITY } else { self.nis }, robust);
+        match outcome {
+            Outcome::Rejected(..) => self.rejected_in_row += 1,
+            Outcome::Accepted(nis, _) if nis <= self.nis => self.rejected_in_row = 0,
+            _ => {}
+        }
+        outcome
+    }
+}
+
 /// Which acoustic measurements a navigator uses: its beacon aiding. Every navigator
 /// takes one; a measurement it does not use is [`Outcome::Skipped`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -258,5 +296,29 @@ mod tests {
         let (x, outcome) = posterior(100.0, Some(student), 10.83);
         assert_eq!(x, 0.0);
         assert!(matches!(outcome, Outcome::Rejected(n, _) if (n - nis).abs() < 1e-9), "{outcome:?}");
+    }
+
+    /// The lost rule against the closed form of repeated scalar updates: x ~ N(0, 1),
+    /// z = 50 with r = 1, gate 100 (NIS 1250). The first [`LOST_AFTER_REJECTIONS`] are
+    /// rejected, the state untouched; then the gate is open: before the k-th accepted
+    /// update the NIS is 2500 / (k (k + 1)), over 100 for k < 5, accepted all the same;
+    /// the fifth (NIS 83.3) falls within the gate and closes it, the mean 50 k / (k + 1)
+    /// = 41.7; a gross residual is rejected again at once.
+    #[test]
+    fn a_gate_opens_after_a_run_of_rejections_and_closes_when_one_fits() {
+        let mut f = AnyFilter::new(FilterKind::Ekf, Vector1::new(0.0), Matrix1::new(1.0));
+        let model = [StateComponent::value(0, 1.0)];
+        let mut gate = Gate::new(100.0);
+        for _ in 0..LOST_AFTER_REJECTIONS {
+            assert!(matches!(gate.update(&mut f, &model, Vector1::new(50.0), None), Outcome::Rejected(..)));
+        }
+        assert_eq!(f.mean()[0], 0.0);
+        for k in 1..=5 {
+            let Outcome::Accepted(nis, _) = gate.update(&mut f, &model, Vector1::new(50.0), None) else { panic!() };
+            assert_abs_diff_eq!(nis, 2500.0 / (k * (k + 1)) as f64, epsilon = 1e-9);
+            assert_abs_diff_eq!(f.mean()[0], 50.0 * k as f64 / (k + 1) as f64, epsilon = 1e-9);
+        }
+        assert!(matches!(gate.update(&mut f, &model, Vector1::new(-1000.0), None), Outcome::Rejected(..)));
+        assert_abs_diff_eq!(f.mean()[0], 50.0 * 5.0 / 6.0, epsilon = 1e-9);
     }
 }

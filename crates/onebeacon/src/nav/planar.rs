@@ -254,6 +254,8 @@ pub struct PlanarNavigator<const N: usize = STATES> {
     yaw_rate_rad_s: f64,
     last_odometry_s: Option<f64>,
     depth_m: f64,
+    /// The gate of ranges and Doppler speeds (`config.nis_gate`).
+    gate: super::Gate,
 }
 
 impl PlanarNavigator {
@@ -319,6 +321,7 @@ impl<const N: usize> PlanarNavigator<N> {
             0.0,
         ]);
         Self {
+            gate: super::Gate::new(config.nis_gate.unwrap_or(f64::INFINITY)),
             config,
             filter: AnyFilter::new(filter, x, p),
             offset_beacons: Vec::new(),
@@ -332,12 +335,13 @@ impl<const N: usize> PlanarNavigator<N> {
         }
     }
 
-    fn gate(&self) -> f64 {
-        self.config.nis_gate.unwrap_or(f64::INFINITY)
-    }
-
-    fn correct(&mut self, model: &dyn ScalarModel<N>, z: f64, gate: f64) -> Outcome {
-        super::gated_update(&mut self.filter, &[model], Vector1::new(z), gate, self.config.robust)
+    /// A gated correction (ranges, Doppler speeds), or an ungated one (heading fixes).
+    fn correct(&mut self, model: &dyn ScalarModel<N>, z: f64, gated: bool) -> Outcome {
+        let z = Vector1::new(z);
+        match gated {
+            true => self.gate.update(&mut self.filter, &[model], z, self.config.robust),
+            false => super::gated_update(&mut self.filter, &[model], z, f64::INFINITY, self.config.robust),
+        }
     }
 
     /// Moves the clock to `t_s`: coasts at the held speed, lets the bias (and, with a
@@ -462,25 +466,25 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
             }
             Kind::Heading { heading_rad } | Kind::Attitude { heading_rad, .. } => {
                 let var = noise.heading_sigma_rad * noise.heading_sigma_rad;
-                self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, f64::INFINITY)
+                self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, false)
             }
             Kind::Range { beacon, range_m } if aiding.range => {
                 let model = self.range_model(&beacon);
-                self.correct(&model, range_m, self.gate())
+                self.correct(&model, range_m, true)
             }
             Kind::Doppler { beacon, radial_speed_m_s } if aiding.doppler => {
                 let model = self.doppler_model(beacon.position_ned_m);
-                self.correct(&model, radial_speed_m_s, self.gate())
+                self.correct(&model, radial_speed_m_s, true)
             }
             Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } if aiding.any() => {
                 let range = if aiding.range {
                     let model = self.range_model(&beacon);
-                    self.correct(&model, range_m, self.gate())
+                    self.correct(&model, range_m, true)
                 } else {
                     Outcome::Skipped
                 };
                 let doppler = if aiding.doppler {
-                    self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, self.gate())
+                    self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, true)
                 } else {
                     Outcome::Skipped
                 };

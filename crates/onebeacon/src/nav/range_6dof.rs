@@ -65,7 +65,7 @@ pub struct Range6DofNavigator<const N: usize = DIM> {
     /// Where the calibration states are and how they move.
     calibration: Calibrated<(), DIM>,
     /// A range whose NIS exceeds it is rejected; a heavy-tailed range update.
-    gate: f64,
+    gate: super::Gate,
     robust: Option<Robust>,
     filter: AnyFilter<N>,
     t_s: f64,
@@ -133,7 +133,7 @@ impl<const N: usize> Range6DofNavigator<N> {
             depth_attitude: noise.depth_attitude_models(),
             aiding,
             calibration: calibration.motion(),
-            gate: f64::INFINITY,
+            gate: super::Gate::new(f64::INFINITY),
             robust: None,
             filter: AnyFilter::new(filter, x, p),
             t_s: t0_s,
@@ -145,7 +145,7 @@ impl<const N: usize> Range6DofNavigator<N> {
     /// Ranges whose NIS exceeds `gate` are rejected; `robust` makes the range update
     /// heavy-tailed.
     pub fn with_range_gate(mut self, gate: f64, robust: Option<Robust>) -> Self {
-        (self.gate, self.robust) = (gate, robust);
+        (self.gate, self.robust) = (super::Gate::new(gate), robust);
         self
     }
 
@@ -206,7 +206,7 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
                 // range update (eq. 3.7-3.10) at the receive time
                 self.advance_to(m.t_s);
                 let model = CalibratedRange { range: self.noise.range_model(&beacon), layout: self.calibration.layout };
-                super::gated_update(&mut self.filter, &[model], Vector1::new(range_m), self.gate, self.robust)
+                self.gate.update(&mut self.filter, &[model], Vector1::new(range_m), self.robust)
             }
             _ => Outcome::Skipped,
         }

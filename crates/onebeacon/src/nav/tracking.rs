@@ -74,6 +74,7 @@ pub struct TrackingNavigator {
     /// White-acceleration standard deviation, m/s^2 per sqrt(s).
     accel_sigma_m_s2: f64,
     filter: AnyFilter<STATES>,
+    gate: super::Gate,
     t_s: f64,
     depth_m: f64,
 }
@@ -101,7 +102,8 @@ impl TrackingNavigator {
         ]);
         let p = Cov::from_diagonal(&sigmas.component_mul(&sigmas));
         let x = State::from([north_m, east_m, 0.0, 0.0, config.bias_m, 0.0]);
-        Self { config, accel_sigma_m_s2, filter: AnyFilter::new(filter, x, p), t_s, depth_m: 0.0 }
+        let gate = super::Gate::new(config.nis_gate.unwrap_or(f64::INFINITY));
+        Self { config, accel_sigma_m_s2, filter: AnyFilter::new(filter, x, p), gate, t_s, depth_m: 0.0 }
     }
 
     /// Predicts to `t_s`; the bias wanders meanwhile.
@@ -142,8 +144,7 @@ impl Navigator for TrackingNavigator {
                 if self.config.aiding.range =>
             {
                 let model: [&dyn ScalarModel<STATES>; 1] = [&range(beacon.position_ned_m, self.depth_m, &self.config)];
-                let gate = self.config.nis_gate.unwrap_or(f64::INFINITY);
-                super::gated_update(&mut self.filter, &model, Vector1::new(range_m), gate, self.config.robust)
+                self.gate.update(&mut self.filter, &model, Vector1::new(range_m), self.config.robust)
             }
             _ => Outcome::Skipped,
         }

@@ -5,7 +5,7 @@
 //! or a UKF ([`GaussianTracker`]), both behind [`Navigator`], so that they run on the
 //! same measurements.
 
-use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, Robust, gated_update};
+use super::{Aiding, Estimate, Gate, Kind, Measurement, Navigator, Outcome, Robust, gated_update};
 use crate::filter::particle::{ParticleFilter, ParticleSettings};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::measure::hoff::{InsReport, UsblBearing};
@@ -260,13 +260,14 @@ impl Navigator for ParticleTracker {
 pub struct GaussianTracker {
     filter: AnyFilter<DIM>,
     config: TrackerConfig,
+    gate: Gate,
     t_s: f64,
 }
 
 impl GaussianTracker {
     pub fn new(config: TrackerConfig, kind: FilterKind, t0_s: f64, mean: &TrackState, sigma: &TrackState) -> Self {
         let p0 = SMatrix::from_diagonal(&sigma.component_mul(sigma));
-        Self { filter: AnyFilter::new(kind, *mean, p0), config, t_s: t0_s }
+        Self { filter: AnyFilter::new(kind, *mean, p0), gate: Gate::new(config.nis_gate), config, t_s: t0_s }
     }
 
     fn advance_to(&mut self, t_s: f64) {
@@ -300,7 +301,7 @@ impl Navigator for GaussianTracker {
                 let usbl = self.config.noise.usbl(&station, station_heading_rad);
                 let models = [usbl.model(UsblAngle::Azimuth), usbl.model(UsblAngle::Elevation)]; // eq. 1-3
                 let z = Vector2::new(azimuth_rad, elevation_rad);
-                gated_update(&mut self.filter, &models, z, self.config.nis_gate, self.config.robust)
+                self.gate.update(&mut self.filter, &models, z, self.config.robust)
             }
             _ => Outcome::Skipped,
         }
