@@ -5,7 +5,9 @@ use crate::BadInput;
 use crate::replay::{Prepared, print_table};
 use anyhow::{Context, Result};
 use nalgebra::{Vector2, Vector3};
-use onebeacon_sim::replay::Log;
+use onebeacon::nav::evaluation::horizontal_error;
+use onebeacon_sim::replay::rts::rts;
+use onebeacon_sim::replay::{Log, row_estimate};
 use onebeacon_sim::run::{Estimate, StepRecord};
 use onebeacon_sim::smooth::{SmoothError, Smoothed, smooth as run_smooth};
 use std::path::PathBuf;
@@ -37,17 +39,28 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
         other => BadInput(other.to_string()).into(),
     })?;
     eprintln!(
-        "smoothed {} poses in {:.3} s ({} iterations); replaying the filters ...",
+        "smoothed {} poses in {:.3} s ({} iterations); the filters' RTS passes ...",
         smoothed.poses.len(),
         smoothed.build_s + smoothed.solve_s,
         smoothed.iterations
     );
-    let extra = |record: &mut StepRecord| record.estimates.push(estimate(&smoothed, record.t_s, record.truth[0].pos));
-    let (r, summary, title, _) = p.replay(" smoothed", &["smoother".into()], extra, |summary| {
-        summary["estimators"]
-            .as_array_mut()
-            .context("the summary lists its estimators")?
-            .push(onebeacon_sim::json::smoother_summary("smoother", &smoothed));
+    let runs = rts(&p.log, p.filter.clone())?;
+    eprintln!("replaying the filters ...");
+    let mut names = vec!["smoother".to_string()];
+    names.extend(runs.iter().map(|r| format!("{}+rts", r.name)));
+    let extra = |record: &mut StepRecord| {
+        let truth = record.truth[0].pos;
+        record.estimates.push(estimate(&smoothed, record.t_s, truth));
+        for run in &runs {
+            // no truth: NaN error and NEES
+            let (error_m, nees) = horizontal_error(run.at(record.t_s), truth.x, truth.y);
+            record.estimates.push(row_estimate(run.at(record.t_s), (error_m, nees.unwrap_or(f64::NAN))));
+        }
+    };
+    let (r, summary, title, _) = p.replay(" smoothed", &names, extra, |summary| {
+        let entries = summary["estimators"].as_array_mut().context("the summary lists its estimators")?;
+        entries.push(onebeacon_sim::json::smoother_summary("smoother", &smoothed));
+        entries.extend(runs.iter().map(onebeacon_sim::json::rts_summary));
         Ok(())
     })?;
     let files = p.finish(&r)?;

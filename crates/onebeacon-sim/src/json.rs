@@ -9,6 +9,7 @@ use crate::replay::{Log, Replay};
 use crate::run::RunOutput;
 use crate::scenario::{Cell, SweepValue};
 use onebeacon::config::stream::InitialFrom;
+use onebeacon::nav::evaluation::ErrorStats;
 use serde_json::{Value, json};
 
 /// JSON number, or null when not finite (JSON has no NaN or infinity).
@@ -99,25 +100,19 @@ pub fn run_summary(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutp
 /// NEES, calibration as errors from nominal, per-beacon offsets) and its solve.
 pub fn smoother_summary(name: &str, s: &crate::smooth::Smoothed) -> Value {
     let (st, dr) = s.score();
-    let scored = st.count > 0;
-    let mut v = json!({
-        "name": name,
-        "rmse_m": num(st.rmse_m()),
-        "mean_error_m": num(st.mean_m()),
-        "final_error_m": if scored { num(st.final_m) } else { Value::Null },
-        "max_error_m": if scored { num(st.max_m) } else { Value::Null },
-        "rejected": s.gated,
-        "nees_mean": num(st.nees_mean()),
-        "nees_band": onebeacon::nav::evaluation::chi_square_band(st.nees_count, 2).map(num),
-        "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
-        "dead_reckoning_rmse_m": num(dr.rmse_m()),
-        "iterations": s.iterations,
-        "cost": {"initial": num(s.cost0), "final": num(s.cost)},
-        "build_s": s.build_s,
-        "solve_s": s.solve_s,
-        "measurements": s.used,
-        "ignored": s.ignored,
-    });
+    let mut v = error_fields(name, &st);
+    for (k, x) in [
+        ("rejected", json!(s.gated)),
+        ("dead_reckoning_rmse_m", num(dr.rmse_m())),
+        ("iterations", json!(s.iterations)),
+        ("cost", json!({"initial": num(s.cost0), "final": num(s.cost)})),
+        ("build_s", json!(s.build_s)),
+        ("solve_s", json!(s.solve_s)),
+        ("measurements", json!(s.used)),
+        ("ignored", json!(s.ignored)),
+    ] {
+        v[k] = x;
+    }
     let mut offsets = serde_json::Map::new();
     for (k, x, sigma) in &s.calibration {
         let cal = json!({"value": num(*x), "sigma": num(*sigma)});
@@ -137,6 +132,35 @@ pub fn smoother_summary(name: &str, s: &crate::smooth::Smoothed) -> Value {
     v
 }
 
+/// The fields of an entry of a summary's `estimators` that score its errors against
+/// the ground truth (null where no row was scored).
+fn error_fields(name: &str, st: &ErrorStats) -> Value {
+    let scored = st.count > 0;
+    json!({
+        "name": name,
+        "rmse_m": num(st.rmse_m()),
+        "mean_error_m": num(st.mean_m()),
+        "final_error_m": if scored { num(st.final_m) } else { Value::Null },
+        "max_error_m": if scored { num(st.max_m) } else { Value::Null },
+        "nees_mean": num(st.nees_mean()),
+        "nees_band": onebeacon::nav::evaluation::chi_square_band(st.nees_count, 2).map(num),
+        "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
+    })
+}
+
+/// A Rauch-Tung-Striebel pass's entry (`smooth`): named `<estimator>+rts`, with its
+/// calibration at the start (what the smoothed run says the log began with).
+pub fn rts_summary(run: &crate::replay::rts::RtsRun) -> Value {
+    let mut v = error_fields(&format!("{}+rts", run.name), &run.stats);
+    v["rts_of"] = json!(run.name);
+    if let Some(e) = run.estimates.first() {
+        for (k, x) in e.calibration() {
+            v[k] = num(x);
+        }
+    }
+    v
+}
+
 /// `replay --json`, the replay's summary.json.
 pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
     let s = &r.session;
@@ -149,22 +173,21 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
         .zip(s.beacon_offsets())
         .map(|(((name, st), e), offsets)| {
             let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m(), e.east_m(), 0.0));
-            let mut v = json!({
-                "name": name,
-                "rmse_m": num(st.rmse_m()),
-                "mean_error_m": num(st.mean_m()),
-                "final_error_m": if st.count > 0 { num(st.final_m) } else { Value::Null },
-                "max_error_m": if st.count > 0 { num(st.max_m) } else { Value::Null },
-                "rejected": st.rejected,
-                "failed_updates": st.failed,
-                "reinitialised": st.reinitialised,
-                "nees_mean": num(st.nees_mean()),
-                "nees_within_95_pct": num(100.0 * st.nees_within_95_fraction()),
-                "nis_mean": num(st.nis_mean()),
-                "nis_band": onebeacon::nav::evaluation::chi_square_band(st.nis_count, 1).map(num),
-                "nis_within_95_pct": num(100.0 * st.nis_within_95_fraction()),
-                "final": {"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())},
-            });
+            let mut v = error_fields(name, st);
+            for (k, val) in [
+                ("rejected", json!(st.rejected)),
+                ("failed_updates", json!(st.failed)),
+                ("reinitialised", json!(st.reinitialised)),
+                ("nis_mean", num(st.nis_mean())),
+                ("nis_band", json!(onebeacon::nav::evaluation::chi_square_band(st.nis_count, 1).map(num))),
+                ("nis_within_95_pct", num(100.0 * st.nis_within_95_fraction())),
+                (
+                    "final",
+                    json!({"t_s": e.t_s, "x_m": x, "y_m": y, "heading_rad": log.frame.heading_from_ned(e.heading_rad())}),
+                ),
+            ] {
+                v[k] = val;
+            }
             for (k, x) in e.calibration() {
                 v[k] = num(x);
             }

@@ -8,6 +8,7 @@ pub(crate) mod geodesy;
 pub mod log;
 mod merge;
 mod rows;
+pub mod rts;
 pub(crate) mod schema;
 pub mod tune;
 pub(crate) mod validate;
@@ -188,6 +189,19 @@ pub fn replay<E: From<LogError>>(
     Ok(Replay { session, items, dropped: stream.dropped(), start, wide_turns })
 }
 
+/// An estimator's entry in a trajectory row (NED) with its error and NEES (NaN: none).
+pub fn row_estimate(e: &onebeacon::nav::Estimate, (error_m, nees): (f64, f64)) -> Estimate {
+    Estimate {
+        vehicle: 0,
+        pos: Vector3::new(e.north_m(), e.east_m(), 0.0),
+        psi: e.heading_rad(),
+        speed: None,
+        sigma_pos: Vector2::new(e.sigma_north_m(), e.sigma_east_m()),
+        error_m,
+        nees,
+    }
+}
+
 /// A trajectory row (NED) from a step.
 fn to_record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepRecord {
     let truth = step.truth;
@@ -195,18 +209,7 @@ fn to_record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepReco
         .estimates
         .iter()
         .enumerate()
-        .map(|(i, e)| {
-            let (error_m, nees) = step.errors.as_ref().map_or((f64::NAN, f64::NAN), |errors| errors[i]);
-            Estimate {
-                vehicle: 0,
-                pos: Vector3::new(e.north_m(), e.east_m(), 0.0),
-                psi: e.heading_rad(),
-                speed: None,
-                sigma_pos: Vector2::new(e.sigma_north_m(), e.sigma_east_m()),
-                error_m,
-                nees,
-            }
-        })
+        .map(|(i, e)| row_estimate(e, step.errors.as_ref().map_or((f64::NAN, f64::NAN), |errors| errors[i])))
         .collect();
     StepRecord {
         t_s: step.t_s,

@@ -133,3 +133,43 @@ fn nees_of_the_final_pose_is_within_its_band() {
     let [lo, hi] = onebeacon::nav::evaluation::chi_square_band(RUNS, 2);
     assert!((lo..=hi).contains(&mean), "mean NEES {mean:.2} outside [{lo:.2}, {hi:.2}] over {RUNS} runs");
 }
+
+/// The filters' cheap smoother on data drawn from the model: the Rauch-Tung-Striebel
+/// pass over the range EKF gives, at the middle ground-truth row, a mean NEES (2 dof)
+/// within the chi-square band of the run count, and agrees with this smoother (the same
+/// MAP problem, solved as a graph) to a tenth of its standard deviation on average;
+/// its last estimate is the filter's. With a range-offset state (its walk a
+/// prediction through the identity), the NEES is in the band too.
+#[test]
+fn rts_of_the_range_ekf_is_consistent_and_agrees_with_the_smoother() {
+    const RUNS: usize = 40;
+    let cfg = SmoothConfig { calibrate: Calibrate::NONE, kernel: None, ..SmoothConfig::default() };
+    let (mut nees_sum, mut gap_sum, mut bias_nees_sum) = (0.0, 0.0, 0.0);
+    for run in 0..RUNS {
+        let mut log = synthetic(&format!("rts{run}"), 120, 1.0, [0.0, 0.0], Some(run as u64 + 101));
+        for e in ["name = \"ekf\"\nkind = \"range-ekf\"", "name = \"bias\"\nkind = \"range-ekf\"\nestimate_bias = true"]
+        {
+            log.description.estimators.push(toml::from_str(e).unwrap());
+        }
+        let runs = crate::replay::rts::rts(&log, None).unwrap();
+        let rts = runs.iter().find(|r| r.name == "ekf").unwrap();
+        let s = smooth(&log, None, &cfg).unwrap();
+        let &(t, n, e) = &s.truth[s.truth.len() / 2];
+        let est = rts.at(t);
+        nees_sum += onebeacon::nav::evaluation::horizontal_error(est, n, e).1.unwrap();
+        let with_bias = runs.iter().find(|r| r.name == "bias").unwrap().at(t);
+        bias_nees_sum += onebeacon::nav::evaluation::horizontal_error(with_bias, n, e).1.unwrap();
+        let (p, cov) = s.at(t);
+        let gap = Vector2::new(est.north_m() - p[0], est.east_m() - p[1]).norm();
+        gap_sum += gap / (cov.trace() / 2.0).sqrt();
+        let filtered = crate::replay::replay(&log, None, |_| Ok::<_, LogError>(())).unwrap();
+        let last = filtered.session.final_estimates()[1];
+        assert_eq!(rts.estimates.last().unwrap().position_ned_m, last.position_ned_m);
+    }
+    let mean = nees_sum / RUNS as f64;
+    let [lo, hi] = onebeacon::nav::evaluation::chi_square_band(RUNS, 2);
+    assert!((lo..=hi).contains(&mean), "RTS mean NEES {mean:.2} outside [{lo:.2}, {hi:.2}] over {RUNS} runs");
+    let bias_mean = bias_nees_sum / RUNS as f64;
+    assert!((lo..=hi).contains(&bias_mean), "with an offset state: mean NEES {bias_mean:.2}");
+    assert!(gap_sum / (RUNS as f64) < 0.1, "RTS and the smoother {:.3} sigma apart", gap_sum / RUNS as f64);
+}

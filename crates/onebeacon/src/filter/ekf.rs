@@ -117,6 +117,15 @@ impl<const N: usize> GaussianFilter<N> for Ekf<N> {
         self.p = model.propagate_covariance(&f, &self.p, q);
     }
 
+    /// The cross covariance of the linearised step: P F'.
+    fn predict_cross<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+        let (x, f) = model.transition(&self.x, dt);
+        let cross = self.p * f.transpose();
+        self.x = x;
+        self.p = model.propagate_covariance(&f, &self.p, q);
+        cross
+    }
+
     /// [`Ekf::update`] with innovation gating: a measurement whose NIS exceeds `max_nis`
     /// (a chi-square quantile with M degrees of freedom) is rejected and leaves the
     /// state untouched.

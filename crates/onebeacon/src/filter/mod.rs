@@ -11,6 +11,7 @@ pub mod ekf;
 pub mod factored;
 pub mod lanes;
 pub mod particle;
+pub mod rts;
 pub mod truncated;
 pub mod ukf;
 
@@ -34,6 +35,9 @@ pub trait GaussianFilter<const N: usize> {
     fn covariance_mut(&mut self) -> &mut SMatrix<f64, N, N>;
     /// Prediction over `dt` seconds through `model`, with additive process noise `q`.
     fn predict<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>);
+    /// [`GaussianFilter::predict`], returning the cross covariance of the state before
+    /// and after it, what a Rauch-Tung-Striebel pass needs ([`rts`]).
+    fn predict_cross<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N>;
     /// Update with measurement `z` of noise covariance `r`; a measurement whose NIS
     /// exceeds `max_nis` is rejected and leaves the state untouched, as does an error.
     fn update_gated<const M: usize, H: MeasurementModel<N, M>>(
@@ -101,6 +105,12 @@ impl<const N: usize> GaussianFilter<N> for AnyFilter<N> {
         match self {
             AnyFilter::Ekf(f) => f.predict(model, dt, q),
             AnyFilter::Ukf(f) => f.predict(model, dt, q),
+        }
+    }
+    fn predict_cross<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+        match self {
+            AnyFilter::Ekf(f) => f.predict_cross(model, dt, q),
+            AnyFilter::Ukf(f) => f.predict_cross(model, dt, q),
         }
     }
     fn update_gated<const M: usize, H: MeasurementModel<N, M>>(

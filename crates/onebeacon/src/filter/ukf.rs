@@ -129,6 +129,40 @@ fn residual<const D: usize>(
     d
 }
 
+/// The unscented transform through `f` of the 2N + 1 sigma points about `x` spread by
+/// `d` (x, x + d_i, x - d_i) with weights (wm0, wc0, wi): the points' weighted mean
+/// (angle-aware), their covariance plus `noise`, and the cross covariance of the state
+/// with them, sum Wc dX dY'.
+fn transform<const N: usize, const D: usize>(
+    x: &SVector<f64, N>,
+    d: &SMatrix<f64, N, N>,
+    (wm0, wc0, wi): (f64, f64, f64),
+    f: impl Fn(&SVector<f64, N>) -> SVector<f64, D>,
+    is_angle: impl Fn(usize) -> bool,
+    noise: &SMatrix<f64, D, D>,
+) -> (SVector<f64, D>, SMatrix<f64, D, D>, SMatrix<f64, N, D>) {
+    let mut ys = Vec::with_capacity(2 * N + 1);
+    ys.push(f(x));
+    for sign in [1.0, -1.0] {
+        for i in 0..N {
+            ys.push(f(&(x + d.column(i) * sign)));
+        }
+    }
+    let m = mean(&ys, wm0, wi, &is_angle);
+    let (mut cov, mut cross) = (*noise, SMatrix::<f64, N, D>::zeros());
+    for (j, yj) in ys.iter().enumerate() {
+        let dy = residual(yj, &m, &is_angle);
+        let w = if j == 0 { wc0 } else { wi };
+        cov += dy * dy.transpose() * w;
+        if j > 0 {
+            // the state offset of point j: +d_i or -d_i
+            let dx = if j <= N { d.column(j - 1).into_owned() } else { -d.column(j - 1 - N) };
+            cross += dx * dy.transpose() * w;
+        }
+    }
+    (m, cov, cross)
+}
+
 impl<const N: usize> GaussianFilter<N> for Ukf<N> {
     fn mean(&self) -> &SVector<f64, N> {
         &self.x
@@ -148,24 +182,19 @@ impl<const N: usize> GaussianFilter<N> for Ukf<N> {
     /// semi-definite leaves the filter as it was.
     #[inline(never)] // keeps the EKF path of AnyFilter small where the UKF is not used
     fn predict<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) {
+        self.predict_cross(model, dt, q);
+    }
+
+    /// The cross covariance of the sigma points before and after: sum Wc dX dY' (the
+    /// covariance itself where the prediction cannot be made).
+    fn predict_cross<P: ProcessModel<N>>(&mut self, model: &P, dt: f64, q: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
         let (c, wm0, wc0, wi) = self.params.weights(N);
-        let Ok(d) = self.spread(c) else { return };
-        let mut y = Vec::with_capacity(2 * N + 1);
-        y.push(model.propagate(&self.x, dt));
-        for sign in [1.0, -1.0] {
-            for i in 0..N {
-                y.push(model.propagate(&(self.x + d.column(i) * sign), dt));
-            }
-        }
-        let is_angle = |k| model.is_angle(k);
-        let m = mean(&y, wm0, wi, is_angle);
-        let mut p = *q;
-        for (j, yj) in y.iter().enumerate() {
-            let r = residual(yj, &m, &is_angle);
-            p += r * r.transpose() * if j == 0 { wc0 } else { wi };
-        }
+        let Ok(d) = self.spread(c) else { return self.p };
+        let (m, p, cross) =
+            transform(&self.x, &d, (wm0, wc0, wi), |x| model.propagate(x, dt), |k| model.is_angle(k), q);
         self.x = m;
         self.p = (p + p.transpose()) * 0.5;
+        cross
     }
 
     #[inline(never)]
@@ -178,27 +207,8 @@ impl<const N: usize> GaussianFilter<N> for Ukf<N> {
     ) -> Result<Gated, FilterError> {
         let (c, wm0, wc0, wi) = self.params.weights(N);
         let d = self.spread(c)?;
-        let mut zs = Vec::with_capacity(2 * N + 1);
-        zs.push(model.predict(&self.x));
-        for sign in [1.0, -1.0] {
-            for i in 0..N {
-                zs.push(model.predict(&(self.x + d.column(i) * sign)));
-            }
-        }
         let is_angle = |k| model.is_angle(k);
-        let zm = mean(&zs, wm0, wi, is_angle);
-        let mut s = *r;
-        let mut pxz = SMatrix::<f64, N, M>::zeros();
-        for (j, zj) in zs.iter().enumerate() {
-            let dz = residual(zj, &zm, &is_angle);
-            let w = if j == 0 { wc0 } else { wi };
-            s += dz * dz.transpose() * w;
-            if j > 0 {
-                // the state offset of point j: +d_i or -d_i
-                let dx = if j <= N { d.column(j - 1).into_owned() } else { -d.column(j - 1 - N) };
-                pxz += dx * dz.transpose() * w;
-            }
-        }
+        let (zm, s, pxz) = transform(&self.x, &d, (wm0, wc0, wi), |x| model.predict(x), is_angle, r);
         let nu = residual(z, &zm, &is_angle);
         if !nu.iter().all(|v| v.is_finite()) || !s.iter().all(|v| v.is_finite()) {
             return Err(FilterError::NonFinite);

@@ -248,6 +248,18 @@ pub trait Navigator: Send {
     fn command_mode(&self) -> Option<usize> {
         None
     }
+    /// Keeps, from now on, what a Rauch-Tung-Striebel pass over this navigator's run
+    /// needs (memory grows with the run: for a log, not a stream); whether it can (the
+    /// Gaussian planar family can).
+    fn keep_history(&mut self) -> bool {
+        false
+    }
+    /// The Rauch-Tung-Striebel smoothed estimates of the run kept since
+    /// [`Navigator::keep_history`]: one per interval between predictions, each holding
+    /// from its time `t_s` on, in time order; empty without a history.
+    fn smoothed(&self) -> Vec<Estimate> {
+        Vec::new()
+    }
     /// The range and angle sets of a factored particle filter's last update.
     fn factored_sets(&self) -> Option<crate::filter::factored::FactoredSets> {
         None

@@ -14,6 +14,7 @@
 //! the sound-speed error; modelling that is left for when a log needs it).
 
 use super::{Aiding, BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
+use crate::filter::rts::History;
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::geo::wrap_angle;
 use crate::measure::{RadialSpeed2d, ScalarModel, SlantRange, StateComponent};
@@ -256,6 +257,9 @@ pub struct PlanarNavigator<const N: usize = STATES> {
     depth_m: f64,
     /// The gate of ranges and Doppler speeds (`config.nis_gate`).
     gate: super::Gate,
+    /// The predictions kept for a Rauch-Tung-Striebel pass, with the depth of each
+    /// interval between them ([`Navigator::keep_history`]).
+    history: Option<(History<N>, Vec<f64>)>,
 }
 
 impl PlanarNavigator {
@@ -332,6 +336,7 @@ impl<const N: usize> PlanarNavigator<N> {
             yaw_rate_rad_s: 0.0,
             last_odometry_s: None,
             depth_m: 0.0,
+            history: None,
         }
     }
 
@@ -365,17 +370,63 @@ impl<const N: usize> PlanarNavigator<N> {
         }
         let n = self.config.noise;
         let q_bias = n.bias_walk_m_per_sqrt_s.powi(2) * dt;
+        let mut q = Cov::<N>::zeros();
         if self.config.estimate_bias {
-            self.filter.covariance_mut()[(idx::BIAS, idx::BIAS)] += q_bias;
+            q[(idx::BIAS, idx::BIAS)] = q_bias;
         }
         for i in STATES..STATES + self.offset_beacons.len() {
-            self.filter.covariance_mut()[(i, i)] += q_bias;
+            q[(i, i)] = q_bias;
         }
-        if n.position_walk_m_per_sqrt_s > 0.0 {
-            let q = n.position_walk_m_per_sqrt_s.powi(2) * dt;
-            let p = self.filter.covariance_mut();
-            p[(idx::N, idx::N)] += q;
-            p[(idx::E, idx::E)] += q;
+        let q_walk = n.position_walk_m_per_sqrt_s.powi(2) * dt;
+        (q[(idx::N, idx::N)], q[(idx::E, idx::E)]) = (q_walk, q_walk);
+        if q != Cov::<N>::zeros() {
+            self.diffuse(&q);
+        }
+    }
+
+    /// Noise `q` added to the covariance, the mean as it was: a prediction through the
+    /// identity, its cross covariance the covariance before.
+    fn diffuse(&mut self, q: &Cov<N>) {
+        let before = (*self.filter.mean(), *self.filter.covariance());
+        *self.filter.covariance_mut() += q;
+        let cross = before.1;
+        self.keep(before, cross);
+    }
+
+    /// A prediction through `model` with noise `q`.
+    fn predict(&mut self, model: &impl ProcessModel<N>, q: &Cov<N>) {
+        if self.history.is_none() {
+            return self.filter.predict(model, 0.0, q);
+        }
+        let before = (*self.filter.mean(), *self.filter.covariance());
+        let cross = self.filter.predict_cross(model, 0.0, q);
+        self.keep(before, cross);
+    }
+
+    /// The prediction just made from `before`, with its cross covariance, in the
+    /// history when one is kept.
+    fn keep(&mut self, before: (State<N>, Cov<N>), cross: Cov<N>) {
+        if let Some((history, depths)) = &mut self.history {
+            history.push(self.t_s, before, (*self.filter.mean(), *self.filter.covariance()), cross);
+            depths.push(self.depth_m);
+        }
+    }
+
+    /// The estimate of mean `x` and covariance `p` at `t_s` and depth `depth_m`.
+    fn estimate_of(t_s: f64, x: &State<N>, p: &Cov<N>, depth_m: f64) -> Estimate {
+        Estimate {
+            t_s,
+            position_ned_m: Vector3::new(x[idx::N], x[idx::E], depth_m),
+            horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
+            heading_state_rad: x[idx::PSI],
+            heading_var_rad2: p[(idx::PSI, idx::PSI)],
+            roll_pitch_rad: [0.0; 2],
+            speed_m_s: None,
+            range_bias_m: x[idx::BIAS],
+            range_scale: x[idx::RANGE_SCALE],
+            distance_scale: x[idx::DISTANCE_SCALE],
+            turn_scale: x[idx::TURN_SCALE],
+            usbl_misalignment_rad: 0.0,
         }
     }
 
@@ -398,7 +449,7 @@ impl<const N: usize> PlanarNavigator<N> {
     fn motion(&mut self, d: f64, lat: f64, dpsi: f64, sigma_d: f64, sigma_lat: f64) {
         let step = OdometryStep { d, lat, dpsi, sigma_d, sigma_lat, noise: self.config.noise };
         let q = step.noise_covariance(self.filter.mean(), 0.0);
-        self.filter.predict(&step, 0.0, &q);
+        self.predict(&step, &q);
     }
 
     /// The slant-range model to `beacon` with this navigator's offset and scale states:
@@ -501,21 +552,19 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
     }
 
     fn estimate(&self) -> Estimate {
-        let (x, p) = (self.filter.mean(), self.filter.covariance());
-        Estimate {
-            t_s: self.t_s,
-            position_ned_m: Vector3::new(x[idx::N], x[idx::E], self.depth_m),
-            horizontal_cov_m2: p.fixed_view::<2, 2>(0, 0).into_owned(),
-            heading_state_rad: x[idx::PSI],
-            heading_var_rad2: p[(idx::PSI, idx::PSI)],
-            roll_pitch_rad: [0.0; 2],
-            speed_m_s: None,
-            range_bias_m: x[idx::BIAS],
-            range_scale: x[idx::RANGE_SCALE],
-            distance_scale: x[idx::DISTANCE_SCALE],
-            turn_scale: x[idx::TURN_SCALE],
-            usbl_misalignment_rad: 0.0,
-        }
+        Self::estimate_of(self.t_s, self.filter.mean(), self.filter.covariance(), self.depth_m)
+    }
+
+    fn keep_history(&mut self) -> bool {
+        self.history = Some((History::new(self.t_s), vec![self.depth_m]));
+        true
+    }
+
+    fn smoothed(&self) -> Vec<Estimate> {
+        let Some((history, depths)) = &self.history else { return Vec::new() };
+        let last = (*self.filter.mean(), *self.filter.covariance());
+        let smoothed = history.smooth(last, |k| k == idx::PSI);
+        smoothed.iter().zip(depths).map(|((t, (x, p)), d)| Self::estimate_of(*t, x, p, *d)).collect()
     }
 }
 

@@ -382,6 +382,8 @@ pub struct Session {
     last_t: Option<f64>,
     /// Items in a row that jumped past the gap: the latest's time and their count.
     jump: Option<(f64, usize)>,
+    /// Whether the estimators keep their history ([`Session::with_history`]).
+    keep_history: bool,
 }
 
 impl std::fmt::Debug for Session {
@@ -421,12 +423,20 @@ impl Session {
             last_t: None,
             jump: None,
             restarts: Vec::new(),
+            keep_history: false,
         }
     }
 
     /// The session with its estimators' initial position sigma set to `sigma_m`.
     pub fn with_position_sigma(mut self, sigma_m: f64) -> Self {
         self.sigma_position_m = sigma_m;
+        self
+    }
+
+    /// The session with every estimator keeping its history for a Rauch-Tung-Striebel
+    /// pass ([`Navigator::keep_history`]; from a restart on, for one restarted).
+    pub fn with_history(mut self) -> Self {
+        self.keep_history = true;
         self
     }
 
@@ -485,6 +495,9 @@ impl Session {
         let sigmas = (self.sigma_position_m, self.sigma_heading_rad);
         self.restarts = std::mem::take(&mut self.builders).into_iter().map(|b| Restart::new(b, pose, sigmas)).collect();
         self.navs = self.restarts.iter().map(|r| r.build(t0, pose)).collect();
+        if self.keep_history {
+            self.navs.iter_mut().for_each(|n| _ = n.keep_history());
+        }
     }
 
     /// Records a rejection while the log has room.
@@ -617,6 +630,9 @@ impl Session {
         // estimate: reported, never silently kept
         for (i, e) in estimates.iter_mut().enumerate() {
             if self.restarts[i].apply(&mut self.navs[i], e, t) {
+                if self.keep_history {
+                    self.navs[i].keep_history();
+                }
                 self.stats[i].reinitialised += 1;
                 reinitialised.push(i);
             }

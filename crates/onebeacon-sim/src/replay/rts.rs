@@ -1,0 +1,59 @@
+//! The cheap smoother: a Rauch-Tung-Striebel pass over each Gaussian filter of a log
+//! ([`onebeacon::filter::rts`]), scored at the ground-truth rows as the filters are.
+
+use super::{Log, LogError, session_and_start};
+use onebeacon::config::estimator::EstimatorKind;
+use onebeacon::nav::Estimate;
+use onebeacon::nav::evaluation::{ErrorStats, horizontal_error};
+use std::collections::BTreeSet;
+
+/// One estimator's Rauch-Tung-Striebel pass.
+#[derive(Debug, Clone)]
+pub struct RtsRun {
+    /// The estimator's name.
+    pub name: String,
+    /// The smoothed estimates, each holding from its time on (NED).
+    pub estimates: Vec<Estimate>,
+    /// Its errors at the ground-truth rows.
+    pub stats: ErrorStats,
+}
+
+impl RtsRun {
+    /// The smoothed estimate at `t_s` (the last one from before it; the first before
+    /// the first).
+    pub fn at(&self, t_s: f64) -> &Estimate {
+        let k = self.estimates.partition_point(|e| e.t_s <= t_s);
+        &self.estimates[k.saturating_sub(1)]
+    }
+}
+
+/// The log's filters run with their history kept, and a Rauch-Tung-Striebel pass over
+/// each one that keeps one (the Gaussian planar family; the others and dead reckoning
+/// are left out), scored
+/// against the ground truth (no rows: empty statistics).
+pub fn rts(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Vec<RtsRun>, LogError> {
+    let (session, _) = session_and_start(log, beacons)?;
+    let mut session = session.with_history();
+    let mut truth = Vec::new();
+    for item in log.items()? {
+        if let Ok(Some(step)) = session.push(&item?)
+            && let Some(p) = step.truth
+        {
+            truth.push((step.t_s, p.north_m, p.east_m));
+        }
+    }
+    // dead reckoning has no correction to carry back
+    let aided = |i: usize| log.description.estimators[i].kind != EstimatorKind::DeadReckoning;
+    let runs = (0..session.names.len()).filter(|&i| aided(i)).filter_map(|i| {
+        let estimates = session.navigator(i)?.smoothed();
+        (!estimates.is_empty()).then(|| {
+            let mut run = RtsRun { name: session.names[i].clone(), estimates, stats: ErrorStats::default() };
+            for &(t, north, east) in &truth {
+                let (error_m, nees) = horizontal_error(run.at(t), north, east);
+                run.stats.push(error_m, nees);
+            }
+            run
+        })
+    });
+    Ok(runs.collect())
+}
