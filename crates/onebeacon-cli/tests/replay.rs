@@ -126,6 +126,17 @@ fn plaza_all_beacons_and_single_beacons() {
         let turn = find(&single, "ekf-cal", "turn_scale").as_f64().unwrap();
         assert!((-0.06..-0.03).contains(&turn), "beacon {b}: turn scale {turn}");
     }
+    // plaza1's filter with noise fitted on plaza2 (ekf-cal-oos): consistent (95 % of its
+    // rows within the 95 % NEES bound where 95 % are expected; ekf-cal, fitted on both
+    // logs, has 42 %) and better than dead reckoning with every beacon alone
+    let all = replay_json(&plaza(1), None, &dir.join("oos"));
+    let within = find(&all, "ekf-cal-oos", "nees_within_95_pct").as_f64().unwrap();
+    assert!(within >= 90.0, "plaza1 ekf-cal-oos: {within} % of rows within the NEES bound");
+    let dr = rmse(&all, "dead-reckoning");
+    for b in ["0", "1", "5", "6"] {
+        let single = replay_json(&plaza(1), Some(b), &dir.join(format!("oos{b}")));
+        assert!(rmse(&single, "ekf-cal-oos") < dr, "plaza1 beacon {b}: {single:?} vs {dr}");
+    }
     // the outputs are all there
     for f in ["trajectory.csv", "summary.json", "rejected.csv", "top_view.png", "error.png"] {
         assert!(dir.join("all1").join(f).is_file(), "{f}");
