@@ -14,7 +14,8 @@
 
 use crate::replay::Log;
 use crate::run::{Estimate, StepRecord, TruthRecord, recorded_bytes};
-use crate::scenario::{EstimatorKind, EstimatorSpec, Scenario};
+use crate::scenario::{EstimatorKind, EstimatorSpec, Host, Scenario};
+use onebeacon::nav::planar::{STATES, STATES_WITH_OFFSETS};
 
 /// The environment variable that sets the budget, GiB.
 pub const ENV: &str = "ONEBEACON_MEMORY_GIB";
@@ -131,6 +132,50 @@ impl Budget {
         let keys = if keep_records { "the log's length (cut it), [[estimators]]" } else { "[[estimators]]" };
         self.check(&format!("replaying {}", log.description.name), need, &detail, keys)
     }
+}
+
+impl Budget {
+    /// Refuses smoothing `log` (`onebeacon smooth`) where it would not fit: the replay's
+    /// share ([`Budget::check_replay`]), the smoother's graph ([`SMOOTHER_NODE_BYTES`] a
+    /// node) and the history each Gaussian filter with beacon aiding keeps for its
+    /// Rauch-Tung-Striebel pass (two means and covariances and a cross covariance a
+    /// prediction, [`rts_step_bytes`]), a node and a prediction per CSV row of at least
+    /// [`MIN_ROW_BYTES`] (an upper bound: only motion rows make nodes, and a filter
+    /// predicts at its motion rows and, with a random walk, at its other rows).
+    pub fn check_smooth(&self, log: &Log) -> Result<(), BudgetError> {
+        let estimators = &log.description.estimators;
+        let kept: Vec<usize> = estimators
+            .iter()
+            .filter(|e| e.kind.aiding(Host::Log).any() && !e.kind.tracks_bearings() && !e.kind.iusbl())
+            .filter(|e| e.track_accel_sigma_m_s2.is_none())
+            .map(|e| if e.estimate_beacon_offsets == Some(true) { STATES_WITH_OFFSETS } else { STATES })
+            .collect();
+        let rows = log.source_bytes() as f64 / MIN_ROW_BYTES;
+        let node = SMOOTHER_NODE_BYTES + kept.iter().map(|&n| rts_step_bytes(n)).sum::<f64>();
+        let row =
+            (size_of::<StepRecord>() + size_of::<TruthRecord>() + estimators.len() * size_of::<Estimate>()) as f64;
+        let need = BASE_BYTES + estimators.len() as f64 * 1e5 + PLOTTED_ROWS * row + rows * node;
+        let detail =
+            format!("{rows:.0} rows, each a node of the graph and a step of {} filters' histories", kept.len());
+        self.check(
+            &format!("smoothing {}", log.description.name),
+            need,
+            &detail,
+            "the log's length (cut it), [[estimators]]",
+        )
+    }
+}
+
+/// The bytes of one node of the smoother's graph and its factors, solver and marginals:
+/// measured on plaza1 (9658 nodes, 13 186 ranges) as the peak resident set of `smooth`
+/// without filters' histories less that of `replay` (9 MB, about 900 bytes a node),
+/// with room for logs denser in measurements.
+const SMOOTHER_NODE_BYTES: f64 = 4096.0;
+
+/// The bytes a Gaussian filter of `n` states keeps per prediction for its
+/// Rauch-Tung-Striebel pass, and the smoothed estimate it gives back.
+fn rts_step_bytes(n: usize) -> f64 {
+    ((2 * (n + n * n) + n * n + 1) * size_of::<f64>() + size_of::<onebeacon::nav::Estimate>()) as f64
 }
 
 /// The fewest bytes a CSV row takes (a time, one value, separators): what bounds the

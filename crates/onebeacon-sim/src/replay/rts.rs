@@ -2,7 +2,6 @@
 //! ([`onebeacon::filter::rts`]), scored at the ground-truth rows as the filters are.
 
 use super::{Log, LogError, session_and_start};
-use onebeacon::config::estimator::EstimatorKind;
 use onebeacon::nav::Estimate;
 use onebeacon::nav::evaluation::{ErrorStats, horizontal_error};
 use std::collections::BTreeSet;
@@ -28,7 +27,7 @@ impl RtsRun {
 }
 
 /// The log's filters run with their history kept, and a Rauch-Tung-Striebel pass over
-/// each one that keeps one (the Gaussian planar family; the others and dead reckoning
+/// each one that keeps one (the Gaussian planar family with beacon aiding; the others
 /// are left out), scored
 /// against the ground truth (no rows: empty statistics).
 pub fn rts(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Vec<RtsRun>, LogError> {
@@ -42,9 +41,7 @@ pub fn rts(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Vec<RtsRun>, Log
             truth.push((step.t_s, p.north_m, p.east_m));
         }
     }
-    // dead reckoning has no correction to carry back
-    let aided = |i: usize| log.description.estimators[i].kind != EstimatorKind::DeadReckoning;
-    let runs = (0..session.names.len()).filter(|&i| aided(i)).filter_map(|i| {
+    let runs = (0..session.names.len()).filter_map(|i| {
         let estimates = session.navigator(i)?.smoothed();
         (!estimates.is_empty()).then(|| {
             let mut run = RtsRun { name: session.names[i].clone(), estimates, stats: ErrorStats::default() };

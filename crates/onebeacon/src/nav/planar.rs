@@ -555,9 +555,12 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
         Self::estimate_of(self.t_s, self.filter.mean(), self.filter.covariance(), self.depth_m)
     }
 
+    /// Dead reckoning (no beacon aiding) has no correction to carry back: it keeps none.
     fn keep_history(&mut self) -> bool {
-        self.history = Some((History::new(self.t_s), vec![self.depth_m]));
-        true
+        if self.config.aiding.any() {
+            self.history = Some((History::new(self.t_s), vec![self.depth_m]));
+        }
+        self.history.is_some()
     }
 
     fn smoothed(&self) -> Vec<Estimate> {
