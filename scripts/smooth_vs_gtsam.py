@@ -2,9 +2,10 @@
 """onebeacon's smoother side by side with GTSAM 4.3 on the plaza logs (docs/smooth.md).
 
 For plaza1 and plaza2, all beacons and each alone: RMSE against the ground truth of dead
-reckoning, the log's filters as shipped (ekf-cal, ekf-cal-gated), ekf-cal's Rauch-Tung-Striebel
-pass (`ekf-cal+rts`, from `smooth`), `onebeacon smooth` without
-calibration variables and with its default ones (range and turn scale), and GTSAM's batch
+reckoning, two of the log's filters as shipped (ekf-cal, with noise chosen on both logs,
+and ekf-cal-oos, with noise fitted on the other log) and their Rauch-Tung-Striebel passes
+(`+rts`, from `smooth`), `onebeacon smooth` without calibration variables, with its
+default ones (range and turn scale) and weighing as ekf-cal-oos (`--like`), and GTSAM's batch
 LM (`../shared/bench/gtsam_smooth.py`: range scale 1, and the scale as a graph variable,
 `--scale est`). Then the time of one solve, back to back, in rounds: `onebeacon smooth`
 with the range scale as a variable (its solve, log reading apart) against GTSAM's LM with
@@ -19,7 +20,7 @@ import argparse, json, os, statistics, subprocess, sys
 
 BENCH = os.path.join('..', 'shared', 'bench', 'gtsam_smooth.py')
 LOGS = {'plaza1': [None, 0, 1, 5, 6], 'plaza2': [None, 0, 1, 5, 6]}
-FILTERS = ['dead-reckoning', 'ekf-cal', 'ekf-cal-gated', 'ekf-cal+rts']
+FILTERS = ['dead-reckoning', 'ekf-cal', 'ekf-cal+rts', 'ekf-cal-oos', 'ekf-cal-oos+rts']
 
 
 def run(cmd):
@@ -58,6 +59,7 @@ def main():
             print(f'{log} beacons {"all" if b is None else b} ...', file=sys.stderr, flush=True)
             cal = ours(a, log, b)
             nocal = ours(a, log, b, '--calibrate', 'none')
+            oos = ours(a, log, b, '--like', 'ekf-cal-oos')
             g1 = gtsam(a, log, b)
             ge = None if a.no_est else gtsam(a, log, b, '--scale', 'est')
             rec = {'log': log, 'beacons': 'all' if b is None else b,
@@ -65,17 +67,18 @@ def main():
                    'smooth_nocal': nocal['smoother']['rmse_m'], 'smooth_nocal_nees': nocal['smoother']['nees_mean'],
                    'smooth': cal['smoother']['rmse_m'], 'smooth_nees': cal['smoother']['nees_mean'],
                    'smooth_nees_band': cal['smoother']['nees_band'],
+                   'smooth_oos': oos['smoother']['rmse_m'], 'smooth_oos_nees': oos['smoother']['nees_mean'],
                    'gtsam_lm': g1['rmse'], 'gtsam_lm_scale_est': ge['rmse'] if ge else None}
             results.write(json.dumps(rec) + '\n')
             rows.append(rec)
     f = lambda v: '-' if v is None else f'{v:.2f}'
-    print('| log | beacons | dead reckoning | ekf-cal | ekf-cal-gated | ekf-cal + RTS | smooth, no calibration (NEES) '
-          '| smooth (NEES) | GTSAM LM | GTSAM LM, scale variable |')
-    print('|---|---|---|---|---|---|---|---|---|---|')
+    print('| log | beacons | dead reckoning | ekf-cal | + RTS | ekf-cal-oos | + RTS | smooth, no calibration (NEES) '
+          '| smooth (NEES) | smooth like ekf-cal-oos (NEES) | GTSAM LM | GTSAM LM, scale variable |')
+    print('|---|---|---|---|---|---|---|---|---|---|---|---|')
     for r in rows:
-        print(f"| {r['log']} | {r['beacons']} | {f(r['dead-reckoning'])} | {f(r['ekf-cal'])} | {f(r['ekf-cal-gated'])} "
-              f"| {f(r['ekf-cal+rts'])} | {f(r['smooth_nocal'])} ({r['smooth_nocal_nees']:.1f}) | {f(r['smooth'])} ({r['smooth_nees']:.1f}) "
-              f"| {f(r['gtsam_lm'])} | {f(r['gtsam_lm_scale_est'])} |")
+        print(f"| {r['log']} | {r['beacons']} | {f(r['dead-reckoning'])} | {f(r['ekf-cal'])} | {f(r['ekf-cal+rts'])} "
+              f"| {f(r['ekf-cal-oos'])} | {f(r['ekf-cal-oos+rts'])} | {f(r['smooth_nocal'])} ({r['smooth_nocal_nees']:.1f}) | {f(r['smooth'])} ({r['smooth_nees']:.1f}) "
+              f"| {f(r['smooth_oos'])} ({r['smooth_oos_nees']:.1f}) | {f(r['gtsam_lm'])} | {f(r['gtsam_lm_scale_est'])} |")
     # time, back to back
     times = {}
     for _ in range(a.rounds):
