@@ -517,6 +517,39 @@ fn smooth<'py>(
     PyTuple::new(py, [d.into_any(), to_py(py, &summary)?])
 }
 
+/// The Rauch-Tung-Striebel pass over each Gaussian filter of a log (the `+rts` lines of
+/// `onebeacon smooth`): a dict from each smoothed estimator's name to `(estimates,
+/// summary)`, estimates a dict of arrays, one row per interval between the filter's
+/// predictions (t_s its start, north_m, east_m, heading_rad, sigma_north_m,
+/// sigma_east_m; NED), the summary its line of `smooth --json`.
+#[pyfunction]
+#[pyo3(signature = (log, beacons = None))]
+fn rts<'py>(py: Python<'py>, log: PathBuf, beacons: Option<Vec<u32>>) -> PyResult<Bound<'py, PyDict>> {
+    let l = Log::load(&log).map_err(input_error)?;
+    let filter = beacon_filter(beacons, &l.beacon_ids()).map_err(|e| input_error(format!("beacons {e}")))?;
+    Budget::resolve(None).map_err(input_error)?.check_smooth(&l).map_err(input_error)?;
+    let runs = py.detach(|| onebeacon_sim::replay::rts::rts(&l, filter)).map_err(input_error)?;
+    let out = PyDict::new(py);
+    for run in &runs {
+        let d = PyDict::new(py);
+        let column = |f: &dyn Fn(&onebeacon::nav::Estimate) -> f64| run.estimates.iter().map(f).collect::<Vec<f64>>();
+        let columns: [(&str, Vec<f64>); 6] = [
+            ("t_s", column(&|e| e.t_s)),
+            ("north_m", column(&|e| e.north_m())),
+            ("east_m", column(&|e| e.east_m())),
+            ("heading_rad", column(&|e| e.heading_rad())),
+            ("sigma_north_m", column(&|e| e.sigma_north_m())),
+            ("sigma_east_m", column(&|e| e.sigma_east_m())),
+        ];
+        for (name, c) in columns {
+            d.set_item(name, PyArray1::from_vec(py, c))?;
+        }
+        let summary = to_py(py, &onebeacon_sim::json::rts_summary(run))?;
+        out.set_item(&run.name, PyTuple::new(py, [d.into_any(), summary])?)?;
+    }
+    Ok(out)
+}
+
 /// The estimators of a stream configuration, step by step: what `onebeacon stream`
 /// runs, for a Python backseat node (ROS 2, MOOS). `feed` takes one measurement (a dict
 /// or a JSON line, docs/logs.md) and returns the estimates line `stream` would print
@@ -695,6 +728,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mc, m)?)?;
     m.add_function(wrap_pyfunction!(replay, m)?)?;
     m.add_function(wrap_pyfunction!(smooth, m)?)?;
+    m.add_function(wrap_pyfunction!(rts, m)?)?;
     m.add_function(wrap_pyfunction!(dsp_process, m)?)?;
     Ok(())
 }

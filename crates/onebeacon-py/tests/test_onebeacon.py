@@ -219,6 +219,19 @@ def test_smooth_is_the_cli_smoother(cli, tmp_path):
         onebeacon.smooth(PLAZA, kernel="nope")
 
 
+def test_rts_is_the_cli_rts_lines(cli, tmp_path):
+    runs = onebeacon.rts(PLAZA, beacons=[5])
+    out = json.loads(cli("smooth", PLAZA, "--beacons", "5", "--json", "--out", tmp_path / "s").stdout)
+    lines = {e["name"]: e for e in out["estimators"] if e["name"].endswith("+rts")}
+    assert sorted(f"{name}+rts" for name in runs) == sorted(lines)
+    assert "dead-reckoning" not in runs
+    estimates, summary = runs["ekf-cal"]
+    assert summary == lines["ekf-cal+rts"]
+    assert np.all(np.diff(estimates["t_s"]) >= 0) and np.all(estimates["sigma_north_m"] > 0)
+    with pytest.raises(onebeacon.InputError, match="beacons 9: not a beacon"):
+        onebeacon.rts(PLAZA, beacons=[9])
+
+
 def test_navigator_step_by_step_equals_the_cli_replay(cli, tmp_path):
     items = cli("replay", PLAZA, "--print-stream").stdout.splitlines()
     summary = json.loads(cli("replay", PLAZA, "--json", "--out", tmp_path / "r").stdout)
