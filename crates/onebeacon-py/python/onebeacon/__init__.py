@@ -9,6 +9,7 @@ The same engine as the ``onebeacon`` command line, from Python, with numpy array
 - ``mc(scenario)``: Monte Carlo over the sweep, the cells of ``onebeacon mc --json``;
 - ``replay(log)``: a real log through its estimators, ``(trajectory, summary)``;
 - ``smooth(log)``: a log smoothed over every pose after the dive, ``(poses, summary)``;
+- ``rts(log)``: each Gaussian filter's Rauch-Tung-Striebel pass, ``{name: (estimates, summary)}``;
 - ``Navigator(config)``: the estimators step by step, for a backseat node;
 - ``dsp.process(samples, fs)``: the acoustic receiver chain on one capture.
 
@@ -22,6 +23,7 @@ from ._native import (
     __version__,
     mc,
     replay,
+    rts,
     run,
     scenarios,
     smooth,
@@ -36,6 +38,7 @@ __all__ = [
     "dsp",
     "mc",
     "replay",
+    "rts",
     "run",
     "scenarios",
     "smooth",

@@ -68,6 +68,11 @@ def smooth(
     kernel: Optional[str] = None,
 ) -> Tuple[Dict[str, npt.NDArray[np.float64]], Dict[str, Any]]: ...
 
+def rts(
+    log: Union[str, "os.PathLike[str]"],
+    beacons: Optional[Sequence[int]] = None,
+) -> Dict[str, Tuple[Dict[str, npt.NDArray[np.float64]], Dict[str, Any]]]: ...
+
 class Navigator:
     """The estimators of a stream configuration, fed one measurement at a time."""
 
