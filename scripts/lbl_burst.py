@@ -9,6 +9,8 @@ the beacons in turn; the first 11 ranges to beacon 0 are 200 m short.
     onebeacon replay DIR/clean.toml        # the same log without it
     onebeacon replay DIR/ungated.toml      # the burst, every estimator with nis_gate = inf
     onebeacon replay DIR/off_start.toml    # no burst, started 39 m off with a 0.5 m sigma
+    onebeacon replay DIR/ranges_start.toml         # [initial] from = "ranges", 60 s window
+    onebeacon replay DIR/ranges_start_burst.toml   # the same with the burst
 
 The estimators are plaza1's (data/plaza/plaza1.toml). Seeded: the files are the same
 on every run. Only the standard library is used."""
@@ -74,6 +76,14 @@ def off_start(t):
     return t.replace('from = "ground_truth"', 'from = "given"\nx_m = 30.0\ny_m = 25.0\nheading_deg = 17.19', 1)
 
 
+def ranges_start(t):
+    """Started from the first 60 s of ranges (the first at 4 s), with the true heading at
+    the window's end (64 s: 0.3 rad plus the turns, in the log's ENU degrees)."""
+    heading = 0.3 + sum(0.02 * math.sin(k / 60.0) for k in range(1, 65))
+    return t.replace('from = "ground_truth"',
+                     f'from = "ranges"\nranges_window_s = 60\nheading_deg = {math.degrees(heading):.4f}', 1)
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: lbl_burst.py DIR")
@@ -84,10 +94,12 @@ def main():
     with open(os.path.join(out, "beacons.csv"), "w") as f:
         f.write("beacon_id,x_m,y_m\n" + "".join(f"{k},{x},{y}\n" for k, (x, y) in BEACONS.items()))
     for name, tag, edit in [("burst", "burst", lambda t: t), ("clean", "clean", lambda t: t),
-                            ("ungated", "burst", ungated), ("off_start", "clean", off_start)]:
+                            ("ungated", "burst", ungated), ("off_start", "clean", off_start),
+                            ("ranges_start", "clean", ranges_start), ("ranges_start_burst", "burst", ranges_start)]:
         with open(os.path.join(out, f"{name}.toml"), "w") as f:
             f.write(description(name, tag, edit))
-    print(f"wrote {out}/burst.toml, clean.toml, ungated.toml, off_start.toml")
+    print(f"wrote {out}/burst.toml, clean.toml, ungated.toml, off_start.toml, ranges_start.toml, "
+          "ranges_start_burst.toml")
 
 
 main()

@@ -11,9 +11,10 @@ use crate::scenario::EstimatorSpec;
 use crate::scenario::load::deserialize;
 use nalgebra::Vector3;
 use onebeacon::config::stream::{Beacon, StreamConfig};
+use onebeacon::filter::FilterKind;
 use onebeacon::geo::Frame;
-use onebeacon::nav::Kind;
 use onebeacon::nav::session::Input;
+use onebeacon::nav::{Aiding, Kind, Measurement, Navigator, PlanarConfig, PlanarNavigator};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -294,53 +295,83 @@ impl Log {
         self.initial_pose().map(|(t0_s, pose)| InitialStart { t0_s, pose, position_sigma_m })
     }
 
-    /// `from = "ranges"`: the fix of the first window's ranges to fixed beacons.
+    /// `from = "ranges"`: the fix of the first window's ranges to fixed beacons, the
+    /// vehicle dead-reckoned through the window on the log's motion rows (in the frame of
+    /// its first range, heading 0 there): each range is to the position the fix seeks
+    /// plus the dead-reckoned displacement since, rotated by the heading then, so a
+    /// moving vehicle is fixed where the window ends.
     fn start_from_ranges(&self) -> Result<InitialStart, LogError> {
         let init = &self.description.initial;
         let fail = |message: String| LogError::File { file: self.description.name.clone(), message };
+        // (beacon, range, dead-reckoned (north, east, heading) since the first range)
         let (mut ranges, mut heading, mut depth, mut window) = (Vec::new(), None, 0.0, None::<(f64, f64)>);
+        let mut dr: Option<PlanarNavigator> = None;
+        // the dead-reckoned pose at t (a depth item moves a navigator's clock on)
+        let dr_pose = |dr: &mut PlanarNavigator, t: f64, depth_m: f64| {
+            dr.process(&Measurement::new(t, Kind::Depth { depth_m }));
+            let e = dr.estimate();
+            (e.north_m(), e.east_m(), e.heading_rad())
+        };
         for item in self.items()? {
             let item = item?;
             let t = item.t_s;
             if window.is_some_and(|(_, end)| t > end) {
                 break;
             }
-            match item.input.to_ned(self.frame) {
-                Input::Measurement(Kind::Range { beacon, range_m })
-                    if beacon.position_ned_m.iter().all(|v| v.is_finite()) =>
-                {
+            let Input::Measurement(kind) = item.input.to_ned(self.frame) else { continue };
+            match kind {
+                Kind::Range { beacon, range_m } if beacon.position_ned_m.iter().all(|v| v.is_finite()) => {
                     window.get_or_insert((t, t + init.ranges_window_s));
-                    ranges.push((beacon.position_ned_m, range_m));
+                    let dr = dr.get_or_insert_with(|| dead_reckoning(t));
+                    ranges.push((beacon.id, beacon.position_ned_m, range_m, dr_pose(dr, t, depth)));
                 }
-                Input::Measurement(Kind::Heading { heading_rad }) if window.is_some() => {
-                    heading.get_or_insert(heading_rad);
+                Kind::Heading { heading_rad } => {
+                    if let Some(dr) = &mut dr {
+                        heading.get_or_insert((heading_rad, dr_pose(dr, t, depth).2));
+                    }
                 }
-                Input::Measurement(Kind::Depth { depth_m }) => depth = depth_m,
+                Kind::Depth { depth_m } => depth = depth_m,
+                // motion alone: a heading or attitude fix is absolute, the frame is not
+                Kind::Odometry { .. } | Kind::BodyOdometry { .. } | Kind::Speed { .. } | Kind::BodyVelocity { .. } => {
+                    if let Some(dr) = &mut dr {
+                        dr.process(&Measurement::new(t, kind));
+                    }
+                }
                 _ => {}
             }
         }
-        let Some((_, end)) = window else {
+        let (Some((_, end)), Some(mut dr)) = (window, dr) else {
             return Err(fail("initial.from = \"ranges\" but the log has no range to a fixed beacon".into()));
         };
-        let fix = onebeacon::nav::fix::multilaterate(&ranges, depth).ok_or_else(|| {
-            fail(format!(
-                "initial.from = \"ranges\": the {} ranges of the first {} s (initial.ranges_window_s) do not fix a position (three beacons not in a line are needed)",
-                ranges.len(),
-                init.ranges_window_s
-            ))
-        })?;
-        let psi = match (init.heading_deg, heading) {
-            (Some(h), _) => self.frame.heading_to_ned(h.to_radians()),
-            (None, Some(h)) => h,
+        let (dn, de, turned) = dr_pose(&mut dr, end, depth);
+        // the heading at the first range: the given one (at the window's end) or the
+        // first measured one, less the turn dead-reckoned up to it
+        let psi0 = match (init.heading_deg, heading) {
+            (Some(h), _) => self.frame.heading_to_ned(h.to_radians()) - turned,
+            (None, Some((h, turned_then))) => h - turned_then,
             (None, None) => {
                 return Err(fail(
                     "initial.from = \"ranges\" needs initial.heading_deg or a heading measurement in the window".into(),
                 ));
             }
         };
+        let rotate = |n: f64, e: f64| {
+            let (s, c) = psi0.sin_cos();
+            Vector3::new(c * n - s * e, s * n + c * e, 0.0)
+        };
+        // a range to b from p0 + R d is a range to b - R d from p0
+        let shifted: Vec<_> = ranges.iter().map(|(id, b, r, (n, e, _))| (*id, b - rotate(*n, *e), *r)).collect();
+        let fix = onebeacon::nav::fix::multilaterate(&shifted, depth).ok_or_else(|| {
+            fail(format!(
+                "initial.from = \"ranges\": the {} ranges of the first {} s (initial.ranges_window_s) do not fix a position (three beacons not in a line are needed)",
+                ranges.len(),
+                init.ranges_window_s
+            ))
+        })?;
         let fix_sigma = fix.covariance.symmetric_eigenvalues().max().max(0.0).sqrt();
         let position_sigma_m = init.position_sigma_m.max(3.0 * fix_sigma);
-        Ok(InitialStart { t0_s: end, pose: (fix.position.x, fix.position.y, psi), position_sigma_m })
+        let p_end = fix.position + rotate(dn, de).xy();
+        Ok(InitialStart { t0_s: end, pose: (p_end.x, p_end.y, psi0 + turned), position_sigma_m })
     }
 
     /// The initial pose (NED) and time, from the description: given, or the first
@@ -391,6 +422,13 @@ impl Log {
         };
         Ok((t0, (p0.north_m, p0.east_m, psi)))
     }
+}
+
+/// A dead-reckoning navigator at the origin, heading 0, from `t0_s`: the displacement
+/// of a vehicle through a window of ranges ([`Log::initial_start`]).
+fn dead_reckoning(t0_s: f64) -> PlanarNavigator {
+    let config = PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() };
+    PlanarNavigator::new(config, FilterKind::Ekf, t0_s, (0.0, 0.0, 0.0), 0.0, 0.0)
 }
 
 #[cfg(test)]
