@@ -303,7 +303,8 @@ impl Log {
     fn start_from_ranges(&self) -> Result<InitialStart, LogError> {
         let init = &self.description.initial;
         let fail = |message: String| LogError::File { file: self.description.name.clone(), message };
-        // (beacon, range, dead-reckoned (north, east, heading) since the first range)
+        // ranges: (beacon id, its position, range, dead-reckoned (north, east, heading)
+        // since the first range)
         let (mut ranges, mut heading, mut depth, mut window) = (Vec::new(), None, 0.0, None::<(f64, f64)>);
         let mut dr: Option<PlanarNavigator> = None;
         // the dead-reckoned pose at t (a depth item moves a navigator's clock on)
