@@ -5,7 +5,6 @@ use crate::BadInput;
 use crate::replay::{Prepared, print_table};
 use anyhow::{Context, Result};
 use nalgebra::{Vector2, Vector3};
-use onebeacon::nav::evaluation::horizontal_error;
 use onebeacon_sim::replay::rts::rts;
 use onebeacon_sim::replay::{Log, row_estimate};
 use onebeacon_sim::run::{Estimate, StepRecord};
@@ -54,7 +53,7 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
         record.estimates.push(estimate(&smoothed, record.t_s, truth));
         for run in &runs {
             // no truth: NaN error and NEES
-            let (error_m, nees) = horizontal_error(run.at(record.t_s), truth.x, truth.y);
+            let (error_m, nees) = run.error(record.t_s, truth.x, truth.y);
             record.estimates.push(row_estimate(run.at(record.t_s), (error_m, nees.unwrap_or(f64::NAN))));
         }
     };

@@ -124,9 +124,8 @@ impl Budget {
     /// row), one trajectory row per CSV row of at least [`MIN_ROW_BYTES`].
     pub fn check_replay(&self, log: &Log, keep_records: bool) -> Result<(), BudgetError> {
         let estimators = log.description.estimators.len();
-        let row = (size_of::<StepRecord>() + size_of::<TruthRecord>() + estimators * size_of::<Estimate>()) as f64;
-        let source = log.source_bytes();
-        let rows = if keep_records { source as f64 / MIN_ROW_BYTES } else { PLOTTED_ROWS };
+        let row = record_bytes(estimators);
+        let rows = if keep_records { log_rows(log) } else { PLOTTED_ROWS };
         let need = BASE_BYTES + estimators as f64 * 1e5 + rows * row;
         let detail = format!("{estimators} estimators, {rows:.0} rows of {row:.0} bytes kept");
         let keys = if keep_records { "the log's length (cut it), [[estimators]]" } else { "[[estimators]]" };
@@ -150,11 +149,10 @@ impl Budget {
             .filter(|e| e.track_accel_sigma_m_s2.is_none())
             .map(|e| if e.estimate_beacon_offsets == Some(true) { STATES_WITH_OFFSETS } else { STATES })
             .collect();
-        let rows = log.source_bytes() as f64 / MIN_ROW_BYTES;
+        let rows = log_rows(log);
         let node = SMOOTHER_NODE_BYTES + kept.iter().map(|&n| rts_step_bytes(n)).sum::<f64>();
-        let row =
-            (size_of::<StepRecord>() + size_of::<TruthRecord>() + estimators.len() * size_of::<Estimate>()) as f64;
-        let need = BASE_BYTES + estimators.len() as f64 * 1e5 + PLOTTED_ROWS * row + rows * node;
+        let replay = BASE_BYTES + estimators.len() as f64 * 1e5 + PLOTTED_ROWS * record_bytes(estimators.len());
+        let need = replay + rows * node;
         let detail =
             format!("{rows:.0} rows, each a node of the graph and a step of {} filters' histories", kept.len());
         self.check(
@@ -176,6 +174,16 @@ const SMOOTHER_NODE_BYTES: f64 = 4096.0;
 /// Rauch-Tung-Striebel pass, and the smoothed estimate it gives back.
 fn rts_step_bytes(n: usize) -> f64 {
     ((2 * (n + n * n) + n * n + 1) * size_of::<f64>() + size_of::<onebeacon::nav::Estimate>()) as f64
+}
+
+/// The bytes of one trajectory row kept, with `estimators` estimates.
+fn record_bytes(estimators: usize) -> f64 {
+    (size_of::<StepRecord>() + size_of::<TruthRecord>() + estimators * size_of::<Estimate>()) as f64
+}
+
+/// The most rows `log` can have: its files' bytes over [`MIN_ROW_BYTES`].
+fn log_rows(log: &Log) -> f64 {
+    log.source_bytes() as f64 / MIN_ROW_BYTES
 }
 
 /// The fewest bytes a CSV row takes (a time, one value, separators): what bounds the

@@ -157,9 +157,19 @@ pub fn stream_setup(config: &std::path::Path) -> Result<Unit, LogError> {
 pub fn replay<E: From<LogError>>(
     log: &Log,
     beacons: Option<BTreeSet<u32>>,
+    record: impl FnMut(StepRecord) -> Result<(), E>,
+) -> Result<Replay, E> {
+    let (session, start) = session_and_start(log, beacons)?;
+    replay_session(log, session, start, record)
+}
+
+/// [`replay`] with the session given (one that keeps its estimators' histories, say).
+fn replay_session<E: From<LogError>>(
+    log: &Log,
+    mut session: Session,
+    start: InitialStart,
     mut record: impl FnMut(StepRecord) -> Result<(), E>,
 ) -> Result<Replay, E> {
-    let (mut session, start) = session_and_start(log, beacons)?;
     let has_truth = log.has_truth();
     let mut heard = false;
     let mut items = 0;

@@ -1,7 +1,7 @@
 //! The cheap smoother: a Rauch-Tung-Striebel pass over each Gaussian filter of a log
 //! ([`onebeacon::filter::rts`]), scored at the ground-truth rows as the filters are.
 
-use super::{Log, LogError, session_and_start};
+use super::{Log, LogError, replay_session, session_and_start};
 use onebeacon::nav::Estimate;
 use onebeacon::nav::evaluation::{ErrorStats, horizontal_error};
 use std::collections::BTreeSet;
@@ -24,6 +24,12 @@ impl RtsRun {
         let k = self.estimates.partition_point(|e| e.t_s <= t_s);
         &self.estimates[k.saturating_sub(1)]
     }
+
+    /// The horizontal error at `t_s` against a true (north, east), m, and its NEES (NaN
+    /// for no truth).
+    pub fn error(&self, t_s: f64, north_m: f64, east_m: f64) -> (f64, Option<f64>) {
+        horizontal_error(self.at(t_s), north_m, east_m)
+    }
 }
 
 /// The log's filters run with their history kept, and a Rauch-Tung-Striebel pass over
@@ -31,22 +37,21 @@ impl RtsRun {
 /// are left out), scored
 /// against the ground truth (no rows: empty statistics).
 pub fn rts(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Vec<RtsRun>, LogError> {
-    let (session, _) = session_and_start(log, beacons)?;
-    let mut session = session.with_history();
+    let (session, start) = session_and_start(log, beacons)?;
     let mut truth = Vec::new();
-    for item in log.items()? {
-        if let Ok(Some(step)) = session.push(&item?)
-            && let Some(p) = step.truth
-        {
-            truth.push((step.t_s, p.north_m, p.east_m));
+    let r = replay_session(log, session.with_history(), start, |rec| {
+        if let Some(p) = rec.truth.first().filter(|p| !p.pos.x.is_nan()) {
+            truth.push((rec.t_s, p.pos.x, p.pos.y));
         }
-    }
+        Ok::<_, LogError>(())
+    })?;
+    let session = &r.session;
     let runs = (0..session.names.len()).filter_map(|i| {
         let estimates = session.navigator(i)?.smoothed();
         (!estimates.is_empty()).then(|| {
             let mut run = RtsRun { name: session.names[i].clone(), estimates, stats: ErrorStats::default() };
             for &(t, north, east) in &truth {
-                let (error_m, nees) = horizontal_error(run.at(t), north, east);
+                let (error_m, nees) = run.error(t, north, east);
                 run.stats.push(error_m, nees);
             }
             run
