@@ -123,6 +123,12 @@ if { scontrol -o show job "$ARRAY"; scontrol -o show job "$MERGE"; } | grep -v '
 fi
 for f in "$CAMPAIGN"/logs/*.out; do echo "  $(basename "$f"): $(grep -v '^{' "$f" | tr '\n' ' ')"; done
 ls "$CAMPAIGN/partials"
+# each shard's log shows its progress (plain lines: stderr is a file there)
+for i in 0 1 2 3; do
+  grep -qE "^mc .* shard $i/4: [0-9]+/[0-9]+ runs in " "$CAMPAIGN/logs/shard-$i.out" || {
+    log "shard $i's log has no progress line"; cat "$CAMPAIGN/logs/shard-$i.out"; exit 1
+  }
+done
 [ -s "$CAMPAIGN/result/mc.json" ] || { log "no merged result"; cat "$CAMPAIGN"/logs/*; exit 1; }
 
 "$ONEBEACON" mc "$SCENARIO" --runs 6 --seed 7 --json > "$RUN/local.json"

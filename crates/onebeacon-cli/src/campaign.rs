@@ -30,10 +30,10 @@ pub fn shard(
     let file = format!("partial-{}-of-{}.json", shard.index, shard.count);
     let staging = Staging::beside(out, &[&file])?;
     let total = shard.len(s.cells().len() * runs) as u64;
-    let bar = crate::progress_bar(total, "runs", format!("mc {} shard {shard}", s.name()));
+    let bar = crate::progress::Progress::new(total, "runs", format!("mc {} shard {shard}", s.name()));
     let start = Instant::now();
     let summaries = monte_carlo_shard(&s, runs, seed, shard, threads, &|| bar.inc(1))?;
-    bar.finish_and_clear();
+    bar.finish();
     let partial = Partial::new(&s, runs, seed, shard, start.elapsed().as_secs_f64(), &summaries);
     staging.write(&partial.file_name(), partial.to_json().as_bytes())?;
     for f in staging.move_files_to()? {

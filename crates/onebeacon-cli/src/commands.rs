@@ -145,11 +145,11 @@ pub fn mc(
     let staging = out.as_deref().map(Staging::new).transpose()?;
 
     let total = (runs * s.cells().len()) as u64;
-    let bar = crate::progress_bar(total, "runs", format!("mc {}", s.name()));
+    let bar = crate::progress::Progress::new(total, "runs", format!("mc {}", s.name()));
     let start = Instant::now();
     let result = monte_carlo(&s, runs, seed, threads, &|| bar.inc(1))?;
     let wall_s = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
+    bar.finish();
 
     write_mc(&s, &result, wall_s, staging, json)
 }

@@ -128,11 +128,12 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     if let Some(t) = &mut table {
         t.write_record(columns)?;
     }
-    // the lines show the progress on a terminal; a bar when they go to a file or a pipe
+    // the lines show the progress on a terminal; a progress report when they go to a
+    // file or a pipe
     let progress = if std::io::IsTerminal::is_terminal(&std::io::stdout()) {
-        indicatif::ProgressBar::hidden()
+        crate::progress::Progress::Hidden
     } else {
-        crate::progress_bar(count as u64, "captures", "dsp process".into())
+        crate::progress::Progress::new(count as u64, "captures", "dsp process".into())
     };
     for k in 0..count {
         let mut captures = recording.next_capture(len).map_err(|e| bad(wav, e))?;
@@ -161,7 +162,7 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
         }
         progress.inc(1);
     }
-    progress.finish_and_clear();
+    progress.finish();
     if let (Some(staging), Some(t)) = (staging, table) {
         t.into_inner().map_err(|e| anyhow::anyhow!("cannot write captures.csv: {}", e.error()))?;
         for f in staging.commit()? {

@@ -48,7 +48,7 @@ pub fn fleet(
     crate::check_memory(name, &s, onebeacon_sim::budget::concurrent_runs(threads, runs), runs)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-fleet", s.name())));
     let staging = Staging::new(&dir)?;
-    let bar = crate::progress_bar(runs as u64, "runs", format!("fleet {}", s.name()));
+    let bar = crate::progress::Progress::new(runs as u64, "runs", format!("fleet {}", s.name()));
     let step = (snapshot_s / f.mission.dt_s).round() as usize;
     let start = Instant::now();
     let work = || -> Vec<RunOutput> {
@@ -74,7 +74,7 @@ pub fn fleet(
         None => work(),
     };
     let wall_s = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
+    bar.finish();
     let stats = statistics(f, seed, &outputs);
 
     let first = &outputs[0];

@@ -21,6 +21,7 @@ mod dsp;
 mod fleet;
 mod output;
 mod plot;
+mod progress;
 mod replay;
 mod report;
 mod smooth;
@@ -373,19 +374,6 @@ fn non_negative_f64(s: &str) -> Result<f64, String> {
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct BadInput(pub String);
-
-/// A progress bar on stderr when it is a terminal (hidden otherwise): "`message`
-/// pos/len `unit` [bar] eta".
-pub(crate) fn progress_bar(total: u64, unit: &str, message: String) -> indicatif::ProgressBar {
-    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(total);
-    let template = format!("{{msg}} {{pos}}/{{len}} {unit} [{{wide_bar}}] eta {{eta}}");
-    bar.set_style(indicatif::ProgressStyle::with_template(&template).expect("a valid template").progress_chars("=> "));
-    bar.set_message(message);
-    bar
-}
 
 fn main() -> ExitCode {
     // Rust ignores SIGPIPE, so printing into a closed pipe (`| head`, a reader that

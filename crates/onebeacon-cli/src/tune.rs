@@ -65,7 +65,7 @@ pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-tune")));
     let staging = Staging::new(&dir)?;
     let started = std::time::Instant::now();
-    let bar = crate::progress_bar(chosen.len() as u64, "estimators", format!("tuning {name}"));
+    let bar = crate::progress::Progress::new(chosen.len() as u64, "estimators", format!("tuning {name}"));
     let mut tuned: Vec<(usize, Tuned)> = Vec::new();
     for &i in &chosen {
         bar.set_message(format!("tuning {}", names[i]));
@@ -77,7 +77,7 @@ pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
         tuned.push((i, t));
         bar.inc(1);
     }
-    bar.finish_and_clear();
+    bar.finish();
     let wall_s = started.elapsed().as_secs_f64();
 
     // every estimator of the log, the tuned ones replaced
