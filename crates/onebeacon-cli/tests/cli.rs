@@ -533,6 +533,16 @@ fn passive_usbl_run_and_mc() {
         (Some("det"), Some("static"))
     );
     assert!(cells[0]["pcrb_rmse_m"].as_f64().unwrap() > 0.0);
+    // the same cells with the lanes forced to the baseline instruction set (the
+    // planner's and the filter's transcendental functions, the normal draws); an
+    // instruction set it does not know is refused
+    let o = bin().args(["mc", scenario, "--json"]).env("ONEBEACON_SIMD", "baseline").output().unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let baseline: serde_json::Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+    assert_eq!(baseline["cells"], v["cells"]);
+    let o = bin().args(["mc", scenario, "--json"]).env("ONEBEACON_SIMD", "avx9").output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(text(&o.stderr).trim_end(), "error: ONEBEACON_SIMD=avx9: expected baseline, avx2 or avx512");
     let o = run(&["run", scenario, "--message", "21", "--out", dir.join("none").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("messages 1 to 20"), "{}", text(&o.stderr));

@@ -101,8 +101,8 @@ fn planner(c: &mut Criterion) {
     let pf = ParticleFilter::<DIM>::gaussian(500_000, &mean, &sigma, ParticleSettings::default(), 1);
     group.bench_function("subsample 20000 of 500000", |b| {
         b.iter(|| {
-            let picked = pf.subsample(20_000, &[0, 1, 2]);
-            let positions: Vec<Vector3<f64>> = picked.iter().map(|x| Vector3::new(x[0], x[1], x[2])).collect();
+            let picked = pf.subsample(20_000, [0, 1, 2]);
+            let positions: Vec<Vector3<f64>> = picked.into_iter().map(Vector3::from).collect();
             let weights = vec![1.0 / positions.len() as f64; positions.len()];
             let belief =
                 Belief { positions: &positions, weights: &weights, velocity_m_s: Vector2::new(1.0, 0.5), lead_s: 8.0 };

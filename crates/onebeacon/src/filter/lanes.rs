@@ -1,12 +1,15 @@
 //! Transcendental functions over slices for particle models: sine and cosine, atan2,
-//! the logarithm and standard normal draws, computed in single precision by branchless
-//! polynomials (Cephes' sinf, cosf, logf and atanf coefficients, S. L. Moshier) that
-//! the compiler vectorises, and returned in f64.
+//! the logarithm, standard normal draws and the moments of USBL angles, computed in
+//! single precision by branchless polynomials (Cephes' sinf, cosf, logf and atanf
+//! coefficients, S. L. Moshier) that the compiler vectorises.
 //!
-//! Each slice function is compiled for AVX-512, for AVX2 and for the baseline, and the
-//! best the processor has is chosen at run time (`multiversion`): the arithmetic is the
-//! same IEEE operations in every version (no fused multiply-add), so the three give
-//! identical results and a run does not depend on the machine's vector width.
+//! Each slice function is compiled for AVX-512, for AVX2 and for the baseline (SSE2 on
+//! x86-64), and the best [`Level`] the processor has is chosen at run time, or a lower
+//! one named by `ONEBEACON_SIMD` (`baseline`, `avx2`, `avx512`): the arithmetic is the
+//! same IEEE operations in every version (no fused multiply-add; sums in a fixed number
+//! of accumulators), so the three give identical results and a run does not depend on
+//! the machine's vector width (the tests compare each level the processor has with the
+//! scalar kernels, bit for bit).
 //!
 //! Single precision is far finer than what these values feed: a step of a few metres
 //! (relative error 1e-7: under a micrometre), an angle residual against a noise of
@@ -14,9 +17,128 @@
 //! makes a hoff2024 filter cycle fit its budget (README, Benchmarks): libm's
 //! scalar atan2 and sin_cos cost some 20 ns a call.
 
-use multiversion::multiversion;
 use rand::Rng;
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use std::sync::OnceLock;
+
+/// An instruction set the slice functions are compiled for, from the least to the most.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Level {
+    /// What every processor of the target has (SSE2 on x86-64).
+    Baseline,
+    /// AVX and AVX2 (x86-64).
+    Avx2,
+    /// AVX-512 F, BW, VL and DQ (x86-64).
+    Avx512,
+}
+
+impl Level {
+    /// The environment variable that caps the level.
+    pub const VARIABLE: &'static str = "ONEBEACON_SIMD";
+
+    /// The levels this processor runs, the least first.
+    pub fn available() -> Vec<Level> {
+        [Level::Baseline, Level::Avx2, Level::Avx512].into_iter().filter(|l| *l <= Self::best()).collect()
+    }
+
+    /// The best level this processor runs.
+    pub fn best() -> Level {
+        static BEST: OnceLock<Level> = OnceLock::new();
+        *BEST.get_or_init(Self::detect)
+    }
+
+    fn detect() -> Level {
+        let mut levels = vec![Level::Baseline];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("avx") {
+                levels.push(Level::Avx2);
+                if ["avx512f", "avx512bw", "avx512vl", "avx512dq"].iter().all(|f| match *f {
+                    "avx512f" => std::arch::is_x86_feature_detected!("avx512f"),
+                    "avx512bw" => std::arch::is_x86_feature_detected!("avx512bw"),
+                    "avx512vl" => std::arch::is_x86_feature_detected!("avx512vl"),
+                    _ => std::arch::is_x86_feature_detected!("avx512dq"),
+                }) {
+                    levels.push(Level::Avx512);
+                }
+            }
+        }
+        levels[levels.len() - 1]
+    }
+
+    /// A level by its name in `ONEBEACON_SIMD`.
+    pub fn parse(name: &str) -> Result<Level, String> {
+        match name.trim() {
+            "baseline" => Ok(Level::Baseline),
+            "avx2" => Ok(Level::Avx2),
+            "avx512" => Ok(Level::Avx512),
+            other => Err(format!("{}={other}: expected baseline, avx2 or avx512", Self::VARIABLE)),
+        }
+    }
+
+    /// The level the slice functions run at: the processor's best, or the one
+    /// `ONEBEACON_SIMD` names if lower (a name it does not know is ignored here; the
+    /// binary refuses it).
+    pub fn current() -> Level {
+        static CURRENT: OnceLock<Level> = OnceLock::new();
+        *CURRENT.get_or_init(|| {
+            let best = Self::best();
+            match std::env::var(Self::VARIABLE).ok().map(|v| Self::parse(&v)) {
+                Some(Ok(cap)) => cap.min(best),
+                _ => best,
+            }
+        })
+    }
+}
+
+/// A slice function compiled once per [`Level`]: `name(args)` runs at
+/// [`Level::current`], `name::at(level, args)` at a given one (which the processor must
+/// run).
+macro_rules! lanes {
+    ($(#[$doc:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block) => {
+        $(#[$doc])*
+        $vis fn $name($($arg: $ty),*) $(-> $ret)? {
+            $name::at(Level::current(), $($arg),*)
+        }
+
+        $vis mod $name {
+            #[allow(unused_imports)]
+            use super::*;
+
+            #[inline(always)]
+            fn body($($arg: $ty),*) $(-> $ret)? $body
+
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,avx")]
+            fn avx512($($arg: $ty),*) $(-> $ret)? {
+                body($($arg),*)
+            }
+
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx2,avx")]
+            fn avx2($($arg: $ty),*) $(-> $ret)? {
+                body($($arg),*)
+            }
+
+            /// The function compiled for `level`.
+            ///
+            /// # Panics
+            /// If the processor does not run `level` ([`Level::available`]).
+            pub fn at(level: Level, $($arg: $ty),*) $(-> $ret)? {
+                assert!(level <= Level::best(), "{level:?} is beyond this processor");
+                match level {
+                    #[cfg(target_arch = "x86_64")]
+                    // SAFETY: the processor has the features (asserted above)
+                    Level::Avx512 => unsafe { avx512($($arg),*) },
+                    #[cfg(target_arch = "x86_64")]
+                    // SAFETY: as above
+                    Level::Avx2 => unsafe { avx2($($arg),*) },
+                    _ => body($($arg),*),
+                }
+            }
+        }
+    };
+}
 
 /// x rounded to the nearest integer (|x| < 2^31), as a float and as an integer: added
 /// to and taken from 1.5 2^52, whose last bits then hold the integer (in two's
@@ -123,87 +245,170 @@ fn atan2_1(y: f32, x: f32) -> f32 {
     if y < 0.0 { -a } else { a }
 }
 
-/// sin and cos of every angle of `a` (radians, |a| below some 1e6).
-#[multiversion(targets("x86_64+avx512f+avx512bw+avx512vl+avx512dq", "x86_64+avx2+avx", "aarch64+neon"))]
-pub fn sin_cos(a: &[f64], sin: &mut [f64], cos: &mut [f64]) {
-    let n = a.len();
-    let (sin, cos) = (&mut sin[..n], &mut cos[..n]);
-    for i in 0..n {
-        let (s, c) = sin_cos1(a[i]);
-        sin[i] = f64::from(s);
-        cos[i] = f64::from(c);
-    }
-}
-
-/// atan2(y_i, x_i) for every i, in [-pi, pi].
-#[multiversion(targets("x86_64+avx512f+avx512bw+avx512vl+avx512dq", "x86_64+avx2+avx", "aarch64+neon"))]
-pub fn atan2(y: &[f64], x: &[f64], out: &mut [f64]) {
-    let n = out.len();
-    let (y, x) = (&y[..n], &x[..n]);
-    for i in 0..n {
-        out[i] = f64::from(atan2_1(y[i] as f32, x[i] as f32));
-    }
-}
-
-/// exp(x_i - shift) for every i, and their sum (in a fixed order), for log-weights x_i
-/// at most `shift` (the largest: weights relative to the heaviest).
-#[multiversion(targets("x86_64+avx512f+avx512bw+avx512vl+avx512dq", "x86_64+avx2+avx", "aarch64+neon"))]
-pub fn exp_shifted(x: &[f64], shift: f64, out: &mut [f64]) -> f64 {
-    let n = out.len();
-    let x = &x[..n];
-    for i in 0..n {
-        out[i] = f64::from(exp1(x[i] - shift));
-    }
-    // four accumulators: a sum the compiler vectorises
-    let mut s = [0.0; 4];
-    let chunks = out.chunks_exact(4);
-    let tail: f64 = chunks.remainder().iter().sum();
-    for c in chunks {
-        for j in 0..4 {
-            s[j] += c[j];
+lanes! {
+    /// sin and cos of every angle of `a` (radians, |a| below some 1e6).
+    pub fn sin_cos(a: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+        let n = a.len();
+        let (sin, cos) = (&mut sin[..n], &mut cos[..n]);
+        for i in 0..n {
+            let (s, c) = sin_cos1(a[i]);
+            sin[i] = f64::from(s);
+            cos[i] = f64::from(c);
         }
     }
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// ln x_i for every i: to single precision for x_i within f32's normal range (1.2e-38
-/// to 3.4e38; a subnormal gives a meaningless result), -inf at 0, +inf above the range,
-/// NaN for a negative or NaN x_i.
-#[multiversion(targets("x86_64+avx512f+avx512bw+avx512vl+avx512dq", "x86_64+avx2+avx", "aarch64+neon"))]
-pub fn ln(x: &[f64], out: &mut [f64]) {
-    let n = out.len();
-    let x = &x[..n];
-    for i in 0..n {
-        out[i] = f64::from(ln1(x[i] as f32));
+lanes! {
+    /// atan2(y_i, x_i) for every i, in [-pi, pi].
+    pub fn atan2(y: &[f64], x: &[f64], out: &mut [f64]) {
+        let n = out.len();
+        let (y, x) = (&y[..n], &x[..n]);
+        for i in 0..n {
+            out[i] = f64::from(atan2_1(y[i] as f32, x[i] as f32));
+        }
     }
 }
 
-/// Box-Muller on 32-bit uniform pairs, `n = out.len() / 2` of them: the i-th 64-bit
-/// draw is SplitMix64's output for the counter `key + (i + 1) gamma` (Steele, Lea and
-/// Flood 2014: a mixing of a Weyl sequence that passes BigCrush), computed in lanes. Its
-/// high half gives u1 = (k + 1/2) 2^-32 and the radius sqrt(-2 ln u1); its low half a
-/// uniform angle, as a quadrant (its top two bits) and an offset within it (the other
-/// 30, centred: within +-pi/4), so that no range reduction is needed. The pair gives
-/// draws `out[i]` and `out[n + i]`.
-#[multiversion(targets("x86_64+avx512f+avx512bw+avx512vl+avx512dq", "x86_64+avx2+avx", "aarch64+neon"))]
-fn box_muller(key: u64, out: &mut [f64]) {
+lanes! {
+    /// exp(x_i - shift) for every i, and their sum (in a fixed order), for log-weights x_i
+    /// at most `shift` (the largest: weights relative to the heaviest).
+    pub fn exp_shifted(x: &[f64], shift: f64, out: &mut [f64]) -> f64 {
+        let n = out.len();
+        let x = &x[..n];
+        for i in 0..n {
+            out[i] = f64::from(exp1(x[i] - shift));
+        }
+        // four accumulators: a sum the compiler vectorises
+        let mut s = [0.0; 4];
+        let chunks = out.chunks_exact(4);
+        let tail: f64 = chunks.remainder().iter().sum();
+        for c in chunks {
+            for j in 0..4 {
+                s[j] += c[j];
+            }
+        }
+        (s[0] + s[1]) + (s[2] + s[3]) + tail
+    }
+}
+
+lanes! {
+    /// ln x_i for every i: to single precision for x_i within f32's normal range (1.2e-38
+    /// to 3.4e38; a subnormal gives a meaningless result), -inf at 0, +inf above the range,
+    /// NaN for a negative or NaN x_i.
+    pub fn ln(x: &[f64], out: &mut [f64]) {
+        let n = out.len();
+        let x = &x[..n];
+        for i in 0..n {
+            out[i] = f64::from(ln1(x[i] as f32));
+        }
+    }
+}
+
+lanes! {
+    /// Box-Muller on 32-bit uniform pairs, `n = out.len() / 2` of them: the i-th 64-bit
+    /// draw is SplitMix64's output for the counter `key + (i + 1) gamma` (Steele, Lea and
+    /// Flood 2014: a mixing of a Weyl sequence that passes BigCrush), computed in lanes. Its
+    /// high half gives u1 = (k + 1/2) 2^-32 and the radius sqrt(-2 ln u1); its low half a
+    /// uniform angle, as a quadrant (its top two bits) and an offset within it (the other
+    /// 30, centred: within +-pi/4), so that no range reduction is needed. The pair gives
+    /// draws `out[i]` and `out[n + i]`.
+    fn box_muller(key: u64, out: &mut [f64]) {
+        let n = out.len() / 2;
+        let (first, second) = out.split_at_mut(n);
+        let second = &mut second[..n];
+        for i in 0..n {
+            let (s, c) = box_muller1(key, i);
+            first[i] = f64::from(s);
+            second[i] = f64::from(c);
+        }
+    }
+}
+
+/// The i-th pair of [`box_muller`] for `key`.
+#[inline(always)]
+fn box_muller1(key: u64, i: usize) -> (f32, f32) {
     const SCALE: f32 = 1.0 / 4_294_967_296.0;
     const GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
-    let n = out.len() / 2;
-    let (first, second) = out.split_at_mut(n);
-    let second = &mut second[..n];
-    for i in 0..n {
-        let mut z = key.wrapping_add((i as u64 + 1).wrapping_mul(GAMMA));
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        let (k1, k2) = ((z >> 32) as u32, z as u32);
-        let radius = (-2.0 * ln1((k1 as f32 + 0.5) * SCALE)).sqrt();
-        let offset = ((k2 & 0x3fff_ffff) as i32 - 0x2000_0000) as f32 * (FRAC_PI_2 / 1_073_741_824.0);
-        let (s, c) = sin_cos_reduced(offset, (k2 >> 30) as i32);
-        first[i] = f64::from(radius * s);
-        second[i] = f64::from(radius * c);
+    let mut z = key.wrapping_add((i as u64 + 1).wrapping_mul(GAMMA));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    let (k1, k2) = ((z >> 32) as u32, z as u32);
+    let radius = (-2.0 * ln1((k1 as f32 + 0.5) * SCALE)).sqrt();
+    let offset = ((k2 & 0x3fff_ffff) as i32 - 0x2000_0000) as f32 * (FRAC_PI_2 / 1_073_741_824.0);
+    let (s, c) = sin_cos_reduced(offset, (k2 >> 30) as i32);
+    (radius * s, radius * c)
+}
+
+lanes! {
+    /// The weighted moments of the angles at which a USBL station hears particles
+    /// (hoff2024 eq. 1-2, the station's heading 0): particle i at (`north`, `east`,
+    /// `down`)_i from a point, the station at the surface `station` (north, east) from
+    /// the same point. With a_i its azimuth less `centre[0]` (wrapped to within pi) and
+    /// e_i its angle from the vertical less `centre[1]`: [sum w a, sum w e, sum w a^2,
+    /// sum w a e, sum w e^2], summed in double precision in 8 accumulators (particle i
+    /// in accumulator i mod 8, whatever the vector width), then pairwise.
+    pub fn angle_moments(
+        north: &[f32],
+        east: &[f32],
+        down: &[f32],
+        weights: &[f32],
+        station: [f32; 2],
+        centre: [f32; 2],
+    ) -> [f64; 5] {
+        const CHUNK: usize = 512;
+        let n = weights.len();
+        let (north, east, down) = (&north[..n], &east[..n], &down[..n]);
+        let mut acc = [[0.0f64; MOMENT_LANES]; 5];
+        let (mut a, mut e) = ([0.0f32; CHUNK], [0.0f32; CHUNK]);
+        for start in (0..n).step_by(CHUNK) {
+            let k = CHUNK.min(n - start);
+            for i in 0..k {
+                (a[i], e[i]) = angles1(north[start + i], east[start + i], down[start + i], station, centre);
+            }
+            let w = &weights[start..start + k];
+            let whole = k / MOMENT_LANES * MOMENT_LANES;
+            for c in (0..whole).step_by(MOMENT_LANES) {
+                for j in 0..MOMENT_LANES {
+                    add_moments(&mut acc, j, a[c + j], e[c + j], w[c + j]);
+                }
+            }
+            for j in 0..k - whole {
+                add_moments(&mut acc, j, a[whole + j], e[whole + j], w[whole + j]);
+            }
+        }
+        acc.map(|m| ((m[0] + m[1]) + (m[2] + m[3])) + ((m[4] + m[5]) + (m[6] + m[7])))
     }
+}
+
+/// The azimuth and the angle from the vertical of [`angle_moments`] for one particle.
+#[inline(always)]
+fn angles1(north: f32, east: f32, down: f32, station: [f32; 2], centre: [f32; 2]) -> (f32, f32) {
+    let (dx, dy) = (north - station[0], east - station[1]);
+    let a = atan2_1(dy, dx) - centre[0];
+    let a = if a > PI {
+        a - 2.0 * PI
+    } else if a <= -PI {
+        a + 2.0 * PI
+    } else {
+        a
+    };
+    (a, atan2_1((dx * dx + dy * dy).sqrt(), down) - centre[1])
+}
+
+/// The accumulators of [`angle_moments`].
+const MOMENT_LANES: usize = 8;
+
+/// One particle's terms of [`angle_moments`] into accumulator `j`.
+#[inline(always)]
+fn add_moments(acc: &mut [[f64; MOMENT_LANES]; 5], j: usize, a: f32, e: f32, w: f32) {
+    let (a, e, w) = (f64::from(a), f64::from(e), f64::from(w));
+    let (wa, we) = (w * a, w * e);
+    acc[0][j] += wa;
+    acc[1][j] += we;
+    acc[2][j] += wa * a;
+    acc[3][j] += wa * e;
+    acc[4][j] += we * e;
 }
 
 /// Fills `out` with independent standard normal draws: Box-Muller on pairs of 32-bit
@@ -262,38 +467,101 @@ mod tests {
         }
     }
 
-    /// The dispatched versions (AVX-512 or AVX2 where the processor has them) give the
-    /// same bits as the scalar kernels called one value at a time in a loop compiled
-    /// for the baseline: no result depends on the vector width.
+    /// Each level the processor runs (forced: `name::at`) gives the same bits as the
+    /// scalar kernels called one value at a time (through `black_box`, so not
+    /// vectorised), sums in the kernels' order: no result depends on the vector width.
     #[test]
-    fn dispatched_versions_match_the_scalar_kernels_bit_for_bit() {
+    fn every_level_matches_the_scalar_kernels_bit_for_bit() {
+        use std::hint::black_box;
         let n = 4099;
         let a: Vec<f64> = (0..n).map(|i| -40.0 + 0.019_53 * i as f64).collect();
         let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.77).cos() * 10f64.powi(i as i32 % 9 - 4)).collect();
-        let (mut s, mut c, mut t) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        sin_cos(&a, &mut s, &mut c);
-        atan2(&a, &b, &mut t);
-        for i in 0..n {
-            let (s1, c1) = std::hint::black_box(sin_cos1(a[i]));
-            assert_eq!(
-                (s[i].to_bits(), c[i].to_bits()),
-                (f64::from(s1).to_bits(), f64::from(c1).to_bits()),
-                "sin_cos {}",
-                a[i]
-            );
-            let t1 = std::hint::black_box(atan2_1(a[i] as f32, b[i] as f32));
-            assert_eq!(t[i].to_bits(), f64::from(t1).to_bits(), "atan2 {} {}", a[i], b[i]);
-        }
         let positive: Vec<f64> = b.iter().map(|v| v.abs() + 1e-30).collect();
-        ln(&positive, &mut t);
-        for i in 0..n {
-            assert_eq!(t[i].to_bits(), f64::from(std::hint::black_box(ln1(positive[i] as f32))).to_bits());
-        }
         let shift = 3.0;
-        exp_shifted(&a, shift, &mut t);
-        for i in 0..n {
-            assert_eq!(t[i].to_bits(), f64::from(std::hint::black_box(exp1(a[i] - shift))).to_bits());
+        // particles about a point, a station 30 m off, angles about the point's
+        let col = |f: &dyn Fn(f32) -> f32| (0..n).map(|i| f(i as f32)).collect::<Vec<f32>>();
+        let (north, east) = (col(&|t| 12.0 * (t * 0.37).sin()), col(&|t| 9.0 * (t * 0.71).cos()));
+        let (down, w) = (col(&|t| 30.0 + (t * 0.13).sin()), col(&|t| 1.0 + (t * 0.05).cos().abs()));
+        let (station, centre) = ([-30.0, 4.0], [3.0, 0.8]);
+        let levels = Level::available();
+        eprintln!("levels this processor runs: {levels:?}; current {:?}", Level::current());
+        for &level in &levels {
+            let (mut s, mut c, mut t) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            sin_cos::at(level, &a, &mut s, &mut c);
+            atan2::at(level, &a, &b, &mut t);
+            for i in 0..n {
+                let (s1, c1) = black_box(sin_cos1(a[i]));
+                assert_eq!((s[i].to_bits(), c[i].to_bits()), (f64::from(s1).to_bits(), f64::from(c1).to_bits()));
+                let t1 = black_box(atan2_1(a[i] as f32, b[i] as f32));
+                assert_eq!(t[i].to_bits(), f64::from(t1).to_bits(), "{level:?} atan2 {} {}", a[i], b[i]);
+            }
+            ln::at(level, &positive, &mut t);
+            for i in 0..n {
+                assert_eq!(t[i].to_bits(), f64::from(black_box(ln1(positive[i] as f32))).to_bits(), "{level:?} ln");
+            }
+            let total = exp_shifted::at(level, &a, shift, &mut t);
+            let mut sums = [0.0; 4];
+            for i in 0..n {
+                let e = f64::from(black_box(exp1(a[i] - shift)));
+                assert_eq!(t[i].to_bits(), e.to_bits(), "{level:?} exp");
+                sums[i % 4] += if i < n / 4 * 4 { e } else { 0.0 };
+            }
+            let tail: f64 = t[n / 4 * 4..].iter().sum();
+            assert_eq!(total.to_bits(), ((sums[0] + sums[1]) + (sums[2] + sums[3]) + tail).to_bits());
+            let mut pairs = vec![0.0; 2 * 1024];
+            box_muller::at(level, 0xDEAD_BEEF, &mut pairs);
+            for i in 0..1024 {
+                let (z1, z2) = black_box(box_muller1(0xDEAD_BEEF, i));
+                assert_eq!(
+                    (pairs[i].to_bits(), pairs[1024 + i].to_bits()),
+                    (f64::from(z1).to_bits(), f64::from(z2).to_bits())
+                );
+            }
+            let moments = angle_moments::at(level, &north, &east, &down, &w, station, centre);
+            let mut acc = [[0.0; MOMENT_LANES]; 5];
+            for i in 0..n {
+                let (a1, e1) = black_box(angles1(north[i], east[i], down[i], station, centre));
+                add_moments(&mut acc, i % MOMENT_LANES, a1, e1, w[i]);
+            }
+            let expected = acc.map(|m| ((m[0] + m[1]) + (m[2] + m[3])) + ((m[4] + m[5]) + (m[6] + m[7])));
+            assert_eq!(moments.map(f64::to_bits), expected.map(f64::to_bits), "{level:?} angle moments");
         }
+    }
+
+    /// The moments of the USBL angles against double precision: atan2 of f64, the sums
+    /// in one pass; within what 4e-7 rad per angle can move them (the angles' bound,
+    /// `functions_match_std_within_single_precision`), particle by particle.
+    #[test]
+    fn angle_moments_match_double_precision() {
+        let n = 3001;
+        let f = |i: usize, k: f64| (i as f64 * k).sin();
+        let (north, east): (Vec<f32>, Vec<f32>) =
+            (0..n).map(|i| ((15.0 * f(i, 0.3)) as f32, (20.0 * f(i, 0.7)) as f32)).unzip();
+        let down: Vec<f32> = (0..n).map(|i| (30.0 + f(i, 0.11)) as f32).collect();
+        let w: Vec<f32> = (0..n).map(|i| (1.0 + 0.5 * f(i, 0.05)) as f32).collect();
+        // the station across the azimuth's wrap: the angles about pi
+        let (station, centre) = ([40.0f32, 0.5], [3.1f32, 0.9]);
+        let got = angle_moments(&north, &east, &down, &w, station, centre);
+        // the sums, and how far an error of eps in each angle can move them
+        let eps = 4e-7 + 1e-7; // the angle's, and the coordinate difference's rounding
+        let (mut expected, mut bounds) = ([0.0; 5], [0.0; 5]);
+        for i in 0..n {
+            let (dx, dy, dz) = (f64::from(north[i] - station[0]), f64::from(east[i] - station[1]), f64::from(down[i]));
+            let a = crate::geo::wrap_angle(dy.atan2(dx) - f64::from(centre[0]));
+            let e = (dx * dx + dy * dy).sqrt().atan2(dz) - f64::from(centre[1]);
+            let wi = f64::from(w[i]);
+            let (da, de) = (a.abs() * eps, e.abs() * eps);
+            for (k, (v, b)) in
+                [(a, eps), (e, eps), (a * a, 2.0 * da), (a * e, da + de), (e * e, 2.0 * de)].into_iter().enumerate()
+            {
+                expected[k] += wi * v;
+                bounds[k] += wi * (b + eps * eps) * 1.001;
+            }
+        }
+        for k in 0..5 {
+            assert!((got[k] - expected[k]).abs() <= bounds[k], "moment {k}: {} against {}", got[k], expected[k]);
+        }
+        assert!(expected[0].abs() > 10.0 * bounds[0], "the azimuths do not cancel out");
     }
 
     /// 1e6 draws against N(0, 1): mean, variance and kurtosis within 5 standard errors,

@@ -263,10 +263,48 @@ impl<const D: usize> ParticleFilter<D> {
 
     /// `m` particles drawn systematically in proportion to their weights (offset one
     /// half: no random draw), for a planner that scores a belief on a subsample; each
-    /// stands for 1 / m of the weight. Components `k` of each.
-    pub fn subsample(&self, m: usize, k: &[usize]) -> Vec<Vec<f64>> {
-        let picked = walk(self.normalised(), (0..m).map(|j| (j as f64 + 0.5) / m as f64));
-        picked.into_iter().map(|i| k.iter().map(|&c| self.x[c][i]).collect()).collect()
+    /// stands for 1 / m of the weight. Components `k` of each. By chunks of particles
+    /// in parallel: each takes the points within its share of the cumulative weight
+    /// (from the sums of the chunks before it) and walks them along its particles.
+    pub fn subsample<const K: usize>(&self, m: usize, k: [usize; K]) -> Vec<[f64; K]> {
+        let w = self.normalised();
+        let totals: Vec<f64> = w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect();
+        let mut offsets = Vec::with_capacity(totals.len() + 1);
+        offsets.push(0.0);
+        for t in &totals {
+            offsets.push(offsets[offsets.len() - 1] + t);
+        }
+        let point = |j: usize| (j as f64 + 0.5) / m as f64;
+        // the first point at or past cumulative weight `c` (the last chunk takes the rest)
+        let first_at = |c: f64| {
+            let mut j = ((c * m as f64 - 0.5).ceil().max(0.0) as usize).min(m);
+            while j > 0 && point(j - 1) >= c {
+                j -= 1;
+            }
+            while j < m && point(j) < c {
+                j += 1;
+            }
+            j
+        };
+        let (chunks, n, x) = (totals.len(), self.len(), &self.x);
+        let picked: Vec<Vec<[f64; K]>> = (0..chunks)
+            .into_par_iter()
+            .map(|c| {
+                let (lo, hi) = (first_at(offsets[c]), if c + 1 == chunks { m } else { first_at(offsets[c + 1]) });
+                let (first, w) = (c * CHUNK, &w[c * CHUNK..((c + 1) * CHUNK).min(n)]);
+                let (mut i, mut cum) = (0, offsets[c] + w[0]);
+                (lo..hi)
+                    .map(|j| {
+                        while point(j) >= cum && i + 1 < w.len() {
+                            i += 1;
+                            cum += w[i];
+                        }
+                        k.map(|comp| x[comp][first + i])
+                    })
+                    .collect()
+            })
+            .collect();
+        picked.concat()
     }
 
     /// The normalised weights.
@@ -664,6 +702,40 @@ mod tests {
             }
             assert_eq!(a.log_weights(), b.log_weights());
             assert_eq!(a.step, b.step);
+        }
+    }
+
+    /// The subsample by chunks of particles in parallel against one walk along the
+    /// running sum of the weights (a brute force written out here): the same particle
+    /// for every point, with m below, near and above the number of particles, over 3
+    /// chunks and a part weighed unevenly.
+    #[test]
+    fn a_subsample_picks_the_particles_of_a_single_walk() {
+        struct Tilt;
+        impl ParticleLikelihood for Tilt {
+            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+                for (lw, v) in log_w.iter_mut().zip(x[0]) {
+                    *lw += 3.0 * v.sin() - 0.5 * v * v;
+                }
+            }
+        }
+        let n = 3 * CHUNK + 77;
+        let mut pf =
+            ParticleFilter::<2>::gaussian(n, &SVector::zeros(), &SVector::from([2.0, 1.0]), Default::default(), 6);
+        pf.reweight(&Tilt);
+        let w = pf.weights();
+        for m in [1, 7, 1000, n - 1, n, 3 * n + 5] {
+            let got = pf.subsample(m, [1, 0]);
+            assert_eq!(got.len(), m);
+            let (mut i, mut cum) = (0, w[0]);
+            for (j, g) in got.iter().enumerate() {
+                let u = (j as f64 + 0.5) / m as f64;
+                while u >= cum && i + 1 < n {
+                    i += 1;
+                    cum += w[i];
+                }
+                assert_eq!(*g, [pf.component(1)[i], pf.component(0)[i]], "m {m}, point {j}");
+            }
         }
     }
 

@@ -3,6 +3,7 @@
 //! would spread the particles' predicted measurements most (eq. 10-12), and the
 //! straight-line waypoint following of eq. 13-16.
 
+use crate::filter::lanes;
 use crate::measure::Usbl;
 use crate::par::*;
 use nalgebra::{Matrix2, Vector2, Vector3};
@@ -60,6 +61,35 @@ pub struct BearingDecision {
     pub candidates: Vec<(Vector2<f64>, f64)>,
 }
 
+/// The belief's particles shifted by the lead, relative to their weighted mean, as
+/// single-precision columns (north, east, down) with their weights, for the lanes.
+struct Columns {
+    north: Vec<f32>,
+    east: Vec<f32>,
+    down: Vec<f32>,
+    weights: Vec<f32>,
+    /// The single-precision weights' sum.
+    total: f64,
+    mean: Vector3<f64>,
+}
+
+impl Columns {
+    fn of(belief: &Belief<'_>) -> Self {
+        let mean = belief.shifted_mean();
+        let shift = belief.velocity_m_s * belief.lead_s;
+        let column = |f: &dyn Fn(&Vector3<f64>) -> f64| belief.positions.iter().map(|x| f(x) as f32).collect();
+        let weights: Vec<f32> = belief.weights.iter().map(|&w| w as f32).collect();
+        Self {
+            north: column(&|x| x.x + shift.x - mean.x),
+            east: column(&|x| x.y + shift.y - mean.y),
+            down: column(&|x| x.z),
+            total: weights.iter().map(|&w| f64::from(w)).sum(),
+            weights,
+            mean,
+        }
+    }
+}
+
 impl BearingPlanner {
     /// The spread of the belief's predicted USBL measurements from a surface vehicle at
     /// `p` (eq. 10): C = Cov(S (h(x_i, p) - E_i h)), S = diag(sigma_alpha^-2,
@@ -67,28 +97,29 @@ impl BearingPlanner {
     /// (eq. 3), scored by the metric. The azimuth is taken relative to the mean's so
     /// that a belief across +-pi is not torn apart.
     pub fn spread(&self, belief: &Belief<'_>, p: Vector2<f64>) -> f64 {
-        self.spread_about(belief, &belief.shifted_mean(), p)
+        self.spread_of(&Columns::of(belief), p)
     }
 
-    /// [`BearingPlanner::spread`] with the belief's shifted mean in hand (one pass over
-    /// the particles fewer per candidate).
-    fn spread_about(&self, belief: &Belief<'_>, mean: &Vector3<f64>, p: Vector2<f64>) -> f64 {
-        let shift = belief.velocity_m_s * belief.lead_s;
-        let at = |x: &Vector3<f64>| Vector3::new(x.x + shift.x, x.y + shift.y, x.z);
+    /// [`BearingPlanner::spread`] on the belief's columns: the angles of eq. 1-2 in the
+    /// lanes (single precision, within some 4e-7 rad: far below the spread of a belief
+    /// the planner scores), about the mean's.
+    fn spread_of(&self, cols: &Columns, p: Vector2<f64>) -> f64 {
         let usbl = Usbl::exact(Vector3::new(p.x, p.y, 0.0), 0.0, self.sigma_usbl_rad_per_m);
-        let (centre, _, sigma) = usbl.angles(mean);
+        let (azimuth, elevation, sigma) = usbl.angles(&cols.mean);
         let s = 1.0 / (sigma * sigma).max(f64::MIN_POSITIVE);
-        // azimuths about the mean's (the covariance does not depend on the centre), one
-        // pass: sums of w h and w h h'
-        let (mut m, mut second) = (Vector2::zeros(), Matrix2::zeros());
-        for (x, w) in belief.positions.iter().zip(belief.weights) {
-            let (a, phi, _) = usbl.angles(&at(x));
-            let r = Vector2::new(crate::geo::wrap_angle(a - centre), phi);
-            m += r * *w;
-            second += r * r.transpose() * *w;
-        }
-        let c = second - m * m.transpose();
-        let c = c * (s * s); // S C S with S = s I
+        let station = [(p.x - cols.mean.x) as f32, (p.y - cols.mean.y) as f32];
+        let [ma, me, saa, sae, see] = lanes::angle_moments(
+            &cols.north,
+            &cols.east,
+            &cols.down,
+            &cols.weights,
+            station,
+            [azimuth as f32, elevation as f32],
+        );
+        let total = cols.total;
+        let (ma, me) = (ma / total, me / total);
+        let (caa, cae, cee) = (saa / total - ma * ma, sae / total - ma * me, see / total - me * me);
+        let c = Matrix2::new(caa, cae, cae, cee) * (s * s); // S C S with S = s I
         match self.metric {
             SpreadMetric::Determinant => c.determinant(),
             SpreadMetric::MaxEigenvalue => c.symmetric_eigenvalues().max(),
@@ -133,12 +164,12 @@ impl BearingPlanner {
     /// The best candidate (eq. 10-12) for a surface vehicle at `asv` moving at
     /// `asv_velocity`.
     pub fn decide(&self, belief: &Belief<'_>, asv: Vector2<f64>, asv_velocity: Vector2<f64>) -> BearingDecision {
-        let mean = belief.shifted_mean();
+        let cols = Columns::of(belief);
         // candidates scored in parallel, collected in order: the same whatever the threads
         let candidates: Vec<(Vector2<f64>, f64)> = self
-            .candidates(mean.xy(), asv, asv_velocity)
+            .candidates(cols.mean.xy(), asv, asv_velocity)
             .into_par_iter()
-            .map(|p| (p, self.spread_about(belief, &mean, p)))
+            .map(|p| (p, self.spread_of(&cols, p)))
             .collect();
         let (waypoint, score) =
             candidates.iter().copied().fold((asv, f64::NEG_INFINITY), |best, c| if c.1 > best.1 { c } else { best });
@@ -191,9 +222,12 @@ mod tests {
     }
 
     /// The spread of eq. 10 against a brute force written out separately: the angles of
-    /// every particle by acos and atan2, their weighted mean and covariance by sums, the
-    /// Mahalanobis scaling by sigma^-2; det and largest eigenvalue of the 2 x 2 closed
-    /// form.
+    /// every particle by acos and atan2 in double precision, their weighted mean and
+    /// covariance by sums, the Mahalanobis scaling by sigma^-2; det and largest
+    /// eigenvalue of the 2 x 2 closed form. The planner's angles are the lanes' (within
+    /// eps = 4e-7 rad, their own test): a covariance entry then moves by at most
+    /// 2 eps (E|a - mean a| + E|b - mean b|) + 4 eps^2, and the determinant and the
+    /// eigenvalue by what that bound carries through their closed forms.
     #[test]
     fn spread_matches_a_brute_force() {
         let positions: Vec<Vector3<f64>> = (0..40)
@@ -235,8 +269,16 @@ mod tests {
         let (caa, cap, cpp) = (caa * k, cap * k, cpp * k);
         let det = caa * cpp - cap * cap;
         let max_eig = (caa + cpp) / 2.0 + (((caa - cpp) / 2.0).powi(2) + cap * cap).sqrt();
-        assert_abs_diff_eq!(planner(SpreadMetric::Determinant).spread(&belief, p) / det, 1.0, epsilon = 1e-9);
-        assert_abs_diff_eq!(planner(SpreadMetric::MaxEigenvalue).spread(&belief, p) / max_eig, 1.0, epsilon = 1e-9);
+        let eps = 4e-7;
+        let spread = |f: &dyn Fn(&(f64, f64)) -> f64| angles.iter().zip(&weights).map(|(a, w)| w * f(a)).sum::<f64>();
+        let (da, dp) = (spread(&|a| (a.0 - ma).abs()), spread(&|a| (a.1 - mp).abs()));
+        let bound = |x: f64, y: f64| k * (2.0 * eps * (x + y) + 4.0 * eps * eps);
+        let (eaa, eap, epp) = (bound(da, da), bound(da, dp), bound(dp, dp));
+        let det_bound = eaa * (cpp + epp) + caa * epp + 2.0 * cap.abs() * eap + eap * eap;
+        let eig_bound = (eaa * eaa + 2.0 * eap * eap + epp * epp).sqrt();
+        assert!(det_bound < 1e-3 * det && eig_bound < 1e-3 * max_eig, "a test that can tell: {det_bound} / {det}");
+        assert_abs_diff_eq!(planner(SpreadMetric::Determinant).spread(&belief, p), det, epsilon = det_bound);
+        assert_abs_diff_eq!(planner(SpreadMetric::MaxEigenvalue).spread(&belief, p), max_eig, epsilon = eig_bound);
     }
 
     /// Candidates lie on the half-annulus r1..r2 about the belief, from the direction of
@@ -313,8 +355,7 @@ mod tests {
             }
         }
         pf.update(&Azimuth);
-        let all: Vec<Vector3<f64>> =
-            pf.subsample(pf.len(), &[0, 1, 2]).iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect();
+        let all: Vec<Vector3<f64>> = pf.subsample(pf.len(), [0, 1, 2]).into_iter().map(Vector3::from).collect();
         let uniform = |n: usize| vec![1.0 / n as f64; n];
         let w_all = uniform(all.len());
         let full = Belief { positions: &all, weights: &w_all, velocity_m_s: Vector2::zeros(), lead_s: 0.0 };
@@ -323,8 +364,7 @@ mod tests {
             let p = planner(metric);
             let best = p.decide(&full, asv, v);
             for m in [20_000, 5_000, 1_000] {
-                let sub: Vec<Vector3<f64>> =
-                    pf.subsample(m, &[0, 1, 2]).iter().map(|q| Vector3::new(q[0], q[1], q[2])).collect();
+                let sub: Vec<Vector3<f64>> = pf.subsample(m, [0, 1, 2]).into_iter().map(Vector3::from).collect();
                 let w = uniform(m);
                 let choice = p.decide(
                     &Belief { positions: &sub, weights: &w, velocity_m_s: Vector2::zeros(), lead_s: 0.0 },

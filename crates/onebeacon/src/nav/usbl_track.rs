@@ -248,8 +248,8 @@ impl Navigator for ParticleTracker {
     }
 
     fn position_sample(&self, m: usize) -> Option<Vec<Vector3<f64>>> {
-        let picked = with_pf!(&self.cloud, pf => pf.subsample(m.min(pf.len()), &[idx::X, idx::Y, idx::Z]));
-        Some(picked.into_iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect())
+        let picked = with_pf!(&self.cloud, pf => pf.subsample(m.min(pf.len()), [idx::X, idx::Y, idx::Z]));
+        Some(picked.into_iter().map(Vector3::from).collect())
     }
 }
 
