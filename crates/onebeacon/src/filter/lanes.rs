@@ -48,22 +48,15 @@ impl Level {
     }
 
     fn detect() -> Level {
-        let mut levels = vec![Level::Baseline];
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("avx") {
-                levels.push(Level::Avx2);
-                if ["avx512f", "avx512bw", "avx512vl", "avx512dq"].iter().all(|f| match *f {
-                    "avx512f" => std::arch::is_x86_feature_detected!("avx512f"),
-                    "avx512bw" => std::arch::is_x86_feature_detected!("avx512bw"),
-                    "avx512vl" => std::arch::is_x86_feature_detected!("avx512vl"),
-                    _ => std::arch::is_x86_feature_detected!("avx512dq"),
-                }) {
-                    levels.push(Level::Avx512);
-                }
+            use std::arch::is_x86_feature_detected as has;
+            if has!("avx2") && has!("avx") {
+                let avx512 = has!("avx512f") && has!("avx512bw") && has!("avx512vl") && has!("avx512dq");
+                return if avx512 { Level::Avx512 } else { Level::Avx2 };
             }
         }
-        levels[levels.len() - 1]
+        Level::Baseline
     }
 
     /// A level by its name in `ONEBEACON_SIMD`.
@@ -101,7 +94,7 @@ macro_rules! lanes {
             $name::at(Level::current(), $($arg),*)
         }
 
-        $vis mod $name {
+        pub(crate) mod $name {
             #[allow(unused_imports)]
             use super::*;
 

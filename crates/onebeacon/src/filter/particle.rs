@@ -438,7 +438,7 @@ impl<const D: usize> ParticleFilter<D> {
         let mut w = self.normalised.take().expect("computed above");
         let mut rng = stream(seed, step, u64::MAX);
         let resampler = self.settings.resampler;
-        let drawn = drawn_ancestors(resampler, &w, &mut rng);
+        let drawn = drawn_ancestors(resampler, &w, &mut rng, |c| stream(seed, step, c as u64));
         let cumulative = cumulative_in_place(&mut w);
         let u0: f64 = rng.random();
         let from = &self.x;
@@ -447,7 +447,7 @@ impl<const D: usize> ParticleFilter<D> {
             let first = c * CHUNK;
             let len = log_w.len();
             let mut rng = stream(seed, step, c as u64);
-            let picked = chunk_ancestors(resampler, cumulative, drawn.as_deref(), first..first + len, u0, &mut rng);
+            let picked = chunk_ancestors(resampler, cumulative, &drawn, (c, first..first + len), u0, &mut rng);
             for (k, to) in to.iter_mut().enumerate() {
                 for (v, &i) in to.iter_mut().zip(&picked) {
                     *v = from[k][i];
@@ -588,14 +588,58 @@ fn walk_from(cum: &[f64], points: impl Iterator<Item = f64>) -> Vec<usize> {
         .collect()
 }
 
-/// The whole draw of the resamplers that draw all new particles at once (multinomial
-/// and residual), for normalised weights `w`: the index of the particle each copies;
-/// None for those drawn chunk by chunk.
-fn drawn_ancestors(resampler: Resampler, w: &[f64], rng: &mut Pcg64) -> Option<Vec<usize>> {
+/// What a resampler draws for all new particles before the chunks walk.
+enum Drawn {
+    /// Nothing (systematic, stratified: each chunk walks from its own points).
+    Nothing,
+    /// The particle each new one copies (residual).
+    Ancestors(Vec<usize>),
+    /// Multinomial's sorted uniforms by exponential spacings, U_(j) = S_j / S_(n+1)
+    /// with S the running sum of n + 1 standard exponentials (Devroye 1986, V.3): each
+    /// chunk of new particles draws its exponentials from its own stream, in parallel;
+    /// `running` holds each chunk's running sums, `before` the sum of the chunks before
+    /// it, `total` S_(n+1).
+    Spacings { running: Vec<f64>, before: Vec<f64>, total: f64 },
+}
+
+/// The draw of the resamplers that draw for all new particles at once, for normalised
+/// weights `w`: the main stream `rng` draws what is not by chunk, `chunk_rng(c)` is
+/// chunk c's stream.
+fn drawn_ancestors(
+    resampler: Resampler,
+    w: &[f64],
+    rng: &mut Pcg64,
+    chunk_rng: impl Fn(usize) -> Pcg64 + Sync,
+) -> Drawn {
     let n = w.len();
     match resampler {
-        Resampler::Systematic | Resampler::Stratified => None,
-        Resampler::Multinomial => Some(multinomial(w, n, rng)),
+        Resampler::Systematic | Resampler::Stratified => Drawn::Nothing,
+        Resampler::Multinomial => {
+            let mut running = vec![0.0; n];
+            let totals: Vec<f64> = running
+                .par_chunks_mut(CHUNK)
+                .enumerate()
+                .map(|(c, e)| {
+                    let mut rng = chunk_rng(c);
+                    let u: Vec<f64> = (0..e.len()).map(|_| 1.0 - rng.random::<f64>()).collect();
+                    crate::filter::lanes::ln(&u, e);
+                    let mut acc = 0.0;
+                    for v in e.iter_mut() {
+                        acc -= *v; // -ln(1 - U): a standard exponential
+                        *v = acc;
+                    }
+                    acc
+                })
+                .collect();
+            let mut before = Vec::with_capacity(totals.len());
+            let mut acc = 0.0;
+            for t in totals {
+                before.push(acc);
+                acc += t;
+            }
+            let total = acc - (1.0 - rng.random::<f64>()).ln();
+            Drawn::Spacings { running, before, total }
+        }
         Resampler::Residual => {
             let mut out = Vec::with_capacity(n);
             let mut residual: Vec<f64> = Vec::with_capacity(n);
@@ -610,28 +654,31 @@ fn drawn_ancestors(resampler: Resampler, w: &[f64], rng: &mut Pcg64) -> Option<V
                 residual.iter_mut().for_each(|r| *r /= total);
                 out.extend(multinomial(&residual, rest, rng));
             }
-            Some(out)
+            Drawn::Ancestors(out)
         }
     }
 }
 
-/// The index of the particle each new particle of `range` copies: its share of `drawn`
-/// (multinomial, residual), or a walk along the cumulative weights `cum` from the
-/// range's first point: (j + u0) / N for systematic, (j + U_j) / N for stratified with
-/// U_j drawn from `rng`.
+/// The index of the particle each new particle of `range` (chunk `c` of the new ones)
+/// copies: its share of the drawn ancestors (residual), or a walk along the cumulative
+/// weights `cum` from the range's first point: (j + u0) / N for systematic, (j + U_j) / N
+/// for stratified with U_j drawn from `rng`, the chunk's spacings for multinomial.
 fn chunk_ancestors(
     resampler: Resampler,
     cum: &[f64],
-    drawn: Option<&[usize]>,
-    range: std::ops::Range<usize>,
+    drawn: &Drawn,
+    (c, range): (usize, std::ops::Range<usize>),
     u0: f64,
     rng: &mut Pcg64,
 ) -> Vec<usize> {
     let n = cum.len() as f64;
     match (drawn, resampler) {
-        (Some(a), _) => a[range].to_vec(),
-        (None, Resampler::Stratified) => walk_from(cum, range.map(|j| (j as f64 + rng.random::<f64>()) / n)),
-        (None, _) => walk_from(cum, range.map(|j| (j as f64 + u0) / n)),
+        (Drawn::Ancestors(a), _) => a[range].to_vec(),
+        (Drawn::Spacings { running, before, total }, _) => {
+            walk_from(cum, running[range].iter().map(|s| (before[c] + s) / total))
+        }
+        (Drawn::Nothing, Resampler::Stratified) => walk_from(cum, range.map(|j| (j as f64 + rng.random::<f64>()) / n)),
+        (Drawn::Nothing, _) => walk_from(cum, range.map(|j| (j as f64 + u0) / n)),
     }
 }
 
@@ -739,6 +786,50 @@ mod tests {
         }
     }
 
+    /// Multinomial resampling by chunks (exponential spacings drawn chunk by chunk): over
+    /// 3 chunks and a part of unevenly weighed particles, the copies of the particles of
+    /// each quarter of the cloud (a binomial count, N W_A on average, variance
+    /// N W_A (1 - W_A)) average within 4 standard errors over 200 resamplings, and the
+    /// draws differ from one resampling to the next.
+    #[test]
+    fn multinomial_by_chunks_draws_in_proportion_to_weight() {
+        struct Tilt;
+        impl ParticleLikelihood for Tilt {
+            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+                for (lw, v) in log_w.iter_mut().zip(x[0]) {
+                    *lw += 2.0 * v - 0.5 * v * v;
+                }
+            }
+        }
+        let n = 3 * CHUNK + 77;
+        let settings = ParticleSettings { resampler: Resampler::Multinomial, ..ParticleSettings::default() };
+        let mut pf = ParticleFilter::<1>::gaussian(n, &SVector::zeros(), &SVector::from([1.0]), settings, 8);
+        pf.reweight(&Tilt);
+        let w = pf.weights();
+        let index: std::collections::HashMap<u64, usize> =
+            pf.component(0).iter().enumerate().map(|(i, v)| (v.to_bits(), i)).collect();
+        let quarters: Vec<std::ops::Range<usize>> = (0..4).map(|q| q * n / 4..(q + 1) * n / 4).collect();
+        let (reps, mut counts, mut last) = (200, [0.0; 4], Vec::new());
+        for _ in 0..reps {
+            let mut p = pf.clone();
+            pf.step += 1; // a fresh draw each time
+            p.resample();
+            let after: Vec<u64> = p.component(0).iter().map(|v| v.to_bits()).collect();
+            assert_ne!(after, last);
+            for v in &after {
+                let i = index[v];
+                counts[quarters.iter().position(|q| q.contains(&i)).unwrap()] += 1.0;
+            }
+            last = after;
+        }
+        for (q, range) in quarters.iter().enumerate() {
+            let wa: f64 = w[range.clone()].iter().sum();
+            let (mean, expected) = (counts[q] / reps as f64, n as f64 * wa);
+            let se = (n as f64 * wa * (1.0 - wa) / reps as f64).sqrt();
+            assert!((mean - expected).abs() < 4.0 * se, "quarter {q}: {mean} against {expected} (se {se})");
+        }
+    }
+
     /// Systematic and stratified resampling by chunks in parallel, over several chunks:
     /// every particle of 3 chunks and a part (drawn from N(0, 1), each value its own)
     /// weighed by exp(-x^2) is copied floor(N w_i) or ceil(N w_i) times (systematic), or
@@ -786,10 +877,11 @@ mod tests {
             let reps = 2000;
             let mut counts = [0.0; 7];
             for _ in 0..reps {
-                let drawn = drawn_ancestors(r, &w, &mut rng);
+                let key = rng.random::<u64>();
+                let drawn = drawn_ancestors(r, &w, &mut rng, |c| stream(key, 0, c as u64));
                 let mut cum = w.to_vec();
                 let u0 = rng.random();
-                let a = chunk_ancestors(r, cumulative_in_place(&mut cum), drawn.as_deref(), 0..n, u0, &mut rng);
+                let a = chunk_ancestors(r, cumulative_in_place(&mut cum), &drawn, (0, 0..n), u0, &mut rng);
                 assert_eq!(a.len(), n);
                 let mut c = [0usize; 7];
                 a.iter().for_each(|&i| c[i] += 1);
@@ -890,15 +982,11 @@ mod tests {
                 }
             }
         }
-        let run = |threads: usize| {
+        let run = |threads: usize, resampler: Resampler| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let settings = ParticleSettings {
-                    resampler: Resampler::Residual,
-                    ess_fraction: 1.0,
-                    roughening_k: Some(0.2),
-                    min_effective: 0.0,
-                };
+                let settings =
+                    ParticleSettings { resampler, ess_fraction: 1.0, roughening_k: Some(0.2), min_effective: 0.0 };
                 let mut pf =
                     ParticleFilter::<2>::gaussian(50_000, &Vector2::zeros(), &Vector2::repeat(3.0), settings, 5);
                 for _ in 0..3 {
@@ -908,7 +996,9 @@ mod tests {
                 (pf.component(0).to_vec(), pf.mean_covariance())
             })
         };
-        assert_eq!(run(1), run(3));
+        for r in [Resampler::Residual, Resampler::Multinomial, Resampler::Systematic, Resampler::Stratified] {
+            assert_eq!(run(1, r), run(3, r), "{r:?}");
+        }
     }
 
     /// An angle component across +-pi: the mean where the particles are (pi, not 0) and
