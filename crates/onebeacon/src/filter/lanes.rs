@@ -331,6 +331,18 @@ lanes! {
     }
 }
 
+lanes! {
+    /// Standard exponential draws -ln u, u = (k + 1/2) 2^-32 with k the high half of
+    /// the i-th 64-bit draw of the counter-based stream of [`box_muller`] for `key`
+    /// (so up to 22.9, where the mass beyond is 1.2e-10).
+    pub fn exponentials(key: u64, out: &mut [f64]) {
+        const SCALE: f32 = 1.0 / 4_294_967_296.0;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = f64::from(-ln1((hash1(key, i).0 as f32 + 0.5) * SCALE));
+        }
+    }
+}
+
 /// The i-th 64-bit draw of [`box_muller`] for `key` (SplitMix64), as its high and low
 /// halves.
 #[inline(always)]
@@ -531,6 +543,12 @@ mod tests {
                     (f64::from(z1).to_bits(), f64::from(z2).to_bits())
                 );
             }
+            let mut e = vec![0.0; 1001];
+            exponentials::at(level, 0xFEED, &mut e);
+            for (i, v) in e.iter().enumerate() {
+                let k = black_box(hash1(0xFEED, i)).0;
+                assert_eq!(v.to_bits(), f64::from(-black_box(ln1((k as f32 + 0.5) / 4_294_967_296.0))).to_bits());
+            }
             let moments = angle_moments::at(level, &north, &east, &down, &w, station, centre);
             let mut acc = [[0.0; MOMENT_LANES]; 5];
             for i in 0..n {
@@ -576,6 +594,26 @@ mod tests {
             assert!((got[k] - expected[k]).abs() <= bounds[k], "moment {k}: {} against {}", got[k], expected[k]);
         }
         assert!(expected[0].abs() > 10.0 * bounds[0], "the azimuths do not cancel out");
+    }
+
+    /// 1e6 exponential draws: mean and variance 1 within 5 standard errors (the
+    /// variance's is sqrt(8 / n)), and the mass beyond 1, 3 and 10 within 5 binomial
+    /// standard errors of e^-x.
+    #[test]
+    fn exponentials_have_the_standard_moments_and_tail() {
+        let n = 1_000_000;
+        let mut e = vec![0.0; n];
+        exponentials(0x5EED, &mut e);
+        let nf = n as f64;
+        let mean = e.iter().sum::<f64>() / nf;
+        let var = e.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / nf;
+        assert!((mean - 1.0).abs() < 5.0 / nf.sqrt(), "mean {mean}");
+        assert!((var - 1.0).abs() < 5.0 * (8.0 / nf).sqrt(), "variance {var}");
+        for x in [1.0f64, 3.0, 10.0] {
+            let p = (-x).exp();
+            let beyond = e.iter().filter(|v| **v > x).count() as f64 / nf;
+            assert!((beyond - p).abs() < 5.0 * (p * (1.0 - p) / nf).sqrt(), "beyond {x}: {beyond} against {p}");
+        }
     }
 
     /// 1e6 draws against N(0, 1): mean, variance and kurtosis within 5 standard errors,

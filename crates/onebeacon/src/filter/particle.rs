@@ -596,7 +596,8 @@ enum Drawn {
     Ancestors(Vec<usize>),
     /// Multinomial's sorted uniforms by exponential spacings, U_(j) = S_j / S_(n+1)
     /// with S the running sum of n + 1 standard exponentials (Devroye 1986, V.3): each
-    /// chunk of new particles draws its exponentials from its own stream, in parallel;
+    /// chunk of new particles draws its exponentials in the lanes from a key of its own
+    /// stream, in parallel;
     /// `running` holds each chunk's running sums, `before` the sum of the chunks before
     /// it, `total` S_(n+1).
     Spacings { running: Vec<f64>, before: Vec<f64>, total: f64 },
@@ -620,12 +621,10 @@ fn drawn_ancestors(
                 .par_chunks_mut(CHUNK)
                 .enumerate()
                 .map(|(c, e)| {
-                    let mut rng = chunk_rng(c);
-                    let u: Vec<f64> = (0..e.len()).map(|_| 1.0 - rng.random::<f64>()).collect();
-                    crate::filter::lanes::ln(&u, e);
+                    crate::filter::lanes::exponentials(chunk_rng(c).random::<u64>(), e);
                     let mut acc = 0.0;
                     for v in e.iter_mut() {
-                        acc -= *v; // -ln(1 - U): a standard exponential
+                        acc += *v;
                         *v = acc;
                     }
                     acc
@@ -752,20 +751,22 @@ mod tests {
         }
     }
 
+    /// Uneven weights for the resampling and subsampling tests: log w = 3 sin x_0 - x_0^2 / 2.
+    struct Tilt;
+    impl ParticleLikelihood for Tilt {
+        fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+            for (lw, v) in log_w.iter_mut().zip(x[0]) {
+                *lw += 3.0 * v.sin() - 0.5 * v * v;
+            }
+        }
+    }
+
     /// The subsample by chunks of particles in parallel against one walk along the
     /// running sum of the weights (a brute force written out here): the same particle
     /// for every point, with m below, near and above the number of particles, over 3
     /// chunks and a part weighed unevenly.
     #[test]
     fn a_subsample_picks_the_particles_of_a_single_walk() {
-        struct Tilt;
-        impl ParticleLikelihood for Tilt {
-            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
-                for (lw, v) in log_w.iter_mut().zip(x[0]) {
-                    *lw += 3.0 * v.sin() - 0.5 * v * v;
-                }
-            }
-        }
         let n = 3 * CHUNK + 77;
         let mut pf =
             ParticleFilter::<2>::gaussian(n, &SVector::zeros(), &SVector::from([2.0, 1.0]), Default::default(), 6);
@@ -793,14 +794,6 @@ mod tests {
     /// draws differ from one resampling to the next.
     #[test]
     fn multinomial_by_chunks_draws_in_proportion_to_weight() {
-        struct Tilt;
-        impl ParticleLikelihood for Tilt {
-            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
-                for (lw, v) in log_w.iter_mut().zip(x[0]) {
-                    *lw += 2.0 * v - 0.5 * v * v;
-                }
-            }
-        }
         let n = 3 * CHUNK + 77;
         let settings = ParticleSettings { resampler: Resampler::Multinomial, ..ParticleSettings::default() };
         let mut pf = ParticleFilter::<1>::gaussian(n, &SVector::zeros(), &SVector::from([1.0]), settings, 8);
