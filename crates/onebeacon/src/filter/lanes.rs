@@ -336,9 +336,8 @@ lanes! {
     /// the i-th 64-bit draw of the counter-based stream of [`box_muller`] for `key`
     /// (so up to 22.9, where the mass beyond is 1.2e-10).
     pub fn exponentials(key: u64, out: &mut [f64]) {
-        const SCALE: f32 = 1.0 / 4_294_967_296.0;
         for (i, o) in out.iter_mut().enumerate() {
-            *o = f64::from(-ln1((hash1(key, i).0 as f32 + 0.5) * SCALE));
+            *o = f64::from(-ln_uniform(hash1(key, i).0));
         }
     }
 }
@@ -355,11 +354,16 @@ fn hash1(key: u64, i: usize) -> (u32, u32) {
     ((z >> 32) as u32, z as u32)
 }
 
+/// ln u for the uniform u = (k + 1/2) 2^-32 in (0, 1) of 32 random bits `k`.
+#[inline(always)]
+fn ln_uniform(k: u32) -> f32 {
+    ln1((k as f32 + 0.5) * (1.0 / 4_294_967_296.0))
+}
+
 /// The pair of normal draws of [`box_muller`] from the halves of one 64-bit draw.
 #[inline(always)]
 fn pair1(k1: u32, k2: u32) -> (f32, f32) {
-    const SCALE: f32 = 1.0 / 4_294_967_296.0;
-    let radius = (-2.0 * ln1((k1 as f32 + 0.5) * SCALE)).sqrt();
+    let radius = (-2.0 * ln_uniform(k1)).sqrt();
     let offset = ((k2 & 0x3fff_ffff) as i32 - 0x2000_0000) as f32 * (FRAC_PI_2 / 1_073_741_824.0);
     let (s, c) = sin_cos_reduced(offset, (k2 >> 30) as i32);
     (radius * s, radius * c)
@@ -547,7 +551,7 @@ mod tests {
             exponentials::at(level, 0xFEED, &mut e);
             for (i, v) in e.iter().enumerate() {
                 let k = black_box(hash1(0xFEED, i)).0;
-                assert_eq!(v.to_bits(), f64::from(-black_box(ln1((k as f32 + 0.5) / 4_294_967_296.0))).to_bits());
+                assert_eq!(v.to_bits(), f64::from(-black_box(ln_uniform(k))).to_bits());
             }
             let moments = angle_moments::at(level, &north, &east, &down, &w, station, centre);
             let mut acc = [[0.0; MOMENT_LANES]; 5];

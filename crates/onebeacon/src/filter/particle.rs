@@ -268,12 +268,7 @@ impl<const D: usize> ParticleFilter<D> {
     /// (from the sums of the chunks before it) and walks them along its particles.
     pub fn subsample<const K: usize>(&self, m: usize, k: [usize; K]) -> Vec<[f64; K]> {
         let w = self.normalised();
-        let totals: Vec<f64> = w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect();
-        let mut offsets = Vec::with_capacity(totals.len() + 1);
-        offsets.push(0.0);
-        for t in &totals {
-            offsets.push(offsets[offsets.len() - 1] + t);
-        }
+        let offsets = sums_before(&w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect::<Vec<f64>>());
         let point = |j: usize| (j as f64 + 0.5) / m as f64;
         // the first point at or past cumulative weight `c` (the last chunk takes the rest)
         let first_at = |c: f64| {
@@ -286,7 +281,7 @@ impl<const D: usize> ParticleFilter<D> {
             }
             j
         };
-        let (chunks, n, x) = (totals.len(), self.len(), &self.x);
+        let (chunks, n, x) = (offsets.len(), self.len(), &self.x);
         let picked: Vec<Vec<[f64; K]>> = (0..chunks)
             .into_par_iter()
             .map(|c| {
@@ -550,18 +545,24 @@ fn ess_of(w: &[f64]) -> f64 {
     1.0 / partial.iter().sum::<f64>()
 }
 
+/// The sum of the `totals` before each (in order: the same whatever the thread count
+/// that computed them).
+fn sums_before(totals: &[f64]) -> Vec<f64> {
+    let mut acc = 0.0;
+    totals
+        .iter()
+        .map(|t| {
+            let before = acc;
+            acc += t;
+            before
+        })
+        .collect()
+}
+
 /// Turns `w` into its running sum, by chunks in parallel (each chunk from the sum of
 /// those before it: the same whatever the thread count).
 fn cumulative_in_place(w: &mut [f64]) -> &[f64] {
-    let totals: Vec<f64> = w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect();
-    let offsets: Vec<f64> = totals
-        .iter()
-        .scan(0.0, |acc, t| {
-            let before = *acc;
-            *acc += t;
-            Some(before)
-        })
-        .collect();
+    let offsets = sums_before(&w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect::<Vec<f64>>());
     w.par_chunks_mut(CHUNK).zip(offsets.par_iter()).for_each(|(c, off)| {
         let mut acc = *off;
         for v in c.iter_mut() {
@@ -630,13 +631,8 @@ fn drawn_ancestors(
                     acc
                 })
                 .collect();
-            let mut before = Vec::with_capacity(totals.len());
-            let mut acc = 0.0;
-            for t in totals {
-                before.push(acc);
-                acc += t;
-            }
-            let total = acc - (1.0 - rng.random::<f64>()).ln();
+            let before = sums_before(&totals);
+            let total = totals.iter().sum::<f64>() - (1.0 - rng.random::<f64>()).ln();
             Drawn::Spacings { running, before, total }
         }
         Resampler::Residual => {
