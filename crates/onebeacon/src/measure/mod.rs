@@ -40,6 +40,12 @@ pub trait ScalarModel<const N: usize> {
     }
     /// The noise variance of a measurement taken at `x`.
     fn variance(&self, x: &SVector<f64, N>) -> f64;
+    /// The state component measured when the Jacobian is the unit row e_k at every x (a
+    /// state measured directly); the filter then picks that component instead of
+    /// multiplying by the row, to the same bits.
+    fn unit_row(&self) -> Option<usize> {
+        None
+    }
     /// A draw of the measurement noise at `x`: sqrt(variance) times a standard normal.
     fn noise<R: Rng + ?Sized>(&self, x: &SVector<f64, N>, rng: &mut R) -> f64
     where
@@ -71,6 +77,9 @@ impl<const N: usize, T: ScalarModel<N> + ?Sized> ScalarModel<N> for &T {
     fn variance(&self, x: &SVector<f64, N>) -> f64 {
         (**self).variance(x)
     }
+    fn unit_row(&self) -> Option<usize> {
+        (**self).unit_row()
+    }
 }
 
 /// Scalar models stacked into one vector measurement with independent components: h(x)
@@ -90,6 +99,9 @@ impl<const N: usize, const M: usize, T: ScalarModel<N>> MeasurementModel<N, M> f
     }
     fn is_angle(&self, i: usize) -> bool {
         self[i].is_angle()
+    }
+    fn unit_row(&self, i: usize) -> Option<usize> {
+        self[i].unit_row()
     }
     fn covariance(&self, x: &SVector<f64, N>) -> SMatrix<f64, M, M> {
         SMatrix::from_diagonal(&SVector::from_fn(|i, _| self[i].variance(x)))

@@ -39,6 +39,9 @@ impl<const N: usize> ScalarModel<N> for StateComponent {
     fn variance(&self, _x: &SVector<f64, N>) -> f64 {
         self.var
     }
+    fn unit_row(&self) -> Option<usize> {
+        Some(self.index)
+    }
 }
 
 #[cfg(test)]
