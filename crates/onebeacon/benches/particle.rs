@@ -61,6 +61,9 @@ fn bench(c: &mut Criterion) {
         b.iter_batched_ref(|| predicted.clone(), |pf| black_box(pf.reweight(&(ins, bearing))), LargeInput)
     });
     group.bench_function("resample", |b| b.iter_batched_ref(|| weighed.clone(), |pf| pf.resample(), LargeInput));
+    // the estimate the tracker reports after every step: mean and covariance, the heading
+    // an angle
+    group.bench_function("mean and covariance", |b| b.iter(|| black_box(weighed.mean_covariance_with_angle(Some(4)))));
     group.finish();
 }
 

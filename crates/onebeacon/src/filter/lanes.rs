@@ -410,6 +410,48 @@ lanes! {
     }
 }
 
+lanes! {
+    /// Adds particles to the weighted products of a particle filter's moments:
+    /// `products[p]` += (w_i x_k,i) x_l,i for the p-th pair (k, l) of `pairs` (a
+    /// component of ones gives the weighted sums), particle i in accumulator i mod 4 (the
+    /// order of a four-way dot product, whatever the vector width). `pairs` comes in
+    /// groups of four (pad with any pair and discard its sum): each group's four sums
+    /// advance together, so that no sum waits on its own last addition. `w`'s length is
+    /// a multiple of 4 and no component is shorter.
+    pub fn add_products(w: &[f64], x: &[&[f64]], pairs: &[(usize, usize)], products: &mut [[f64; 4]]) {
+        // a block's w x_k stay in the first level of cache for the pairs that read them
+        const BLOCK: usize = 128;
+        fn quads(s: &[f64], n: usize) -> &[[f64; 4]] {
+            &s[..n].as_chunks::<4>().0[..n / 4]
+        }
+        let mut wx = vec![0.0; x.len() * BLOCK];
+        for start in (0..w.len()).step_by(BLOCK) {
+            let n = BLOCK.min(w.len() - start);
+            let w = &w[start..start + n];
+            for (xk, wxk) in x.iter().zip(wx.chunks_exact_mut(BLOCK)) {
+                for ((wx, w), x) in wxk[..n].iter_mut().zip(w).zip(&xk[start..start + n]) {
+                    *wx = w * x;
+                }
+            }
+            for (group, acc) in pairs.chunks_exact(4).zip(products.chunks_exact_mut(4)) {
+                let a: [&[[f64; 4]]; 4] = std::array::from_fn(|q| quads(&wx[group[q].0 * BLOCK..], n));
+                let b: [&[[f64; 4]]; 4] = std::array::from_fn(|q| quads(&x[group[q].1][start..], n));
+                let quad = |c: usize| (a.map(|a| a[c]), b.map(|b| b[c]));
+                let mut sum: [[f64; 4]; 4] = std::array::from_fn(|q| acc[q]);
+                for c in 0..n / 4 {
+                    let (a, b) = quad(c);
+                    for q in 0..4 {
+                        for j in 0..4 {
+                            sum[q][j] += a[q][j] * b[q][j];
+                        }
+                    }
+                }
+                acc.copy_from_slice(&sum);
+            }
+        }
+    }
+}
+
 /// The azimuth and the angle from the vertical of [`angle_moments`] for one particle.
 #[inline(always)]
 fn angles1(north: f32, east: f32, down: f32, station: [f32; 2], centre: [f32; 2]) -> (f32, f32) {
@@ -561,6 +603,20 @@ mod tests {
             }
             let expected = acc.map(|m| ((m[0] + m[1]) + (m[2] + m[3])) + ((m[4] + m[5]) + (m[6] + m[7])));
             assert_eq!(moments.map(f64::to_bits), expected.map(f64::to_bits), "{level:?} angle moments");
+            // three components (ones among them: sums) and six pairs with two of padding
+            let ones = vec![1.0; 4096];
+            let comps = [&a[..4096], &b[..4096], &ones[..]];
+            let pairs = [(0, 2), (1, 2), (0, 0), (0, 1), (1, 1), (1, 0), (0, 0), (0, 0)];
+            let mut products = [[0.25; 4]; 8];
+            add_products::at(level, &positive[..4096], &comps, &pairs, &mut products);
+            let mut expected = [[0.25; 4]; 8];
+            for i in 0..4096 {
+                for (p, &(k, l)) in pairs[..6].iter().enumerate() {
+                    expected[p][i % 4] += black_box(black_box(positive[i] * comps[k][i]) * comps[l][i]);
+                }
+            }
+            let bits = |p: &[[f64; 4]]| p.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&products[..6]), bits(&expected[..6]), "{level:?} products");
         }
     }
 

@@ -355,8 +355,14 @@ impl<const D: usize> ParticleFilter<D> {
             let heaviest = w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b });
             x[k][heaviest.0]
         });
-        // per chunk: sum w x_k and sum w x_k x_l (k <= l), each a loop over contiguous
-        // arrays (vectorised), reduced in chunk order
+        // per chunk: sum w x_k (w x_k times a component of ones) and sum w x_k x_l
+        // (k <= l), each a four-way dot product over the chunk (in the lanes, the pairs in
+        // groups of four), reduced in chunk order
+        let mut pairs: Vec<(usize, usize)> =
+            (0..D).map(|k| (k, D)).chain((0..D).flat_map(|k| (k..D).map(move |l| (k, l)))).collect();
+        let used = pairs.len();
+        pairs.resize(used.next_multiple_of(4), (0, 0));
+        let ones = vec![1.0; CHUNK.min(w.len())];
         let partial: Vec<(SVector<f64, D>, SMatrix<f64, D, D>)> = (0..w.len().div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
@@ -366,14 +372,20 @@ impl<const D: usize> ParticleFilter<D> {
                     x[k][start..end].iter().map(|a| crate::geo::wrap_near(a - reference)).collect()
                 });
                 let comp = |k: usize| if Some(k) == angle { &wrapped[..] } else { &x[k][start..end] };
+                let comps: Vec<&[f64]> = (0..D).map(comp).chain([&ones[..w.len()]]).collect();
+                let whole = w.len() / 4 * 4;
+                let mut products = vec![[0.0; 4]; pairs.len()];
+                crate::filter::lanes::add_products(&w[..whole], &comps, &pairs, &mut products);
+                // the tail of fewer than four particles apart, as a four-way dot product
+                // sums it, then the four accumulators pairwise
                 let (mut s, mut ss) = (SVector::<f64, D>::zeros(), SMatrix::<f64, D, D>::zeros());
-                for k in 0..D {
-                    let xk = comp(k);
-                    s[k] = dot(w, xk);
-                    let wx: Vec<f64> = w.iter().zip(xk).map(|(w, x)| w * x).collect();
-                    for l in k..D {
-                        ss[(k, l)] = dot(&wx, comp(l));
-                        ss[(l, k)] = ss[(k, l)];
+                for (&(k, l), a) in pairs[..used].iter().zip(&products) {
+                    let tail: f64 = (whole..w.len()).map(|i| w[i] * comps[k][i] * comps[l][i]).sum();
+                    let total = (a[0] + a[1]) + (a[2] + a[3]) + tail;
+                    if l == D {
+                        s[k] = total;
+                    } else {
+                        (ss[(k, l)], ss[(l, k)]) = (total, total);
                     }
                 }
                 (s, ss)
@@ -523,20 +535,6 @@ fn ess_tempered(log_w: &[f64], inc: &[f64], lambda: f64) -> f64 {
         .collect();
     let (s, s2) = partial.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
     s * s / s2
-}
-
-/// sum a_i b_i with four accumulators (a loop the compiler vectorises; the order is
-/// fixed, so the result is the same on every run).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 4];
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = a4.remainder().iter().zip(b4.remainder()).map(|(a, b)| a * b).sum();
-    for (a, b) in a4.zip(b4) {
-        for j in 0..4 {
-            acc[j] += a[j] * b[j];
-        }
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// The effective sample size of normalised weights, 1 / sum w_i^2.
@@ -988,6 +986,58 @@ mod tests {
         for r in [Resampler::Residual, Resampler::Multinomial, Resampler::Systematic, Resampler::Stratified] {
             assert_eq!(run(1, r), run(3, r), "{r:?}");
         }
+    }
+
+    /// sum a_i b_i with four accumulators, the tail apart: the reference order.
+    fn dot(a: &[f64], b: &[f64]) -> f64 {
+        let mut acc = [0.0; 4];
+        let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+        let tail: f64 = a4.remainder().iter().zip(b4.remainder()).map(|(a, b)| a * b).sum();
+        for (a, b) in a4.zip(b4) {
+            for j in 0..4 {
+                acc[j] += a[j] * b[j];
+            }
+        }
+        (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+    }
+
+    /// The mean and covariance equal, to the bit, the chunk-by-chunk four-way dot
+    /// products written out pair by pair (8 components, an angle among them, a chunk and
+    /// a part with a tail of 3).
+    #[test]
+    fn mean_and_covariance_are_the_dot_products_of_each_chunk() {
+        let n = 2 * CHUNK + 4099;
+        let mean = SVector::<f64, 8>::from([0.5, 50.0, 30.0, 0.0, 3.0, 1.5, 0.0, 0.002]);
+        let sigma = SVector::<f64, 8>::from([2.0, 10.0, 2.0, 0.05, 0.5, 0.3, 0.001, 0.003]);
+        let mut pf = ParticleFilter::<8>::gaussian(n, &mean, &sigma, ParticleSettings::default(), 9);
+        pf.update(&Tilt);
+        let (m, c) = pf.mean_covariance_with_angle(Some(4));
+        let w = pf.normalised();
+        let reference =
+            pf.x[4][w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b }).0];
+        let (mut mean, mut second) = (SVector::<f64, 8>::zeros(), SMatrix::<f64, 8, 8>::zeros());
+        for start in (0..n).step_by(CHUNK) {
+            let end = (start + CHUNK).min(n);
+            let w = &w[start..end];
+            let comps: Vec<Vec<f64>> = (0..8)
+                .map(|k| {
+                    let x = &pf.x[k][start..end];
+                    if k == 4 { x.iter().map(|a| crate::geo::wrap_near(a - reference)).collect() } else { x.to_vec() }
+                })
+                .collect();
+            for k in 0..8 {
+                mean[k] += dot(w, &comps[k]);
+                let wx: Vec<f64> = w.iter().zip(&comps[k]).map(|(w, x)| w * x).collect();
+                for l in k..8 {
+                    second[(k, l)] += dot(&wx, &comps[l]);
+                    second[(l, k)] = second[(k, l)];
+                }
+            }
+        }
+        let cov = second - mean * mean.transpose();
+        mean[4] = crate::geo::wrap_near(mean[4] + reference);
+        assert!(m.iter().zip(mean.iter()).all(|(a, b)| a.to_bits() == b.to_bits()), "{m} {mean}");
+        assert!(c.iter().zip(cov.iter()).all(|(a, b)| a.to_bits() == b.to_bits()), "{c} {cov}");
     }
 
     /// An angle component across +-pi: the mean where the particles are (pi, not 0) and
