@@ -75,8 +75,11 @@ pub(crate) struct Lines {
 }
 
 impl Lines {
-    fn new(total: u64, unit: &str, message: String, every: Duration, out: Box<dyn Write + Send>) -> Self {
+    /// Starts with a line of the work to do, so that a log shows the work began before
+    /// its first unit is done (a campaign's first runs can take minutes).
+    fn new(total: u64, unit: &str, message: String, every: Duration, mut out: Box<dyn Write + Send>) -> Self {
         let now = Instant::now();
+        let _ = writeln!(out, "{message}: 0/{total} {unit}, started");
         Self { message, unit: unit.to_string(), total, done: 0, start: now, last: now, every, out }
     }
 
@@ -147,9 +150,10 @@ mod tests {
         }
     }
 
-    /// 10 runs, one every 2 s, a line every 5 s: lines after runs 3, 6 and 9 (at 6, 12
-    /// and 18 s: the first run at or past 5 s since the last line), none at the last
-    /// run, then the total; the rate and time left from the runs done so far.
+    /// 10 runs, one every 2 s, a line every 5 s: a line at the start, lines after runs
+    /// 3, 6 and 9 (at 6, 12 and 18 s: the first run at or past 5 s since the last line),
+    /// none at the last run, then the total; the rate and time left from the runs done
+    /// so far.
     #[test]
     fn lines_come_every_interval_with_rate_and_time_left_then_the_total() {
         let out = Shared::default();
@@ -160,7 +164,8 @@ mod tests {
         }
         lines.finish(t0 + Duration::from_secs(20));
         let text = String::from_utf8(out.0.lock().unwrap().clone()).unwrap();
-        let expected = "mc x: 3/10 runs (30 %), 2.00 s per run, 14 s left\n\
+        let expected = "mc x: 0/10 runs, started\n\
+                        mc x: 3/10 runs (30 %), 2.00 s per run, 14 s left\n\
                         mc x: 6/10 runs (60 %), 2.00 s per run, 8.00 s left\n\
                         mc x: 9/10 runs (90 %), 2.00 s per run, 2.00 s left\n\
                         mc x: 10/10 runs in 20 s\n";
