@@ -1,10 +1,12 @@
 //! Progress of long work on stderr: a bar when stderr is a terminal; otherwise plain
-//! lines (done of total, rate, time left) every few seconds and one at the end, so that
-//! a campaign whose stderr goes to a file (a Slurm shard's log, `2> log`) shows how far
-//! it is.
+//! lines (done of total, rate, time left) every few seconds, also while no unit
+//! finishes (a thread of their own writes them), and one at the end, so that a campaign
+//! whose stderr goes to a file (a Slurm shard's log, `2> log`) shows how far it is.
 
 use std::io::Write;
-use std::sync::Mutex;
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// How often a plain line is written while work goes on.
@@ -13,7 +15,7 @@ const LINE_EVERY: Duration = Duration::from_secs(5);
 /// Progress of `total` units of work, safe to advance from worker threads.
 pub(crate) enum Progress {
     Bar(indicatif::ProgressBar),
-    Lines(Mutex<Lines>),
+    Lines(Ticker),
     Hidden,
 }
 
@@ -22,8 +24,8 @@ impl Progress {
     /// stderr otherwise.
     pub(crate) fn new(total: u64, unit: &str, message: String) -> Self {
         if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-            let lines = Lines::new(total, unit, message, LINE_EVERY, Box::new(std::io::stderr()));
-            return Self::Lines(Mutex::new(lines));
+            let lines = Lines::new(total, unit, message, Box::new(std::io::stderr()));
+            return Self::Lines(Ticker::start(lines, LINE_EVERY));
         }
         let bar = indicatif::ProgressBar::new(total);
         let template = format!("{{msg}} {{pos}}/{{len}} {unit} [{{wide_bar}}] eta {{eta}}");
@@ -38,7 +40,7 @@ impl Progress {
     pub(crate) fn inc(&self, n: u64) {
         match self {
             Self::Bar(b) => b.inc(n),
-            Self::Lines(l) => l.lock().unwrap_or_else(|e| e.into_inner()).advance(n, Instant::now()),
+            Self::Lines(t) => t.lines().done += n,
             Self::Hidden => {}
         }
     }
@@ -47,7 +49,7 @@ impl Progress {
     pub(crate) fn set_message(&self, message: String) {
         match self {
             Self::Bar(b) => b.set_message(message),
-            Self::Lines(l) => l.lock().unwrap_or_else(|e| e.into_inner()).message = message,
+            Self::Lines(t) => t.lines().message = message,
             Self::Hidden => {}
         }
     }
@@ -56,10 +58,58 @@ impl Progress {
     pub(crate) fn finish(&self) {
         match self {
             Self::Bar(b) => b.finish_and_clear(),
-            Self::Lines(l) => l.lock().unwrap_or_else(|e| e.into_inner()).finish(Instant::now()),
+            Self::Lines(t) => {
+                t.stop();
+                t.lines().finish(Instant::now());
+            }
             Self::Hidden => {}
         }
     }
+}
+
+/// A thread that writes a line every interval until stopped (by `finish`, or when
+/// dropped: work that ends in an error writes no total).
+pub(crate) struct Ticker {
+    lines: Arc<Mutex<Lines>>,
+    stop: Mutex<Option<mpsc::Sender<()>>>,
+    thread: Mutex<Option<JoinHandle<()>>>,
+}
+
+impl Ticker {
+    fn start(lines: Lines, every: Duration) -> Self {
+        let lines = Arc::new(Mutex::new(lines));
+        let (stop, stopped) = mpsc::channel::<()>();
+        let shared = Arc::clone(&lines);
+        let thread = std::thread::spawn(move || {
+            while let Err(RecvTimeoutError::Timeout) = stopped.recv_timeout(every) {
+                lock(&shared).line(Instant::now());
+            }
+        });
+        Self { lines, stop: Mutex::new(Some(stop)), thread: Mutex::new(Some(thread)) }
+    }
+
+    fn lines(&self) -> MutexGuard<'_, Lines> {
+        lock(&self.lines)
+    }
+
+    /// Stops the thread and waits for it (a line it is writing is written whole).
+    fn stop(&self) {
+        drop(lock(&self.stop).take());
+        if let Some(thread) = lock(&self.thread).take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+impl Drop for Ticker {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
+
+/// A lock that a panicked holder does not poison for the others.
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// The plain-line reporter.
@@ -69,45 +119,34 @@ pub(crate) struct Lines {
     total: u64,
     done: u64,
     start: Instant,
-    last: Instant,
-    every: Duration,
     out: Box<dyn Write + Send>,
 }
 
 impl Lines {
-    /// Starts with a line of the work to do, so that a log shows the work began before
-    /// its first unit is done (a campaign's first runs can take minutes).
-    fn new(total: u64, unit: &str, message: String, every: Duration, mut out: Box<dyn Write + Send>) -> Self {
-        let now = Instant::now();
-        let _ = writeln!(out, "{message}: 0/{total} {unit}, started");
-        Self { message, unit: unit.to_string(), total, done: 0, start: now, last: now, every, out }
+    fn new(total: u64, unit: &str, message: String, out: Box<dyn Write + Send>) -> Self {
+        Self { message, unit: unit.to_string(), total, done: 0, start: Instant::now(), out }
     }
 
-    fn advance(&mut self, n: u64, now: Instant) {
-        self.done += n;
-        if now.duration_since(self.last) < self.every || self.done >= self.total {
+    /// A line of how far the work is at `now`: before the first unit the time so far,
+    /// then the rate and the time left at that rate.
+    fn line(&mut self, now: Instant) {
+        let elapsed = now.duration_since(self.start).as_secs_f64();
+        let (done, total, unit) = (self.done, self.total, &self.unit);
+        let percent = 100.0 * done as f64 / total.max(1) as f64;
+        let head = format!("{}: {done}/{total} {unit} ({percent:.0} %)", self.message);
+        if done == 0 {
+            let _ = writeln!(self.out, "{head}, {} so far", duration(elapsed));
             return;
         }
-        self.last = now;
-        let elapsed = now.duration_since(self.start).as_secs_f64();
-        let rate = self.done as f64 / elapsed.max(1e-9);
-        let left = (self.total - self.done) as f64 / rate.max(1e-12);
+        let rate = done as f64 / elapsed.max(1e-9);
+        let left = total.saturating_sub(done) as f64 / rate.max(1e-12);
         // the rate as units a second when they are quicker than a second each
         let pace = if rate > 1.0 {
-            format!("{rate:.1} {}/s", self.unit)
+            format!("{rate:.1} {unit}/s")
         } else {
-            format!("{} per {}", duration(1.0 / rate), self.unit.trim_end_matches('s'))
+            format!("{} per {}", duration(1.0 / rate), unit.trim_end_matches('s'))
         };
-        let _ = writeln!(
-            self.out,
-            "{}: {}/{} {} ({:.0} %), {pace}, {} left",
-            self.message,
-            self.done,
-            self.total,
-            self.unit,
-            100.0 * self.done as f64 / self.total.max(1) as f64,
-            duration(left)
-        );
+        let _ = writeln!(self.out, "{head}, {pace}, {} left", duration(left));
     }
 
     fn finish(&mut self, now: Instant) {
@@ -150,26 +189,56 @@ mod tests {
         }
     }
 
-    /// 10 runs, one every 2 s, a line every 5 s: a line at the start, lines after runs
-    /// 3, 6 and 9 (at 6, 12 and 18 s: the first run at or past 5 s since the last line),
-    /// none at the last run, then the total; the rate and time left from the runs done
-    /// so far.
+    /// 10 runs, one every 2 s, lines at 1, 5, 11 and 15 s: the time so far before the
+    /// first run, then the runs done, the rate and the time left at that rate; then the
+    /// total.
     #[test]
-    fn lines_come_every_interval_with_rate_and_time_left_then_the_total() {
+    fn lines_give_the_rate_and_time_left_then_the_total() {
         let out = Shared::default();
-        let mut lines = Lines::new(10, "runs", "mc x".into(), Duration::from_secs(5), Box::new(out.clone()));
+        let mut lines = Lines::new(10, "runs", "mc x".into(), Box::new(out.clone()));
         let t0 = lines.start;
+        let at = |s: f64| t0 + Duration::from_secs_f64(s);
+        lines.line(at(1.0));
         for k in 1..=10 {
-            lines.advance(1, t0 + Duration::from_secs(2 * k));
+            lines.done += 1;
+            if k == 2 || k == 5 || k == 7 {
+                lines.line(at(f64::from(2 * k + 1)));
+            }
         }
-        lines.finish(t0 + Duration::from_secs(20));
+        lines.finish(at(20.0));
         let text = String::from_utf8(out.0.lock().unwrap().clone()).unwrap();
-        let expected = "mc x: 0/10 runs, started\n\
-                        mc x: 3/10 runs (30 %), 2.00 s per run, 14 s left\n\
-                        mc x: 6/10 runs (60 %), 2.00 s per run, 8.00 s left\n\
-                        mc x: 9/10 runs (90 %), 2.00 s per run, 2.00 s left\n\
+        let expected = "mc x: 0/10 runs (0 %), 1.00 s so far\n\
+                        mc x: 2/10 runs (20 %), 2.50 s per run, 20 s left\n\
+                        mc x: 5/10 runs (50 %), 2.20 s per run, 11 s left\n\
+                        mc x: 7/10 runs (70 %), 2.14 s per run, 6.43 s left\n\
                         mc x: 10/10 runs in 20 s\n";
         assert_eq!(text, expected);
+    }
+
+    /// The thread writes lines while no unit is done, and stops on `finish` (no line
+    /// after the total, while the progress lives on) and on drop (no total).
+    #[test]
+    fn the_ticker_writes_while_no_unit_finishes_and_stops() {
+        let read = |s: &Shared| String::from_utf8(s.0.lock().unwrap().clone()).unwrap();
+        let out = Shared::default();
+        let every = Duration::from_millis(20);
+        let progress =
+            Progress::Lines(Ticker::start(Lines::new(3, "runs", "mc y".into(), Box::new(out.clone())), every));
+        std::thread::sleep(Duration::from_millis(150));
+        progress.finish();
+        let text = read(&out);
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(lines.len() >= 3, "{text}");
+        let (total, ticks) = lines.split_last().unwrap();
+        assert!(ticks.iter().all(|l| l.starts_with("mc y: 0/3 runs (0 %), ") && l.ends_with(" so far")), "{text}");
+        assert!(total.starts_with("mc y: 0/3 runs in "), "{text}");
+        std::thread::sleep(Duration::from_millis(100));
+        assert_eq!(read(&out), text, "a line after the total");
+        drop(progress);
+
+        let dropped = Shared::default();
+        drop(Ticker::start(Lines::new(3, "runs", "mc z".into(), Box::new(dropped.clone())), Duration::from_secs(60)));
+        assert_eq!(read(&dropped), "", "a dropped ticker wrote");
     }
 
     #[test]
