@@ -71,8 +71,8 @@ impl Progress {
 /// dropped: work that ends in an error writes no total).
 pub(crate) struct Ticker {
     lines: Arc<Mutex<Lines>>,
-    stop: Mutex<Option<mpsc::Sender<()>>>,
-    thread: Mutex<Option<JoinHandle<()>>>,
+    /// The thread and the sender whose drop stops it, until stopped.
+    running: Mutex<Option<(mpsc::Sender<()>, JoinHandle<()>)>>,
 }
 
 impl Ticker {
@@ -85,7 +85,7 @@ impl Ticker {
                 lock(&shared).line(Instant::now());
             }
         });
-        Self { lines, stop: Mutex::new(Some(stop)), thread: Mutex::new(Some(thread)) }
+        Self { lines, running: Mutex::new(Some((stop, thread))) }
     }
 
     fn lines(&self) -> MutexGuard<'_, Lines> {
@@ -94,8 +94,8 @@ impl Ticker {
 
     /// Stops the thread and waits for it (a line it is writing is written whole).
     fn stop(&self) {
-        drop(lock(&self.stop).take());
-        if let Some(thread) = lock(&self.thread).take() {
+        if let Some((stop, thread)) = lock(&self.running).take() {
+            drop(stop);
             let _ = thread.join();
         }
     }

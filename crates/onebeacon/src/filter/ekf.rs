@@ -152,6 +152,7 @@ impl<const N: usize> GaussianFilter<N> for Ekf<N> {
             return Err(FilterError::NonFinite);
         }
         let pht = times_ht(model, &h, &self.p);
+        // S = H (P H') + R, with H (P H') = ((P H')' H')'
         let s = times_ht(model, &h, &pht.transpose()).transpose() + r;
         // Cholesky proves S positive definite; the closed-form inverse of small
         // matrices is several times faster than inverting through the factor.

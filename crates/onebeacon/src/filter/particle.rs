@@ -268,7 +268,7 @@ impl<const D: usize> ParticleFilter<D> {
     /// (from the sums of the chunks before it) and walks them along its particles.
     pub fn subsample<const K: usize>(&self, m: usize, k: [usize; K]) -> Vec<[f64; K]> {
         let w = self.normalised();
-        let offsets = sums_before(&w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect::<Vec<f64>>());
+        let offsets = weight_before_chunks(w);
         let point = |j: usize| (j as f64 + 0.5) / m as f64;
         // the first point at or past cumulative weight `c` (the last chunk takes the rest)
         let first_at = |c: f64| {
@@ -557,10 +557,15 @@ fn sums_before(totals: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// The weight of the chunks before each chunk of `w` (summed by chunks in parallel).
+fn weight_before_chunks(w: &[f64]) -> Vec<f64> {
+    sums_before(&w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect::<Vec<f64>>())
+}
+
 /// Turns `w` into its running sum, by chunks in parallel (each chunk from the sum of
 /// those before it: the same whatever the thread count).
 fn cumulative_in_place(w: &mut [f64]) -> &[f64] {
-    let offsets = sums_before(&w.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect::<Vec<f64>>());
+    let offsets = weight_before_chunks(w);
     w.par_chunks_mut(CHUNK).zip(offsets.par_iter()).for_each(|(c, off)| {
         let mut acc = *off;
         for v in c.iter_mut() {
