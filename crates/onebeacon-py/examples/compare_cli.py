@@ -4,7 +4,7 @@
    whether the cells are identical, and each one's wall time (best of ROUNDS);
 2. one navigator update from Python (`Navigator.feed` of a range, then of an odometry
    item, on plaza1's configuration) per call, to set beside the Rust bench
-   `cargo bench -p onebeacon-sim --bench replay -- "session push"`.
+   `cargo bench -p onebeacon-bench --bench replay -- "session push"`.
 
     python compare_cli.py [SCENARIO] [ROUNDS]      (CLI: $ONEBEACON_CLI or target/release/onebeacon)
 """

@@ -31,6 +31,44 @@ fn replay_is_the_session_fed_item_by_item() {
     assert_eq!(r.items, 4091 + 4090 + 1816); // every CSV row of the three sources
 }
 
+/// The replay's dead reckoning on plaza1 ends where the odometry CSV, integrated here
+/// by hand from the first ground-truth pose (its heading column, as plaza1.toml says),
+/// puts it: to a micrometre, under one of the three ways a row's heading change may
+/// meet its distance (turn then move, move then turn, move at the mid heading). The
+/// three end points lie metres apart, so the test tells them apart.
+#[test]
+fn dead_reckoning_ends_where_the_odometry_integrated_by_hand_puts_it() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/plaza");
+    let rows = |file: &str| -> Vec<Vec<f64>> {
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        text.lines().skip(1).map(|l| l.split(',').map(|v| v.trim().parse().unwrap()).collect()).collect()
+    };
+    let start = &rows("plaza1_ground_truth.csv")[0];
+    let mut odometry = rows("plaza1_odometry.csv");
+    odometry.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    // the heading at which a row's distance is travelled, as a fraction of its turn
+    let by_hand = |turned_before: f64| {
+        let (mut x, mut y, mut h) = (start[1], start[2], start[3]); // east, north, heading from east
+        for r in odometry.iter().filter(|r| r[0] > start[0]) {
+            let (d, dh) = (r[1], r[2]);
+            let at = h + turned_before * dh;
+            (x, y, h) = (x + d * at.cos(), y + d * at.sin(), h + dh);
+        }
+        (x, y)
+    };
+    let ends = [by_hand(1.0), by_hand(0.0), by_hand(0.5)];
+    let l = log(1);
+    let r = replay(&l, None, |_| Ok::<_, LogError>(())).unwrap();
+    let dr = r.session.names.iter().position(|n| n == "dead-reckoning").unwrap();
+    let e = r.session.final_estimates()[dr];
+    // the log is east-north-up; estimates are north-east-down
+    let (north, east) = (e.position_ned_m.x, e.position_ned_m.y);
+    let off: Vec<f64> = ends.iter().map(|(x, y)| (north - y).hypot(east - x)).collect();
+    assert!(off.iter().any(|&o| o < 1e-6), "dead reckoning ends at ({east}, {north}); by hand {ends:?}");
+    let (a, b) = (ends[0], ends[1]);
+    assert!((a.0 - b.0).hypot(a.1 - b.1) > 0.1, "the conventions must differ: {ends:?}");
+}
+
 #[test]
 #[ignore]
 fn measure_plaza_table() {
