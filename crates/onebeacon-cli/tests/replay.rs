@@ -524,3 +524,58 @@ fn smooth_matches_gtsam_on_plaza2_and_refuses_bad_flags() {
     assert!(err.contains("line 3, column `r`"), "{err}");
     assert!(!bad.exists());
 }
+
+/// README's "Your own log": its TOML block, word for word, replays a synthetic dive
+/// (1 m/s due east from its given start, for 10 min; exact speed, heading and ranges
+/// to the beacon, so each estimator ends on the truth, 600 m east of the start, within
+/// the ranges' and the speed's rounding); and its "On a vehicle" line streams through
+/// it. A README whose keys no longer parse fails here.
+#[test]
+fn the_readme_log_description_runs_as_written() {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md")).unwrap();
+    let block = |after: &str, fence: &str| -> String {
+        let rest = &readme[readme.find(after).unwrap_or_else(|| panic!("README has no {after}"))..];
+        let start = rest.find(fence).unwrap() + fence.len();
+        rest[start..start + rest[start..].find("```").unwrap()].to_string()
+    };
+    let dir = scratch("readme");
+    std::fs::write(dir.join("my-dive.toml"), block("## Your own log", "```toml\n")).unwrap();
+    let (start, speed) = ((120.0, -40.0), 1.0);
+    let mut nav = String::from("t_s,speed_m_s,heading_deg\n");
+    let mut ranges = String::from("t_s,beacon,range_m\n");
+    for i in 0..=600 {
+        let t = f64::from(i);
+        nav.push_str(&format!("{t},{speed},90\n"));
+        if i % 5 == 0 && i > 0 {
+            let (north, east) = (start.0, start.1 + speed * t);
+            ranges.push_str(&format!("{t},1,{:.3}\n", f64::hypot(north, east)));
+        }
+    }
+    std::fs::write(dir.join("nav.csv"), nav).unwrap();
+    std::fs::write(dir.join("ranges.csv"), ranges).unwrap();
+    let config = dir.join("my-dive.toml").display().to_string();
+    let out = dir.join("out").display().to_string();
+    let o = run(&["replay", &config, "--out", &out, "--json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let trajectory = std::fs::read_to_string(dir.join("out").join("trajectory.csv")).unwrap();
+    let mut lines = trajectory.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let last: Vec<f64> = lines.last().unwrap().split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect();
+    for name in ["dead-reckoning", "ekf"] {
+        let at = |c: &str| last[header.iter().position(|h| *h == format!("{name}_{c}")).unwrap()];
+        let (north, east) = (at("north_m"), at("east_m"));
+        let off = (north - start.0).hypot(east - (start.1 + 600.0 * speed));
+        assert!(off < 0.5, "{name} ends at ({north}, {east}), {off} m off");
+    }
+    // the JSON lines the README's shell block quotes, one estimate line out for each
+    let shell = block("## On a vehicle", "```sh\n");
+    let lines: Vec<&str> = shell.split('\'').filter(|q| q.starts_with('{')).collect();
+    assert_eq!(lines.len(), 3, "{lines:?}");
+    let o = stream(&config, (lines.join("\n") + "\n").into_bytes());
+    assert!(o.status.success() && o.stderr.is_empty(), "{}", text(&o.stderr));
+    let out: Vec<Value> = text(&o.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(out.len(), 3, "{out:?}");
+    let ekf = &out[2]["estimates"][1];
+    assert_eq!(ekf["name"], "ekf");
+    assert_eq!(ekf["outcome"], "accepted", "{ekf}");
+}

@@ -1,6 +1,9 @@
 //! Properties of the garin2024 reproduction at Monte Carlo counts small enough for CI.
 //! The full reproduction is `onebeacon mc garin2024` (300 runs).
 
+mod common;
+
+use common::t_interval_99;
 use onebeacon_sim::metrics::CellSummary;
 use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::scenario::{Scenario, builtin, parse};
@@ -17,8 +20,26 @@ fn cell<'a>(r: &'a onebeacon_sim::montecarlo::McResult, cell: usize, name: &str)
     &r.cells[cell].estimators.iter().find(|(n, _)| n.label == name).unwrap().1
 }
 
+/// The runs whose mean error lies within q1 - 1.5 IQR .. q3 + 1.5 IQR of all of them
+/// (quartiles by linear interpolation).
+fn inliers(runs: &[f64]) -> Vec<f64> {
+    let mut sorted = runs.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let q = |p: f64| {
+        let x = p * (sorted.len() - 1) as f64;
+        let (i, f) = (x.floor() as usize, x.fract());
+        sorted[i] + f * (sorted[(i + 1).min(sorted.len() - 1)] - sorted[i])
+    };
+    let (q1, q3) = (q(0.25), q(0.75));
+    let fence = 1.5 * (q3 - q1);
+    runs.iter().copied().filter(|&v| v >= q1 - fence && v <= q3 + fence).collect()
+}
+
 /// range+doppler beats range-only at short and long T_com; error grows with T_com; at
-/// T_com = 3 s the error is of the paper's size (3.61 m; accepted 2.5-5 m).
+/// T_com = 3 s the mean error is within 10 % of the paper's 3.61 m (Table 3, what
+/// docs/reproductions.md claims), up to the sampling of these 40 runs: the 99 % t
+/// interval of the inlier runs' mean (section 4.1.1's 1.5 IQR rule, applied here by
+/// hand) must reach within 10 % of 3.61 m.
 #[test]
 fn range_doppler_beats_rosb_and_error_grows_with_t_com() {
     let s = garin(&[3.0, 20.0]);
@@ -29,7 +50,9 @@ fn range_doppler_beats_rosb_and_error_grows_with_t_com() {
         "T_com 3: {:.3} vs {:.3}; T_com 20: {:.3} vs {:.3}",
         rd3.mean_error_m, rosb3.mean_error_m, rd20.mean_error_m, rosb20.mean_error_m
     );
-    assert!((2.5..5.0).contains(&rd3.mean_error_m), "range+doppler at 3 s: {}", rd3.mean_error_m);
+    let (lo, hi) = t_interval_99(&inliers(&rd3.run_mean_errors_m));
+    let (paper, within) = (3.61, 0.1 * 3.61);
+    assert!(lo <= paper + within && hi >= paper - within, "range+doppler at 3 s: {lo:.3}-{hi:.3} m against {paper} m");
     assert!(rd3.mean_error_m < rosb3.mean_error_m);
     assert!(rd20.mean_error_m < rosb20.mean_error_m);
     assert!(rd20.mean_error_m > rd3.mean_error_m + 1.0);
