@@ -1,8 +1,7 @@
-//! The real plaza logs (data/plaza) through the replay engine. The table of the closing
-//! note: `cargo test --release -p onebeacon-sim --test plaza -- --ignored --nocapture`.
+//! The real plaza logs (data/plaza) through the replay engine (the table of
+//! docs/reproductions.md: `scripts/reproduce --only plaza`).
 
 use onebeacon_sim::replay::{Log, LogError, replay};
-use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 fn log(n: u8) -> Log {
@@ -55,34 +54,4 @@ fn dead_reckoning_ends_where_the_odometry_integrated_by_hand_puts_it() {
     assert!(off.iter().any(|&o| o < 1e-6), "dead reckoning ends at ({east}, {north}); by hand {ends:?}");
     let (a, b) = (ends[0], ends[1]);
     assert!((a.0 - b.0).hypot(a.1 - b.1) > 0.1, "the conventions must differ: {ends:?}");
-}
-
-#[test]
-#[ignore]
-fn measure_plaza_table() {
-    for n in [1, 2] {
-        let l = log(n);
-        let names = replay(&l, None, |_| Ok::<_, LogError>(())).unwrap().session.names;
-        eprintln!("| plaza{n} beacons | {} |", names.join(" | "));
-        for b in [None, Some(0), Some(1), Some(5), Some(6)] {
-            let r = replay(&l, b.map(|b| BTreeSet::from([b])), |_| Ok::<_, LogError>(())).unwrap();
-            let cells: Vec<String> = r
-                .session
-                .stats
-                .iter()
-                .zip(r.session.final_estimates())
-                .map(|(s, e)| {
-                    format!(
-                        "{:.2} [{} rej, b {:.2}, kr {:.3}, kt {:.3}]",
-                        s.rmse_m(),
-                        s.rejected,
-                        e.range_bias_m,
-                        e.range_scale,
-                        e.turn_scale
-                    )
-                })
-                .collect();
-            eprintln!("| {} | {} |", b.map_or("all".into(), |b| b.to_string()), cells.join(" | "));
-        }
-    }
 }
