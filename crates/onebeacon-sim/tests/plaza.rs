@@ -21,7 +21,8 @@ fn dead_reckoning_ends_where_the_odometry_integrated_by_hand_puts_it() {
         let text = std::fs::read_to_string(dir.join(file)).unwrap();
         text.lines().skip(1).map(|l| l.split(',').map(|v| v.trim().parse().unwrap()).collect()).collect()
     };
-    let start = &rows("plaza1_ground_truth.csv")[0];
+    let truth = rows("plaza1_ground_truth.csv");
+    let start = &truth[0];
     let mut odometry = rows("plaza1_odometry.csv");
     odometry.sort_by(|a, b| a[0].total_cmp(&b[0]));
     // the heading at which a row's distance is travelled, as a fraction of its turn
@@ -43,9 +44,8 @@ fn dead_reckoning_ends_where_the_odometry_integrated_by_hand_puts_it() {
     })
     .unwrap();
     // one row scored per ground-truth pose, every CSV row of the three sources read
-    let lines = |file: &str| std::fs::read_to_string(dir.join(file)).unwrap().lines().count() - 1;
-    assert_eq!(scored, lines("plaza1_ground_truth.csv"));
-    assert_eq!(r.items, lines("plaza1_ground_truth.csv") + lines("plaza1_odometry.csv") + lines("plaza1_ranges.csv"));
+    assert_eq!(scored, truth.len());
+    assert_eq!(r.items, truth.len() + odometry.len() + rows("plaza1_ranges.csv").len());
     let dr = r.session.names.iter().position(|n| n == "dead-reckoning").unwrap();
     let e = r.session.final_estimates()[dr];
     // the log is east-north-up; estimates are north-east-down

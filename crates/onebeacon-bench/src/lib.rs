@@ -1,1 +1,0 @@
-//! Nothing but the benchmarks in `benches/` (criterion): `cargo bench -p onebeacon-bench`.
