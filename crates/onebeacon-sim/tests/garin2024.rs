@@ -1,9 +1,7 @@
 //! Properties of the garin2024 reproduction at Monte Carlo counts small enough for CI.
 //! The full reproduction is `onebeacon mc garin2024` (300 runs).
 
-mod common;
-
-use common::t_interval_99;
+use crate::common::t_interval_99;
 use onebeacon_sim::metrics::CellSummary;
 use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::scenario::{Scenario, builtin, parse};

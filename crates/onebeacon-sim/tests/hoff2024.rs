@@ -2,9 +2,7 @@
 //! particle filter's consistency, and results that do not depend on the thread count.
 //! The full reproduction is `onebeacon mc hoff2024` (5e5 particles, 1 h, 20 runs).
 
-mod common;
-
-use common::t_interval_99;
+use crate::common::t_interval_99;
 use onebeacon_sim::montecarlo::monte_carlo;
 use onebeacon_sim::scenario::passive_usbl::GuidanceKind;
 use onebeacon_sim::scenario::{Scenario, builtin, parse};

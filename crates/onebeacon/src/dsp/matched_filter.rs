@@ -222,10 +222,10 @@ impl RangeEstimate {
 }
 
 /// The detection threshold of [`RangeEstimate::peak_ratio`] for 8000-lag captures (5
-/// elements, the rypkema chirps): no noise-only capture of 2000 exceeded 0.058 (median
-/// 0.035), so the false-alarm rate is below 1/2000 per capture; pulses at 20 dB 2E/N0
-/// per element give 0.22 or more in 99 % of pings, at 10 dB half of them pass
-/// (`measure_detection_statistic` in tests/dsp_chain.rs of onebeacon-sim).
+/// elements, the rypkema chirps): no noise-only capture of 2000 reached it (median
+/// 0.035), every ping of 300 at 20 dB 2E/N0 per element did (0.22 or more), at 10 dB
+/// about one in five (docs/reproductions.md, the receiver chain; the example
+/// `dsp_trials` of onebeacon-sim).
 pub const DETECTION_THRESHOLD_8000: f64 = 0.07;
 
 /// [`DETECTION_THRESHOLD_8000`] scaled to `lags` lags.
