@@ -37,14 +37,29 @@ type Area<DB> = DrawingArea<DB, plotters::coord::Shift>;
 macro_rules! both {
     ($path:expr, $size:expr, |$root:ident| $draw:expr) => {{
         let (path, size): (&Path, (u32, u32)) = ($path, $size);
+        let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
         {
-            let $root = BitMapBackend::new(path, size).into_drawing_area();
+            let $root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
             $draw?;
         }
+        crate::plot::write_png(path, size, &rgb)?;
         let svg = path.with_extension("svg");
         let $root = SVGBackend::new(&svg, size).into_drawing_area();
         $draw
     }};
+}
+
+/// Writes 8-bit RGB pixels, row by row, as the PNG `path` (the png crate: plotters' own
+/// encoder would pull in the whole `image` crate for this one format).
+fn write_png(path: &Path, (width, height): (u32, u32), rgb: &[u8]) -> Result<()> {
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(rgb)?;
+    writer.finish()?;
+    Ok(())
 }
 
 fn colour(i: usize) -> RGBColor {
