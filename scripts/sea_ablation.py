@@ -51,31 +51,30 @@ def variant(parts, keep):
     return text
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("scenario")
-    ap.add_argument("--runs", type=int)
-    ap.add_argument("--bin", default=str(ROOT / "target/release/onebeacon"))
-    ap.add_argument("--out")
-    a = ap.parse_args()
-    path = pathlib.Path(a.scenario)
+def ablate(scenario, runs=None, binary=str(ROOT / "target/release/onebeacon"), out=None):
+    """Runs the variants of the scenario file `scenario`: none of its sources, each alone,
+    all. Returns the variants' labels, the estimators, and per (label, estimator) the mean
+    of the run means, the half-width of its 95 % interval, the mean NEES over every run and
+    the run count; and `out`, where each variant's TOML and mc.json went (default
+    /tmp/ablation_NAME)."""
+    path = pathlib.Path(scenario)
     try:
         text = path.read_text()
     except OSError as e:
-        sys.exit(f"{a.scenario}: {e.strerror}")
+        sys.exit(f"{scenario}: {e.strerror}")
     parts = blocks(text)
     sources = [h for h, _ in parts if is_source(h)]
     if not sources:
-        sys.exit(f"{a.scenario}: no [sea.*] or [current] table: nothing to ablate")
+        sys.exit(f"{scenario}: no [sea.*] or [current] table: nothing to ablate")
     name = re.search(r'^name\s*=\s*"([^"]+)"', text, re.M)
-    out = pathlib.Path(a.out or f"/tmp/ablation_{name.group(1) if name else path.stem}")
+    out = pathlib.Path(out or f"/tmp/ablation_{name.group(1) if name else path.stem}")
     out.mkdir(parents=True, exist_ok=True)
     rows = [("none", [])] + [(s, [s]) for s in sources] + [("all", sources)]
     table = {}
     for label, keep in rows:
         toml = out / f"{label}.toml"
         toml.write_text(variant(parts, keep))
-        cmd = [a.bin, "mc", str(toml), "--json"] + (["--runs", str(a.runs)] if a.runs else [])
+        cmd = [binary, "mc", str(toml), "--json"] + (["--runs", str(runs)] if runs else [])
         print(f"{label}: {' '.join(cmd)}", file=sys.stderr, flush=True)
         run = subprocess.run(cmd, capture_output=True, text=True)
         if run.returncode != 0:
@@ -88,16 +87,29 @@ def main():
             sd = math.sqrt(sum((e - mean) ** 2 for e in errs) / (n - 1)) if n > 1 else float("nan")
             table[(label, c["estimator"])] = (mean, 1.96 * sd / math.sqrt(n), c["nees_mean_all_runs"], n)
     estimators = list(dict.fromkeys(e for _, e in table))
+    return [label for label, _ in rows], estimators, table, out
+
+
+def cell(entry):
+    """One table cell: mean error (+- the 95 % half-width) / mean NEES."""
+    mean, ci, nees, _ = entry
+    return f"{mean:.2f} (+-{ci:.2f}) / {nees:.1f}"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scenario")
+    ap.add_argument("--runs", type=int)
+    ap.add_argument("--bin", default=str(ROOT / "target/release/onebeacon"))
+    ap.add_argument("--out")
+    a = ap.parse_args()
+    labels, estimators, table, out = ablate(a.scenario, a.runs, a.bin, a.out)
     head = "| sources | " + " | ".join(f"{e}: mean error, m (95 % CI) / NEES" for e in estimators) + " |"
     lines = [head, "|" + "---|" * (len(estimators) + 1)]
-    for label, _ in rows:
-        cells = []
-        for e in estimators:
-            mean, ci, nees, n = table[(label, e)]
-            cells.append(f"{mean:.2f} (+-{ci:.2f}) / {nees:.1f}")
-        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    for label in labels:
+        lines.append(f"| {label} | " + " | ".join(cell(table[(label, e)]) for e in estimators) + " |")
     runs = next(iter(table.values()))[3]
-    md = f"{path.name}, base cell, {runs} runs (scripts/sea_ablation.py)\n\n" + "\n".join(lines) + "\n"
+    md = f"{pathlib.Path(a.scenario).name}, base cell, {runs} runs (scripts/sea_ablation.py)\n\n" + "\n".join(lines) + "\n"
     (out / "ablation.md").write_text(md)
     print(md)
 
