@@ -67,11 +67,11 @@ fn main() {
                        "sync_frames": sync.len(), "sync_rms_m": rms(&sync), "sync_68_m": percentile(&sync, 0.68)});
 
     step("the chirp's detection statistic");
-    let chirp = chirp_detection_statistics(n(2000, 50), &SNRS_CHIRP_DB, n(300, 20), 9);
+    let (chirp, chirp_lags) = chirp_detection_statistics(n(2000, 50), &SNRS_CHIRP_DB, n(300, 20), 9);
     let chirp_rows: Vec<Value> = std::iter::once(None)
         .chain(SNRS_CHIRP_DB.iter().map(Some))
         .zip(&chirp)
-        .map(|(snr, s)| json!({"snr_db": snr, "statistic": quantiles(s, detection_threshold(8000))}))
+        .map(|(snr, s)| json!({"snr_db": snr, "statistic": quantiles(s, detection_threshold(chirp_lags))}))
         .collect();
 
     step("the frame's detection statistic");
@@ -88,7 +88,7 @@ fn main() {
 
     let out = json!({
         "pings": pings, "modes": modes, "garin": garin,
-        "chirp_detection": {"lags": 8000, "threshold": detection_threshold(8000), "rows": chirp_rows},
+        "chirp_detection": {"lags": chirp_lags, "threshold": detection_threshold(chirp_lags), "rows": chirp_rows},
         "frame_detection": {"lags": lags, "threshold": detection_threshold(lags), "rows": frame_rows},
     });
     println!("{out:#}");

@@ -50,7 +50,7 @@ fn frame_sync_range_at_20_db() {
 /// probability under 1e-4).
 #[test]
 fn the_chirp_threshold_separates_noise_from_pings_at_20_db() {
-    let sets = chirp_detection_statistics(40, &[20.0], 40, 11);
+    let (sets, _) = chirp_detection_statistics(40, &[20.0], 40, 11);
     let alarms = sets[0].iter().filter(|&&s| s >= DETECTION_THRESHOLD_8000).count();
     let detected = sets[1].iter().filter(|&&s| s >= DETECTION_THRESHOLD_8000).count();
     assert_eq!(alarms, 0);

@@ -34,6 +34,19 @@ pub fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
+/// A receiver 300 m deep and a source from a random direction within +-45 deg of
+/// elevation at `range` m (free field).
+fn free_field(geo: &mut rand_pcg::Pcg64Mcg, range: f64) -> (Vector3<f64>, Vector3<f64>) {
+    let u = direction(TAU * geo.random::<f64>(), PI / 4.0 + PI / 2.0 * geo.random::<f64>());
+    let receiver = Vector3::new(0.0, 0.0, 300.0);
+    (receiver, receiver + u * range)
+}
+
+/// One capture of `samples` samples of unit white noise per element.
+fn noise_capture(elements: usize, samples: usize, noise: &mut rand_pcg::Pcg64Mcg) -> Vec<Vec<f64>> {
+    (0..elements).map(|_| (0..samples).map(|_| gauss(noise, 1.0)).collect()).collect()
+}
+
 /// `n` pings from random directions (elevation within +-45 deg, where azimuth is well
 /// defined) at 30-290 m, through `channel`, processed by the receiver. `multipath`: 5 m
 /// of water, beacon at 1 m, receiver at 2.5 m, horizontal ranges.
@@ -52,9 +65,7 @@ pub fn chirp_errors(n: usize, channel: &Channel, multipath: bool, seed: u64) -> 
             let rx = Vector3::new(0.0, 0.0, 2.5);
             (rx, rx + Vector3::new(range * az.cos(), range * az.sin(), -1.5))
         } else {
-            let u = direction(TAU * geo.random::<f64>(), PI / 4.0 + PI / 2.0 * geo.random::<f64>());
-            let rx = Vector3::new(0.0, 0.0, 300.0);
-            (rx, rx + u * range)
+            free_field(&mut geo, range)
         };
         let caps = simulate_ping(&chirp, &source, &receiver, &Matrix3::identity(), &el, channel, &mut noise);
         let est = rx.process(&caps);
@@ -187,18 +198,20 @@ pub fn frame_sync_errors(n: usize, seed: u64) -> Vec<f64> {
 /// The detection statistic (the peak of the combined, unit-energy matched-filter output,
 /// `RangeEstimate::peak_ratio`) of the rypkema chirp on the 5-element array: over `n`
 /// noise-only captures, then over `n_per_snr` pings at each of `snrs_db` (2E/N0 per
-/// element; random directions at 30-290 m). Returns the statistics of each set.
-pub fn chirp_detection_statistics(n: usize, snrs_db: &[f64], n_per_snr: usize, seed: u64) -> Vec<Vec<f64>> {
+/// element; random directions at 30-290 m). Returns the statistics of each set and the
+/// number of lags they were taken over.
+pub fn chirp_detection_statistics(n: usize, snrs_db: &[f64], n_per_snr: usize, seed: u64) -> (Vec<Vec<f64>>, usize) {
     let chirp = Lfm::new(7e3, 9e3, 0.02);
     let el = pyramid_8cm();
-    let mut rx = Receiver::new(chirp, &el, ReceiverConfig::default());
     let cfg = ReceiverConfig::default();
+    let mut rx = Receiver::new(chirp, &el, cfg.clone());
     let mut noise = rng(seed, 0, Stream::Acoustic);
+    let mut lags = 0;
     let noise_only = (0..n)
         .map(|_| {
-            let caps: Vec<Vec<f64>> =
-                (0..el.len()).map(|_| (0..cfg.capture_len).map(|_| gauss(&mut noise, 1.0)).collect()).collect();
-            rx.process(&caps).range.peak_ratio()
+            let range = rx.process(&noise_capture(el.len(), cfg.capture_len, &mut noise)).range;
+            lags = range.distribution.len();
+            range.peak_ratio()
         })
         .collect();
     let mut geo = rng(seed, 0, Stream::Initial);
@@ -208,16 +221,14 @@ pub fn chirp_detection_statistics(n: usize, snrs_db: &[f64], n_per_snr: usize, s
         let set = (0..n_per_snr)
             .map(|_| {
                 let range = 30.0 + 260.0 * geo.random::<f64>();
-                let u = direction(TAU * geo.random::<f64>(), PI / 4.0 + PI / 2.0 * geo.random::<f64>());
-                let receiver = Vector3::new(0.0, 0.0, 300.0);
-                let source = receiver + u * range;
+                let (receiver, source) = free_field(&mut geo, range);
                 let caps = simulate_ping(&chirp, &source, &receiver, &Matrix3::identity(), &el, &channel, &mut noise);
                 rx.process(&caps).range.peak_ratio()
             })
             .collect();
         sets.push(set);
     }
-    sets
+    (sets, lags)
 }
 
 /// A ping config of garin2024's frame at `snr_db` (2E/N0 of the whole frame, per
@@ -258,11 +269,11 @@ pub fn frame_detection_statistics(n: usize, snrs_db: &[f64], n_per_snr: usize, s
     let mut noise = rng(seed, 0, Stream::Acoustic);
     let peak_to_mean = |d: &[f64]| d.iter().copied().fold(0.0, f64::max) * d.len() as f64 / d.iter().sum::<f64>();
     let mut lags = 0;
+    let frame = c.frame();
     let mut noise_only = FrameSet { statistic: vec![], peak_over_mean: vec![], synchronised: 0 };
     for _ in 0..n {
-        let caps: Vec<Vec<f64>> =
-            (0..elements.len()).map(|_| (0..c.capture.samples).map(|_| gauss(&mut noise, 1.0)).collect()).collect();
-        let sync = receive_frame(&c.frame(), &elements, &config, &caps).sync;
+        let caps = noise_capture(elements.len(), c.capture.samples, &mut noise);
+        let sync = receive_frame(&frame, &elements, &config, &caps).sync;
         lags = sync.distribution.len();
         noise_only.statistic.push(sync.peak_ratio());
         noise_only.peak_over_mean.push(peak_to_mean(&sync.distribution));
