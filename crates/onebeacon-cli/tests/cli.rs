@@ -1,27 +1,8 @@
 //! End-to-end tests of the `onebeacon` binary: outputs, determinism, bad input.
 
+use crate::common::{bin, run, scratch, text};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_onebeacon"))
-}
-
-/// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("onebeacon-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().expect("binary runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
 
 const SHORT: &str = r#"
 name = "short"
@@ -298,7 +279,7 @@ fn slurm_jobs_never_run_their_paths() {
         assert_eq!(merged["cells"], whole["cells"]);
     }
     let mut seen = Vec::new();
-    let mut stack = vec![dir.clone()];
+    let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         for e in std::fs::read_dir(&d).unwrap().map(Result::unwrap) {
             seen.push(e.file_name().to_string_lossy().into_owned());

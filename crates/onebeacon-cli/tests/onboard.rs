@@ -2,22 +2,12 @@
 //! piped through `onebeacon stream` with the run's configuration give the simulator's
 //! own decisions, because the simulator and the vehicle run the same controllers.
 
+use crate::common::{bin, scratch};
 use onebeacon::config::stream::StreamConfig;
 use serde_json::Value;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_onebeacon"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("onebeacon-onboard-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::process::Stdio;
 
 /// A built-in scenario with `edits` (line prefix -> replacement line) applied.
 fn edited(dir: &Path, builtin: &str, edits: &[(&str, &str)]) -> String {

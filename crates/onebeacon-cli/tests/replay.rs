@@ -1,28 +1,14 @@
 //! `onebeacon replay` and `onebeacon stream` on the real plaza logs (data/plaza), and
 //! their bad input.
 
+use crate::common::{bin, run, scratch, text};
 use serde_json::Value;
 use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_onebeacon"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("onebeacon-replay-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::path::Path;
+use std::process::{Output, Stdio};
 
 fn plaza(n: u8) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../data/plaza/plaza{n}.toml")).display().to_string()
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().expect("binary runs")
 }
 
 /// `onebeacon stream CONFIG` fed `input` on stdin (from a thread, so a large input
@@ -40,10 +26,6 @@ fn stream(config: &str, input: Vec<u8>) -> Output {
     let o = child.wait_with_output().unwrap();
     writer.join().unwrap();
     o
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
 }
 
 /// `replay --json` (files into `out`): estimator name -> summary object.

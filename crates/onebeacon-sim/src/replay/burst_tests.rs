@@ -2,7 +2,7 @@
 //! ranges to one beacon were about 200 m short captured the calibrated filters): with
 //! their default keys, no estimator of the planar family follows it.
 
-use super::{Log, replay, write_log};
+use super::{Log, TestLog, replay, write_log};
 use std::fmt::Write as _;
 
 /// Long-baseline beacons (id, north, east), 400-600 m from the path.
@@ -37,7 +37,7 @@ enum First {
 
 /// 900 s of exact odometry (1.5 m/s, turning both ways) and exact ranges, one every 2 s
 /// to the beacons in turn, beacon 0's first [`BURST`] as `first` says.
-fn lbl_log(name: &str, first: First, gate: &str) -> Log {
+fn lbl_log(name: &str, first: First, gate: &str) -> TestLog {
     let (mut odo, mut ranges, mut truth) =
         (String::from("t,d,dh\n"), String::from("t,beacon,r\n"), String::from("t,x,y\n"));
     let mut pose = [0.0f64, 0.0, 0.3];

@@ -442,7 +442,7 @@ mod tests {
 
     /// A log description (`body`, then a dead-reckoning estimator) and its CSV files in
     /// a directory of their own, loaded.
-    fn load(name: &str, body: &str, files: &[(&str, &str)]) -> Result<Log, LogError> {
+    fn load(name: &str, body: &str, files: &[(&str, &str)]) -> Result<crate::replay::TestLog, LogError> {
         let toml = format!(
             "name = \"{name}\"\n{body}\n[initial]\nfrom = \"given\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n\
              [[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n"
@@ -718,11 +718,13 @@ y = "y"
         let d = LogDescription::parse(toml, "no-initial.toml").unwrap();
         assert_eq!((d.initial.from, d.initial.heading_from), (InitialFrom::GroundTruth, HeadingFrom::Column));
         assert_eq!((d.initial.position_sigma_m, d.initial.heading_sigma_deg, d.initial.track_m), (1.0, 5.0, 2.0));
-        let dir = std::env::temp_dir().join(format!("onebeacon-log-{}-no-initial", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(dir.join("t.csv"), "t,x,y,h\n4.0,1.0,2.0,0.25\n5.0,1.5,2.0,0.25\n").unwrap();
-        std::fs::write(dir.join("log.toml"), toml).unwrap();
-        let log = Log::load(&dir.join("log.toml")).unwrap();
+        let log = crate::replay::write_log(
+            "log",
+            "no-initial",
+            toml,
+            &[("t.csv", "t,x,y,h\n4.0,1.0,2.0,0.25\n5.0,1.5,2.0,0.25\n")],
+        )
+        .unwrap();
         assert_eq!(log.initial_pose().unwrap(), (4.0, (1.0, 2.0, 0.25)));
     }
 

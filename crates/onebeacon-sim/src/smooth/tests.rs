@@ -14,7 +14,7 @@ const BEACONS: [(u32, f64, f64); 2] = [(1, 40.0, -30.0), (2, -20.0, 60.0)];
 /// noise, the ground truth, written to a directory of its own and loaded. Truth's steps
 /// are the odometry's plus noise of the smoother's default model (`noisy`), so the
 /// data follow the model exactly.
-fn synthetic(name: &str, steps: usize, scale: f64, offsets: [f64; 2], noisy: Option<u64>) -> Log {
+fn synthetic(name: &str, steps: usize, scale: f64, offsets: [f64; 2], noisy: Option<u64>) -> crate::replay::TestLog {
     let n = PlanarNoise::default();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(noisy.unwrap_or(0));
     let mut draw = |sigma: f64| if noisy.is_some() { Normal::new(0.0, sigma).unwrap().sample(&mut rng) } else { 0.0 };
