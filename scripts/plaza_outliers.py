@@ -11,17 +11,17 @@ must be in (0, limits.max_range_m]); the others reach the estimators.
 Only the standard library is used."""
 import math, os, shutil, sys
 
-import plaza_common
-from plaza_common import rows
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import plaza_common  # noqa: E402
+from plaza_common import rows  # noqa: E402
 
 ERRORS_M = [-200.0, -75.0, 50.0, 175.0, 300.0]
 
 
-def main():
-    if len(sys.argv) != 2:
-        sys.exit("usage: plaza_outliers.py DIR")
+def write(out, say=print):
+    """plaza1 with the outliers in directory OUT: its CSV files and plaza1_outliers.toml;
+    `say` is told each outlier."""
     src = plaza_common.DATA
-    out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
     for f in ["plaza1_beacons.csv", "plaza1_ground_truth.csv", "plaza1_odometry.csv"]:
         shutil.copy(os.path.join(src, f), os.path.join(out, f))
@@ -39,7 +39,7 @@ def main():
         x, y = truth_at(t)
         r = math.hypot(x - beacons[b][0], y - beacons[b][1]) + e
         ranges.append({"t_s": f"{t:.6f}", "beacon_id": str(b), "range_m": f"{r:.6f}"})
-        print(f"t = {t - t0:.1f} s, beacon {b}: range {r:.1f} m (error {e:+.0f} m)")
+        say(f"t = {t - t0:.1f} s, beacon {b}: range {r:.1f} m (error {e:+.0f} m)")
     with open(os.path.join(out, "plaza1_ranges.csv"), "w") as f:
         f.write("t_s,beacon_id,range_m\n")
         for r in ranges:  # appended at the end: the source sorts by time
@@ -49,4 +49,12 @@ def main():
     with open(os.path.join(out, "plaza1_outliers.toml"), "w") as f:
         f.write(text)
 
-main()
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: plaza_outliers.py DIR")
+    write(sys.argv[1])
+
+
+if __name__ == "__main__":
+    main()

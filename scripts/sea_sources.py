@@ -20,7 +20,7 @@ the plain filter's without the error.
                converts with 1500 m/s; the state: a range scale (estimate_range_scale);
                20 and 50 m deep
 
-Usage: scripts/sea_sources.py clock|sound_speed [BIN] [OUT_DIR]
+Usage: scripts/sea_sources.py clock|link|sound_speed [BIN] [OUT_DIR]
        (default target/release/onebeacon, /tmp/sea_SOURCE)
 """
 import json
@@ -46,52 +46,60 @@ SOURCES = {
         "depths": "[20.0, 50.0]",
     },
 }
-if len(sys.argv) < 2 or sys.argv[1] not in SOURCES:
-    sys.exit(f"usage: {sys.argv[0]} {'|'.join(SOURCES)} [BIN] [OUT_DIR]")
-SOURCE = SOURCES[sys.argv[1]]
-BIN = sys.argv[2] if len(sys.argv) > 2 else str(ROOT / "target/release/onebeacon")
-OUT = pathlib.Path(sys.argv[3] if len(sys.argv) > 3 else f"/tmp/sea_{sys.argv[1]}")
-
-ESTIMATORS = f"""
+ESTIMATORS = """
 [[estimators]]
 kind = "range-ekf"
 
 [[estimators]]
 kind = "range-ekf"
 name = "range-ekf-state"
-{SOURCE["state"]}
+{state}
 
 [[estimators]]
 kind = "dead-reckoning"
 
 [sweep]
 path = ["circular", "lawnmower", "stationary"]
-depth_m = {SOURCE["depths"]}
+depth_m = {depths}
 guidance = ["A", "circle"]
 """
 
 
-def scenario(with_error: bool) -> str:
+def scenario(source: str, with_error: bool) -> str:
+    """The TOML of the built-in sousa cut to an hour, with the range EKF, the range EKF
+    with SOURCE's state and dead reckoning, and (with_error) SOURCE's error."""
+    s = SOURCES[source]
     base = (ROOT / "scenarios/sousa.toml").read_text()
     base = base.replace("duration_s = 7200", "duration_s = 3600")
     assert "duration_s = 3600" in base, "sousa.toml's duration line moved"
-    base = base[: base.index("# The first estimator")] + ESTIMATORS
+    base = base[: base.index("# The first estimator")] + ESTIMATORS.format(state=s["state"], depths=s["depths"])
     if with_error:
-        base = base.replace("[mission]", SOURCE["sea"] + "\n[mission]", 1)
+        base = base.replace("[mission]", s["sea"] + "\n[mission]", 1)
     return base
 
 
-def run(name: str, with_error: bool) -> dict:
-    OUT.mkdir(parents=True, exist_ok=True)
-    path = OUT / f"{name}.toml"
-    path.write_text(scenario(with_error))
-    subprocess.run([BIN, "mc", str(path), "--out", str(OUT / name)], check=True, stdout=subprocess.DEVNULL)
-    cells = json.loads((OUT / name / "mc.json").read_text())["cells"]
+def run(source: str, with_error: bool, binary: str, out: pathlib.Path, runs=None) -> dict:
+    """`onebeacon mc` of scenario(SOURCE, with_error) (its 10 runs, or `runs`) in OUT: its
+    cells by (path, depth, guidance, estimator)."""
+    name = "sea" if with_error else "clean"
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / f"{name}.toml"
+    path.write_text(scenario(source, with_error))
+    cmd = [binary, "mc", str(path), "--out", str(out / name)] + (["--runs", str(runs)] if runs else [])
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"sea_sources: {' '.join(cmd)} failed ({done.returncode}): {done.stderr.strip()}")
+    cells = json.loads((out / name / "mc.json").read_text())["cells"]
     return {(c["sweep"]["path"], c["sweep"]["depth_m"], c["sweep"]["guidance"], c["estimator"]): c for c in cells}
 
 
 def main() -> None:
-    clean, sea = run("clean", False), run("sea", True)
+    if len(sys.argv) < 2 or sys.argv[1] not in SOURCES:
+        sys.exit(f"usage: {sys.argv[0]} {'|'.join(SOURCES)} [BIN] [OUT_DIR]")
+    source = sys.argv[1]
+    binary = sys.argv[2] if len(sys.argv) > 2 else str(ROOT / "target/release/onebeacon")
+    out = pathlib.Path(sys.argv[3] if len(sys.argv) > 3 else f"/tmp/sea_{source}")
+    clean, sea = run(source, False, binary, out), run(source, True, binary, out)
     print(f"{'cell':28} {'estimator':16} {'clean m':>8} {'NEES':>6} {'sea m':>8} {'NEES':>6} {'sea / plain clean':>18}")
     for key in sorted(clean):
         path, depth, guidance, est = key
