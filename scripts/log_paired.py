@@ -27,7 +27,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from paired import t975  # noqa: E402  (one table of Student's t)
+from paired import t975, verdict  # noqa: E402  (one table of Student's t, one verdict)
 
 SUFFIX = "_error_m"
 
@@ -67,10 +67,6 @@ def compare(a, b, stretches=10):
     sd = math.sqrt(sum((x - m) ** 2 for x in d) / (stretches - 1))
     ra, rb = rmse(a), rmse(b)
     return ra - rb, t975(stretches - 1) * sd / math.sqrt(stretches) / (ra + rb), stretches
-
-
-def verdict(mean, half):
-    return "tie" if not abs(mean) > half else ("lower" if mean < 0 else "higher")
 
 
 def main():

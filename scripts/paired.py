@@ -38,6 +38,11 @@ def paired(a: list, b: list) -> tuple:
     return (m, t975(n - 1) * sd / math.sqrt(n), n)
 
 
+def verdict(mean: float, half: float) -> str:
+    """'tie' when the interval mean +- half holds zero, else 'lower' or 'higher'."""
+    return "tie" if not abs(mean) > half else ("lower" if mean < 0 else "higher")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("mc_json")
@@ -73,10 +78,9 @@ def main() -> None:
             if v == args.base:
                 continue
             m, h, n = paired(c["run_mean_errors_m"], base["run_mean_errors_m"])
-            verdict = "tie" if not (abs(m) > h) else ("lower" if m < 0 else "higher")
             sweep, vehicle, est = key
             label = " ".join(f"{k}={x}" for k, x in json.loads(sweep).items()) + (f" {est}" if est else "")
-            print(f"{label:48} {v:28} {m:+11.3f} {f'[{m - h:+.3f}, {m + h:+.3f}]':>20} {n:4d}  {verdict}")
+            print(f"{label:48} {v:28} {m:+11.3f} {f'[{m - h:+.3f}, {m + h:+.3f}]':>20} {n:4d}  {verdict(m, h)}")
 
 
 if __name__ == "__main__":
