@@ -11,9 +11,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 py=${1:?usage: scripts/dsp_peers.sh PYTHON [ROUNDS]}
 rounds=${2:-3}
-cargo build --profile bench -q -p onebeacon --example dsp_peer
+cargo build --release -q -p onebeacon --example dsp_peer
 for round in $(seq "$rounds"); do
-  target/bench/examples/dsp_peer 60
+  target/release/examples/dsp_peer 60
   env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE OPENBLAS_NUM_THREADS=1 "$py" ../shared/bench/dsp_numpy.py 30 \
     | grep -E "ping_full|ping_range"
 done

@@ -13,10 +13,10 @@ py=${1:?usage: scripts/pf_peers.sh PYTHON [N ...]}
 shift
 sizes=("${@:-1e5 5e5}")
 peers=../shared/bench/pf_peers.py
-cargo build --profile bench -q -p onebeacon --example pf_peer
+cargo build --release -q -p onebeacon --example pf_peer
 for n in ${sizes[@]}; do
   for round in 1 2; do
-    target/bench/examples/pf_peer "$n" 12
+    target/release/examples/pf_peer "$n" 12
     env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE OPENBLAS_NUM_THREADS=1 "$py" "$peers" numpy "$n" 12
     env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE OPENBLAS_NUM_THREADS=1 "$py" "$peers" stonesoup "$n" 6
   done
