@@ -52,7 +52,8 @@ def write(out, say=print):
 
 def main():
     if len(sys.argv) != 2:
-        sys.exit("usage: plaza_outliers.py DIR")
+        print("usage: plaza_outliers.py DIR", file=sys.stderr)
+        sys.exit(2)
     write(sys.argv[1])
 
 

@@ -95,7 +95,8 @@ def run(source: str, with_error: bool, binary: str, out: pathlib.Path, runs=None
 
 def main() -> None:
     if len(sys.argv) < 2 or sys.argv[1] not in SOURCES:
-        sys.exit(f"usage: {sys.argv[0]} {'|'.join(SOURCES)} [BIN] [OUT_DIR]")
+        print(f"usage: {sys.argv[0]} {'|'.join(SOURCES)} [BIN] [OUT_DIR]", file=sys.stderr)
+        sys.exit(2)
     source = sys.argv[1]
     binary = sys.argv[2] if len(sys.argv) > 2 else str(ROOT / "target/release/onebeacon")
     out = pathlib.Path(sys.argv[3] if len(sys.argv) > 3 else f"/tmp/sea_{source}")
