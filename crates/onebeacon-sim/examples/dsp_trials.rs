@@ -1,4 +1,4 @@
-//! The receiver chain's trials at the counts behind docs/reproductions.md's receiver
+//! The receiver chain's trials at the counts behind docs/reproductions/receiver.md's
 //! tables, as JSON on stdout (scripts/reproduce formats them):
 //! `cargo run --release -p onebeacon-sim --example dsp_trials [-- --quick]`.
 //! `--quick` runs each trial at a tenth of its count or less (what CI checks).

@@ -1,6 +1,6 @@
 //! The receiver chain on simulated pings (rypkema 3.2, 4.2; garin2024 eqs. 9, 12) at
 //! small counts; examples/dsp_trials.rs measures the same trials at the counts behind
-//! docs/reproductions.md's receiver tables (`scripts/reproduce --only receiver-pings`).
+//! docs/reproductions/receiver.md's tables (`scripts/reproduce --only receiver-pings`).
 
 use crate::dsp_trials::*;
 use onebeacon::dsp::beamform::{angle_between, direction};
@@ -21,7 +21,7 @@ fn twenty_db_free_field_range_and_azimuth() {
 }
 
 /// At 10 dB the bank (classical matched filters, coherent combination across elements at
-/// the strongest lags) identifies nearly every ping (docs/reproductions.md,
+/// the strongest lags) identifies nearly every ping (docs/reproductions/receiver.md,
 /// receiver-modes, over 1000 pings); here smaller counts against 95 % and 97.5 %.
 #[test]
 fn modes_are_identified_at_10_db() {

@@ -35,7 +35,7 @@ fn inliers(runs: &[f64]) -> Vec<f64> {
 
 /// range+doppler beats range-only at short and long T_com; error grows with T_com; at
 /// T_com = 3 s the mean error is within 10 % of the paper's 3.61 m (Table 3, what
-/// docs/reproductions.md claims), up to the sampling of these 40 runs: the 99 % t
+/// docs/reproductions/garin2024.md claims), up to the sampling of these 40 runs: the 99 % t
 /// interval of the inlier runs' mean (section 4.1.1's 1.5 IQR rule, applied here by
 /// hand) must reach within 10 % of 3.61 m.
 #[test]

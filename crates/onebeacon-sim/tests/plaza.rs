@@ -1,5 +1,5 @@
 //! The real plaza logs (data/plaza) through the replay engine (the table of
-//! docs/reproductions.md: `scripts/reproduce --only plaza`).
+//! docs/reproductions/plaza.md: `scripts/reproduce --only plaza`).
 
 use onebeacon_sim::replay::{Log, LogError, replay};
 use std::path::PathBuf;

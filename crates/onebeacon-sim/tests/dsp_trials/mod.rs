@@ -1,6 +1,6 @@
 //! Trials of the receiver chain on simulated pings (rypkema 3.2, 4.2; garin2024 eqs. 9,
 //! 12): tests/dsp_chain.rs checks them at small counts, examples/dsp_trials.rs measures
-//! them at the counts behind docs/reproductions.md's receiver tables.
+//! them at the counts behind docs/reproductions/receiver.md's tables.
 #![allow(dead_code)] // each includer uses a part
 
 use nalgebra::{Matrix3, Vector3};

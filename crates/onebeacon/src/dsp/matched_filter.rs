@@ -224,7 +224,7 @@ impl RangeEstimate {
 /// The detection threshold of [`RangeEstimate::peak_ratio`] for 8000-lag captures (5
 /// elements, the rypkema chirps): no noise-only capture of 2000 reached it (median
 /// 0.035), every ping of 300 at 20 dB 2E/N0 per element did (0.22 or more), at 10 dB
-/// about one in five (docs/reproductions.md, the receiver chain; the example
+/// about one in five (docs/reproductions/receiver.md; the example
 /// `dsp_trials` of onebeacon-sim).
 pub const DETECTION_THRESHOLD_8000: f64 = 0.07;
 
