@@ -6,7 +6,7 @@ error sources (each `[sea.*]` table, and `[current]` where the world has one), a
 `onebeacon mc --json` on variants of it: none of them, each alone, all of them. The sweep
 is dropped, so each variant is one cell (the scenario's base cell); runs and seed are the
 scenario's (or --runs). Prints a table of every estimator's mean error (with the spread
-of its runs' means as a 95 % interval of the mean, every run counted) and NEES per variant, and writes it as
+of its runs' means as a 95 % interval of the mean, Student's t, every run counted) and NEES per variant, and writes it as
 Markdown to OUT_DIR/ablation.md with each variant's mc.json beside it.
 
 Usage: scripts/sea_ablation.py SCENARIO.toml [--runs N] [--bin BIN] [--out OUT_DIR]
@@ -19,6 +19,9 @@ import pathlib
 import re
 import subprocess
 import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from paired import t975  # noqa: E402  (one table of Student's t)
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
@@ -85,7 +88,8 @@ def ablate(scenario, runs=None, binary=str(ROOT / "target/release/onebeacon"), o
             n = len(errs)
             mean = sum(errs) / n
             sd = math.sqrt(sum((e - mean) ** 2 for e in errs) / (n - 1)) if n > 1 else float("nan")
-            table[(label, c["estimator"])] = (mean, 1.96 * sd / math.sqrt(n), c["nees_mean_all_runs"], n)
+            half = t975(n - 1) * sd / math.sqrt(n) if n > 1 else float("nan")
+            table[(label, c["estimator"])] = (mean, half, c["nees_mean_all_runs"], n)
     estimators = list(dict.fromkeys(e for _, e in table))
     return [label for label, _ in rows], estimators, table, out
 
