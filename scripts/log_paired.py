@@ -49,9 +49,13 @@ def errors(path):
     return out
 
 
-def rmse(values):
+def mse(values):
     finite = [v for v in values if math.isfinite(v)]
-    return math.sqrt(sum(v * v for v in finite) / len(finite)) if finite else float("nan")
+    return sum(v * v for v in finite) / len(finite) if finite else float("nan")
+
+
+def rmse(values):
+    return math.sqrt(mse(values))
 
 
 def compare(a, b, stretches=10):
@@ -61,7 +65,7 @@ def compare(a, b, stretches=10):
     if n < 2 * stretches:
         raise ValueError(f"{n} rows: fewer than 2 per stretch for {stretches} stretches")
     cuts = [round(j * n / stretches) for j in range(stretches + 1)]
-    d = [rmse(a[lo:hi]) ** 2 - rmse(b[lo:hi]) ** 2 for lo, hi in zip(cuts, cuts[1:])]
+    d = [mse(a[lo:hi]) - mse(b[lo:hi]) for lo, hi in zip(cuts, cuts[1:])]
     w = [(hi - lo) / n for lo, hi in zip(cuts, cuts[1:])]
     m = sum(wi * di for wi, di in zip(w, d))
     sd = math.sqrt(sum((x - m) ** 2 for x in d) / (stretches - 1))
