@@ -84,14 +84,20 @@ def ablate(scenario, runs=None, binary=str(ROOT / "target/release/onebeacon"), o
             sys.exit(f"{label}: onebeacon failed: {run.stderr.strip()}")
         (out / f"{label}.json").write_text(run.stdout)
         for c in json.loads(run.stdout)["cells"]:
-            errs = c["run_mean_errors_m"]
-            n = len(errs)
-            mean = sum(errs) / n
-            sd = math.sqrt(sum((e - mean) ** 2 for e in errs) / (n - 1)) if n > 1 else float("nan")
-            half = t975(n - 1) * sd / math.sqrt(n) if n > 1 else float("nan")
-            table[(label, c["estimator"])] = (mean, half, c["nees_mean_all_runs"], n)
+            table[(label, c["estimator"])] = summary(c)
     estimators = list(dict.fromkeys(e for _, e in table))
     return [label for label, _ in rows], estimators, table, out
+
+
+def summary(c):
+    """An mc cell's mean of the run means, the half-width of its 95 % interval, the mean
+    NEES over every run and the run count."""
+    errs = c["run_mean_errors_m"]
+    n = len(errs)
+    mean = sum(errs) / n
+    sd = math.sqrt(sum((e - mean) ** 2 for e in errs) / (n - 1)) if n > 1 else float("nan")
+    half = t975(n - 1) * sd / math.sqrt(n) if n > 1 else float("nan")
+    return (mean, half, c["nees_mean_all_runs"], n)
 
 
 def cell(entry):
