@@ -38,6 +38,18 @@ def paired(a: list, b: list) -> tuple:
     return (m, t975(n - 1) * sd / math.sqrt(n), n)
 
 
+def welch(a: list, b: list) -> tuple:
+    """mean(a) - mean(b) of two independent samples, the half-width of its 95 % interval
+    (Welch: Student's t at the Welch-Satterthwaite degrees of freedom, rounded down), and
+    those degrees of freedom. For runs of two different worlds, which do not pair."""
+    na, nb = len(a), len(b)
+    ma, mb = sum(a) / na, sum(b) / nb
+    va = sum((x - ma) ** 2 for x in a) / (na - 1) / na
+    vb = sum((x - mb) ** 2 for x in b) / (nb - 1) / nb
+    dof = (va + vb) ** 2 / (va ** 2 / (na - 1) + vb ** 2 / (nb - 1))
+    return (ma - mb, t975(max(1, int(dof))) * math.sqrt(va + vb), dof)
+
+
 def verdict(mean: float, half: float) -> str:
     """'tie' when the interval mean +- half holds zero, else 'lower' or 'higher'."""
     return "tie" if not abs(mean) > half else ("lower" if mean < 0 else "higher")
