@@ -50,6 +50,19 @@ def welch(a: list, b: list) -> tuple:
     return (ma - mb, t975(max(1, int(dof))) * math.sqrt(va + vb), dof)
 
 
+def binomial_upper(k: int, n: int) -> float:
+    """The one-sided 95 % upper bound of a share seen k times in n (Clopper-Pearson: the p
+    at which k or fewer in n has probability 0.05), by bisection."""
+    if k >= n:
+        return 1.0
+    low, high = 0.0, 1.0
+    for _ in range(60):
+        p = (low + high) / 2
+        at_most_k = sum(math.comb(n, i) * p ** i * (1 - p) ** (n - i) for i in range(k + 1))
+        low, high = (p, high) if at_most_k > 0.05 else (low, p)
+    return (low + high) / 2
+
+
 def verdict(mean: float, half: float) -> str:
     """'tie' when the interval mean +- half holds zero, else 'lower' or 'higher'."""
     return "tie" if not abs(mean) > half else ("lower" if mean < 0 else "higher")

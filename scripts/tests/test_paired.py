@@ -1,5 +1,6 @@
 """scripts/paired.py's Welch interval (two worlds' runs, unpaired): the closed form of equal
-variances and sizes, and its coverage against its nominal 95 % on unequal variances."""
+variances and sizes, and its coverage against its nominal 95 % on unequal variances; its
+binomial upper bound against closed forms."""
 import math
 import os
 import random
@@ -31,3 +32,15 @@ def test_the_interval_covers_the_true_difference_95_times_in_100():
         covered += abs(m - 0.5) <= h
     sd = math.sqrt(trials * 0.95 * 0.05)
     assert abs(covered - 0.95 * trials) <= 3 * sd, f"{covered} of {trials} intervals cover the truth"
+
+
+def test_the_binomial_upper_bound_meets_its_closed_forms():
+    # none seen in n: (1 - p)^n = 0.05, p = 1 - 0.05^(1/n) (300 runs: 0.99 %, near the
+    # "rule of three" 3 / n); n - 1 seen in n: 1 - p^n = 0.05, p = 0.95^(1/n)
+    assert abs(paired.binomial_upper(0, 300) - (1 - 0.05 ** (1 / 300))) < 1e-12
+    assert abs(paired.binomial_upper(9, 10) - 0.95 ** (1 / 10)) < 1e-12
+    # a middle value against a brute-force scan of the binomial's tail
+    n, k = 300, 3
+    tail = lambda p: sum(math.comb(n, i) * p ** i * (1 - p) ** (n - i) for i in range(k + 1))
+    scan = next(j / 1e5 for j in range(1, 100000) if tail(j / 1e5) <= 0.05)
+    assert abs(paired.binomial_upper(k, n) - scan) <= 1e-5
