@@ -1,0 +1,176 @@
+"""docs/reproductions/garin2024.md's tables: range + Doppler EKF on one fixed beacon."""
+
+import json
+import re
+
+from .common import ABLATION, ROOT, RUNS, cli, cli_on_toml, header, mc, paired_cell
+from .sea import ablation
+
+
+# garin2024 Table 4: mean positioning error (outliers) in m, proposed method and ROSB,
+# 300 simulated missions per T_com
+GARIN_PAPER = {
+    3: ("3.61 (1)", "4.59 (4)"),
+    6: ("5.04 (5)", "6.23 (6)"),
+    9: ("6.45 (1)", "7.72 (5)"),
+    12: ("8.09 (6)", "9.25 (15)"),
+    15: ("9.55 (6)", "10.67 (10)"),
+    20: ("12.13 (6)", "12.97 (29)"),
+}
+
+
+GARIN_ESTIMATORS = ["range+doppler", "rosb", "range+doppler-ukf", "range+doppler-robust"]
+
+
+def garin2024(quick):
+    """docs/reproductions/garin2024.md: `onebeacon mc garin2024` (300 runs per cell)."""
+    cells = mc("garin2024", quick)
+    rows = header("T_com", *(f"{e} (outliers)" for e in GARIN_ESTIMATORS), "paper: proposed", "paper: ROSB")
+    for t in sorted({c["sweep"]["t_com_s"] for c in cells}):
+        by = {c["estimator"]: c for c in cells if c["sweep"]["t_com_s"] == t}
+        ours = [f"{by[e]['mean_error_m']:.2f} ({by[e]['outliers']})" for e in GARIN_ESTIMATORS]
+        paper = GARIN_PAPER[round(t)]
+        rows.append(f"| {t:g} s | " + " | ".join(ours) + f" | {paper[0]} | {paper[1]} |")
+    return rows
+
+
+def garin2024_over_10m(quick):
+    """docs/reproductions/garin2024.md: the runs (of 300) whose mean error is over 10 m,
+    of the paper's filter and its robust form, from the same campaign."""
+    cells = mc("garin2024", quick)
+    t_com = sorted({c["sweep"]["t_com_s"] for c in cells})
+    rows = header("T_com", *(f"{t:g} s" for t in t_com))
+    for e in ("range+doppler", "range+doppler-robust"):
+        counts = []
+        for t in t_com:
+            (c,) = [c for c in cells if c["estimator"] == e and c["sweep"]["t_com_s"] == t]
+            counts.append(str(sum(m > 10.0 for m in c["run_mean_errors_m"])))
+        rows.append(f"| {e} | " + " | ".join(counts) + " |")
+    return rows
+
+
+def runs_over(means, by_median):
+    """How many of the run mean errors `means` are over 10 m, or over 3 x their median
+    (the upper one) when `by_median`."""
+    limit = 3 * sorted(means)[len(means) // 2] if by_median else 10.0
+    return sum(m > limit for m in means)
+
+
+# garin2024 with the beacon elsewhere: (north, east), its label, whether a run's outlier
+# threshold is 3 x the median of its cell (where the median itself nears 10 m) instead of 10 m
+GARIN_BEACONS = [((50, 100), "centre", False), ((0, 0), "the start", False),
+                 ((100, 255), "far corner", False), ((50, 400), "145 m east of the area", False),
+                 ((-100, 125), "100 m south", True)]
+
+
+GARIN_BEACON_ESTIMATORS = ["range+doppler", "range+doppler-ukf", "range+doppler-robust", "rosb"]
+
+
+def garin2024_beacon(quick):
+    """docs/reproductions/garin2024.md: `onebeacon mc` of garin2024's TOML with the beacon
+    moved (`[beacon]`) and 0 or 30 % of the frames lost (`comms.frame_loss_prob`), at T_com
+    3 and 20 s: the runs over 10 m (or over 3 x their cell's median) of each estimator, and
+    the robust filter's paired difference from the paper's (run mean errors, m, 95 %)."""
+    runs = RUNS["garin2024-beacon"][0 if quick else 1]
+    base = cli("scenarios", "--show", "garin2024")
+    rows = header("beacon (north, east)", "frames lost",
+                  *(f"T_com {t} s: published / ukf / robust / rosb" for t in (3, 20)),
+                  "robust - published, 3 s", "robust - published, 20 s")
+    for (north, east), label, by_median in GARIN_BEACONS:
+        for loss in (0.0, 0.3):
+            toml = re.sub(r"(?m)^north_m = .*$", f"north_m = {north}.0", base, count=1)
+            toml = re.sub(r"(?m)^east_m = .*$", f"east_m = {east}.0", toml, count=1)
+            toml = re.sub(r"(?m)^frame_loss_prob = .*$", f"frame_loss_prob = {loss}", toml)
+            toml = re.sub(r"(?m)^t_com_s = \[.*$", "t_com_s = [3.0, 20.0]", toml)
+            cells = json.loads(cli_on_toml("mc", toml, "--runs", str(runs), "--json"))["cells"]
+            counts, pairs = [], []
+            for t in (3.0, 20.0):
+                by = {c["estimator"]: c for c in cells if c["sweep"]["t_com_s"] == t}
+                counts.append(" / ".join(str(runs_over(by[e]["run_mean_errors_m"], by_median))
+                                         for e in GARIN_BEACON_ESTIMATORS))
+                pairs.append(paired_cell(by["range+doppler-robust"], by["range+doppler"]))
+            where = f"({north}, {east}), {label}" + (", over 3 x median" if by_median else "")
+            rows.append(f"| {where} | {round(loss * 100)} % | " + " | ".join(counts + pairs) + " |")
+    return rows
+
+
+def garin2024_paired(quick):
+    """docs/reproductions/garin2024.md: paired differences of the run mean errors (every
+    run, outliers too), m, with 95 % intervals, from the same campaign."""
+    cells = mc("garin2024", quick)
+    pairs = [("range+doppler", "rosb"), ("range+doppler-ukf", "range+doppler"),
+             ("range+doppler-robust", "range+doppler")]
+    rows = header("T_com", *(f"{a} - {b}" for a, b in pairs))
+    for t in sorted({c["sweep"]["t_com_s"] for c in cells}):
+        by = {c["estimator"]: c for c in cells if c["sweep"]["t_com_s"] == t}
+        rows.append(f"| {t:g} s | " + " | ".join(paired_cell(by[a], by[b]) for a, b in pairs) + " |")
+    return rows
+
+
+def garin2024_sea(quick):
+    """docs/reproductions/garin2024.md, garin2024-sea: `onebeacon mc garin2024-sea` (300 runs per
+    T_com): mean error over the runs that are not outliers (NEES over them), and for the
+    augmented filter its NEES over every run and its runs over 20 m."""
+    cells = mc("garin2024-sea", quick)
+    rows = header(
+        "T_com",
+        "paper's filter",
+        "its robust form (garin2024.toml)",
+        "range+doppler-sea: robust + offset and drift states + Student-t ranges, gated",
+        "its runs over 20 m",
+    )
+    for t in sorted({c["sweep"]["t_com_s"] for c in cells}):
+        by = {c["estimator"]: c for c in cells if c["sweep"]["t_com_s"] == t}
+        plain = [f"{by[e]['mean_error_m']:.1f} ({by[e]['nees_mean']:.0f})" for e in ("range+doppler", "range+doppler-robust")]
+        sea = by["range+doppler-sea"]
+        over = sum(m > 20.0 for m in sea["run_mean_errors_m"])
+        rows.append(
+            f"| {t:g} s | {plain[0]} | {plain[1]} | {sea['mean_error_m']:.2f} ({sea['nees_mean']:.2f} / "
+            f"{sea['nees_mean_all_runs']:.2f}) | {over} / {sea['runs']} |"
+        )
+    return rows
+
+
+def garin2024_sea_ablation(quick):
+    """docs/reproductions/garin2024.md, garin2024-sea: each error source alone, T_com 3 s, 100 runs."""
+    return ablation("garin2024-sea", quick,
+                    [(e, e) for e in ("range+doppler", "range+doppler-robust", "range+doppler-sea")])
+
+
+# the current of garin2024-current (docs/reproductions/garin2024.md): unsourced, see there
+GARIN_CURRENT = """
+[sea.current]
+speed_m_s = 0.1
+toward_deg = 45
+speed_sigma_m_s = 0.03
+direction_sigma_deg = 20
+"""
+
+
+def garin2024_current(quick):
+    """docs/reproductions/garin2024.md: garin2024-sea with GARIN_CURRENT, alone and with the
+    rest of its sea (the base cell, T_com 3 s, 100 runs): each filter's mean error (95 %
+    interval) / mean NEES, and the other two against the paper's filter, paired by run."""
+    parts = ABLATION.blocks((ROOT / "scenarios/garin2024-sea.toml").read_text() + GARIN_CURRENT)
+    sources = [h for h, _ in parts if ABLATION.is_source(h)]
+    runs = RUNS["garin2024-current"][0 if quick else 1]
+    base, others = "range+doppler", ("range+doppler-robust", "range+doppler-sea")
+    rows = header("sources", base, *others, *(f"{e} - {base}" for e in others))
+    for label, keep in (("sea.current", ["sea.current"]), ("all", sources)):
+        toml = ABLATION.variant(parts, keep)
+        by = {c["estimator"]: c for c in json.loads(cli_on_toml("mc", toml, "--runs", str(runs), "--json"))["cells"]}
+        rows.append(f"| {label} | " + " | ".join(ABLATION.cell(ABLATION.summary(by[e])) for e in (base, *others))
+                    + " | " + " | ".join(paired_cell(by[e], by[base]) for e in others) + " |")
+    return rows
+
+
+# the tables of this module by the name that marks them in docs/
+TABLES = {
+    "garin2024": garin2024,
+    "garin2024-over-10m": garin2024_over_10m,
+    "garin2024-beacon": garin2024_beacon,
+    "garin2024-paired": garin2024_paired,
+    "garin2024-sea": garin2024_sea,
+    "garin2024-sea-ablation": garin2024_sea_ablation,
+    "garin2024-current": garin2024_current,
+}

@@ -1,0 +1,86 @@
+"""docs/reproductions/rypkema.md's tables: inverted USBL, a fleet commanded by chirps."""
+
+import functools
+import json
+import re
+
+from .common import RUNS, cli, cli_on_toml, figure, header
+
+
+# rypkema Table 3: the 2-norm error's 68 % / 95 %, m, all six missions, real data
+# against the LBL reference
+RYPKEMA_PAPER = "7.89 / 22.74"
+
+
+RYPKEMA_AUVS = ["platypus", "quokka", "wombat"]
+
+
+@functools.cache
+def fleet(scenario, campaign, quick, reference=False):
+    """The error percentiles by label (`fleet/iusbl`, `platypus/iusbl`, ...) of `onebeacon
+    fleet SCENARIO --runs N --json`, N from RUNS[campaign]; `reference` adds the 3.9 m LBL
+    reference of the -sea scenarios (`[reference] sigma_m`) to a clean one. --quick draws
+    the pings the abstract way (`signal.model = "abstract"`). Run once per script run."""
+    runs = RUNS[campaign][0 if quick else 1]
+    toml = cli("scenarios", "--show", scenario)
+    if quick:
+        toml = re.sub(r'(?m)^model = "channel"', 'model = "abstract"', toml)
+    if reference:
+        toml += "\n[reference]\nsigma_m = 3.9\n"
+    stats = json.loads(cli_on_toml("fleet", toml, "--runs", str(runs), "--json", out=True))["statistics"]
+    return {p["label"]: p for p in stats["tracks"] + stats["fleet"]}
+
+
+def percent_cell(p, digits=None):
+    """'68 % / 95 %' of an error percentile, each a figure()."""
+    return f"{figure(p['p68_m'], digits)} / {figure(p['p95_m'], digits)}"
+
+
+def fleet_row(label, stats, key, bold=False, digits=None):
+    """A row of the fleet tables: `label`, then `key`'s percent_cell in each mission's
+    `stats`, in bold when `bold`."""
+    cells = [percent_cell(s[key], digits) for s in stats]
+    return f"| {label} | " + " | ".join(f"**{c}**" if bold else c for c in cells) + " |"
+
+
+def rypkema(quick):
+    """docs/reproductions/rypkema.md: `onebeacon fleet rypkema-m1|m6 --runs 2`: the
+    2-norm error while submerged, 68 % / 95 %, m, per AUV and for the fleet."""
+    missions = ("rypkema-m1", "rypkema-m6")
+    stats = [fleet(m, "rypkema", quick) for m in missions]
+    rows = header("", *missions)
+    auvs = " / ".join(RYPKEMA_AUVS)
+    rows.append(f"| {auvs}, iusbl | " + " | ".join(
+        ", ".join(percent_cell(s[f"{a}/iusbl"]) for a in RYPKEMA_AUVS) for s in stats) + " |")
+    rows += [fleet_row("fleet, iusbl (factored)", stats, "fleet/iusbl", bold=True),
+             fleet_row("fleet, iusbl-joint (same likelihoods, no factoring)", stats, "fleet/iusbl-joint"),
+             fleet_row("fleet, dead reckoning", stats, "fleet/dead-reckoning")]
+    rows.append(f"| paper, Table 3 (all six missions, real data against LBL) | {RYPKEMA_PAPER} | |")
+    return rows
+
+
+def rypkema_sea(quick):
+    """docs/reproductions/rypkema.md, rypkema-m1-sea and rypkema-m6-sea: the fleet's iusbl error,
+    68 % / 95 %, m, against the truth, against the 3.9 m reference alone and with the sea
+    (`onebeacon fleet rypkema-m1-sea|m6-sea`), and dead reckoning in the -sea runs."""
+    missions = ("rypkema-m1", "rypkema-m6")
+    truth = [fleet(m, "rypkema", quick) for m in missions]
+    reference = [fleet(m, "rypkema-reference", quick, reference=True) for m in missions]
+    sea = [fleet(f"{m}-sea", "rypkema-sea", quick) for m in missions]
+    n = {k: RUNS[k][1] for k in ("rypkema", "rypkema-reference", "rypkema-sea")}
+    return header("", *missions) + [
+        fleet_row(f"against the truth (the reproduction above, {n['rypkema']} runs)", truth, "fleet/iusbl",
+                  digits=2),
+        fleet_row(f"against the 3.9 m reference, no sea (`[reference]` alone, {n['rypkema-reference']} runs)",
+                  reference, "fleet/iusbl", digits=2),
+        fleet_row(f"rypkema-*-sea: the reference and the sea ({n['rypkema-sea']} runs)", sea, "fleet/iusbl",
+                  bold=True, digits=2),
+        f"| paper, Table 3 (all six missions, against LBL) | {RYPKEMA_PAPER} | |",
+        fleet_row("dead reckoning in the -sea runs", sea, "fleet/dead-reckoning", digits=2)]
+
+
+# the tables of this module by the name that marks them in docs/
+TABLES = {
+    "rypkema": rypkema,
+    "rypkema-sea": rypkema_sea,
+}
