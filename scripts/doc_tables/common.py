@@ -91,6 +91,12 @@ def cli_on_toml(command, toml, *args, out=False, progress=False):
                    progress=progress)
 
 
+def mc_text(toml, runs, *args, progress=False):
+    """The cells of `onebeacon mc FILE --runs RUNS --json ARGS...` on the scenario text
+    `toml` (`progress`: as cli)."""
+    return json.loads(cli_on_toml("mc", toml, "--runs", str(runs), "--json", *args, progress=progress))["cells"]
+
+
 @functools.cache
 def mc(scenario, quick):
     """The cells of `onebeacon mc SCENARIO --runs N --json` at RUNS' count, run once per

@@ -1,9 +1,8 @@
 """docs/reproductions/garin2024.md's tables: range + Doppler EKF on one fixed beacon."""
 
-import json
 import re
 
-from .common import ABLATION, ROOT, RUNS, cli, cli_on_toml, header, mc, paired_cell
+from .common import ABLATION, ROOT, RUNS, cli, header, mc, mc_text, paired_cell
 from .sea import ablation
 
 
@@ -82,7 +81,7 @@ def garin2024_beacon(quick):
             toml = re.sub(r"(?m)^east_m = .*$", f"east_m = {east}.0", toml, count=1)
             toml = re.sub(r"(?m)^frame_loss_prob = .*$", f"frame_loss_prob = {loss}", toml)
             toml = re.sub(r"(?m)^t_com_s = \[.*$", "t_com_s = [3.0, 20.0]", toml)
-            cells = json.loads(cli_on_toml("mc", toml, "--runs", str(runs), "--json"))["cells"]
+            cells = mc_text(toml, runs)
             counts, pairs = [], []
             for t in (3.0, 20.0):
                 by = {c["estimator"]: c for c in cells if c["sweep"]["t_com_s"] == t}
@@ -158,7 +157,7 @@ def garin2024_current(quick):
     rows = header("sources", base, *others, *(f"{e} - {base}" for e in others))
     for label, keep in (("sea.current", ["sea.current"]), ("all", sources)):
         toml = ABLATION.variant(parts, keep)
-        by = {c["estimator"]: c for c in json.loads(cli_on_toml("mc", toml, "--runs", str(runs), "--json"))["cells"]}
+        by = {c["estimator"]: c for c in mc_text(toml, runs)}
         rows.append(f"| {label} | " + " | ".join(ABLATION.cell(ABLATION.summary(by[e])) for e in (base, *others))
                     + " | " + " | ".join(paired_cell(by[e], by[base]) for e in others) + " |")
     return rows

@@ -2,13 +2,12 @@
 passive USBL, particle filter, the ASV's planner."""
 
 import functools
-import json
 import math
 import re
 import statistics
 
-from .common import (PAIRED, ROOT, RUNS, blocks_kept, cli, cli_on_toml, figure, header, interval,
-    mc, nees_figure, paired_cell)
+from .common import (PAIRED, ROOT, RUNS, blocks_kept, cli, figure, header, interval,
+    mc, mc_text, nees_figure, paired_cell)
 from .sea import ablation
 
 
@@ -21,7 +20,7 @@ def hoff2024_campaign(scenario, quick):
     toml = cli("scenarios", "--show", scenario)
     toml = re.sub(r"(?m)^duration_s = \d+", "duration_s = 900", toml)
     toml = re.sub(r"(?m)^particles = \d+", "particles = 50000", toml)
-    return json.loads(cli_on_toml("mc", toml, "--runs", str(RUNS[scenario][0]), "--json"))["cells"]
+    return mc_text(toml, RUNS[scenario][0])
 
 
 def hoff2024_cells(scenario, quick, vehicle="auv"):
@@ -202,8 +201,7 @@ def hoff2024_sea_long(quick):
     rows = header("usbl_floor_deg", "runs", "mean error, m", "median", "95th percentile", "runs over 5 m",
                   "runs over 20 m (95 % upper bound of the share)", "NEES (every run)", "NEES band")
     for floor, label in (("1.25", "1.25 (as shipped)"), ("1.0", "1.0")):
-        (c,) = json.loads(cli_on_toml("mc", pf_sea_alone(floor), "--runs", str(runs), "--json",
-                                      progress=not quick))["cells"]
+        (c,) = mc_text(pf_sea_alone(floor), runs, progress=not quick)
         errors = sorted(c["run_mean_errors_m"])
         n = len(errors)
         over = sum(e > 20.0 for e in errors)
@@ -222,8 +220,7 @@ def hoff2024_sea_floors(quick):
     runs = RUNS["hoff2024-sea-floors"][0 if quick else 1]
     rows = header("usbl_floor_deg", "mean error, m", "NEES (every run)", "NEES band")
     for floor in ("1.0", "1.25", "1.5", "2.0"):
-        (c,) = json.loads(cli_on_toml("mc", pf_sea_alone(floor), "--runs", str(runs), "--seed", "1001", "--json",
-                                      progress=not quick))["cells"]
+        (c,) = mc_text(pf_sea_alone(floor), runs, "--seed", "1001", progress=not quick)
         lo, hi = c["nees_band"]
         rows.append(f"| {floor} | {figure(c['mean_error_m'])} | {figure(c['nees_mean'])} "
                     f"({figure(c['nees_mean_all_runs'])}) | {lo:.2f}-{hi:.2f} |")
