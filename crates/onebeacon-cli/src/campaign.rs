@@ -47,7 +47,7 @@ pub fn shard(
 pub fn merge_partials(paths: &[PathBuf], out: Option<PathBuf>, json: bool) -> Result<()> {
     let bad = |e: MergeError| BadInput(e.to_string());
     let merged = merge(read_partials(paths, &crate::budget()).map_err(bad)?).map_err(bad)?;
-    let staging = out.as_deref().map(Staging::new).transpose()?;
+    let staging = out.as_deref().map(|d| Staging::new(d, paths)).transpose()?;
     commands::write_mc(&merged.scenario, &merged.result, merged.wall_s, staging, json)
 }
 

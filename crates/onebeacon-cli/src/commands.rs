@@ -11,7 +11,7 @@ use onebeacon_sim::run::{GuidanceSnapshot, simulate, simulate_messages, simulate
 const BELIEF_SAMPLES: usize = 50_000;
 use onebeacon_sim::scenario::{self, BUILTINS};
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// `onebeacon scenarios [--show NAME]`
@@ -63,7 +63,7 @@ pub fn run(
         .into());
     }
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-run", s.name())));
-    let staging = Staging::new(&dir)?;
+    let staging = Staging::new(&dir, &scenario_inputs(name))?;
     let cell = s.base_cell();
     let passive = matches!(s, Scenario::PassiveUsbl(_));
     if passive && !(1..=s.steps()).contains(&message) {
@@ -128,6 +128,13 @@ pub fn run(
     Ok(())
 }
 
+/// The files a command reads for the scenario `name`: its TOML file, or nothing for a
+/// built-in one.
+pub(crate) fn scenario_inputs(name: &str) -> Vec<PathBuf> {
+    let file = Path::new(name);
+    if onebeacon_sim::scenario::builtin(name).is_none() && file.exists() { vec![file.to_path_buf()] } else { vec![] }
+}
+
 /// `onebeacon mc SCENARIO [--runs N] [--seed N] [--threads N] [--out DIR] [--json]`
 pub fn mc(
     name: &str,
@@ -142,7 +149,7 @@ pub fn mc(
     let seed = seed.unwrap_or(s.seed());
     crate::check_memory(name, &s, onebeacon_sim::budget::concurrent_runs(threads, runs), 0)?;
     // an unwritable --out fails before the runs, not after
-    let staging = out.as_deref().map(Staging::new).transpose()?;
+    let staging = out.as_deref().map(|d| Staging::new(d, &scenario_inputs(name))).transpose()?;
 
     let total = (runs * s.cells().len()) as u64;
     let bar = crate::progress::Progress::new(total, "runs", format!("mc {}", s.name()));

@@ -87,7 +87,9 @@ pub fn process(wav: &Path, config: Option<&str>, out: Option<PathBuf>, as_json: 
     let frames = open()?.check().map_err(|e| bad(wav, e))?;
     let len = if frames <= c.capture.samples { frames } else { c.capture.samples };
     let mut chain = Chain::new(c, len).map_err(|e| bad(wav, e))?;
-    let staging = out.as_deref().map(Staging::new).transpose()?;
+    let mut inputs = vec![wav.to_path_buf()];
+    inputs.extend(config.map(PathBuf::from));
+    let staging = out.as_deref().map(|d| Staging::new(d, &inputs)).transpose()?;
     let mut recording = open()?;
     if frames == len {
         let found = chain.process(&recording.next_capture(len).map_err(|e| bad(wav, e))?);

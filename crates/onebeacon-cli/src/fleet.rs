@@ -47,7 +47,7 @@ pub fn fleet(
     let seed = seed.unwrap_or(s.seed());
     crate::check_memory(name, &s, onebeacon_sim::budget::concurrent_runs(threads, runs), runs)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{}-fleet", s.name())));
-    let staging = Staging::new(&dir)?;
+    let staging = Staging::new(&dir, &crate::commands::scenario_inputs(name))?;
     let bar = crate::progress::Progress::new(runs as u64, "runs", format!("fleet {}", s.name()));
     let step = (snapshot_s / f.mission.dt_s).round() as usize;
     let start = Instant::now();

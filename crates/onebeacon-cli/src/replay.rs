@@ -28,7 +28,15 @@ pub(crate) struct Prepared {
 }
 
 impl Prepared {
-    pub(crate) fn new(log: Log, out: Option<PathBuf>, beacons: Option<Vec<u32>>, command: &str) -> Result<Self> {
+    /// The log `log` (its estimators read from `estimators` when given) prepared for
+    /// `command`, writing to `out` (default: out/<log>-<command>[-beacons-...]).
+    pub(crate) fn new(
+        log: Log,
+        estimators: Option<&Path>,
+        out: Option<PathBuf>,
+        beacons: Option<Vec<u32>>,
+        command: &str,
+    ) -> Result<Self> {
         let known = log.beacon_ids();
         let filter = beacon_filter(beacons, &known)?;
         let used: Vec<u32> =
@@ -39,7 +47,9 @@ impl Prepared {
         let dir =
             out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-{command}{}", suffix.unwrap_or_default())));
         crate::budget().check_replay(&log, false).map_err(|e| BadInput(e.to_string()))?;
-        let staging = Staging::new(&dir)?;
+        let mut inputs = log.files();
+        inputs.extend(estimators.map(Path::to_path_buf));
+        let staging = Staging::new(&dir, &inputs)?;
         Ok(Self { log, filter, used, staging })
     }
 
@@ -119,7 +129,7 @@ pub fn replay(
         stdout.flush()?;
         return Ok(());
     }
-    let p = Prepared::new(log, out, beacons, "replay")?;
+    let p = Prepared::new(log, estimators, out, beacons, "replay")?;
     let (r, summary, title, wall_s) = p.replay("", &[], |_| {}, |_| Ok(()))?;
     let files = p.finish(&r)?;
     if as_json {

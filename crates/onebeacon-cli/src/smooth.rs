@@ -32,7 +32,7 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
     let cfg = onebeacon_sim::smooth::config(&log, a.like.as_deref(), a.calibrate.as_deref(), a.kernel.as_deref())
         .map_err(|e| BadInput(format!("--{e}")))?;
     crate::budget().check_smooth(&log).map_err(|e| BadInput(e.to_string()))?;
-    let p = Prepared::new(log, a.out.clone(), a.beacons.clone(), "smooth")?;
+    let p = Prepared::new(log, a.estimators.as_deref(), a.out.clone(), a.beacons.clone(), "smooth")?;
     // a log that cannot be read or has nothing to smooth is bad input (exit 2)
     let smoothed = run_smooth(&p.log, p.filter.as_ref(), &cfg).map_err(|e| match e {
         SmoothError::Log(e) => anyhow::Error::from(e),

@@ -63,7 +63,7 @@ pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
     }
     let name = &log.description.name;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-tune")));
-    let staging = Staging::new(&dir)?;
+    let staging = Staging::new(&dir, &log.files())?;
     let started = std::time::Instant::now();
     let bar = crate::progress::Progress::new(chosen.len() as u64, "estimators", format!("tuning {name}"));
     let mut tuned: Vec<(usize, Tuned)> = Vec::new();

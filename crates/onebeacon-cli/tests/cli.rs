@@ -173,6 +173,35 @@ fn sharded_mc_merges_into_the_unsharded_cells() {
     let err = text(&out.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("missing shard(s) 0, 2 of 3"), "{err}");
+    // the merge's --out over its own partials: refused, the partials kept (cfb7f93
+    // replaced the directory and lost them)
+    let out = run(&["mc", "merge", parts.to_str().unwrap(), "--out", parts.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("an input of this command"), "{}", text(&out.stderr));
+    assert!(one.exists());
+}
+
+/// Eight shards of one campaign finishing at once on one machine: each partial is
+/// listed in the directory's marker (at cfb7f93 some updates were lost, and `--out` over
+/// that directory was then refused).
+#[test]
+fn concurrent_shards_each_list_their_partial() {
+    let dir = scratch("shards-at-once");
+    let scenario = short_scenario(&dir);
+    let parts = dir.join("parts");
+    let children: Vec<_> = (0..8)
+        .map(|i| {
+            let shard = format!("{i}/8");
+            let args = ["mc", &scenario, "--runs", "8", "--shard", &shard, "--out", parts.to_str().unwrap()];
+            bin().args(args).stdout(std::process::Stdio::null()).spawn().unwrap()
+        })
+        .collect();
+    for mut c in children {
+        assert!(c.wait().unwrap().success());
+    }
+    let marker = std::fs::read_to_string(parts.join(".onebeacon-output")).unwrap();
+    let listed = marker.lines().filter(|l| l.starts_with("partial-")).count();
+    assert_eq!(listed, 8, "{marker}");
 }
 
 #[test]

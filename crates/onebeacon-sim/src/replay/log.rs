@@ -53,9 +53,19 @@ pub struct Log {
     /// Latitude and longitude to local positions, when the log has them.
     pub(super) geodetic: Option<Geodetic>,
     pub(super) base: PathBuf,
+    /// The description's own path.
+    path: PathBuf,
 }
 
 impl Log {
+    /// Every file the log reads: its description, its CSV files and its beacons file.
+    pub fn files(&self) -> Vec<PathBuf> {
+        let mut files = vec![self.path.clone()];
+        files.extend(self.description.sources.iter().map(|s| self.base.join(&s.file)));
+        files.extend(self.description.beacons.iter().map(|b| self.base.join(&b.file)));
+        files
+    }
+
     /// The bytes of the log's CSV files (those that can be read; the replay names the
     /// others).
     pub fn source_bytes(&self) -> u64 {
@@ -226,7 +236,8 @@ impl Log {
         let geodetic = description.geodetic(&base)?;
         let beacons = description.beacons_about(&base, geodetic.as_ref())?;
         // beacon tracks first, so that ranges may name tracked beacons
-        let mut log = Self { description, frame, beacons, tracked: BTreeSet::new(), geodetic, base };
+        let (tracked, path) = (BTreeSet::new(), path.to_path_buf());
+        let mut log = Self { description, frame, beacons, tracked, geodetic, base, path };
         let mut tracked = BTreeSet::new();
         for s in log.description.sources.iter().filter(|s| s.kind == SourceKind::BeaconTrack) {
             let mut rows = SourceRows::open(&log, s)?;
