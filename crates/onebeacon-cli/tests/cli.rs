@@ -366,6 +366,10 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
     let plaza1 = plaza1.to_str().unwrap();
     let out_dir = dir.join("should-not-exist");
     let out = out_dir.to_str().unwrap();
+    let wav = out_dir.join("ping.wav").to_string_lossy().into_owned();
+    let fifo = dir.join("fifo.toml").to_string_lossy().into_owned();
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
 
     let cases: Vec<(Vec<&str>, &[&str])> = vec![
         // tuning what weighs no measurement
@@ -397,7 +401,18 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["mc", "merge", &shards, "--out", out], &["partial-0-of-1000000000.json", "shards 1000000000"]),
         (vec!["mc", "merge", &runs, "--out", out], &["partial-runs.json", "should hold 1000000000"]),
         (vec!["run", "garin2025", "--out", out], &["garin2025", "garin2024"]),
-        (vec!["mc", &missing, "--out", out], &["nope.toml", "cannot read"]),
+        (vec!["mc", &missing, "--out", out], &["nope.toml", "cannot open"]),
+        // every reader of a file the user names: regular files only, never read without
+        // bound (cfb7f93 grew to 4.2 GB on /dev/zero)
+        (vec!["run", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
+        (vec!["fleet", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
+        (vec!["replay", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
+        (vec!["smooth", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
+        (vec!["tune", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
+        (vec!["stream", "/dev/zero"], &["/dev/zero", "not a regular file"]),
+        (vec!["replay", plaza1, "--estimators", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
+        (vec!["dsp", "simulate", "--config", "/dev/zero", "--out", &wav], &["/dev/zero", "not a regular file"]),
+        (vec!["run", &fifo, "--out", out], &["fifo.toml", "not a regular file"]),
         (vec!["mc", &malformed, "--out", out], &["malformed.toml", "line 2"]),
         (vec!["mc", &unknown, "--out", out], &["unknown.toml", "t_comm_s", "t_com_s"]),
         (vec!["mc", &wrong_type, "--out", out], &["type.toml", "sensors.range_noise_m", "line 3"]),

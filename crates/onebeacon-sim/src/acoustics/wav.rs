@@ -20,10 +20,10 @@ pub struct Recording<R: Read> {
     read: usize,
 }
 
-impl Recording<std::io::BufReader<std::fs::File>> {
-    /// Opens the WAV at `path` ([`Recording::new`]).
+impl Recording<std::io::BufReader<std::io::Take<std::fs::File>>> {
+    /// Opens the WAV at `path` ([`Recording::new`]): a regular file, read to its length.
     pub fn open(path: &Path, channels: usize, fs_hz: f64) -> Result<Self, WavError> {
-        let file = std::fs::File::open(path).map_err(|e| WavError(format!("cannot open: {e}")))?;
+        let file = crate::input_file::open_bounded(path).map_err(WavError)?;
         Self::new(std::io::BufReader::new(file), channels, fs_hz)
     }
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 pub(super) struct Table {
     pub(super) file: String,
     header: Vec<String>,
-    reader: csv::Reader<LineLimited<std::fs::File>>,
+    reader: csv::Reader<LineLimited<std::io::Take<std::fs::File>>>,
     record: csv::StringRecord,
 }
 
@@ -46,8 +46,8 @@ impl Table {
     pub(super) fn open(base: &Path, file: &Path) -> Result<Self, LogError> {
         let path = base.join(file);
         let name = path.display().to_string();
-        let f = std::fs::File::open(&path)
-            .map_err(|e| LogError::File { file: name.clone(), message: format!("cannot open: {e}") })?;
+        let f =
+            crate::input_file::open_bounded(&path).map_err(|message| LogError::File { file: name.clone(), message })?;
         let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(LineLimited { inner: f, line: 0 });
         let header = reader
             .headers()

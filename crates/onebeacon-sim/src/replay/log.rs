@@ -83,7 +83,7 @@ impl LogDescription {
     pub fn load(path: &Path) -> Result<Self, LogError> {
         let name = path.display().to_string();
         let text =
-            std::fs::read_to_string(path).map_err(|e| LogError::File { file: name.clone(), message: e.to_string() })?;
+            crate::input_file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
         Self::parse(&text, &name)
     }
 
@@ -214,8 +214,7 @@ struct EstimatorFile {
 /// own (`replay --estimators`).
 pub fn load_estimators(path: &Path) -> Result<Vec<EstimatorSpec>, LogError> {
     let name = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| LogError::File { file: name.clone(), message: e.to_string() })?;
+    let text = crate::input_file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
     let f: EstimatorFile = deserialize(&text, &name)?;
     if f.estimators.is_empty() {
         return Err(LogError::File { file: name, message: "no [[estimators]] table".into() });

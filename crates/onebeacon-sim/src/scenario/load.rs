@@ -10,7 +10,7 @@ use std::path::Path;
 pub enum ScenarioError {
     #[error("unknown scenario `{name}`: built-in scenarios are {available}; or give the path of a .toml file")]
     UnknownBuiltin { name: String, available: String },
-    #[error("{source_name}: cannot read: {message}")]
+    #[error("{source_name}: {message}")]
     Io { source_name: String, message: String },
     #[error("{source_name}: line {line}: {message}")]
     Syntax { source_name: String, line: usize, message: String },
@@ -46,8 +46,8 @@ pub fn load_builtin(name: &str) -> Result<Scenario, ScenarioError> {
 /// Loads the scenario of the TOML file at `path`.
 pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ScenarioError::Io { source_name: name.clone(), message: e.to_string() })?;
+    let text = crate::input_file::read_text(path)
+        .map_err(|message| ScenarioError::Io { source_name: name.clone(), message })?;
     parse(&text, &name)
 }
 

@@ -193,8 +193,8 @@ impl PingConfig {
     /// Reads `path`, or the defaults.
     pub fn load(path: Option<&str>) -> Result<Self, ScenarioError> {
         let Some(path) = path else { return Ok(Self::default()) };
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ScenarioError::Io { source_name: path.to_string(), message: e.to_string() })?;
+        let text = crate::input_file::read_text(std::path::Path::new(path))
+            .map_err(|message| ScenarioError::Io { source_name: path.to_string(), message })?;
         Self::parse(&text, path)
     }
 
