@@ -532,10 +532,18 @@ impl Session {
         if let Some(dt) = dt.filter(|dt| *dt < 0.0) {
             return Err(self.screen(item, format!("time {t} s is {:.6} s before the previous item's", -dt)));
         }
-        if let Some(dt) = dt.filter(|dt| *dt > self.limits.max_time_gap_s) {
+        // before the first item the start time given is the previous time: a stream on
+        // another clock (UNIX seconds against t0_s = 0) is a jump like any other
+        let given_t0 = match self.start {
+            Start::At { t0_s: Some(t0), .. } if self.last_t.is_none() && !self.started() => Some(t0),
+            _ => None,
+        };
+        let gap = dt.or(given_t0.map(|t0| t - t0));
+        if let Some(dt) = gap.filter(|dt| *dt > self.limits.max_time_gap_s) {
             // a lone jump is a corrupt time; a few items in a row on the new clock are a
             // real gap (a vehicle back from the surface), taken as the new time base
             let most = self.limits.max_time_gap_s;
+            let previous = if given_t0.is_some() { "the start time (initial.t0_s)" } else { "the previous item" };
             let seen = match self.jump {
                 Some((t_jump, n)) if (t - t_jump).abs() <= most => n + 1,
                 _ => 1,
@@ -545,10 +553,16 @@ impl Session {
                 return Err(self.screen(
                     item,
                     format!(
-                        "time {t:?} s jumps {dt:?} s past the previous item (limits.max_time_gap_s = {most}; \
+                        "time {t:?} s jumps {dt:?} s past {previous} (limits.max_time_gap_s = {most}; \
                          {JUMP_ITEMS} items in a row on the new clock restart it)"
                     ),
                 ));
+            }
+            // the new clock is the time base: estimators not yet started start on it
+            if let Start::At { pose, .. } = self.start
+                && given_t0.is_some()
+            {
+                self.start = Start::At { t0_s: None, pose };
             }
         }
         if let Err(reason) = self.limits.check(&item.input, dt) {
@@ -701,6 +715,37 @@ mod tests {
         let after: Vec<bool> = [10_000.0, 10_001.0, 10_002.0, 10_003.0].map(|t| s.push(&item(t)).is_ok()).to_vec();
         assert_eq!(after, [false, false, true, true]);
         assert_eq!(s.screened, 3);
+    }
+
+    /// A stream on another clock than the configuration's `t0_s` (a vehicle counting
+    /// UNIX seconds against `run --messages`' t0_s = 0): the first items are a jump like
+    /// any other, screened until three in a row set the new time base, and the
+    /// estimators start there instead of predicting across 1.7e9 s (cfb7f93: 3.3e9 m off,
+    /// every item accepted).
+    #[test]
+    fn the_gap_from_the_start_time_to_the_first_item_is_screened() {
+        let est = vec![("dr".to_string(), PlanarConfig::default(), FilterKind::Ekf)];
+        let start = Start::At { t0_s: Some(0.0), pose: (0.0, 0.0, 0.0) };
+        let mut s = Session::new(Frame::Ned, planar(est), start, (1.0, 0.1), None);
+        let t0 = 1.7e9;
+        let speed = |t: f64| Item { t_s: t, input: Input::Measurement(Kind::Speed { speed_m_s: 1.0 }) };
+        let first = s.push(&speed(t0)).unwrap_err();
+        assert!(first.reason.contains("past the start time (initial.t0_s)"), "{first}");
+        assert!(s.push(&speed(t0 + 1.0)).is_err());
+        assert!(s.push(&speed(t0 + 2.0)).unwrap().is_some(), "the third on the new clock starts the estimators");
+        for k in 3..=12 {
+            assert!(s.push(&speed(t0 + k as f64)).is_ok());
+        }
+        // 10 s at 1 m/s heading north from the new start
+        let e = &s.final_estimates()[0];
+        assert!((e.north_m() - 10.0).abs() < 1e-6 && e.east_m().abs() < 1e-6, "{} {}", e.north_m(), e.east_m());
+        assert_eq!(s.screened, 2);
+        // a start time close to the stream's is kept as given
+        let start = Start::At { t0_s: Some(t0 - 5.0), pose: (0.0, 0.0, 0.0) };
+        let est = vec![("dr".to_string(), PlanarConfig::default(), FilterKind::Ekf)];
+        let mut s = Session::new(Frame::Ned, planar(est), start, (1.0, 0.1), None);
+        assert!(s.push(&speed(t0)).unwrap().is_some());
+        assert_eq!(s.final_estimates()[0].t_s, t0);
     }
 
     /// A stream whose ground truth has no heading (`heading_from = "track"`) starts at
