@@ -316,6 +316,16 @@ impl Limits {
 /// Items in a row past the time gap that are taken as a new time base.
 const JUMP_ITEMS: usize = 3;
 
+/// Whether two items are the same message: equal, NaN fields (a tracked beacon's
+/// position before it is resolved) equal to NaN.
+fn same_input(a: &Input, b: &Input) -> bool {
+    a == b || (a.name() == b.name() && format!("{a:?}") == format!("{b:?}"))
+}
+
+/// How many items of one time are kept to screen repeats among them (a logger or a
+/// bridge that sends a message twice); past it, repeats at that time are not looked for.
+const REPEATS_KEPT: usize = 64;
+
 /// An item that no estimator saw: out of time order, out of the [`Limits`], or naming a
 /// beacon whose position is not known.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -382,6 +392,9 @@ pub struct Session {
     last_t: Option<f64>,
     /// Items in a row that jumped past the gap: the latest's time and their count.
     jump: Option<(f64, usize)>,
+    /// The items taken at the time of the last one (at most [`REPEATS_KEPT`]), against
+    /// which a repeated message is screened.
+    at_last_t: Vec<Input>,
     /// Whether the estimators keep their history ([`Session::with_history`]).
     keep_history: bool,
 }
@@ -422,6 +435,7 @@ impl Session {
             limits: Limits::default(),
             last_t: None,
             jump: None,
+            at_last_t: Vec::new(),
             restarts: Vec::new(),
             keep_history: false,
         }
@@ -567,6 +581,19 @@ impl Session {
         }
         if let Err(reason) = self.limits.check(&item.input, dt) {
             return Err(self.screen(item, reason));
+        }
+        // a message repeated at its own time (a logger or a bridge sending it twice) is
+        // weighed once: twice would count its evidence twice, and a particle filter
+        // with no time to spread between them collapses
+        if self.last_t == Some(t) && self.at_last_t.iter().any(|a| same_input(a, &item.input)) {
+            let reason = "a repeat of an item already taken at this time (a message sent twice)";
+            return Err(self.screen(item, reason.into()));
+        }
+        if self.last_t != Some(t) {
+            self.at_last_t.clear();
+        }
+        if self.at_last_t.len() < REPEATS_KEPT {
+            self.at_last_t.push(item.input.clone());
         }
         let item = &Item { t_s: t, input: item.input.clone().to_ned(self.frame) };
         if let Input::BeaconPosition { beacon_id, position } = item.input {
@@ -746,6 +773,29 @@ mod tests {
         let mut s = Session::new(Frame::Ned, planar(est), start, (1.0, 0.1), None);
         assert!(s.push(&speed(t0)).unwrap().is_some());
         assert_eq!(s.final_estimates()[0].t_s, t0);
+    }
+
+    /// A message repeated at its own time (a logger or a bridge sending it twice) is
+    /// screened, NaN fields and all (a tracked beacon's unresolved position); another
+    /// message at that time, or the same at a later time, is taken. At cfb7f93 every
+    /// line of a rypkema stream twice put the iUSBL navigator 53 m off; ten times, 267
+    /// restarts.
+    #[test]
+    fn a_repeated_message_is_weighed_once() {
+        let start = Start::At { t0_s: None, pose: (0.0, 0.0, 0.0) };
+        let mut s = Session::new(Frame::Ned, Vec::new(), start, (1.0, 0.1), None);
+        let speed = |t: f64, v: f64| Item { t_s: t, input: Input::Measurement(Kind::Speed { speed_m_s: v }) };
+        let unresolved = BeaconFix::fixed(3, Vector3::repeat(f64::NAN));
+        let range = Item { t_s: 1.0, input: Input::Measurement(Kind::Range { beacon: unresolved, range_m: 50.0 }) };
+        assert!(s.push(&speed(1.0, 1.0)).is_ok());
+        let again = s.push(&speed(1.0, 1.0)).unwrap_err();
+        assert!(again.reason.contains("a repeat"), "{again}");
+        assert!(s.push(&speed(1.0, 1.5)).is_ok(), "another value at the same time");
+        let first = s.push(&range).map(|_| ()).map_err(|e| e.reason);
+        assert!(!first.as_ref().is_err_and(|r| r.contains("a repeat")), "{first:?}");
+        assert!(s.push(&range).unwrap_err().reason.contains("a repeat"));
+        assert!(s.push(&speed(2.0, 1.0)).is_ok(), "the same value later");
+        assert_eq!(s.screened, 2 + usize::from(first.is_err()));
     }
 
     /// A stream whose ground truth has no heading (`heading_from = "track"`) starts at
