@@ -57,13 +57,21 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
             record.estimates.push(row_estimate(run.at(record.t_s), (error_m, nees.unwrap_or(f64::NAN))));
         }
     };
+    let mut warnings = smoothed.warnings.clone();
     let (r, summary, title, _) = p.replay(" smoothed", &names, extra, |summary| {
         let entries = summary["estimators"].as_array_mut().context("the summary lists its estimators")?;
         entries.push(onebeacon_sim::json::smoother_summary("smoother", &smoothed));
         entries.extend(runs.iter().map(onebeacon_sim::json::rts_summary));
+        warnings.extend(worse_than_the_filters(entries));
+        if let Some(list) = summary["warnings"].as_array_mut() {
+            list.extend(warnings.iter().map(|w| serde_json::json!(w)));
+        }
         Ok(())
     })?;
     let files = p.finish(&r)?;
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
     if a.json {
         outln!("{summary}");
         return Ok(());
@@ -94,6 +102,32 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
         outln!("  {}", f.display());
     }
     Ok(())
+}
+
+/// How much larger than the best filter's RMSE the smoother's may be before it is said
+/// to have failed: it weighs the same measurements with hindsight, so on a log with
+/// ground truth it should not be far above the filters (no source: a guard, with a
+/// metre's slack for logs where every error is small).
+const WORSE_FACTOR: f64 = 2.0;
+
+/// A warning where the smoother's RMSE (`entries`' "smoother") is more than
+/// [`WORSE_FACTOR`] times, and a metre above, the best filter's (with or without its RTS
+/// pass; dead reckoning left out). None without ground truth (no RMSE).
+fn worse_than_the_filters(entries: &[serde_json::Value]) -> Option<String> {
+    let rmse = |e: &serde_json::Value| e["rmse_m"].as_f64().filter(|v| v.is_finite());
+    let smoother = entries.iter().find(|e| e["name"] == "smoother").and_then(rmse)?;
+    let (best, name) = entries
+        .iter()
+        .filter(|e| e["name"] != "smoother" && !e["name"].as_str().is_some_and(|n| n.starts_with("dead-reckoning")))
+        .filter_map(|e| Some((rmse(e)?, e["name"].as_str()?.to_string())))
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    (smoother > WORSE_FACTOR * best && smoother > best + 1.0).then(|| {
+        format!(
+            "the smoother's RMSE {smoother:.3} m is over {WORSE_FACTOR} times the best filter's ({name}, {best:.3} m) on \
+             the same rows: the solve found a wrong optimum (a misplaced beacon, a units slip, a calibration the \
+             data cannot fix); do not use its track"
+        )
+    })
 }
 
 /// The smoother's row at time `t`, scored against the truth `truth` (NaN: none).

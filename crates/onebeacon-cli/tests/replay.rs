@@ -507,6 +507,37 @@ fn smooth_matches_gtsam_on_plaza2_and_refuses_bad_flags() {
     assert!(!bad.exists());
 }
 
+/// plaza2 with beacon 0's position multiplied by 100 (a units slip): the smoother
+/// warns, on stderr and in summary.json, that its range scale stopped at its bound and
+/// that its RMSE is far above the filters' (cfb7f93: nothing said, 899 m on plaza1).
+#[test]
+fn smooth_says_when_it_fails() {
+    let dir = scratch("smooth-slip");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/plaza");
+    for f in ["plaza2.toml", "plaza2_odometry.csv", "plaza2_ranges.csv", "plaza2_ground_truth.csv"] {
+        std::fs::copy(data.join(f), dir.join(f)).unwrap();
+    }
+    let beacons = std::fs::read_to_string(data.join("plaza2_beacons.csv")).unwrap();
+    let mut lines: Vec<String> = beacons.lines().map(String::from).collect();
+    let f: Vec<String> = lines[1].split(',').map(String::from).collect();
+    let scaled = |v: &str| (v.parse::<f64>().unwrap() * 100.0).to_string();
+    lines[1] = format!("{},{},{}", f[0], scaled(&f[1]), scaled(&f[2]));
+    std::fs::write(dir.join("plaza2_beacons.csv"), lines.join("\n") + "\n").unwrap();
+    let log = dir.join("plaza2.toml");
+    let out = dir.join("s");
+    let o = run(&["smooth", log.to_str().unwrap(), "--out", out.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(err.contains("warning: the smoother's range_scale ended at its bound"), "{err}");
+    assert!(err.contains("times the best filter's"), "{err}");
+    let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let warnings = summary["warnings"].as_array().unwrap();
+    assert!(warnings.iter().any(|w| w.as_str().unwrap().contains("do not use its track")), "{warnings:?}");
+    // the log as it is: no such warning
+    let o = run(&["smooth", &plaza(2), "--out", dir.join("ok").to_str().unwrap(), "--json"]);
+    assert!(!text(&o.stderr).contains("smoother"), "{}", text(&o.stderr));
+}
+
 /// README's "Your own log": its TOML block, word for word, replays a synthetic dive
 /// (1 m/s due east from its given start, for 10 min; exact speed, heading and ranges
 /// to the beacon, so each estimator ends on the truth, 600 m east of the start, within

@@ -105,6 +105,8 @@ pub fn smoother_summary(name: &str, s: &crate::smooth::Smoothed) -> Value {
         ("rejected", json!(s.gated)),
         ("dead_reckoning_rmse_m", num(dr.rmse_m())),
         ("iterations", json!(s.iterations)),
+        ("converged", json!(s.converged)),
+        ("warnings", json!(s.warnings)),
         ("cost", json!({"initial": num(s.cost0), "final": num(s.cost)})),
         ("build_s", json!(s.build_s)),
         ("solve_s", json!(s.solve_s)),

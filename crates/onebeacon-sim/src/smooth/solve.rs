@@ -24,11 +24,13 @@ const RELATIVE_TOLERANCE: f64 = 1e-6;
 /// The least damping (relative to the normal matrix's diagonal) after a rejected step.
 const REJECTED_LAMBDA: f64 = 1e-5;
 
-/// How the solver weighs and stops.
+/// How the solver weighs, bounds and stops.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct SolveOptions {
+pub(crate) struct SolveOptions<'a> {
     pub kernel: Option<Robust>,
     pub max_iterations: usize,
+    /// Variables kept within (index, low, high): each step is projected on them.
+    pub bounds: &'a [(usize, f64, f64)],
 }
 
 /// The optimum, how it was reached, and the marginal covariances there.
@@ -36,6 +38,9 @@ pub(crate) struct SolveOptions {
 pub(crate) struct Solution {
     pub x: Vec<f64>,
     pub iterations: usize,
+    /// Whether the cost settled (a step lowered it by less than the tolerance, or no
+    /// step could lower it) before the iteration cap.
+    pub converged: bool,
     pub cost0: f64,
     pub cost: f64,
     /// (north, east, heading) covariance per pose.
@@ -240,13 +245,25 @@ pub(crate) fn solve(
     let mut iterations = 0;
     let mut chol = None;
     let mut ne = problem.normal(&x);
-    while iterations < opt.max_iterations && lambda < 1e12 {
+    let mut converged = false;
+    loop {
+        if lambda >= 1e12 {
+            // no step lowers the cost: a minimum
+            converged = true;
+            break;
+        }
+        if iterations >= opt.max_iterations {
+            break;
+        }
         iterations += 1;
         let Some(step) = problem.step(&ne, lambda, &mut chol) else {
             (lambda, nu) = ((lambda * nu).max(REJECTED_LAMBDA), 2.0 * nu);
             continue;
         };
-        let trial: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+        let mut trial: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+        for &(i, lo, hi) in opt.bounds {
+            trial[i] = trial[i].clamp(lo, hi);
+        }
         let trial_cost = total_cost(factors, active, &trial, opt.kernel);
         // the decrease the quadratic model predicts, (lambda h^T D h - h^T g) / 2
         let damped: f64 = (0..problem.dim).map(|i| problem.diagonal(&ne, i) * step[i] * step[i]).sum();
@@ -261,6 +278,7 @@ pub(crate) fn solve(
             nu = 2.0;
             ne = problem.normal(&x);
             if gain <= RELATIVE_TOLERANCE * cost || step.amax() < 1e-9 {
+                converged = true;
                 break;
             }
         } else {
@@ -288,7 +306,7 @@ pub(crate) fn solve(
             }
         }
     }
-    Ok(Solution { x, iterations, cost0, cost, poses: blocks, calibration: s_inv })
+    Ok(Solution { x, iterations, converged, cost0, cost, poses: blocks, calibration: s_inv })
 }
 
 /// The entries of the inverse of L L^T on the pattern of L (Takahashi, Fagan and Chen's

@@ -173,3 +173,24 @@ fn rts_of_the_range_ekf_is_consistent_and_agrees_with_the_smoother() {
     assert!((lo..=hi).contains(&bias_mean), "with an offset state: mean NEES {bias_mean:.2}");
     assert!(gap_sum / (RUNS as f64) < 0.1, "RTS and the smoother {:.3} sigma apart", gap_sum / RUNS as f64);
 }
+
+/// A beacon's position off by a units slip (x100): the range scale, which at cfb7f93
+/// went to 0.013 (and negative with an estimator's priors) in silence, stops at its
+/// bound and says so; a solve cut at one iteration says it stopped at its cap; the same
+/// log as it is says nothing.
+#[test]
+fn a_bound_or_a_cap_reached_is_said() {
+    let mut log = synthetic("slip", 300, 1.0, [0.0, 0.0], Some(7));
+    let cfg = SmoothConfig::default();
+    let s = smooth(&log, None, &cfg).unwrap();
+    assert!(s.converged && s.warnings.is_empty(), "{:?}", s.warnings);
+    let capped = smooth(&log, None, &SmoothConfig { max_iterations: 1, ..cfg }).unwrap();
+    assert!(!capped.converged);
+    assert!(capped.warnings[0].contains("cap of 1 iterations"), "{:?}", capped.warnings);
+    let b = log.beacons.get_mut(&1).unwrap();
+    *b *= 100.0;
+    let s = smooth(&log, None, &cfg).unwrap();
+    let scale = s.calibration.iter().find(|c| c.0 == "range_scale").unwrap().1;
+    assert!((SCALE_BOUNDS.0..=SCALE_BOUNDS.1).contains(&scale), "{scale}");
+    assert!(s.warnings.iter().any(|w| w.contains("range_scale ended at its bound")), "{:?}", s.warnings);
+}
