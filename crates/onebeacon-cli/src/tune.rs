@@ -26,6 +26,7 @@ pub struct TuneArgs {
 pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
     let TuneArgs { estimators, keys, beacons, each_beacon, out, json: as_json } = args;
     let log = Log::load(path)?;
+    crate::budget().check_replay(&log, false).map_err(|e| BadInput(e.to_string()))?;
     let filter = crate::replay::beacon_filter(beacons, &log.beacon_ids())?;
     let mut sets = vec![filter.clone()];
     if each_beacon {

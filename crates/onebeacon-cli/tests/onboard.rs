@@ -136,3 +136,44 @@ fn messages_of_a_world_without_a_streamable_computer_are_refused() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("--messages: garin2024") && e.contains("passive_usbl"), "{e}");
 }
+
+/// `stream` and its memory budget: hoff2024's surface vehicle with 2e6 particles in its
+/// particle filter, run on 2 minutes of its messages, peaks (wait4's ru_maxrss) below
+/// the estimate the budget checks: a budget of the measured peak is refused, up front,
+/// with one line, and one of twice the peak is taken (the estimate is an upper bound,
+/// and not over twice the measurement). cfb7f93 ignored the budget in `stream`.
+#[cfg(target_os = "linux")]
+#[test]
+fn the_streams_memory_estimate_bounds_its_peak() {
+    let dir = scratch("stream-memory");
+    let scenario = edited(&dir, "hoff2024", &[("duration_s = ", "duration_s = 120.0")]);
+    let run = run_messages(&scenario, &dir);
+    let config = std::fs::read_to_string(run.join("asv.stream.toml")).unwrap();
+    assert!(config.contains("\nparticles = 500000"), "the pf's particles");
+    let big = dir.join("big.toml");
+    std::fs::write(&big, config.replace("\nparticles = 500000", "\nparticles = 2000000")).unwrap();
+    let input = std::fs::File::open(run.join("asv.input.jsonl")).unwrap();
+    let stream = |gib: Option<f64>| {
+        let mut c = bin();
+        c.arg("stream").arg(&big).stdin(Stdio::null()).stdout(Stdio::null()).stderr(Stdio::piped());
+        if let Some(g) = gib {
+            c.args(["--memory-gib", &g.to_string()]);
+        }
+        c
+    };
+    let child = stream(None).stdin(input).spawn().unwrap();
+    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
+    // SAFETY: waits for our own child, writing into the two locals
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as i32);
+    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0, "stream failed: {status}");
+    let peak_gib = usage.ru_maxrss as f64 * 1024.0 / (1u64 << 30) as f64;
+    assert!(peak_gib > 0.2, "2e6 particles of 8 states hold at least 0.27 GB: {peak_gib} GiB");
+    let refused = stream(Some(peak_gib)).output().unwrap();
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "a budget of the measured peak ({peak_gib} GiB) is taken: {err}");
+    assert!(err.contains("would hold about") && err.contains("particles"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    let taken = stream(Some(2.0 * peak_gib)).output().unwrap();
+    assert!(taken.status.success(), "twice the peak refused: {}", String::from_utf8_lossy(&taken.stderr));
+}

@@ -575,7 +575,8 @@ impl PyNavigator {
     /// beacons, initial state, estimators; its sources are ignored).
     #[new]
     fn new(config: PathBuf) -> PyResult<Self> {
-        let unit = stream_setup(&config).map_err(input_error)?;
+        let budget = Budget::resolve(None).map_err(input_error)?;
+        let unit = stream_setup(&config, &budget).map_err(input_error)?;
         Ok(Self { unit: std::sync::Mutex::new(unit), lines: Lines::default() })
     }
 

@@ -14,7 +14,9 @@
 
 use crate::replay::Log;
 use crate::run::{Estimate, StepRecord, TruthRecord, recorded_bytes};
-use crate::scenario::{EstimatorKind, EstimatorSpec, Host, Scenario};
+use crate::scenario::{EstimatorSpec, Host, Scenario};
+use onebeacon::config::estimator::particle_filter_bytes;
+use onebeacon::config::stream::StreamConfig;
 use onebeacon::nav::planar::{STATES, STATES_WITH_OFFSETS};
 
 /// The environment variable that sets the budget, GiB.
@@ -126,7 +128,7 @@ impl Budget {
         let estimators = log.description.estimators.len();
         let row = record_bytes(estimators);
         let rows = if keep_records { log_rows(log) } else { PLOTTED_ROWS };
-        let need = BASE_BYTES + estimators as f64 * 1e5 + rows * row;
+        let need = BASE_BYTES + filters_bytes(&log.description.estimators) + rows * row;
         let detail = format!("{estimators} estimators, {rows:.0} rows of {row:.0} bytes kept");
         let keys = if keep_records { "the log's length (cut it), [[estimators]]" } else { "[[estimators]]" };
         self.check(&format!("replaying {}", log.description.name), need, &detail, keys)
@@ -151,7 +153,7 @@ impl Budget {
             .collect();
         let rows = log_rows(log);
         let node = SMOOTHER_NODE_BYTES + kept.iter().map(|&n| rts_step_bytes(n)).sum::<f64>();
-        let replay = BASE_BYTES + estimators.len() as f64 * 1e5 + PLOTTED_ROWS * record_bytes(estimators.len());
+        let replay = BASE_BYTES + filters_bytes(estimators) + PLOTTED_ROWS * record_bytes(estimators.len());
         let need = replay + rows * node;
         let detail =
             format!("{rows:.0} rows, each a node of the graph and a step of {} filters' histories", kept.len());
@@ -162,6 +164,28 @@ impl Budget {
             "the log's length (cut it), [[estimators]]",
         )
     }
+}
+
+impl Budget {
+    /// Refuses the vehicle's computer of `config` (`onebeacon stream`, the Python
+    /// `Navigator`) where it would not fit ([`StreamConfig::working_set_bytes`]), before
+    /// its filters are built.
+    pub fn check_stream(&self, config: &StreamConfig) -> Result<(), BudgetError> {
+        let need = BASE_BYTES + config.working_set_bytes();
+        let vehicles = config.tracked.len().max(1);
+        let detail = format!("{} estimator(s) for {vehicles} vehicle(s)", config.estimators.len());
+        let keys = if vehicles > 1 {
+            "the estimators' `particles`, [[tracked]], controller.planner_particles"
+        } else {
+            "the estimators' `particles`, controller.planner_particles"
+        };
+        self.check(&format!("the vehicle's computer of {}", config.name), need, &detail, keys)
+    }
+}
+
+/// What the filters of `estimators` hold for one vehicle, bytes.
+fn filters_bytes(estimators: &[EstimatorSpec]) -> f64 {
+    estimators.iter().map(EstimatorSpec::working_set_bytes).sum()
 }
 
 /// The bytes of one node of the smoother's graph and its factors, solver and marginals:
@@ -206,23 +230,11 @@ fn physical_memory_bytes() -> Option<f64> {
     Some(kib * 1024.0)
 }
 
-/// The bytes of a particle filter of `n` particles of `d` states (module doc).
-fn particle_filter_bytes(n: usize, d: usize) -> f64 {
-    n as f64 * (2.0 * d as f64 + 5.0) * 8.0
-}
-
 /// The working set of one run of `s`, bytes: its filters (one per estimator and
 /// vehicle) and the planner's subsamples, without the recorded steps.
 fn run_bytes(s: &Scenario) -> f64 {
     let specs = |e: &[EstimatorSpec], vehicles: usize| -> f64 {
-        let one: f64 = e
-            .iter()
-            .map(|e| match e.kind {
-                EstimatorKind::Particle => particle_filter_bytes(e.particle_settings().0, onebeacon::models::hoff::DIM),
-                _ => 1e5,
-            })
-            .sum();
-        one * vehicles as f64
+        e.iter().map(EstimatorSpec::working_set_bytes).sum::<f64>() * vehicles as f64
     };
     BASE_BYTES
         + match s {

@@ -181,15 +181,17 @@ pub fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Opt
 
 /// The vehicle's computer `onebeacon stream CONFIG` (and the Python `Navigator`) runs,
 /// from a log description: its stream configuration with the fixed beacons of its files
-/// ([`onebeacon::config::stream::StreamConfig::unit`]).
-pub fn stream_setup(config: &std::path::Path) -> Result<Unit, LogError> {
+/// ([`onebeacon::config::stream::StreamConfig::unit`]), refused where its filters would
+/// not fit in `budget`.
+pub fn stream_setup(config: &std::path::Path, budget: &crate::budget::Budget) -> Result<Unit, LogError> {
     let d = LogDescription::load(config)?;
     let base = config.parent().unwrap_or(std::path::Path::new("."));
     let beacons =
         d.fixed_beacons(base)?.into_iter().map(|(id, p)| Beacon { id, x_m: p.x, y_m: p.y, z_m: p.z }).collect();
-    d.stream_config(beacons)
-        .unit()
-        .map_err(|v| LogError::File { file: config.display().to_string(), message: v.to_string() })
+    let file = config.display().to_string();
+    let stream = d.stream_config(beacons);
+    budget.check_stream(&stream).map_err(|e| LogError::File { file: file.clone(), message: e.to_string() })?;
+    stream.unit().map_err(|v| LogError::File { file, message: v.to_string() })
 }
 
 /// Runs every estimator of `log` over its stream, giving `record` one trajectory row
