@@ -379,6 +379,14 @@ fn with_progress<T: Send>(
     result.map_err(|_| PyRuntimeError::new_err("the computation panicked (a bug: please report it with the scenario)"))
 }
 
+/// Runs `work` with the GIL released, checking for signals every 0.1 s
+/// ([`with_progress`] without a callback): Ctrl-C raises KeyboardInterrupt once the work
+/// stops, which is at once where it reads [`Progress::stopped`] (a replay, row by row),
+/// else when it is done; never a half-made result.
+fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce(&dyn Progress) -> T + Send) -> PyResult<T> {
+    with_progress(py, 0, None, work)
+}
+
 /// The memory budget ([`onebeacon_sim::budget`]: $ONEBEACON_MEMORY_GIB, else half this
 /// machine's memory) checked for `s` with `concurrent` runs at once, `recorded` of them
 /// kept whole.
@@ -401,7 +409,7 @@ fn run<'py>(
     check_memory(&s, 1, 1)?;
     let seed = seed.unwrap_or(s.seed());
     let cell = s.base_cell();
-    let out = py.detach(|| simulate(&s, &cell, seed, run, true));
+    let out = interruptible(py, |_| simulate(&s, &cell, seed, run, true))?;
     let columns = trajectory_dict(py, &s.vehicle_names(), &s.track_labels(), &out.trajectory)?;
     let summary = to_py(py, &onebeacon_sim::json::run_summary(&s, seed, run, &cell, &out))?;
     PyTuple::new(py, [columns.into_any(), summary])
@@ -459,14 +467,18 @@ fn replay<'py>(
     let budget = Budget::resolve(None).map_err(input_error)?;
     budget.check_replay(&l, true).map_err(input_error)?;
     let started = std::time::Instant::now();
-    let (records, r) = py.detach(|| {
+    let (records, r) = interruptible(py, |stop| {
         let mut records = Vec::new();
         let r = run_replay::<onebeacon_sim::replay::LogError>(&l, filter, |rec| {
+            if stop.stopped() {
+                // what is raised is the KeyboardInterrupt
+                return Err(onebeacon_sim::replay::LogError::File { file: String::new(), message: "stopped".into() });
+            }
             records.push(rec);
             Ok(())
         });
         (records, r)
-    });
+    })?;
     let r = r.map_err(input_error)?;
     let summary = onebeacon_sim::json::replay_summary(&l, &used, &r, started.elapsed().as_secs_f64());
     for w in r.warnings(l.has_truth()) {
@@ -496,8 +508,8 @@ fn smooth<'py>(
     let filter = beacon_filter(beacons, &l.beacon_ids()).map_err(|e| input_error(format!("beacons {e}")))?;
     let cfg = onebeacon_sim::smooth::config(&l, like.as_deref(), calibrate.as_deref(), kernel.as_deref())
         .map_err(input_error)?;
-    Budget::resolve(None).map_err(input_error)?.check_replay(&l, true).map_err(input_error)?;
-    let s = py.detach(|| onebeacon_sim::smooth::smooth(&l, filter.as_ref(), &cfg)).map_err(input_error)?;
+    Budget::resolve(None).map_err(input_error)?.check_smooth(&l).map_err(input_error)?;
+    let s = interruptible(py, |_| onebeacon_sim::smooth::smooth(&l, filter.as_ref(), &cfg))?.map_err(input_error)?;
     let d = PyDict::new(py);
     let column = |f: &dyn Fn(usize) -> f64| (0..s.t_s.len()).map(f).collect::<Vec<f64>>();
     let columns: [(&str, Vec<f64>); 8] = [
@@ -528,7 +540,7 @@ fn rts<'py>(py: Python<'py>, log: PathBuf, beacons: Option<Vec<u32>>) -> PyResul
     let l = Log::load(&log).map_err(input_error)?;
     let filter = beacon_filter(beacons, &l.beacon_ids()).map_err(|e| input_error(format!("beacons {e}")))?;
     Budget::resolve(None).map_err(input_error)?.check_smooth(&l).map_err(input_error)?;
-    let runs = py.detach(|| onebeacon_sim::replay::rts::rts(&l, filter)).map_err(input_error)?;
+    let runs = interruptible(py, |_| onebeacon_sim::replay::rts::rts(&l, filter))?.map_err(input_error)?;
     let out = PyDict::new(py);
     for run in &runs {
         let d = PyDict::new(py);
@@ -714,7 +726,8 @@ fn dsp_process<'py>(
     }
     let captures: Vec<Vec<f64>> = view.rows().into_iter().map(|r| r.to_vec()).collect();
     let len = view.ncols();
-    let found = py.detach(|| Chain::new(c, len).map(|mut chain| chain.process(&captures))).map_err(input_error)?;
+    let found =
+        interruptible(py, |_| Chain::new(c, len).map(|mut chain| chain.process(&captures)))?.map_err(input_error)?;
     to_py(py, &found.result)
 }
 

@@ -395,6 +395,41 @@ def test_ctrl_c_stops_mc_and_raises_keyboard_interrupt():
     assert elapsed < 5.0, elapsed
 
 
+def long_log(tmp_path, rows):
+    """A log of `rows` odometry rows (0.1 s, 0.1 m each, a slow turn) with a ground-truth
+    row each: a replay of about a second per 200 000 rows."""
+    t = np.arange(rows) * 0.1
+    np.savetxt(tmp_path / "odo.csv", np.column_stack([t, np.full(rows, 0.1), np.full(rows, 1e-3)]),
+               delimiter=",", header="t,d,dh", comments="", fmt="%.3f")
+    np.savetxt(tmp_path / "truth.csv", np.column_stack([t, np.zeros(rows), np.zeros(rows), np.zeros(rows)]),
+               delimiter=",", header="t,x,y,h", comments="", fmt="%.3f")
+    log = tmp_path / "long.toml"
+    log.write_text(
+        'name = "long"\nframe = "ned"\n'
+        '[[source]]\nkind = "odometry"\nfile = "odo.csv"\ntime = "t"\ndistance = "d"\nheading_change = "dh"\n'
+        '[[source]]\nkind = "ground_truth"\nfile = "truth.csv"\ntime = "t"\nx = "x"\ny = "y"\nheading = "h"\n'
+        '[[estimators]]\nname = "dr"\nkind = "dead-reckoning"\n'
+    )
+    return log
+
+
+@pytest.mark.parametrize("call", ["replay", "smooth"])
+def test_ctrl_c_during_a_log_raises_keyboard_interrupt(tmp_path, call):
+    # cfb7f93 ignored Ctrl-C here, then raised a PanicException after the whole work
+    import _thread
+
+    log = long_log(tmp_path, 600_000)
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        getattr(onebeacon, call)(log)
+    elapsed = time.perf_counter() - start
+    if call == "replay":
+        # the replay stops at the next row; unstopped it takes about 3 s here
+        assert elapsed < 1.5, elapsed
+
+
 def test_dsp_process_takes_real_numbers_only_and_one_capture(cli, tmp_path):
     wav = tmp_path / "ping.wav"
     cli("dsp", "simulate", "--out", wav)

@@ -59,7 +59,8 @@ fn expand(tree: &str, prefix: &str, out: &mut Vec<String>) {
     let tree = tree.trim();
     if let Some(open) = tree.find('{') {
         let head = tree[..open].trim().trim_end_matches("::");
-        let inner = &tree[open + 1..tree.rfind('}').unwrap_or(tree.len())];
+        // (a `use ` inside a string literal has no closing brace after its opening one)
+        let inner = &tree[open + 1..tree.rfind('}').filter(|&c| c > open).unwrap_or(tree.len())];
         let prefix = if head.is_empty() { prefix.to_string() } else { format!("{prefix}{head}::") };
         let mut depth = 0;
         let mut start = 0;

@@ -251,6 +251,8 @@ impl GuidanceKind {
     }
 }
 
+pub use onebeacon::config::controller::MAX_LEAD_PERIODS;
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Guidance {
@@ -474,6 +476,14 @@ pub(super) fn validate_passive(s: &PassiveUsbl) -> Result<(), Violation> {
     check_count("guidance.radii", g.radii, 1, 1000)?;
     check_count("guidance.angles", g.angles, 1, 10_000)?;
     check_count("guidance.planner_particles", g.planner_particles, 1, 10_000_000)?;
+    let period = s.mission.message_period_s;
+    if let Some(why) = onebeacon::guidance::bearing::planner_too_slow(g.radii, g.angles, g.planner_particles, period) {
+        return Err(Violation { key: "guidance.radii".into(), value: g.radii.to_string(), allowed: why });
+    }
+    if g.lead_periods > MAX_LEAD_PERIODS {
+        let allowed = format!("must be at most {MAX_LEAD_PERIODS} (the belief's straight-line prediction)");
+        return Err(Violation { key: "guidance.lead_periods".into(), value: format!("{:?}", g.lead_periods), allowed });
+    }
     check_fields!("initial", s.initial, {
         position_sigma_m: Positive,
         depth_sigma_m: Positive,

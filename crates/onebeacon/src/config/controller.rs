@@ -6,7 +6,8 @@
 
 use super::check::Violation;
 use crate::geo::Frame;
-use crate::guidance::bearing::{BearingPlanner, SpreadMetric};
+use crate::guidance::bearing::{BearingPlanner, SpreadMetric, planner_too_slow};
+use crate::nav::session::Limits;
 use crate::vehicle::autonomy::{Autonomy, AutonomySettings, Behaviour};
 use crate::vehicle::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
 use crate::vehicle::behaviours::Behaviours;
@@ -112,6 +113,11 @@ impl Default for BehavioursSpec {
         Self { speed_m_s: d.speed_m_s, depth_m: d.depth_m, modes: Vec::new(), decide_on: "depth".into() }
     }
 }
+
+/// The most message periods a planner may lead its belief by: beyond a few, the
+/// straight-line prediction from the estimated velocity means nothing (hoff2024 sec. 5
+/// leads by 2). No source: a guard against a slip (1e9 sent commands 4e9 s ahead).
+pub const MAX_LEAD_PERIODS: f64 = 100.0;
 
 /// The command modes a bank holds (rypkema: 4).
 pub const MODES: usize = 4;
@@ -219,8 +225,10 @@ impl ControllerSpec {
         }
     }
 
-    /// Checks the keys; `kinds` are the line kinds a stream may carry.
-    pub fn check(&self, kinds: &[&str]) -> Result<(), Violation> {
+    /// Checks the keys; `kinds` are the line kinds a stream may carry, `limits` the
+    /// vehicle's (every setpoint within them: speeds within max_speed_m_s, depths within
+    /// max_depth_m, distances and positions within max_range_m).
+    pub fn check(&self, kinds: &[&str], limits: &Limits) -> Result<(), Violation> {
         let bad = |key: &str, value: String, allowed: &str| {
             Err(Violation { key: format!("controller.{key}"), value, allowed: allowed.into() })
         };
@@ -229,6 +237,14 @@ impl ControllerSpec {
         }
         let positive = |key: &str, v: f64| {
             if v.is_finite() && v > 0.0 { Ok(()) } else { bad(key, format!("{v:?}"), "must be a number > 0") }
+        };
+        // a setpoint within the vehicle's limits (`limit` names the [limits] key)
+        let within = |key: &str, v: f64, most: f64, limit: &str| {
+            if v.abs() <= most {
+                Ok(())
+            } else {
+                bad(key, format!("{v:?}"), &format!("must be within {most} (limits.{limit}, the vehicle's)"))
+            }
         };
         match self {
             ControllerSpec::Bearing(b) => {
@@ -245,23 +261,36 @@ impl ControllerSpec {
                 ] {
                     positive(key, v)?;
                 }
-                if !(b.lead_periods.is_finite() && b.lead_periods >= 0.0) {
-                    return bad("lead_periods", format!("{:?}", b.lead_periods), "must be a number >= 0");
+                if !(b.lead_periods.is_finite() && (0.0..=MAX_LEAD_PERIODS).contains(&b.lead_periods)) {
+                    let allowed = format!("must be a number from 0 to {MAX_LEAD_PERIODS}");
+                    return bad("lead_periods", format!("{:?}", b.lead_periods), &allowed);
                 }
                 for (key, n) in [("radii", b.radii), ("angles", b.angles), ("planner_particles", b.planner_particles)] {
                     if !(1..=10_000_000).contains(&n) {
                         return bad(key, n.to_string(), "must be a count in 1..=10000000");
                     }
                 }
-                if !(b.home_x_m.is_finite() && b.home_y_m.is_finite()) {
-                    return bad("home_x_m", format!("({:?}, {:?})", b.home_x_m, b.home_y_m), "must be finite");
+                if let Some(why) = planner_too_slow(b.radii, b.angles, b.planner_particles, b.period_s) {
+                    return bad("radii", b.radii.to_string(), &why);
+                }
+                within("nominal_speed_m_s", b.nominal_speed_m_s, limits.max_speed_m_s, "max_speed_m_s")?;
+                for (key, v) in [
+                    ("r2_m", b.r2_m),
+                    ("circle_radius_m", b.circle_radius_m),
+                    ("offset_m", b.offset_m),
+                    ("home_x_m", b.home_x_m),
+                    ("home_y_m", b.home_y_m),
+                ] {
+                    within(key, v, limits.max_range_m, "max_range_m")?;
                 }
             }
             ControllerSpec::Behaviours(b) => {
                 positive("speed_m_s", b.speed_m_s)?;
+                within("speed_m_s", b.speed_m_s, limits.max_speed_m_s, "max_speed_m_s")?;
                 if !(b.depth_m.is_finite() && b.depth_m >= 0.0) {
                     return bad("depth_m", format!("{:?}", b.depth_m), "must be a depth >= 0");
                 }
+                within("depth_m", b.depth_m, limits.max_depth_m, "max_depth_m")?;
                 for (i, m) in b.modes.iter().enumerate() {
                     if !(1..=MODES).contains(&m.mode) {
                         return bad(&format!("modes[{i}].mode"), m.mode.to_string(), "must be 1 to 4");
@@ -277,6 +306,18 @@ impl ControllerSpec {
                             return bad(&format!("modes[{i}].{k}"), value, "the behaviour needs it, a number > 0");
                         }
                     }
+                    for (k, v) in [("offset_north_m", m.offset_north_m), ("offset_east_m", m.offset_east_m)]
+                        .into_iter()
+                        .chain(["radius_m", "length_m", "buffer_m"].map(|k| (k, m.value(k).unwrap_or(0.0))))
+                    {
+                        within(&format!("modes[{i}].{k}"), v, limits.max_range_m, "max_range_m")?;
+                    }
+                    within(
+                        &format!("modes[{i}].ceiling_m"),
+                        m.ceiling_m.unwrap_or(0.0),
+                        limits.max_depth_m,
+                        "max_depth_m",
+                    )?;
                 }
             }
         }
@@ -322,5 +363,40 @@ impl ControllerSpec {
             }
         };
         Helm { controller, decide_on }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn checked(toml: &str) -> Result<(), Violation> {
+        let spec: ControllerSpec = toml::from_str(toml).unwrap();
+        spec.check(&["own_fix", "depth"], &Limits::default())
+    }
+
+    /// What cfb7f93 took and sent out: a planner 5000 times over its period's work (11 s
+    /// a decision against 4 s), a lead of 1e9 periods, a home 1e308 m away, an AUV
+    /// commanded 1e9 m deep at 1e308 m/s. Each is refused by its key; hoff2024's and
+    /// rypkema's settings are taken.
+    #[test]
+    fn the_controllers_work_and_setpoints_are_bounded() {
+        assert!(checked("kind = \"bearing\"").is_ok());
+        let refused = |toml: &str, key: &str, words: &str| {
+            let v = checked(toml).unwrap_err();
+            assert_eq!(v.key, format!("controller.{key}"), "{toml}: {v}");
+            assert!(v.allowed.contains(words), "{toml}: {v}");
+        };
+        refused("kind = \"bearing\"\nradii = 1000\nangles = 1000", "radii", "at most 4.000e8 fit a period of 4 s");
+        assert!(checked("kind = \"bearing\"\nradii = 10\nangles = 100\nperiod_s = 1.0").is_ok());
+        refused("kind = \"bearing\"\nlead_periods = 1e9", "lead_periods", "from 0 to 100");
+        refused("kind = \"bearing\"\nhome_x_m = 1e308", "home_x_m", "limits.max_range_m");
+        refused("kind = \"bearing\"\nnominal_speed_m_s = 1e308", "nominal_speed_m_s", "limits.max_speed_m_s");
+        let auv = "kind = \"behaviours\"\n";
+        assert!(checked(auv).is_ok());
+        refused(&format!("{auv}depth_m = 1e9"), "depth_m", "limits.max_depth_m");
+        refused(&format!("{auv}speed_m_s = 1e308"), "speed_m_s", "limits.max_speed_m_s");
+        let mode = "[[modes]]\nmode = 1\nbehaviour = \"loiter\"\nradius_m = 1e12";
+        refused(&format!("{auv}{mode}"), "modes[0].radius_m", "limits.max_range_m");
     }
 }

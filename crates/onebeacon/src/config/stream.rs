@@ -318,9 +318,6 @@ impl StreamConfig {
         for (v, init) in self.tracked.iter().enumerate() {
             init.check(&format!("tracked[{v}]"))?;
         }
-        if let Some(c) = &self.controller {
-            c.check(&crate::io::kinds())?;
-        }
         let l = &self.limits;
         for (key, v) in [
             ("max_range_m", l.max_range_m),
@@ -333,7 +330,12 @@ impl StreamConfig {
         }
         check_count("limits.max_beacons", l.max_beacons, 1, 1 << 20)?;
         check_count("limits.max_rejections", l.max_rejections, 0, 100_000_000)?;
-        check_count("limits.max_line_bytes", l.max_line_bytes, 64, 1 << 26)
+        check_count("limits.max_line_bytes", l.max_line_bytes, 64, 1 << 26)?;
+        // the controller's setpoints within the limits, checked first
+        match &self.controller {
+            Some(c) => c.check(&crate::io::kinds(), l),
+            None => Ok(()),
+        }
     }
 
     /// A session of the estimators on a vehicle that starts as `initial` says, starting
