@@ -387,7 +387,7 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["fleet", "rypkema-m1", "--memory-gib", "0.01", "--out", out], &["rypkema-m1", "recorded runs", "budget"]),
         (vec!["replay", plaza1, "--memory-gib", "0.01", "--out", out], &["replaying plaza1", "budget"]),
         // the smoother's graph and the filters' histories, which a replay does not hold
-        (vec!["smooth", plaza1, "--memory-gib", "0.5", "--out", out], &["smoothing plaza1", "histories", "budget"]),
+        (vec!["smooth", plaza1, "--memory-gib", "0.2", "--out", out], &["smoothing plaza1", "histories", "budget"]),
         (vec!["mc", "merge", partial.to_str().unwrap(), "--memory-gib", "1e-9", "--out", out], &["merging", "budget"]),
         (vec!["mc", &long_step, "--out", out], &["step.toml", "mission.dt_s", "duration"]),
         (vec!["mc", &crawl, "--out", out], &["crawl.toml", "mission.speed_m_s", "1e8 steps"]),

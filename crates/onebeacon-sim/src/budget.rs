@@ -123,11 +123,11 @@ impl Budget {
 impl Budget {
     /// Refuses replaying `log` where it would not fit: its estimators, the rows the plots
     /// keep (20 000 at most) and, with `keep_records` (the Python package returns every
-    /// row), one trajectory row per CSV row of at least [`MIN_ROW_BYTES`].
+    /// row), one trajectory row per data row of its CSV files (counted).
     pub fn check_replay(&self, log: &Log, keep_records: bool) -> Result<(), BudgetError> {
         let estimators = log.description.estimators.len();
         let row = record_bytes(estimators);
-        let rows = if keep_records { log_rows(log) } else { PLOTTED_ROWS };
+        let rows = if keep_records { source_rows(log, |_| true) } else { PLOTTED_ROWS };
         let need = BASE_BYTES + filters_bytes(&log.description.estimators) + rows * row;
         let detail = format!("{estimators} estimators, {rows:.0} rows of {row:.0} bytes kept");
         let keys = if keep_records { "the log's length (cut it), [[estimators]]" } else { "[[estimators]]" };
@@ -138,12 +138,15 @@ impl Budget {
 impl Budget {
     /// Refuses smoothing `log` (`onebeacon smooth`) where it would not fit: the replay's
     /// share ([`Budget::check_replay`]), the smoother's graph ([`SMOOTHER_NODE_BYTES`] a
-    /// node) and the history each Gaussian filter with beacon aiding keeps for its
-    /// Rauch-Tung-Striebel pass (two means and covariances and a cross covariance a
-    /// prediction, [`rts_step_bytes`]), a node and a prediction per CSV row of at least
-    /// [`MIN_ROW_BYTES`] (an upper bound: only motion rows make nodes, and a filter
-    /// predicts at its motion rows and, with a random walk, at its other rows).
+    /// motion row, [`SMOOTHER_FACTOR_BYTES`] any other row) and the history each
+    /// Gaussian filter with beacon aiding keeps for its Rauch-Tung-Striebel pass (two
+    /// means and covariances and a cross covariance a prediction, [`rts_step_bytes`]) at
+    /// every row (an upper bound: a filter predicts at its motion rows and, with a random
+    /// walk, at its other rows). Rows are counted in the files. Measured against it:
+    /// plaza1 252 MB (0.4 GB estimated), 600 000 odometry and truth rows 1016 MB (1.6 GB);
+    /// cfb7f93's estimate was 6-12 times the need.
     pub fn check_smooth(&self, log: &Log) -> Result<(), BudgetError> {
+        use crate::replay::schema::SourceKind::*;
         let estimators = &log.description.estimators;
         let kept: Vec<usize> = estimators
             .iter()
@@ -151,12 +154,18 @@ impl Budget {
             .filter(|e| e.track_accel_sigma_m_s2.is_none())
             .map(|e| if e.estimate_beacon_offsets == Some(true) { STATES_WITH_OFFSETS } else { STATES })
             .collect();
-        let rows = log_rows(log);
-        let node = SMOOTHER_NODE_BYTES + kept.iter().map(|&n| rts_step_bytes(n)).sum::<f64>();
+        // the rows counted: motion rows make the graph's nodes, the others its factors
+        let motion = |k| matches!(k, Odometry | BodyOdometry | BodyVelocity | Speed | SpeedHeading);
+        let nodes = source_rows(log, motion);
+        let others = source_rows(log, |k| !motion(k));
+        let history = kept.iter().map(|&n| rts_step_bytes(n)).sum::<f64>();
         let replay = BASE_BYTES + filters_bytes(estimators) + PLOTTED_ROWS * record_bytes(estimators.len());
-        let need = replay + rows * node;
-        let detail =
-            format!("{rows:.0} rows, each a node of the graph and a step of {} filters' histories", kept.len());
+        let need = replay + nodes * SMOOTHER_NODE_BYTES + others * SMOOTHER_FACTOR_BYTES + (nodes + others) * history;
+        let detail = format!(
+            "{nodes:.0} motion rows (nodes of the graph) and {others:.0} other rows, each a step of {} filters' \
+             histories",
+            kept.len()
+        );
         self.check(
             &format!("smoothing {}", log.description.name),
             need,
@@ -188,11 +197,36 @@ fn filters_bytes(estimators: &[EstimatorSpec]) -> f64 {
     estimators.iter().map(EstimatorSpec::working_set_bytes).sum()
 }
 
-/// The bytes of one node of the smoother's graph and its factors, solver and marginals:
-/// measured on plaza1 (9658 nodes, 13 186 ranges) as the peak resident set of `smooth`
-/// without filters' histories less that of `replay` (9 MB, about 900 bytes a node),
-/// with room for logs denser in measurements.
-const SMOOTHER_NODE_BYTES: f64 = 4096.0;
+/// The bytes of one node of the smoother's graph (a motion row) with its motion factor,
+/// solver and marginals: measured as the peak resident set of `smooth` on a log of
+/// 600 000 odometry rows and as many ground-truth rows (1016 MB, /usr/bin/time -v: about
+/// 1.6 kB a row), rounded up; plaza1 (9658 nodes, 13 186 ranges) takes about 0.9 kB a
+/// node.
+const SMOOTHER_NODE_BYTES: f64 = 2048.0;
+/// The bytes of one other row (a measurement's factor, a ground-truth row), at most:
+/// a factor holds a few dozen numbers. No measurement of its own: the node's quarter.
+const SMOOTHER_FACTOR_BYTES: f64 = 512.0;
+
+/// The data rows of `log`'s sources whose kind `which` picks, counted (the lines of
+/// each file but its header); a file that cannot be read counts nothing (the replay
+/// names it).
+fn source_rows(log: &Log, which: impl Fn(crate::replay::schema::SourceKind) -> bool) -> f64 {
+    use std::io::Read;
+    let mut rows = 0u64;
+    for s in log.description.sources.iter().filter(|s| which(s.kind)) {
+        let Ok(mut f) = crate::input_file::open_bounded(&log.base.join(&s.file)) else { continue };
+        let mut buf = vec![0u8; 1 << 16];
+        let mut lines = 0u64;
+        while let Ok(n) = f.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            lines += buf[..n].iter().filter(|&&b| b == b'\n').count() as u64;
+        }
+        rows += lines.saturating_sub(1);
+    }
+    rows as f64
+}
 
 /// The bytes a Gaussian filter of `n` states keeps per prediction for its
 /// Rauch-Tung-Striebel pass, and the smoothed estimate it gives back.
@@ -205,14 +239,6 @@ fn record_bytes(estimators: usize) -> f64 {
     (size_of::<StepRecord>() + size_of::<TruthRecord>() + estimators * size_of::<Estimate>()) as f64
 }
 
-/// The most rows `log` can have: its files' bytes over [`MIN_ROW_BYTES`].
-fn log_rows(log: &Log) -> f64 {
-    log.source_bytes() as f64 / MIN_ROW_BYTES
-}
-
-/// The fewest bytes a CSV row takes (a time, one value, separators): what bounds the
-/// rows of a log from its files' sizes.
-const MIN_ROW_BYTES: f64 = 16.0;
 /// The rows a replay keeps for its plots, at most.
 const PLOTTED_ROWS: f64 = 20_000.0;
 

@@ -52,7 +52,7 @@ pub struct Log {
     pub(super) tracked: BTreeSet<u32>,
     /// Latitude and longitude to local positions, when the log has them.
     pub(super) geodetic: Option<Geodetic>,
-    pub(super) base: PathBuf,
+    pub(crate) base: PathBuf,
     /// The description's own path.
     path: PathBuf,
 }
