@@ -405,6 +405,18 @@ fn check_array_geometry(elements: &[[f64; 3]]) -> Result<(), Violation> {
             });
         }
     }
+    // a line array measures one cone angle about its line, not azimuth and inclination
+    let far = (1..p.len()).max_by(|&a, &b| (p[a] - p[0]).norm().total_cmp(&(p[b] - p[0]).norm())).unwrap_or(0);
+    let line = (p[far] - p[0]).normalize();
+    if p.iter().all(|q| (q - p[0]).cross(&line).norm() < CLOSE_M) {
+        return Err(Violation {
+            key: "array.elements_m".into(),
+            value: format!("{elements:?}"),
+            allowed: "must not lie on one line (within 1 mm): a line array measures one cone angle about its line, \
+                      not azimuth and inclination; place an element at least 1 mm off the line"
+                .into(),
+        });
+    }
     Ok(())
 }
 
@@ -435,9 +447,17 @@ mod tests {
             ("[clock]\noffset_s = -1\n", "must arrive within the capture window"),
             ("[array]\nkind = \"custom\"\nelements_m = [[0.1, 0, 0], [0.1, 0, 0], [0.1, 0, 0]]\n", "elements_m[1]"),
             ("[array]\nkind = \"custom\"\nelements_m = [[0, 0, 0], [0.05, 0, 0], [0.0501, 0, 0.0002]]\n", "element 1"),
+            // colinear: cfb7f93 reported a direction 48 deg off as consistent
+            (
+                "[array]\nkind = \"custom\"\nelements_m = [[0, 0, 0], [0.05, 0, 0], [0.1, 0, 0.0005], [0.15, 0, 0]]\n",
+                "one cone angle",
+            ),
         ] {
             let e = PingConfig::parse(text, "ping.toml").unwrap_err().to_string();
             assert!(e.contains(key), "{text}: {e}");
         }
+        // an element 2 mm off the line through the others: an array of two dimensions
+        let plane = "[array]\nkind = \"custom\"\nelements_m = [[0, 0, 0], [0.05, 0, 0.002], [0.1, 0, 0]]\n";
+        assert!(PingConfig::parse(plane, "ping.toml").is_ok());
     }
 }

@@ -111,6 +111,15 @@ impl SoundSpeed {
     }
 }
 
+/// `key` = `v` within `lo..=hi` (`what` says what the range is).
+fn within(key: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<(), Violation> {
+    if (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(Violation { key: key.into(), value: format!("{v:?}"), allowed: format!("from {lo} to {hi} ({what})") })
+    }
+}
+
 fn check_link(l: &LinkErrors) -> Result<(), Violation> {
     for (key, v) in [
         ("sea.link.loss_prob", l.loss_prob),
@@ -119,8 +128,11 @@ fn check_link(l: &LinkErrors) -> Result<(), Violation> {
     ] {
         check(key, v, Rule::Probability)?;
     }
-    check("sea.link.multipath_excess_m", l.multipath_excess_m, Rule::NonNegative)?;
-    check("sea.link.false_max_range_m", l.false_max_range_m, Rule::NonNegative)?;
+    // the upper bounds are guards (no source): far past any sea, short of a units slip
+    let path = "m; a reflection's extra path";
+    within("sea.link.multipath_excess_m", l.multipath_excess_m, 0.0, 1000.0, path)?;
+    let range = "m; an acoustic modem's reach is tens of km";
+    within("sea.link.false_max_range_m", l.false_max_range_m, 0.0, 1e5, range)?;
     let bad = |key: &str, v: f64, allowed: String| Err(Violation { key: key.into(), value: format!("{v:?}"), allowed });
     if l.loss_prob >= 1.0 {
         return bad("sea.link.loss_prob", l.loss_prob, "must be below 1 (every message lost)".into());
@@ -130,11 +142,11 @@ fn check_link(l: &LinkErrors) -> Result<(), Violation> {
     }
     if let Some(b) = l.loss_burst_mean {
         let least = 1.0 / (1.0 - l.loss_prob);
-        if !(b.is_finite() && b >= least) {
+        if !(b.is_finite() && (least..=1e4).contains(&b)) {
             return bad(
                 "sea.link.loss_burst_mean",
                 b,
-                format!("a mean run of lost messages >= 1 / (1 - loss_prob) = {least} (independent losses)"),
+                format!("a mean run of lost messages from 1 / (1 - loss_prob) = {least} (independent losses) to 1e4"),
             );
         }
     }
@@ -186,15 +198,17 @@ fn check_usbl(u: &UsblErrors) -> Result<(), Violation> {
 }
 
 /// A current's keys under `table` (`current`, `sea.current`).
+/// The bounds of the speed keys are guards (no source): the strongest tidal races run
+/// at about 5 m/s.
 pub(super) fn check_current(table: &str, c: &Current) -> Result<(), Violation> {
-    for (key, v, rule) in [
-        ("speed_m_s", c.speed_m_s, Rule::NonNegative),
-        ("toward_deg", c.toward_deg, Rule::Finite),
-        ("speed_sigma_m_s", c.speed_sigma_m_s, Rule::NonNegative),
-        ("direction_sigma_deg", c.direction_sigma_deg, Rule::NonNegative),
-        ("time_constant_s", c.time_constant_s, Rule::Positive),
+    check(&format!("{table}.toward_deg"), c.toward_deg, Rule::Finite)?;
+    for (key, v, lo, hi, what) in [
+        ("speed_m_s", c.speed_m_s, 0.0, 10.0, "m/s"),
+        ("speed_sigma_m_s", c.speed_sigma_m_s, 0.0, 10.0, "m/s"),
+        ("direction_sigma_deg", c.direction_sigma_deg, 0.0, 180.0, "deg"),
+        ("time_constant_s", c.time_constant_s, 1e-3, 1e7, "s, > 0"),
     ] {
-        check(&format!("{table}.{key}"), v, rule)?;
+        within(&format!("{table}.{key}"), v, lo, hi, what)?;
     }
     Ok(())
 }
@@ -304,14 +318,12 @@ impl Sea {
         if let Some(s) = &self.sound_speed {
             s.check()?;
         }
+        // guards (no source): a modem's crystal drifts by tens of ppm, a clock set by
+        // hand is a second off
         let c = &self.clocks;
-        for (key, v) in [
-            ("sea.clocks.offset_sigma_s", c.offset_sigma_s),
-            ("sea.clocks.drift_sigma_ppm", c.drift_sigma_ppm),
-            ("sea.clocks.walk_s_per_sqrt_s", c.walk_s_per_sqrt_s),
-        ] {
-            check(key, v, Rule::NonNegative)?;
-        }
+        within("sea.clocks.offset_sigma_s", c.offset_sigma_s, 0.0, 10.0, "s")?;
+        within("sea.clocks.drift_sigma_ppm", c.drift_sigma_ppm, 0.0, 1000.0, "ppm")?;
+        within("sea.clocks.walk_s_per_sqrt_s", c.walk_s_per_sqrt_s, 0.0, 0.01, "s/sqrt(s)")?;
         Ok(())
     }
 }
@@ -322,6 +334,39 @@ mod tests {
 
     fn refused(sea: &Sea, kind: World) -> Option<String> {
         sea.check(kind).err().map(|v| format!("{}: {}", v.key, v.allowed))
+    }
+
+    /// The keys cfb7f93 left without an upper bound (rc 0 with null cells or errors of
+    /// 1e6-1e9 m): each refused by its name at 1e9, taken at a sea's value.
+    #[test]
+    fn the_seas_keys_have_upper_bounds() {
+        let clocks = |c: ClockErrors| Sea { clocks: c, ..Sea::default() };
+        let link = |l: LinkErrors| Sea { link: l, ..Sea::default() };
+        let current = |c: Current| Sea { current: c, ..Sea::default() };
+        let big = 1e9;
+        let cases = [
+            (clocks(ClockErrors { drift_sigma_ppm: big, ..ClockErrors::default() }), "sea.clocks.drift_sigma_ppm"),
+            (clocks(ClockErrors { offset_sigma_s: big, ..ClockErrors::default() }), "sea.clocks.offset_sigma_s"),
+            (clocks(ClockErrors { walk_s_per_sqrt_s: big, ..ClockErrors::default() }), "sea.clocks.walk_s_per_sqrt_s"),
+            (current(Current { speed_m_s: big, ..Current::default() }), "sea.current.speed_m_s"),
+            (current(Current { speed_sigma_m_s: big, ..Current::default() }), "sea.current.speed_sigma_m_s"),
+            (current(Current { direction_sigma_deg: big, ..Current::default() }), "sea.current.direction_sigma_deg"),
+            (current(Current { time_constant_s: big, ..Current::default() }), "sea.current.time_constant_s"),
+            (link(LinkErrors { multipath_excess_m: big, ..LinkErrors::default() }), "sea.link.multipath_excess_m"),
+            (link(LinkErrors { false_max_range_m: big, ..LinkErrors::default() }), "sea.link.false_max_range_m"),
+            (link(LinkErrors { loss_burst_mean: Some(big), ..LinkErrors::default() }), "sea.link.loss_burst_mean"),
+        ];
+        for (sea, key) in cases {
+            let why = refused(&sea, World::FixedBeacon).unwrap_or_default();
+            assert!(why.starts_with(&format!("{key}: ")) && why.contains("from "), "{key}: {why}");
+        }
+        let sea = Sea {
+            clocks: ClockErrors { drift_sigma_ppm: 20.0, offset_sigma_s: 1e-3, ..ClockErrors::default() },
+            current: Current { speed_m_s: 0.5, ..Current::default() },
+            link: LinkErrors { multipath_excess_m: 30.0, ..LinkErrors::default() },
+            ..Sea::default()
+        };
+        assert_eq!(refused(&sea, World::FixedBeacon), None);
     }
 
     /// Each table is checked against the worlds it applies to: refused by its name
