@@ -161,6 +161,8 @@ fn the_streams_memory_estimate_bounds_its_peak() {
         }
         c
     };
+    // waited for by wait4 below, which gives its resource usage
+    #[allow(clippy::zombie_processes)]
     let child = stream(None).stdin(input).spawn().unwrap();
     let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
     // SAFETY: waits for our own child, writing into the two locals
