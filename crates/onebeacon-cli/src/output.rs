@@ -6,8 +6,10 @@
 //! that lists the files onebeacon wrote there. The rule users get (README, docs/outputs.md):
 //! `--out DIR` may name a new directory, an empty one, or an earlier onebeacon output that
 //! holds nothing but what the marker lists; that one is replaced whole. Anything else (a
-//! directory with other files, the working directory or one that holds it, a symbolic
-//! link) is refused before any work starts, and nothing is deleted.
+//! directory with other files, the working directory or one that holds it, one that is
+//! or holds an input of the command, a symbolic link) is refused before any work starts,
+//! and nothing is deleted. What appears in the directory while the command runs is
+//! carried into the new output at the swap, never deleted.
 
 use crate::BadInput;
 use anyhow::{Context, Result};
