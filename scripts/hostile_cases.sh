@@ -158,7 +158,7 @@ timeout 30 $B stream slow.toml < hm/asv.input.jsonl > o26 2> e26; rc=$?
 say "26 stream (controller radii = angles = 1000)" "rc $rc $( [ $rc = 124 ] && echo "(still deciding at 30 s, $(wc -l < o26) lines out)"); $(line e26 | cut -c1-200)"
 r27=""; for kv in "lead_periods 1e9" "home_x_m 1e308"; do
   set -- $kv; sed "s/^$1 = .*/$1 = $2/" hm/asv.stream.toml > set.toml; timeout 20 $B stream set.toml < /dev/null > /dev/null 2>&1; r27="$r27 [$1 = $2: rc $?]"; done
-sed '0,/^depth_m = /s/^depth_m = .*/depth_m = 1e9/' m1r/platypus.stream.toml > deep.stream.toml
+sed '/^\[controller\]/,/^\[\[/ s/^depth_m = .*/depth_m = 1e9/' m1r/platypus.stream.toml > deep.stream.toml
 grep -q '^depth_m = 1e9' deep.stream.toml && { timeout 20 $B stream deep.stream.toml < /dev/null > /dev/null 2>&1; r27="$r27 [behaviour depth_m = 1e9: rc $?]"; }
 say "27 stream controllers: lead_periods, home_x_m, depth_m" "$r27"
 # 28 a line array
