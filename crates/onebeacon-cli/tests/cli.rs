@@ -854,7 +854,8 @@ fn out_never_takes_what_onebeacon_did_not_write() {
         std::fs::copy(e.path(), dl.join(e.file_name())).unwrap();
     }
     let before = names_in(&dl);
-    refused(&["replay", dl.join("plaza1.toml").to_str().unwrap(), "--out", dl.to_str().unwrap()], &dir, "not empty");
+    let log = dl.join("plaza1.toml");
+    refused(&["replay", log.to_str().unwrap(), "--out", dl.to_str().unwrap()], &dir, "an input of this command");
     assert_eq!(names_in(&dl), before);
     // an earlier output with a file of the user's added
     let out = dir.join("o");
