@@ -496,9 +496,12 @@ impl Session {
 
     /// Starts the estimators by time `t_s` when their start is a given pose due by then
     /// (a controller that decides before the first item reads them); whether they run.
+    /// A time further past the start time than `limits.max_time_gap_s` starts nothing:
+    /// it is another clock, which the items set ([`Session::push`]).
     pub fn start_by(&mut self, t_s: f64) -> bool {
+        let gap = self.limits.max_time_gap_s;
         if let (false, Start::At { t0_s, pose }) = (self.started(), self.start)
-            && t0_s.is_none_or(|t0| t_s >= t0)
+            && t0_s.is_none_or(|t0| t_s >= t0 && t_s - t0 <= gap)
         {
             self.begin(t0_s.unwrap_or(t_s), pose);
         }
@@ -755,6 +758,8 @@ mod tests {
         let start = Start::At { t0_s: Some(0.0), pose: (0.0, 0.0, 0.0) };
         let mut s = Session::new(Frame::Ned, planar(est), start, (1.0, 0.1), None);
         let t0 = 1.7e9;
+        // a controller deciding on that clock does not start the estimators at 0 either
+        assert!(!s.start_by(t0));
         let speed = |t: f64| Item { t_s: t, input: Input::Measurement(Kind::Speed { speed_m_s: 1.0 }) };
         let first = s.push(&speed(t0)).unwrap_err();
         assert!(first.reason.contains("past the start time (initial.t0_s)"), "{first}");
