@@ -15,8 +15,8 @@
 use crate::replay::Log;
 use crate::run::{Estimate, StepRecord, TruthRecord, recorded_bytes};
 use crate::scenario::{EstimatorSpec, Host, Scenario};
-use onebeacon::config::estimator::particle_filter_bytes;
 use onebeacon::config::stream::StreamConfig;
+use onebeacon::config::working_set::particle_filter_bytes;
 use onebeacon::nav::planar::{STATES, STATES_WITH_OFFSETS};
 
 /// The environment variable that sets the budget, GiB.

@@ -331,34 +331,7 @@ pub const NOISE_KEYS: [(&str, bool); 9] = [
     ("position_walk_m_per_sqrt_s", false),
 ];
 
-/// The bytes a particle filter of `n` particles of `d` states holds at most: two copies
-/// of its states (the spare one for resampling) and five per-particle vectors
-/// (log-weights, increments, normalised weights, cumulative weights, ancestors).
-/// Measured: hoff2024's `run` with 5e7 particles peaked at 7.83 GB resident against
-/// 8.47 GB estimated (onebeacon_sim::budget).
-pub fn particle_filter_bytes(n: usize, d: usize) -> f64 {
-    n as f64 * (2.0 * d as f64 + 5.0) * 8.0
-}
-
-/// What a Gaussian filter and its navigator hold, bytes: an upper bound for every
-/// filter of a few dozen states.
-const GAUSSIAN_BYTES: f64 = 1e5;
-
 impl EstimatorSpec {
-    /// An upper bound of the bytes this estimator holds for one vehicle: its particles
-    /// ([`particle_filter_bytes`]; the iUSBL navigator's factored cloud of 4 values a
-    /// particle), else a Gaussian filter's.
-    pub fn working_set_bytes(&self) -> f64 {
-        match self.kind {
-            EstimatorKind::Particle => particle_filter_bytes(self.particle_settings().0, crate::models::hoff::DIM),
-            EstimatorKind::Iusbl | EstimatorKind::IusblJoint => particle_filter_bytes(
-                self.iusbl.as_ref().map_or_else(|| IusblKeys::default().particles, |k| k.particles),
-                4,
-            ),
-            _ => GAUSSIAN_BYTES,
-        }
-    }
-
     /// An estimator of `kind` with every other key at its default.
     pub fn new(kind: EstimatorKind) -> Self {
         Self {

@@ -3,8 +3,9 @@
 //! with the iUSBL navigator's table in [`iusbl`], its checks beside it and each spec's
 //! navigator on a log or a stream), the `[controller]` table
 //! ([`controller`]), the stream configuration that puts them together into a
-//! [`crate::vehicle::unit::Unit`] ([`stream`]), and the rules a key obeys with the
-//! one-line error that names it ([`check`]). A vehicle reads its configuration with this
+//! [`crate::vehicle::unit::Unit`] ([`stream`]), what it holds in memory
+//! ([`working_set`]), and the rules a key obeys with the one-line error that names it
+//! ([`check`]). A vehicle reads its configuration with this
 //! crate alone; the simulator reads its scenarios and logs into the same types.
 
 mod builder;
@@ -14,3 +15,4 @@ pub mod estimator;
 mod estimator_check;
 pub mod iusbl;
 pub mod stream;
+pub mod working_set;

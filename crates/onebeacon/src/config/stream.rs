@@ -351,21 +351,6 @@ impl StreamConfig {
         session
     }
 
-    /// An upper bound of the bytes the vehicle's computer holds: each estimator's
-    /// ([`EstimatorSpec::working_set_bytes`]) for each vehicle it estimates (its own, or
-    /// each of `[[tracked]]`), and a bearing planner's subsample of 3-d positions per
-    /// vehicle and candidate; the bounded logs besides (limits.max_rejections is 0 in a
-    /// stream).
-    pub fn working_set_bytes(&self) -> f64 {
-        let vehicles = self.tracked.len().max(1) as f64;
-        let estimators: f64 = self.estimators.iter().map(EstimatorSpec::working_set_bytes).sum();
-        let planner = match &self.controller {
-            Some(ControllerSpec::Bearing(b)) => 4.0 * 24.0 * b.planner_particles as f64,
-            _ => 0.0,
-        };
-        vehicles * (estimators + planner)
-    }
-
     /// The vehicle's computer: one session per vehicle it estimates (its own from
     /// `[initial]`, or each of `[[tracked]]`), each started at its given pose or at the
     /// first ground-truth line, and the `[controller]` when there is one; no rejection
