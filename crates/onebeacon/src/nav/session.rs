@@ -317,9 +317,11 @@ impl Limits {
 const JUMP_ITEMS: usize = 3;
 
 /// Whether two items are the same message: equal, NaN fields (a tracked beacon's
-/// position before it is resolved) equal to NaN.
+/// position before it is resolved) equal to NaN. A capture (thousands of samples) is
+/// compared by value alone, not through its printed form.
 fn same_input(a: &Input, b: &Input) -> bool {
-    a == b || (a.name() == b.name() && format!("{a:?}") == format!("{b:?}"))
+    let capture = matches!(a, Input::Measurement(Kind::Capture(_)));
+    a == b || (!capture && a.name() == b.name() && format!("{a:?}") == format!("{b:?}"))
 }
 
 /// How many items of one time are kept to screen repeats among them (a logger or a
