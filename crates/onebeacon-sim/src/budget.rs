@@ -1,6 +1,7 @@
 //! The memory budget: one check, made before any allocation that scales with the input,
 //! by every command and by the Python package alike (`run`, `mc`, `fleet`, `replay`,
-//! `mc merge`).
+//! `smooth`, `tune`, `stream`, `mc merge`; Python's `Navigator` too). What a vehicle's
+//! filters hold is the onboard crate's figure (`onebeacon::config::working_set`).
 //!
 //! A configuration is refused up front, with the keys to change, where the estimate of
 //! the bytes it would hold exceeds the budget: by default half of this machine's
