@@ -163,6 +163,24 @@ pub fn rts_summary(run: &crate::replay::rts::RtsRun) -> Value {
     v
 }
 
+/// Each beacon's corrections by one estimator: counts, mean NIS, the range residual's
+/// mean and RMS (m) and its mean over the predicted sigma, and whether the gate shut
+/// most of them out.
+fn per_beacon_fields(p: &onebeacon::nav::diagnosis::PerBeacon) -> Value {
+    let beacon = |b: &onebeacon::nav::diagnosis::BeaconStats| {
+        json!({
+            "corrections": b.count,
+            "rejected": b.rejected,
+            "nis_mean": num(b.nis_mean()),
+            "range_residual_mean_m": num(b.residual_mean_m()),
+            "range_residual_rms_m": num(b.residual_rms_m()),
+            "range_residual_mean_sigma": num(b.normalised_mean()),
+            "gated_out": b.gated_out(),
+        })
+    };
+    Value::Object(p.0.iter().map(|(id, b)| (id.to_string(), beacon(b))).collect())
+}
+
 /// `replay --json`, the replay's summary.json.
 pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
     let s = &r.session;
@@ -173,7 +191,8 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
         .zip(&s.stats)
         .zip(&finals)
         .zip(s.beacon_offsets())
-        .map(|(((name, st), e), offsets)| {
+        .zip(&s.beacon_stats)
+        .map(|((((name, st), e), offsets), per_beacon)| {
             let (x, y, _) = log.frame.from_ned(&nalgebra::Vector3::new(e.north_m(), e.east_m(), 0.0));
             let mut v = error_fields(name, st);
             for (k, val) in [
@@ -198,6 +217,7 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
                     offsets.iter().map(|(b, o, sigma)| (b.to_string(), json!({"offset_m": o, "sigma_m": sigma})));
                 v["beacon_offsets"] = Value::Object(per_beacon.collect());
             }
+            v["per_beacon"] = per_beacon_fields(per_beacon);
             v
         })
         .collect();

@@ -57,7 +57,8 @@ pub const MIN_SCORED_ROWS: usize = 30;
 
 impl Replay {
     /// What makes the replay's scores suspect, one line each: a source that dropped more
-    /// rows than it kept, an estimator scored on fewer than [`MIN_SCORED_ROWS`] rows.
+    /// rows than it kept, an estimator scored on fewer than [`MIN_SCORED_ROWS`] rows,
+    /// and what the innovations say without the truth ([`Session::findings`]).
     pub fn warnings(&self, has_truth: bool) -> Vec<String> {
         let mut w: Vec<String> = self
             .dropped
@@ -90,6 +91,7 @@ impl Replay {
                  source's increment_frame = \"start\" (docs/logs.md, \"Motion models\")"
             ));
         }
+        w.extend(self.session.findings());
         w
     }
 }

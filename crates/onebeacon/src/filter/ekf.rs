@@ -159,8 +159,9 @@ impl<const N: usize> GaussianFilter<N> for Ekf<N> {
         let det_s = det_from_cholesky(&s.cholesky().ok_or(FilterError::InnovationNotPositiveDefinite)?);
         let s_inv = s.try_inverse().ok_or(FilterError::InnovationNotPositiveDefinite)?;
         let nis = nu.dot(&(s_inv * nu));
+        let innovation = Innovation::of(&nu, &s, det_s, nis);
         if nis > max_nis {
-            return Ok(Gated::Rejected(nis, det_s));
+            return Ok(Gated::Rejected(innovation));
         }
         let k = pht * s_inv;
         self.x += k * nu;
@@ -170,7 +171,7 @@ impl<const N: usize> GaussianFilter<N> for Ekf<N> {
         let a = self.p - k * pht.transpose();
         let p = a - (times_ht(model, &h, &a) - k * r) * k.transpose();
         self.p = (p + p.transpose()) * 0.5;
-        Ok(Gated::Accepted(nis, det_s))
+        Ok(Gated::Accepted(innovation))
     }
 }
 
@@ -193,26 +194,50 @@ fn times_ht<const R: usize, const N: usize, const M: usize, H: MeasurementModel<
     out
 }
 
-/// What a gated update did, with the measurement's NIS and the determinant of its
-/// innovation covariance S (with the NIS, the measurement's likelihood).
+/// How a measurement compared with its prediction before an update: its NIS, the
+/// determinant of its innovation covariance S (with the NIS, the measurement's
+/// likelihood), and its first component's innovation z - h(x) with that component's
+/// standard deviation sqrt(S_00) (a range's residual in metres: the mean of many tells
+/// a biased beacon).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Innovation {
+    pub nis: f64,
+    pub det_s: f64,
+    pub residual: f64,
+    pub sigma: f64,
+}
+
+impl Innovation {
+    /// The innovation `nu` with covariance `s` (its determinant `det_s`) and NIS `nis`.
+    pub(crate) fn of<const M: usize>(nu: &SVector<f64, M>, s: &SMatrix<f64, M, M>, det_s: f64, nis: f64) -> Self {
+        Self { nis, det_s, residual: nu[0], sigma: s[(0, 0)].max(0.0).sqrt() }
+    }
+
+    /// No comparison to report (a navigator that weighs without a Gaussian prediction).
+    pub const NONE: Innovation = Innovation { nis: f64::NAN, det_s: f64::NAN, residual: f64::NAN, sigma: f64::NAN };
+}
+
+/// What a gated update did, with the measurement's [`Innovation`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Gated {
-    Accepted(f64, f64),
-    Rejected(f64, f64),
+    Accepted(Innovation),
+    Rejected(Innovation),
 }
 
 impl Gated {
-    pub fn nis(self) -> f64 {
+    pub fn innovation(self) -> Innovation {
         match self {
-            Gated::Accepted(n, _) | Gated::Rejected(n, _) => n,
+            Gated::Accepted(i) | Gated::Rejected(i) => i,
         }
+    }
+
+    pub fn nis(self) -> f64 {
+        self.innovation().nis
     }
 
     /// det S.
     pub fn det_s(self) -> f64 {
-        match self {
-            Gated::Accepted(_, d) | Gated::Rejected(_, d) => d,
-        }
+        self.innovation().det_s
     }
 }
 

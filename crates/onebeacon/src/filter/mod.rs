@@ -15,7 +15,7 @@ pub mod rts;
 pub mod truncated;
 pub mod ukf;
 
-pub use ekf::{Ekf, FilterError, Gated, MeasurementModel, ProcessModel};
+pub use ekf::{Ekf, FilterError, Gated, Innovation, MeasurementModel, ProcessModel};
 pub use ukf::{Ukf, UkfParams};
 
 use nalgebra::{SMatrix, SVector};

@@ -216,8 +216,9 @@ impl<const N: usize> GaussianFilter<N> for Ukf<N> {
         let s_chol = s.cholesky().ok_or(FilterError::InnovationNotPositiveDefinite)?;
         let nis = nu.dot(&s_chol.solve(&nu));
         let det_s = super::ekf::det_from_cholesky(&s_chol);
+        let innovation = super::ekf::Innovation::of(&nu, &s, det_s, nis);
         if nis > max_nis {
-            return Ok(Gated::Rejected(nis, det_s));
+            return Ok(Gated::Rejected(innovation));
         }
         let k = s_chol.solve(&pxz.transpose()).transpose(); // K = Pxz S^-1
         // Joseph form with the statistically linearised H = Pxz' P^-1 and the effective
@@ -229,7 +230,7 @@ impl<const N: usize> GaussianFilter<N> for Ukf<N> {
         let p = self.p - kpxz - kpxz.transpose() + k * s * k.transpose();
         self.x += k * nu;
         self.p = (p + p.transpose()) * 0.5;
-        Ok(Gated::Accepted(nis, det_s))
+        Ok(Gated::Accepted(innovation))
     }
 }
 

@@ -259,8 +259,8 @@ pub fn step_json(line: usize, step: &Step, names: &[String], frame: Frame) -> Va
             if let Some(o) = step.outcomes[i] {
                 let (outcome, nis) = match o {
                     Outcome::Applied => ("applied", None),
-                    Outcome::Accepted(n, _) => ("accepted", Some(n)),
-                    Outcome::Rejected(n, _) => ("rejected", Some(n)),
+                    Outcome::Accepted(i) => ("accepted", Some(i.nis)),
+                    Outcome::Rejected(i) => ("rejected", Some(i.nis)),
                     Outcome::Skipped => ("skipped", None),
                     Outcome::Failed(_) => ("failed", None),
                 };

@@ -99,9 +99,9 @@ impl ErrorStats {
     pub fn push_outcome(&mut self, outcome: &Outcome, rejections: bool) {
         match *outcome {
             Outcome::Failed(_) => self.failed += 1,
-            Outcome::Accepted(nis, det_s) => self.push_nis(nis, det_s, false),
-            Outcome::Rejected(nis, det_s) => {
-                self.push_nis(nis, det_s, true);
+            Outcome::Accepted(i) => self.push_nis(i.nis, i.det_s, false),
+            Outcome::Rejected(i) => {
+                self.push_nis(i.nis, i.det_s, true);
                 self.rejected += usize::from(rejections);
             }
             Outcome::Applied | Outcome::Skipped => {}
@@ -185,6 +185,7 @@ pub fn chi_square_band(n: usize, dof: usize) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nav::Innovation;
     use approx::assert_relative_eq;
 
     /// Two errors, 4 and 6 m with NEES 1 and 3: mean 5, rmse sqrt(26), halves 4 and 6;
@@ -207,10 +208,11 @@ mod tests {
     /// Cauchy k = 1 (ln 2 / 2 and ln 26 / 2); ungated and Gaussian, (ln 2 pi + NIS) / 2.
     #[test]
     fn own_likelihood_of_gated_and_robust_corrections() {
+        let accepted = |nis: f64| Outcome::Accepted(Innovation { nis, det_s: 1.0, residual: nis.sqrt(), sigma: 1.0 });
         let cost = |gate, kernel| {
             let mut s = ErrorStats::default().weighed_as(gate, kernel);
-            s.push_outcome(&Outcome::Accepted(1.0, 1.0), true);
-            s.push_outcome(&Outcome::Rejected(25.0, 1.0), true);
+            s.push_outcome(&accepted(1.0), true);
+            s.push_outcome(&Outcome::Rejected(Innovation { nis: 25.0, ..accepted(1.0).innovation().unwrap() }), true);
             s.neg_log_likelihood() - std::f64::consts::TAU.ln()
         };
         assert_relative_eq!(cost(None, None), 13.0);
@@ -219,7 +221,7 @@ mod tests {
         assert_relative_eq!(cost(None, Some(Robust::Huber { k: 1.0 })), 0.5 + 4.5);
         assert_relative_eq!(cost(None, Some(Robust::Cauchy { k: 1.0 })), 0.5 * (2f64.ln() + 26f64.ln()));
         let mut g = ErrorStats::default();
-        g.push_outcome(&Outcome::Accepted(1.0, 1.0), true);
+        g.push_outcome(&accepted(1.0), true);
         assert_relative_eq!(g.neg_log_likelihood(), 0.5 * (std::f64::consts::TAU.ln() + 1.0));
     }
 

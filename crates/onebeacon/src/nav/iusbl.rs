@@ -293,7 +293,7 @@ impl IusblNavigator {
         let ping = rx.process(&c.samples, lags);
         if !ping.range.detected() {
             self.missed = self.missed.saturating_add(1);
-            return Outcome::Rejected(f64::NAN, f64::NAN); // no pulse heard: nothing to weigh
+            return Outcome::Rejected(super::Innovation::NONE); // no pulse heard: nothing to weigh
         }
         self.missed = 0;
         self.confirmation.push(ping.mode);
@@ -312,7 +312,7 @@ impl IusblNavigator {
             floor: self.config.floor,
         };
         update(&mut self.filter, self.config.factored, &like, &att);
-        Outcome::Accepted(f64::NAN, f64::NAN)
+        Outcome::Accepted(super::Innovation::NONE)
     }
 
     fn process_fix(&mut self, t: f64, beacon: &super::BeaconFix, r: f64, az: f64, incl: f64, mode: usize) -> Outcome {
@@ -329,7 +329,7 @@ impl IusblNavigator {
             floor: c.floor,
         };
         update(&mut self.filter, c.factored, &like, &att);
-        Outcome::Accepted(f64::NAN, f64::NAN)
+        Outcome::Accepted(super::Innovation::NONE)
     }
 
     /// The beacon's position as its last ping reported it (the beacon-centred frame's

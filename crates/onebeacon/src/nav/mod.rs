@@ -7,6 +7,7 @@
 //! replay and the live stream drive them through this interface alone, and score them
 //! with one [`evaluation`].
 
+pub mod diagnosis;
 pub mod evaluation;
 pub mod event;
 pub mod fix;
@@ -32,12 +33,15 @@ pub use usbl_track::{GaussianTracker, MisalignmentPrior, ParticleTracker, Tracke
 
 pub use crate::measure::Robust;
 
+pub use crate::filter::Innovation;
+
 use crate::filter::{AnyFilter, FilterError, Gated, GaussianFilter, MeasurementModel};
 use nalgebra::{Matrix2, Matrix3, SVector, Vector3};
 
 /// One update of `filter` with the stacked `models` and their values `z`, gated at
 /// `gate` (NIS with the nominal noise), with the noise inflated by `robust` when given:
-/// accepted or rejected with its nominal NIS, or failed (the filter left as it was).
+/// accepted or rejected with its nominal innovation, or failed (the filter left as it
+/// was).
 pub(crate) fn gated_update<const N: usize, const M: usize, H: MeasurementModel<N, M>>(
     filter: &mut AnyFilter<N>,
     models: &H,
@@ -48,21 +52,21 @@ pub(crate) fn gated_update<const N: usize, const M: usize, H: MeasurementModel<N
     let r = models.covariance(filter.mean());
     let Some(robust) = robust else {
         return match filter.update_gated(models, &z, &r, gate) {
-            Ok(Gated::Accepted(nis, det_s)) => Outcome::Accepted(nis, det_s),
-            Ok(Gated::Rejected(nis, det_s)) => Outcome::Rejected(nis, det_s),
+            Ok(Gated::Accepted(i)) => Outcome::Accepted(i),
+            Ok(Gated::Rejected(i)) => Outcome::Rejected(i),
             Err(e) => Outcome::Failed(e),
         };
     };
-    // the nominal NIS first: a gate of -1 rejects, leaving the state as it was
-    let (nis, det_s) = match filter.update_gated(models, &z, &r, -1.0) {
-        Ok(g) => (g.nis(), g.det_s()),
+    // the nominal innovation first: a gate of -1 rejects, leaving the state as it was
+    let innovation = match filter.update_gated(models, &z, &r, -1.0) {
+        Ok(g) => g.innovation(),
         Err(e) => return Outcome::Failed(e),
     };
-    if nis > gate {
-        return Outcome::Rejected(nis, det_s);
+    if innovation.nis > gate {
+        return Outcome::Rejected(innovation);
     }
-    match filter.update_gated(models, &z, &(r * robust.inflation(nis, M)), f64::INFINITY) {
-        Ok(_) => Outcome::Accepted(nis, det_s),
+    match filter.update_gated(models, &z, &(r * robust.inflation(innovation.nis, M)), f64::INFINITY) {
+        Ok(_) => Outcome::Accepted(innovation),
         Err(e) => Outcome::Failed(e),
     }
 }
@@ -72,34 +76,58 @@ pub(crate) fn gated_update<const N: usize, const M: usize, H: MeasurementModel<N
 /// navigator whose error has outgrown its covariance is not shut out for good.
 pub const LOST_AFTER_REJECTIONS: u32 = 30;
 
-/// A navigator's NIS gate (infinity: none) with the one rule that keeps it from
-/// locking the navigator out: after [`LOST_AFTER_REJECTIONS`] rejections in a row the
-/// gate opens, and stays open until a correction falls within it again.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The beacons a gate counts rejections of one by one; the rest share one count.
+const GATED_BEACONS: usize = 64;
+
+/// A navigator's NIS gate (infinity: none) with the rule that keeps it from locking the
+/// navigator, or one beacon, out: after [`LOST_AFTER_REJECTIONS`] rejections in a row
+/// (of any beacon: the navigator is lost) the gate opens for every beacon, and after as
+/// many in a row of one beacon's measurements (one beacon reads biased, or the navigator
+/// drifted away from it while the others kept it) it opens for that beacon; it stays
+/// open until a correction falls within it again.
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Gate {
     nis: f64,
     rejected_in_row: u32,
+    /// (beacon, its measurements rejected in a row), at most [`GATED_BEACONS`].
+    beacons: Vec<(u32, u32)>,
 }
 
 impl Gate {
     pub(crate) fn new(nis: f64) -> Self {
-        Self { nis, rejected_in_row: 0 }
+        Self { nis, rejected_in_row: 0, beacons: Vec::new() }
     }
 
-    /// [`gated_update`] at this gate (none while it is open), counting the rejections.
+    /// [`gated_update`] of a measurement of `beacon` (None: of no beacon) at this gate
+    /// (none while it is open), counting the rejections.
     pub(crate) fn update<const N: usize, const M: usize, H: MeasurementModel<N, M>>(
         &mut self,
         filter: &mut AnyFilter<N>,
         models: &H,
         z: SVector<f64, M>,
         robust: Option<Robust>,
+        beacon: Option<u32>,
     ) -> Outcome {
-        let open = self.rejected_in_row >= LOST_AFTER_REJECTIONS;
+        let slot = beacon.and_then(|id| match self.beacons.iter().position(|(b, _)| *b == id) {
+            Some(k) => Some(k),
+            None if self.beacons.len() < GATED_BEACONS => {
+                self.beacons.push((id, 0));
+                Some(self.beacons.len() - 1)
+            }
+            None => None,
+        });
+        let in_row = slot.map_or(0, |k| self.beacons[k].1);
+        let open = self.rejected_in_row.max(in_row) >= LOST_AFTER_REJECTIONS;
         let outcome = gated_update(filter, models, z, if open { f64::INFINITY } else { self.nis }, robust);
-        match outcome {
-            Outcome::Rejected(..) => self.rejected_in_row += 1,
-            Outcome::Accepted(nis, _) if nis <= self.nis => self.rejected_in_row = 0,
-            _ => {}
+        let reset = match outcome {
+            Outcome::Rejected(..) => false,
+            Outcome::Accepted(i) if i.nis <= self.nis => true,
+            _ => return outcome,
+        };
+        let count = |n: &mut u32| *n = if reset { 0 } else { *n + 1 };
+        count(&mut self.rejected_in_row);
+        if let Some(k) = slot {
+            count(&mut self.beacons[k].1);
         }
         outcome
     }
@@ -139,14 +167,24 @@ pub enum Outcome {
     /// An input was applied (odometry, speed, body velocity), or a measurement held for
     /// the filter's next tick (a frame fused with the next inertial sample).
     Applied,
-    /// A correction was accepted or rejected by the gate, with its NIS and the
-    /// determinant of its innovation covariance (nominal noise).
-    Accepted(f64, f64),
-    Rejected(f64, f64),
+    /// A correction was accepted or rejected by the gate, with its innovation (nominal
+    /// noise).
+    Accepted(Innovation),
+    Rejected(Innovation),
     /// Not used by this navigator (dead reckoning and beacons, say).
     Skipped,
     /// The update could not be computed; the state is unchanged.
     Failed(FilterError),
+}
+
+impl Outcome {
+    /// The innovation of a correction weighed (accepted or rejected).
+    pub fn innovation(&self) -> Option<Innovation> {
+        match *self {
+            Outcome::Accepted(i) | Outcome::Rejected(i) => Some(i),
+            _ => None,
+        }
+    }
 }
 
 /// A navigator's estimate at one time: the part every navigator has (position, heading,
@@ -298,16 +336,39 @@ mod tests {
         let (x, outcome) = posterior(100.0, Some(huber), f64::INFINITY);
         assert_abs_diff_eq!(x, gauss(100.0, r / w_huber), epsilon = 1e-9);
         assert_abs_diff_eq!(x, 10.74, epsilon = 0.01);
-        let Outcome::Accepted(n, det_s) = outcome else { panic!("{outcome:?}") };
-        assert_abs_diff_eq!(n, nis, epsilon = 1e-9);
-        assert_abs_diff_eq!(det_s, p + r, epsilon = 1e-12);
+        let Outcome::Accepted(i) = outcome else { panic!("{outcome:?}") };
+        assert_abs_diff_eq!(i.nis, nis, epsilon = 1e-9);
+        assert_abs_diff_eq!(i.det_s, p + r, epsilon = 1e-12);
+        assert_abs_diff_eq!(i.residual, 100.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(i.sigma, (p + r).sqrt(), epsilon = 1e-12);
         let w_t = 5.0 / (4.0 + nis);
         assert_abs_diff_eq!(posterior(100.0, Some(student), f64::INFINITY).0, gauss(100.0, r / w_t), epsilon = 1e-9);
         assert_abs_diff_eq!(posterior(100.0, Some(student), f64::INFINITY).0, 0.988, epsilon = 0.001);
         // gated on the nominal NIS: rejected, the state untouched
         let (x, outcome) = posterior(100.0, Some(student), 10.83);
         assert_eq!(x, 0.0);
-        assert!(matches!(outcome, Outcome::Rejected(n, _) if (n - nis).abs() < 1e-9), "{outcome:?}");
+        assert!(matches!(outcome, Outcome::Rejected(i) if (i.nis - nis).abs() < 1e-9), "{outcome:?}");
+    }
+
+    /// One beacon's measurements shut out while another's are taken: x ~ N(0, 1) measured
+    /// by beacon 1 as 0 and by beacon 2 as 50 (r = 1, gate 100), in turn. Beacon 1's are
+    /// accepted and would keep a navigator-wide count at zero for ever; beacon 2's own
+    /// count opens the gate for it after [`LOST_AFTER_REJECTIONS`] of its rejections in a
+    /// row, and the next of beacon 2's is taken.
+    #[test]
+    fn a_gate_opens_for_one_beacon_shut_out_while_the_others_are_taken() {
+        let mut f = AnyFilter::new(FilterKind::Ekf, Vector1::new(0.0), Matrix1::new(1.0));
+        let model = [StateComponent::value(0, 1.0)];
+        let mut gate = Gate::new(100.0);
+        for k in 0..=LOST_AFTER_REJECTIONS {
+            let a = gate.update(&mut f, &model, Vector1::new(0.0), None, Some(1));
+            assert!(matches!(a, Outcome::Accepted(..)), "{a:?}");
+            let b = gate.update(&mut f, &model, Vector1::new(50.0), None, Some(2));
+            match k < LOST_AFTER_REJECTIONS {
+                true => assert!(matches!(b, Outcome::Rejected(..)), "{k}: {b:?}"),
+                false => assert!(matches!(b, Outcome::Accepted(i) if i.nis > 100.0), "{k}: {b:?}"),
+            }
+        }
     }
 
     /// The lost rule against the closed form of repeated scalar updates: x ~ N(0, 1),
@@ -322,15 +383,15 @@ mod tests {
         let model = [StateComponent::value(0, 1.0)];
         let mut gate = Gate::new(100.0);
         for _ in 0..LOST_AFTER_REJECTIONS {
-            assert!(matches!(gate.update(&mut f, &model, Vector1::new(50.0), None), Outcome::Rejected(..)));
+            assert!(matches!(gate.update(&mut f, &model, Vector1::new(50.0), None, None), Outcome::Rejected(..)));
         }
         assert_eq!(f.mean()[0], 0.0);
         for k in 1..=5 {
-            let Outcome::Accepted(nis, _) = gate.update(&mut f, &model, Vector1::new(50.0), None) else { panic!() };
+            let Outcome::Accepted(Innovation { nis, .. }) = gate.update(&mut f, &model, Vector1::new(50.0), None, None) else { panic!() };
             assert_abs_diff_eq!(nis, 2500.0 / (k * (k + 1)) as f64, epsilon = 1e-9);
             assert_abs_diff_eq!(f.mean()[0], 50.0 * k as f64 / (k + 1) as f64, epsilon = 1e-9);
         }
-        assert!(matches!(gate.update(&mut f, &model, Vector1::new(-1000.0), None), Outcome::Rejected(..)));
+        assert!(matches!(gate.update(&mut f, &model, Vector1::new(-1000.0), None, None), Outcome::Rejected(..)));
         assert_abs_diff_eq!(f.mean()[0], 50.0 * 5.0 / 6.0, epsilon = 1e-9);
     }
 }

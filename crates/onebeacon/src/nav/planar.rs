@@ -340,12 +340,13 @@ impl<const N: usize> PlanarNavigator<N> {
         }
     }
 
-    /// A gated correction (ranges, Doppler speeds), or an ungated one (heading fixes).
-    fn correct(&mut self, model: &dyn ScalarModel<N>, z: f64, gated: bool) -> Outcome {
+    /// A correction gated as a measurement of beacon `gated` (ranges, Doppler speeds),
+    /// or an ungated one (`None`: heading fixes).
+    fn correct(&mut self, model: &dyn ScalarModel<N>, z: f64, gated: Option<u32>) -> Outcome {
         let z = Vector1::new(z);
         match gated {
-            true => self.gate.update(&mut self.filter, &[model], z, self.config.robust),
-            false => super::gated_update(&mut self.filter, &[model], z, f64::INFINITY, self.config.robust),
+            Some(beacon) => self.gate.update(&mut self.filter, &[model], z, self.config.robust, Some(beacon)),
+            None => super::gated_update(&mut self.filter, &[model], z, f64::INFINITY, self.config.robust),
         }
     }
 
@@ -517,32 +518,32 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
             }
             Kind::Heading { heading_rad } | Kind::Attitude { heading_rad, .. } => {
                 let var = noise.heading_sigma_rad * noise.heading_sigma_rad;
-                self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, false)
+                self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, None)
             }
             Kind::Range { beacon, range_m } if aiding.range => {
                 let model = self.range_model(&beacon);
-                self.correct(&model, range_m, true)
+                self.correct(&model, range_m, Some(beacon.id))
             }
             Kind::Doppler { beacon, radial_speed_m_s } if aiding.doppler => {
                 let model = self.doppler_model(beacon.position_ned_m);
-                self.correct(&model, radial_speed_m_s, true)
+                self.correct(&model, radial_speed_m_s, Some(beacon.id))
             }
             Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } if aiding.any() => {
                 let range = if aiding.range {
                     let model = self.range_model(&beacon);
-                    self.correct(&model, range_m, true)
+                    self.correct(&model, range_m, Some(beacon.id))
                 } else {
                     Outcome::Skipped
                 };
                 let doppler = if aiding.doppler {
-                    self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, true)
+                    self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, Some(beacon.id))
                 } else {
                     Outcome::Skipped
                 };
                 // the worse of the two outcomes
                 match (range, doppler) {
                     (Outcome::Failed(e), _) | (_, Outcome::Failed(e)) => Outcome::Failed(e),
-                    (Outcome::Rejected(n, d), _) | (_, Outcome::Rejected(n, d)) => Outcome::Rejected(n, d),
+                    (Outcome::Rejected(i), _) | (_, Outcome::Rejected(i)) => Outcome::Rejected(i),
                     (Outcome::Skipped, b) => b,
                     (a, _) => a,
                 }
@@ -757,7 +758,7 @@ mod tests {
         assert_abs_diff_eq!(e.range_bias_m, bias, epsilon = 0.1);
         let outlier = Kind::Range { beacon: BeaconFix::fixed(0, beacons[0]), range_m: truth.norm() + bias + 20.0 };
         let before = nav.estimate();
-        assert!(matches!(nav.process(&Measurement::new(t, outlier.clone())), Outcome::Rejected(nis, _) if nis > 10.83));
+        assert!(matches!(nav.process(&Measurement::new(t, outlier.clone())), Outcome::Rejected(i) if i.nis > 10.83));
         assert_eq!(nav.estimate(), before);
         let mut dr = start(PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() });
         assert_eq!(dr.process(&Measurement::new(1.0, outlier)), Outcome::Skipped);
@@ -937,6 +938,6 @@ mod tests {
             2.0,
             Kind::Doppler { beacon: BeaconFix::fixed(0, beacon), radial_speed_m_s: -1.5 },
         ));
-        assert!(matches!(out, Outcome::Accepted(nis, _) if nis < 1.0), "{out:?}");
+        assert!(matches!(out, Outcome::Accepted(i) if i.nis < 1.0), "{out:?}");
     }
 }

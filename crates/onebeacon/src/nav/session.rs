@@ -4,6 +4,7 @@
 //! measurements, beacon positions, ground truth, in the source's frame.
 
 use crate::geo::Frame;
+use crate::nav::diagnosis::PerBeacon;
 use crate::nav::evaluation::{ErrorStats, horizontal_error};
 use crate::nav::restart::Restart;
 use crate::nav::{BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
@@ -377,6 +378,8 @@ pub struct Session {
     beacons: Option<BTreeSet<u32>>,
     tracked: BTreeMap<u32, Vector3<f64>>,
     pub stats: Vec<ErrorStats>,
+    /// Each estimator's corrections beacon by beacon (at most `limits.max_beacons`).
+    pub beacon_stats: Vec<PerBeacon>,
     /// Gate rejections and screened items, the first `limits.max_rejections` of them.
     pub rejected: Vec<Rejection>,
     /// Items before the start, beacon measurements left out by the beacon filter, and
@@ -428,6 +431,7 @@ impl Session {
             beacons,
             tracked: BTreeMap::new(),
             stats: vec![ErrorStats::default(); n],
+            beacon_stats: vec![PerBeacon::default(); n],
             rejected: Vec::new(),
             before_start: 0,
             left_out: 0,
@@ -467,6 +471,12 @@ impl Session {
     }
 
     /// What the session waits for before it starts.
+    /// What the estimators' innovations say of the run so far
+    /// ([`super::diagnosis::findings`]): one line each.
+    pub fn findings(&self) -> Vec<String> {
+        super::diagnosis::findings(&self.names, &self.stats, &self.beacon_stats)
+    }
+
     pub fn waiting_for(&self) -> String {
         match self.start {
             Start::At { t0_s: Some(t0), .. } => format!("the start time {t0} s"),
@@ -651,10 +661,11 @@ impl Session {
                     for (i, nav) in self.navs.iter_mut().enumerate() {
                         let out = nav.process(&m);
                         self.stats[i].push_outcome(&out, true);
+                        self.beacon_stats[i].push(&kind, &out, self.limits.max_beacons);
                         outcomes[i] = Some(out);
                     }
                     for (i, out) in outcomes.iter().enumerate() {
-                        if let Some(Outcome::Rejected(nis, _)) = *out {
+                        if let Some(Outcome::Rejected(super::Innovation { nis, .. })) = *out {
                             self.log_rejection(Rejection {
                                 estimator: Some(i),
                                 t_s: t,

@@ -367,7 +367,7 @@ impl<const N: usize, P: ProcessModel<N> + Send> Navigator for SingleBeaconNaviga
                 self.unmirror();
                 self.floor_speed();
                 match nis {
-                    Ok(g) => Outcome::Accepted(g.nis(), g.det_s()),
+                    Ok(g) => Outcome::Accepted(g.innovation()),
                     Err(e) => Outcome::Failed(e),
                 }
             }

@@ -144,7 +144,7 @@ impl Navigator for TrackingNavigator {
                 if self.config.aiding.range =>
             {
                 let model: [&dyn ScalarModel<STATES>; 1] = [&range(beacon.position_ned_m, self.depth_m, &self.config)];
-                self.gate.update(&mut self.filter, &model, Vector1::new(range_m), self.config.robust)
+                self.gate.update(&mut self.filter, &model, Vector1::new(range_m), self.config.robust, Some(beacon.id))
             }
             _ => Outcome::Skipped,
         }

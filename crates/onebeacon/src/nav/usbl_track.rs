@@ -225,7 +225,7 @@ impl Navigator for ParticleTracker {
         };
         self.cache = OnceCell::new();
         // a particle filter has no innovation covariance: no NIS
-        if ok { Outcome::Accepted(f64::NAN, f64::NAN) } else { Outcome::Rejected(f64::NAN, f64::NAN) }
+        if ok { Outcome::Accepted(super::Innovation::NONE) } else { Outcome::Rejected(super::Innovation::NONE) }
     }
 
     fn predict_to(&mut self, t_s: f64) {
@@ -301,7 +301,7 @@ impl Navigator for GaussianTracker {
                 let usbl = self.config.noise.usbl(&station, station_heading_rad);
                 let models = [usbl.model(UsblAngle::Azimuth), usbl.model(UsblAngle::Elevation)]; // eq. 1-3
                 let z = Vector2::new(azimuth_rad, elevation_rad);
-                self.gate.update(&mut self.filter, &models, z, self.config.robust)
+                self.gate.update(&mut self.filter, &models, z, self.config.robust, Some(station.id))
             }
             _ => Outcome::Skipped,
         }
