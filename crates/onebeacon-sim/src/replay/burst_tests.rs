@@ -3,6 +3,7 @@
 //! their default keys, no estimator of the planar family follows it.
 
 use super::{Log, TestLog, replay, write_log};
+use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
 /// Long-baseline beacons (id, north, east), 400-600 m from the path.
@@ -116,6 +117,18 @@ fn an_early_false_burst_to_one_beacon_captures_no_default_estimator() {
     }
 }
 
+/// The pose of [`lbl_log`]'s vehicle at `end` s: 1.5 m a second, turning 0.02 sin(t / 60)
+/// rad a second.
+fn true_pose(end: usize) -> [f64; 3] {
+    let mut pose = [0.0f64, 0.0, 0.3];
+    for k in 1..=end {
+        let dh = 0.02 * (k as f64 / 60.0).sin();
+        let (s, c) = (pose[2] + dh / 2.0).sin_cos();
+        pose = [pose[0] + c * 1.5, pose[1] + s * 1.5, pose[2] + dh];
+    }
+    pose
+}
+
 /// `[initial] from = "ranges"` on a moving vehicle: the fix of the first 60 s of ranges,
 /// each carried to the window's end by the dead reckoning of the exact odometry, is the
 /// true pose there (to 1 cm); with beacon 0's ranges in that window false (7 of 30, the
@@ -123,20 +136,14 @@ fn an_early_false_burst_to_one_beacon_captures_no_default_estimator() {
 /// picks that fit.
 #[test]
 fn a_start_from_the_ranges_of_a_moving_vehicle_resists_the_burst() {
-    // the path of lbl_log: 1.5 m a second, turning 0.02 sin(t / 60) rad a second
-    let (mut pose, end) = ([0.0f64, 0.0, 0.3], 62);
-    for k in 1..=end {
-        let dh = 0.02 * (k as f64 / 60.0).sin();
-        let (s, c) = (pose[2] + dh / 2.0).sin_cos();
-        pose = [pose[0] + c * 1.5, pose[1] + s * 1.5, pose[2] + dh];
-    }
+    let pose = true_pose(62);
     for first in [First::True, First::False] {
         let mut log = lbl_log(if first == First::True { "moving" } else { "moving-burst" }, first, "");
         let init = &mut log.description.initial;
         init.from = onebeacon::config::stream::InitialFrom::Ranges;
         init.ranges_window_s = 60.0;
         init.heading_deg = Some(pose[2].to_degrees());
-        let start = log.initial_start().unwrap();
+        let start = log.initial_start(None).unwrap();
         assert!((start.t0_s - 62.001).abs() < 1e-9, "{start:?}");
         let (n, e, psi) = start.pose;
         assert!((n - pose[0]).hypot(e - pose[1]) < 0.01, "{start:?} against {pose:?}");
@@ -164,4 +171,43 @@ fn a_biased_beacon_is_named_without_the_truth() {
         assert!(lines[0].contains(&format!(" {name} +")), "{name} missing: {lines:?}");
     }
     assert!(!lines[0].contains("ekf-offsets"), "{lines:?}");
+}
+
+/// `[initial] from = "ranges"` on some beacons fixes the start from those alone: two
+/// beacons cannot fix a position, so a run on beacons 0 and 1 is refused (before issue
+/// 53 the fix took all four and a run on one or two beacons was helped by the others);
+/// three give the true pose.
+#[test]
+fn a_start_from_the_ranges_uses_only_the_beacons_run() {
+    let pose = true_pose(62);
+    let mut log = lbl_log("some-beacons", First::True, "");
+    let init = &mut log.description.initial;
+    init.from = onebeacon::config::stream::InitialFrom::Ranges;
+    init.ranges_window_s = 60.0;
+    init.heading_deg = Some(pose[2].to_degrees());
+    let two: BTreeSet<u32> = [0, 1].into();
+    let e = log.initial_start(Some(&two)).unwrap_err().to_string();
+    assert!(e.contains("ranges of beacons 0, 1") && e.contains("do not fix a position"), "{e}");
+    let three: BTreeSet<u32> = [0, 1, 2].into();
+    let start = log.initial_start(Some(&three)).unwrap();
+    let (n, e, _) = start.pose;
+    assert!((n - pose[0]).hypot(e - pose[1]) < 0.01, "{start:?} against {pose:?}");
+}
+
+/// A fix of a moving vehicle's ranges dead-reckoned on a heading 34 deg off (the given
+/// heading is the start's, not the window end's) lands 26 m from the truth. Each beacon's
+/// ranges in the window share that error: counted as one measurement per beacon, the
+/// stated sigma covers it (28.9 m; before issue 53, counted one per range, 10.4 m).
+#[test]
+fn a_start_from_the_ranges_states_a_sigma_that_covers_its_error() {
+    let pose = true_pose(62);
+    let mut log = lbl_log("wrong-heading", First::True, "");
+    let init = &mut log.description.initial;
+    init.from = onebeacon::config::stream::InitialFrom::Ranges;
+    init.ranges_window_s = 60.0;
+    init.heading_deg = Some(0.3f64.to_degrees());
+    let start = log.initial_start(None).unwrap();
+    let error = (start.pose.0 - pose[0]).hypot(start.pose.1 - pose[1]);
+    assert!(error > 20.0, "{start:?} against {pose:?}");
+    assert!(start.position_sigma_m >= error, "sigma {} m, error {error} m", start.position_sigma_m);
 }

@@ -9,7 +9,7 @@ use super::rows::SourceRows;
 pub use super::schema::*;
 use crate::scenario::EstimatorSpec;
 use crate::scenario::load::deserialize;
-use nalgebra::Vector3;
+use nalgebra::{Vector2, Vector3};
 use onebeacon::config::stream::{Beacon, StreamConfig};
 use onebeacon::filter::FilterKind;
 use onebeacon::geo::Frame;
@@ -295,12 +295,13 @@ impl Log {
 
     /// The initial time, pose (NED) and position sigma, from the description: given,
     /// the first ground-truth pose (heading from its column or its track), or a fix from
-    /// the first ranges (its sigma: the larger of `position_sigma_m` and three times
-    /// the fix's). Reads the log only as far as it needs.
-    pub fn initial_start(&self) -> Result<InitialStart, LogError> {
+    /// the first ranges of `beacons` (all when None: a run on some beacons is not helped
+    /// by the others; its sigma the larger of `position_sigma_m` and three times the
+    /// fix's). Reads the log only as far as it needs.
+    pub fn initial_start(&self, beacons: Option<&BTreeSet<u32>>) -> Result<InitialStart, LogError> {
         let position_sigma_m = self.description.initial.position_sigma_m;
         if self.description.initial.from == InitialFrom::Ranges {
-            return self.start_from_ranges();
+            return self.start_from_ranges(beacons);
         }
         self.initial_pose().map(|(t0_s, pose)| InitialStart { t0_s, pose, position_sigma_m })
     }
@@ -310,7 +311,7 @@ impl Log {
     /// its first range, heading 0 there): each range is to the position the fix seeks
     /// plus the dead-reckoned displacement since, rotated by the heading then, so a
     /// moving vehicle is fixed where the window ends.
-    fn start_from_ranges(&self) -> Result<InitialStart, LogError> {
+    fn start_from_ranges(&self, beacons: Option<&BTreeSet<u32>>) -> Result<InitialStart, LogError> {
         let init = &self.description.initial;
         let fail = |message: String| LogError::File { file: self.description.name.clone(), message };
         // ranges: (beacon id, its position, range, dead-reckoned (north, east, heading)
@@ -331,7 +332,10 @@ impl Log {
             }
             let Input::Measurement(kind) = item.input.to_ned(self.frame) else { continue };
             match kind {
-                Kind::Range { beacon, range_m } if beacon.position_ned_m.iter().all(|v| v.is_finite()) => {
+                Kind::Range { beacon, range_m }
+                    if beacon.position_ned_m.iter().all(|v| v.is_finite())
+                        && beacons.is_none_or(|b| b.contains(&beacon.id)) =>
+                {
                     window.get_or_insert((t, t + init.ranges_window_s));
                     let dr = dr.get_or_insert_with(|| dead_reckoning(t));
                     ranges.push((beacon.id, beacon.position_ned_m, range_m, dr_pose(dr, t, depth)));
@@ -372,15 +376,45 @@ impl Log {
         };
         // a range to b from p0 + R d is a range to b - R d from p0
         let shifted: Vec<_> = ranges.iter().map(|(id, b, r, (n, e, _))| (*id, b - rotate(*n, *e), *r)).collect();
+        let used = beacons.map_or(String::new(), |b| {
+            format!(" of beacons {}", b.iter().map(u32::to_string).collect::<Vec<_>>().join(", "))
+        });
         let fix = onebeacon::nav::fix::multilaterate(&shifted, depth).ok_or_else(|| {
             fail(format!(
-                "initial.from = \"ranges\": the {} ranges of the first {} s (initial.ranges_window_s) do not fix a position (three beacons not in a line are needed)",
+                "initial.from = \"ranges\": the {} ranges{used} in the first {} s (initial.ranges_window_s) do not fix a position (three beacons not in a line are needed; with fewer, start from = \"given\" or \"ground_truth\")",
                 ranges.len(),
                 init.ranges_window_s
             ))
         })?;
-        let fix_sigma = fix.covariance.symmetric_eigenvalues().max().max(0.0).sqrt();
-        let position_sigma_m = init.position_sigma_m.max(3.0 * fix_sigma);
+        // the ranges of one beacon in one window share its errors (its offset, the
+        // window's dead reckoning): counted as one measurement per beacon, not one per
+        // range, the fix's covariance grows by ranges / beacons
+        let heard: BTreeSet<u32> = ranges.iter().map(|r| r.0).collect();
+        let shared = ranges.len() as f64 / heard.len().max(1) as f64;
+        let fix_sigma = (shared * fix.covariance.symmetric_eigenvalues().max().max(0.0)).sqrt();
+        // an error the beacons share (a range scale, a biased beacon) leaves no residual:
+        // with four beacons or more, the spread of the fixes without one beacon each
+        // (the jackknife's variance, (n - 1) / n times their sum of squares about their
+        // mean) measures it
+        let without: Vec<Vector2<f64>> = if heard.len() >= 4 {
+            heard
+                .iter()
+                .filter_map(|b| {
+                    let others: Vec<_> = shifted.iter().filter(|r| r.0 != *b).copied().collect();
+                    onebeacon::nav::fix::multilaterate(&others, depth).map(|f| f.position)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let jackknife_sigma = if without.len() >= 2 {
+            let n = without.len() as f64;
+            let mean = without.iter().sum::<Vector2<f64>>() / n;
+            ((n - 1.0) / n * without.iter().map(|p| (p - mean).norm_squared()).sum::<f64>() / 2.0).sqrt()
+        } else {
+            0.0
+        };
+        let position_sigma_m = init.position_sigma_m.max(3.0 * fix_sigma).max(jackknife_sigma);
         let p_end = fix.position + rotate(dn, de).xy();
         Ok(InitialStart { t0_s: end, pose: (p_end.x, p_end.y, psi0 + turned), position_sigma_m })
     }
@@ -1005,7 +1039,7 @@ heading_clockwise = true
         log.description.initial.from = InitialFrom::Ranges;
         log.description.initial.ranges_window_s = 10.0;
         log.description.initial.heading_deg = Some(90.0);
-        let InitialStart { t0_s: t0, pose: (n, e, psi), position_sigma_m: sigma } = log.initial_start().unwrap();
+        let InitialStart { t0_s: t0, pose: (n, e, psi), position_sigma_m: sigma } = log.initial_start(None).unwrap();
         assert_eq!(t0, 11.0);
         // the 150 m outlier keeps a Huber weight of about 1e-4: 1 mm of pull
         assert_abs_diff_eq!(n, p.0, epsilon = 0.01);
@@ -1014,7 +1048,7 @@ heading_clockwise = true
         assert_eq!(sigma, 1.0); // the fix is exact: position_sigma_m's default
         // the replay starts there and says so in its summary (in the log's frame)
         let r = crate::replay::replay(&log, None, |_| Ok::<_, LogError>(())).unwrap();
-        assert_eq!(r.start, log.initial_start().unwrap());
+        assert_eq!(r.start, log.initial_start(None).unwrap());
         let v = crate::json::replay_summary(&log, &[0, 1, 2], &r, 0.0);
         let at = |k: &str| v["start"][k].as_f64().unwrap();
         assert_eq!((v["start"]["from"].as_str(), at("t_s"), at("position_sigma_m")), (Some("ranges"), 11.0, 1.0));
@@ -1023,7 +1057,7 @@ heading_clockwise = true
         let mut log = load("ranges-two", body, &[("r.csv", &two)]).unwrap();
         log.description.initial.from = InitialFrom::Ranges;
         log.description.initial.heading_deg = Some(0.0);
-        let e = log.initial_start().unwrap_err().to_string();
+        let e = log.initial_start(None).unwrap_err().to_string();
         assert!(e.contains("initial.ranges_window_s") && e.contains("three beacons"), "{e}");
     }
 

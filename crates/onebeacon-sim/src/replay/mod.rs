@@ -163,7 +163,7 @@ fn session_and_start(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<(Sessi
             message: "key `tracked`: a stream's surface vehicle tracking several vehicles; replay runs the one vehicle of `[initial]`".into(),
         });
     }
-    let start = log.initial_start()?;
+    let start = log.initial_start(beacons.as_ref())?;
     let d = &log.description;
     let at = Start::At { t0_s: Some(start.t0_s), pose: start.pose };
     let session = d.stream_config(Vec::new()).session(&d.initial, at, beacons);

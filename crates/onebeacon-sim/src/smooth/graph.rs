@@ -45,7 +45,7 @@ struct Heard {
 }
 
 pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) -> Result<Graph, SmoothError> {
-    let start = log.initial_start()?;
+    let start = log.initial_start(beacons)?;
     let noise = &cfg.noise;
     let mut g = Graph {
         t_s: vec![start.t0_s],

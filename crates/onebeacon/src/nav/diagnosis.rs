@@ -5,7 +5,7 @@
 //! print these; summary.json carries them and each beacon's figures.
 
 use super::evaluation::{ErrorStats, chi_square_band};
-use super::{Kind, Outcome};
+use super::{Innovation, Kind, Outcome};
 use std::collections::BTreeMap;
 
 /// Corrections (of one beacon, by one estimator) below which their statistics say too
@@ -47,9 +47,15 @@ pub struct BeaconStats {
 impl BeaconStats {
     /// Counts what weighing measurement `kind` did.
     pub fn push(&mut self, kind: &Kind, outcome: &Outcome) {
-        let Some(i) = outcome.innovation() else { return };
+        if let Some(i) = outcome.innovation() {
+            self.push_innovation(kind, i, matches!(outcome, Outcome::Rejected(_)));
+        }
+    }
+
+    /// Counts one innovation of measurement `kind`, `rejected` or not.
+    pub fn push_innovation(&mut self, kind: &Kind, i: Innovation, rejected: bool) {
         self.count += 1;
-        self.rejected += usize::from(matches!(outcome, Outcome::Rejected(_)));
+        self.rejected += usize::from(rejected);
         if i.nis.is_finite() {
             self.nis_sum += i.nis;
             self.nis_count += 1;
@@ -190,7 +196,7 @@ pub fn findings(names: &[String], stats: &[ErrorStats], beacons: &[PerBeacon]) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::nav::{BeaconFix, Innovation};
+    use crate::nav::BeaconFix;
     use nalgebra::Vector3;
 
     /// `n` ranges of beacon `id`, each `z` sigma (sigma 2 m) off its prediction, the

@@ -277,6 +277,12 @@ pub trait Navigator: Send {
     fn body_velocity_m_s(&self) -> Option<Vector3<f64>> {
         None
     }
+    /// The innovation a range `m` would have, without taking it (the navigator moved to
+    /// its time first, as any measurement moves it): how a beacon held out of the run is
+    /// predicted. None for a navigator that cannot say, or for another kind.
+    fn weigh(&mut self, _m: &Measurement) -> Option<Innovation> {
+        None
+    }
     /// Each beacon's estimated range offset and its standard deviation (beacon, m, m),
     /// for a navigator that estimates one per beacon.
     fn beacon_offsets(&self) -> Vec<(u32, f64, f64)> {

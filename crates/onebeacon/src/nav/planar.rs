@@ -13,7 +13,7 @@
 //! every combination. Doppler speeds are not scaled by k_r (acoustic Doppler speeds share
 //! the sound-speed error; modelling that is left for when a log needs it).
 
-use super::{Aiding, BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
+use super::{Aiding, BeaconFix, Estimate, Innovation, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::rts::History;
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::geo::wrap_angle;
@@ -486,6 +486,16 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
         let (x, p) = (self.filter.mean(), self.filter.covariance());
         let slot = |i: usize| STATES + i;
         self.offset_beacons.iter().enumerate().map(|(i, &b)| (b, x[slot(i)], p[(slot(i), slot(i))].sqrt())).collect()
+    }
+
+    /// Whatever the aiding (dead reckoning's prediction is the baseline of a held-out
+    /// beacon), with the beacon's own offset state where it would have one.
+    fn weigh(&mut self, m: &Measurement) -> Option<Innovation> {
+        let Kind::Range { beacon, range_m } = m.kind else { return None };
+        self.advance_to(m.t_s);
+        let model = self.range_model(&beacon);
+        super::gated_update(&mut self.filter, &[&model as &dyn ScalarModel<N>], Vector1::new(range_m), -1.0, None)
+            .innovation()
     }
 
     /// Processes one measurement (measurements in time order; an earlier time is taken

@@ -4,7 +4,7 @@
 //! measurements, beacon positions, ground truth, in the source's frame.
 
 use crate::geo::Frame;
-use crate::nav::diagnosis::PerBeacon;
+use crate::nav::diagnosis::{BeaconStats, PerBeacon};
 use crate::nav::evaluation::{ErrorStats, horizontal_error};
 use crate::nav::restart::Restart;
 use crate::nav::{BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome};
@@ -380,6 +380,10 @@ pub struct Session {
     pub stats: Vec<ErrorStats>,
     /// Each estimator's corrections beacon by beacon (at most `limits.max_beacons`).
     pub beacon_stats: Vec<PerBeacon>,
+    /// The beacon held out ([`Session::with_held_out`]) and each estimator's prediction
+    /// of its ranges.
+    held_out: Option<u32>,
+    pub held_out_stats: Vec<BeaconStats>,
     /// Gate rejections and screened items, the first `limits.max_rejections` of them.
     pub rejected: Vec<Rejection>,
     /// Items before the start, beacon measurements left out by the beacon filter, and
@@ -432,6 +436,8 @@ impl Session {
             tracked: BTreeMap::new(),
             stats: vec![ErrorStats::default(); n],
             beacon_stats: vec![PerBeacon::default(); n],
+            held_out: None,
+            held_out_stats: vec![BeaconStats::default(); n],
             rejected: Vec::new(),
             before_start: 0,
             left_out: 0,
@@ -457,6 +463,14 @@ impl Session {
     /// pass ([`Navigator::keep_history`]; from a restart on, for one restarted).
     pub fn with_history(mut self) -> Self {
         self.keep_history = true;
+        self
+    }
+
+    /// The session with beacon `id` held out: no estimator takes its measurements; each
+    /// one predicts its ranges ([`Navigator::weigh`]) into `held_out_stats`. A score that
+    /// needs no ground truth: how well the others predict a beacon never heard.
+    pub fn with_held_out(mut self, id: u32) -> Self {
+        self.held_out = Some(id);
         self
     }
 
@@ -658,7 +672,13 @@ impl Session {
             Input::Measurement(m) => {
                 if let Some(kind) = self.resolve(m).map_err(|reason| self.screen(item, reason))? {
                     let m = Measurement::new(t, kind.clone());
-                    for (i, nav) in self.navs.iter_mut().enumerate() {
+                    let held = self.held_out.is_some() && kind.beacon().map(|b| b.id) == self.held_out;
+                    for (i, nav) in self.navs.iter_mut().enumerate().filter(|_| held) {
+                        if let Some(innovation) = nav.weigh(&m) {
+                            self.held_out_stats[i].push_innovation(&kind, innovation, false);
+                        }
+                    }
+                    for (i, nav) in self.navs.iter_mut().enumerate().filter(|_| !held) {
                         let out = nav.process(&m);
                         self.stats[i].push_outcome(&out, true);
                         self.beacon_stats[i].push(&kind, &out, self.limits.max_beacons);
@@ -722,7 +742,7 @@ impl Session {
         let Some(position) = position else {
             return Err(format!("beacon {id}'s position is not known yet (no beacon_position item for it)"));
         };
-        if !self.beacons.as_ref().is_none_or(|b| b.contains(&id)) {
+        if self.held_out != Some(id) && !self.beacons.as_ref().is_none_or(|b| b.contains(&id)) {
             self.left_out += 1;
             return Ok(None);
         }

@@ -6,7 +6,7 @@
 //! State [N, E, vN, vE, b, k_r]: horizontal NED position (m) and velocity (m/s), the
 //! range offset b (m) and scale error k_r (ranges read (1 + k_r) r + b).
 
-use super::{Estimate, Kind, Measurement, Navigator, Outcome, PlanarConfig};
+use super::{Estimate, Innovation, Kind, Measurement, Navigator, Outcome, PlanarConfig};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::measure::{ScalarModel, SlantRange};
 use nalgebra::{SMatrix, SVector, Vector1, Vector3};
@@ -107,6 +107,12 @@ impl TrackingNavigator {
     }
 
     /// Predicts to `t_s`; the bias wanders meanwhile.
+    /// The slant-range model to a beacon at `beacon` (NED, m).
+    fn range(&self, beacon: Vector3<f64>) -> SlantRange {
+        let var = self.config.noise.range_sigma_m.powi(2);
+        SlantRange { beacon, depth_m: self.depth_m, bias: Some(idx::BIAS), scale: Some(idx::RANGE_SCALE), var }
+    }
+
     fn advance_to(&mut self, t_s: f64) {
         let dt = (t_s - self.t_s).max(0.0);
         self.t_s = self.t_s.max(t_s);
@@ -126,15 +132,15 @@ impl TrackingNavigator {
 impl Navigator for TrackingNavigator {
     /// Ranges correct the track and depths enter slant ranges; a craft tracked from
     /// outside gives no other measurement this model uses.
+    fn weigh(&mut self, m: &Measurement) -> Option<Innovation> {
+        let Kind::Range { beacon, range_m } = m.kind else { return None };
+        self.advance_to(m.t_s);
+        let model: [&dyn ScalarModel<STATES>; 1] = [&self.range(beacon.position_ned_m)];
+        super::gated_update(&mut self.filter, &model, Vector1::new(range_m), -1.0, None).innovation()
+    }
+
     fn process(&mut self, m: &Measurement) -> Outcome {
         self.advance_to(m.t_s);
-        let range = |beacon: Vector3<f64>, depth_m: f64, c: &PlanarConfig| SlantRange {
-            beacon,
-            depth_m,
-            bias: Some(idx::BIAS),
-            scale: Some(idx::RANGE_SCALE),
-            var: c.noise.range_sigma_m.powi(2),
-        };
         match m.kind {
             Kind::Depth { depth_m } => {
                 self.depth_m = depth_m;
@@ -143,7 +149,7 @@ impl Navigator for TrackingNavigator {
             Kind::Range { beacon, range_m } | Kind::RangeDoppler { beacon, range_m, .. }
                 if self.config.aiding.range =>
             {
-                let model: [&dyn ScalarModel<STATES>; 1] = [&range(beacon.position_ned_m, self.depth_m, &self.config)];
+                let model: [&dyn ScalarModel<STATES>; 1] = [&self.range(beacon.position_ned_m)];
                 self.gate.update(&mut self.filter, &model, Vector1::new(range_m), self.config.robust, Some(beacon.id))
             }
             _ => Outcome::Skipped,
