@@ -205,12 +205,18 @@ enum Command {
         json: bool,
         /// Print the merged, time-ordered stream as JSON Lines (the input of `stream`)
         /// and stop.
-        #[arg(long, conflicts_with_all = ["json", "out", "beacons"])]
+        #[arg(long, conflicts_with_all = ["json", "out", "beacons", "holdout"])]
         print_stream: bool,
         /// Run the `[[estimators]]` of this TOML file instead of the log's (what `tune`
         /// writes).
         #[arg(long, value_name = "FILE")]
         estimators: Option<PathBuf>,
+        /// Leave each of these beacons out in turn (ids, comma-separated, or `all`): every
+        /// estimator runs without it and predicts its ranges; the residual RMS, mean and
+        /// mean NIS of those predictions (a score without ground truth) go to the table,
+        /// holdout.csv and summary.json's `holdout`.
+        #[arg(long, value_delimiter = ',', value_name = "IDS|all")]
+        holdout: Option<Vec<String>>,
     },
     /// Smooth a log after the dive: every pose at once (sparse nonlinear least squares
     /// over the motion, heading, range, Doppler and USBL measurements, with calibration
@@ -466,9 +472,10 @@ fn main() -> ExitCode {
         Command::Dsp { command: DspCommand::Process { wav, config, out, json } } => {
             dsp::process(&wav, config.as_deref(), out, json)
         }
-        Command::Replay { log, out, beacons, json, print_stream, estimators } => {
-            replay::replay(&log, out, beacons, json, print_stream, estimators.as_deref())
-        }
+        Command::Replay { log, out, beacons, json, print_stream, estimators, holdout } => replay::replay(
+            &log,
+            replay::ReplayArgs { out, beacons, as_json: json, print_stream, estimators: estimators.as_deref(), holdout },
+        ),
         Command::Smooth { log, out, beacons, like, estimators, calibrate, kernel, json } => {
             smooth::smooth(&log, smooth::SmoothArgs { out, beacons, json, like, estimators, calibrate, kernel })
         }

@@ -108,20 +108,24 @@ impl Prepared {
     }
 }
 
-/// `onebeacon replay LOG.toml [--out DIR] [--beacons 0,5] [--json] [--print-stream]`
-pub fn replay(
-    path: &Path,
-    out: Option<PathBuf>,
-    beacons: Option<Vec<u32>>,
-    as_json: bool,
-    print_stream: bool,
-    estimators: Option<&Path>,
-) -> Result<()> {
+/// What `onebeacon replay` was asked.
+pub struct ReplayArgs<'a> {
+    pub out: Option<PathBuf>,
+    pub beacons: Option<Vec<u32>>,
+    pub as_json: bool,
+    pub print_stream: bool,
+    pub estimators: Option<&'a Path>,
+    pub holdout: Option<Vec<String>>,
+}
+
+/// `onebeacon replay LOG.toml [--out DIR] [--beacons 0,5] [--json] [--print-stream]
+/// [--estimators FILE] [--holdout IDS|all]`
+pub fn replay(path: &Path, args: ReplayArgs) -> Result<()> {
     let mut log = Log::load(path)?;
-    if let Some(file) = estimators {
+    if let Some(file) = args.estimators {
         log.description.estimators = onebeacon_sim::replay::log::load_estimators(file)?;
     }
-    if print_stream {
+    if args.print_stream {
         let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
         for item in log.items()? {
             writeln!(stdout, "{}", jsonl::item_json(&item?))?;
@@ -129,18 +133,132 @@ pub fn replay(
         stdout.flush()?;
         return Ok(());
     }
-    let p = Prepared::new(log, estimators, out, beacons, "replay")?;
-    let (r, summary, title, wall_s) = p.replay("", &[], |_| {}, |_| Ok(()))?;
+    let p = Prepared::new(log, args.estimators, args.out, args.beacons, "replay")?;
+    let held = holdout_beacons(args.holdout, &p.used)?;
+    let names: Vec<String> = p.log.description.estimators.iter().map(|e| e.name()).collect();
+    let mut table = Vec::new();
+    if !held.is_empty() {
+        let progress = crate::progress::Progress::new(held.len() as u64, "beacons", "holding out".into());
+        for id in &held {
+            progress.set_message(format!("holding out beacon {id}"));
+            table.push((*id, onebeacon_sim::replay::holdout(&p.log, p.filter.as_ref(), *id)?));
+            progress.inc(1);
+        }
+        progress.finish();
+    }
+    let (r, summary, title, wall_s) = p.replay(
+        "",
+        &[],
+        |_| {},
+        |s| {
+            if !table.is_empty() {
+                s["holdout"] = holdout_json(&names, &table);
+                p.staging.write("holdout.csv", &holdout_csv(&names, &table)?)?;
+            }
+            Ok(())
+        },
+    )?;
     let files = p.finish(&r)?;
-    if as_json {
+    if args.as_json {
         outln!("{summary}");
         return Ok(());
     }
     outln!("{title}: {} measurements, replayed in {:.1} ms", r.items, wall_s * 1e3);
     print_table(&summary, &r.dropped)?;
+    print_holdout(&names, &table)?;
     outln!("wrote:");
     for f in files {
         outln!("  {}", f.display());
+    }
+    Ok(())
+}
+
+/// `--holdout` checked against the beacons run: the ids to hold out in turn.
+fn holdout_beacons(asked: Option<Vec<String>>, used: &[u32]) -> Result<Vec<u32>> {
+    let Some(asked) = asked else { return Ok(Vec::new()) };
+    let list = || used.iter().map(u32::to_string).collect::<Vec<_>>().join(", ");
+    if asked.iter().any(|a| a == "all") {
+        if used.len() < 2 {
+            return Err(BadInput(format!("--holdout all: one beacon ({}) leaves none to run on", list())).into());
+        }
+        return Ok(used.to_vec());
+    }
+    let mut ids = Vec::new();
+    for a in &asked {
+        let id = a.trim().parse::<u32>().ok().filter(|id| used.contains(id)).ok_or_else(|| {
+            BadInput(format!("--holdout {a}: not a beacon of this run (beacons: {}; or `all`)", list()))
+        })?;
+        if used.len() < 2 {
+            return Err(BadInput(format!("--holdout {id}: the only beacon of this run leaves none to run on")).into());
+        }
+        if !ids.contains(&id) {
+            ids.push(id);
+        }
+    }
+    Ok(ids)
+}
+
+type HoldoutTable = [(u32, Vec<onebeacon::nav::diagnosis::BeaconStats>)];
+
+/// summary.json's `holdout`: per beacon held out, per estimator, its ranges predicted.
+fn holdout_json(names: &[String], table: &HoldoutTable) -> serde_json::Value {
+    let num = |v: f64| if v.is_finite() { serde_json::json!(v) } else { serde_json::Value::Null };
+    let per = |stats: &[onebeacon::nav::diagnosis::BeaconStats]| {
+        let entries = names.iter().zip(stats).map(|(n, b)| {
+            let v = serde_json::json!({
+                "ranges": b.residual_count,
+                "residual_rms_m": num(b.residual_rms_m()),
+                "residual_mean_m": num(b.residual_mean_m()),
+                "nis_mean": num(b.nis_mean()),
+            });
+            (n.clone(), v)
+        });
+        serde_json::Value::Object(entries.collect())
+    };
+    serde_json::Value::Object(table.iter().map(|(id, stats)| (id.to_string(), per(stats))).collect())
+}
+
+fn holdout_csv(names: &[String], table: &HoldoutTable) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(["beacon", "estimator", "ranges", "residual_rms_m", "residual_mean_m", "nis_mean"])?;
+    for (id, stats) in table {
+        for (n, b) in names.iter().zip(stats) {
+            let f = |v: f64| format!("{v:.4}");
+            w.write_record([
+                id.to_string(),
+                n.clone(),
+                b.residual_count.to_string(),
+                f(b.residual_rms_m()),
+                f(b.residual_mean_m()),
+                f(b.nis_mean()),
+            ])?;
+        }
+    }
+    Ok(w.into_inner()?)
+}
+
+/// The holdout table: one line per estimator, per beacon held out its predicted ranges'
+/// residual RMS (m), mean (m) and mean NIS.
+fn print_holdout(names: &[String], table: &HoldoutTable) -> Result<()> {
+    if table.is_empty() {
+        return Ok(());
+    }
+    outln!("held out (each beacon's ranges predicted by a run without it): residual RMS m / mean m / mean NIS");
+    let header: String = table.iter().map(|(id, _)| format!(" {:>22}", format!("beacon {id}"))).collect();
+    outln!("{:<20}{header}", "estimator");
+    for (k, name) in names.iter().enumerate() {
+        let cells: String = table
+            .iter()
+            .map(|(_, stats)| {
+                let b = &stats[k];
+                let cell = match b.residual_count {
+                    0 => "-".to_string(),
+                    _ => format!("{:.2} / {:+.2} / {:.1}", b.residual_rms_m(), b.residual_mean_m(), b.nis_mean()),
+                };
+                format!(" {cell:>22}")
+            })
+            .collect();
+        outln!("{name:<20}{cells}");
     }
     Ok(())
 }

@@ -592,3 +592,35 @@ fn the_readme_log_description_runs_as_written() {
     assert_eq!(ekf["name"], "ekf");
     assert_eq!(ekf["outcome"], "accepted", "{ekf}");
 }
+
+/// `replay --holdout all` on plaza2: every beacon held out in turn, its ranges predicted
+/// by each estimator (a score without ground truth), in the table, holdout.csv and the
+/// summary; the calibrated filters predict every beacon better than dead reckoning does.
+/// A beacon not run, or a run with one beacon, is refused with one line, exit 2.
+#[test]
+fn holdout_scores_each_beacon_without_the_truth() {
+    let dir = scratch("holdout");
+    let out = dir.join("h").display().to_string();
+    let o = run(&["replay", &plaza(2), "--holdout", "all", "--json", "--out", &out]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rms = |b: &str, e: &str| v["holdout"][b][e]["residual_rms_m"].as_f64().unwrap();
+    for b in ["0", "1", "5", "6"] {
+        for e in ["ekf-cal", "ekf-cal-oos"] {
+            assert!(rms(b, e) < rms(b, "dead-reckoning"), "beacon {b}: {e} {} m", rms(b, e));
+        }
+    }
+    let csv = std::fs::read_to_string(dir.join("h").join("holdout.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 4 * 9, "{csv}");
+    for (args, says) in [
+        (vec!["--holdout", "3"], "--holdout 3: not a beacon of this run (beacons: 0, 1, 5, 6; or `all`)"),
+        (vec!["--holdout", "all", "--beacons", "5"], "--holdout all: one beacon (5) leaves none to run on"),
+    ] {
+        let log = plaza(2);
+        let mut a = vec!["replay", &log, "--out", &out];
+        a.extend(args);
+        let o = run(&a);
+        assert_eq!(o.status.code(), Some(2));
+        assert_eq!(text(&o.stderr).trim(), format!("error: {says}"));
+    }
+}

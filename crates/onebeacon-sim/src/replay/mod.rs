@@ -22,6 +22,7 @@ pub use rows::Dropped;
 use log::IncrementFrame;
 use onebeacon::config::stream::Beacon;
 use onebeacon::nav::Kind;
+use onebeacon::nav::diagnosis::BeaconStats;
 use onebeacon::nav::session::{Input, Session, Start, Step};
 use onebeacon::vehicle::unit::Unit;
 
@@ -194,6 +195,16 @@ pub fn stream_setup(config: &std::path::Path, budget: &crate::budget::Budget) ->
     let stream = d.stream_config(beacons);
     budget.check_stream(&stream).map_err(|e| LogError::File { file: file.clone(), message: e.to_string() })?;
     stream.unit().map_err(|v| LogError::File { file, message: v.to_string() })
+}
+
+/// Each estimator's prediction of beacon `id`'s ranges by a run that never hears them,
+/// on the other beacons of `beacons` (the log's when None), started without it:
+/// `replay --holdout`, a score that needs no ground truth.
+pub fn holdout(log: &Log, beacons: Option<&BTreeSet<u32>>, id: u32) -> Result<Vec<BeaconStats>, LogError> {
+    let others: BTreeSet<u32> = beacons.cloned().unwrap_or_else(|| log.beacon_ids()).into_iter().filter(|b| *b != id).collect();
+    let (session, start) = session_and_start(log, Some(others))?;
+    let r = replay_session(log, session.with_held_out(id), start, |_| Ok::<_, LogError>(()))?;
+    Ok(r.session.held_out_stats)
 }
 
 /// Runs every estimator of `log` over its stream, giving `record` one trajectory row
