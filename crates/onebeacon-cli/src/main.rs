@@ -233,8 +233,9 @@ enum Command {
         #[arg(long, value_delimiter = ',', value_name = "IDS")]
         beacons: Option<Vec<u32>>,
         /// Weigh the measurements as this estimator of the log does (its noise, kernel,
-        /// gate and calibration); default: the filters' default noise, a Huber kernel and
-        /// the calibration variables range_scale and turn_scale.
+        /// gate and calibration); default: the log's [noise] (the filters' defaults for
+        /// keys it does not give), a Huber kernel and the calibration variables
+        /// range_scale and turn_scale.
         #[arg(long, value_name = "ESTIMATOR")]
         like: Option<String>,
         /// Read the `[[estimators]]` of this TOML file instead of the log's (for the

@@ -123,7 +123,7 @@ pub struct ReplayArgs<'a> {
 pub fn replay(path: &Path, args: ReplayArgs) -> Result<()> {
     let mut log = Log::load(path)?;
     if let Some(file) = args.estimators {
-        log.description.estimators = onebeacon_sim::replay::log::load_estimators(file)?;
+        log.description.use_estimators(file)?;
     }
     if args.print_stream {
         let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
@@ -277,6 +277,10 @@ pub(crate) fn print_table(summary: &serde_json::Value, dropped: &[onebeacon_sim:
         f("heading_rad").to_degrees(),
         f("position_sigma_m")
     );
+    if let Some(noise) = summary["noise"].as_object().filter(|n| !n.is_empty()) {
+        let keys: Vec<String> = noise.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+        outln!("noise ([noise], to every estimator that does not set its own): {}", keys.join(", "));
+    }
     for d in dropped.iter().filter(|d| d.dropped > 0) {
         outln!("{}: {} rows out of time order dropped (time_order = \"drop\")", d.file, d.dropped);
     }

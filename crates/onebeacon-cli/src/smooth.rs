@@ -27,7 +27,7 @@ pub struct SmoothArgs {
 pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
     let mut log = Log::load(path)?;
     if let Some(file) = &a.estimators {
-        log.description.estimators = onebeacon_sim::replay::log::load_estimators(file)?;
+        log.description.use_estimators(file)?;
     }
     let cfg = onebeacon_sim::smooth::config(&log, a.like.as_deref(), a.calibrate.as_deref(), a.kernel.as_deref())
         .map_err(|e| BadInput(format!("--{e}")))?;
@@ -57,12 +57,19 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
             record.estimates.push(row_estimate(run.at(record.t_s), (error_m, nees.unwrap_or(f64::NAN))));
         }
     };
+    let noise_from = match (&a.like, p.log.description.noise_keys()) {
+        (Some(name), _) => format!("--like {name}"),
+        (None, Some(_)) => "the log's [noise], the defaults for the rest".to_string(),
+        (None, None) => "the defaults".to_string(),
+    };
     let mut warnings = smoothed.warnings.clone();
     let (r, summary, title, _) = p.replay(" smoothed", &names, extra, |summary| {
         let entries = summary["estimators"].as_array_mut().context("the summary lists its estimators")?;
         entries.push(onebeacon_sim::json::smoother_summary("smoother", &smoothed));
         entries.extend(runs.iter().map(onebeacon_sim::json::rts_summary));
         warnings.extend(worse_than_the_filters(entries));
+        let keys = onebeacon_sim::json::noise_keys(&cfg.noise);
+        summary["smoother_noise"] = serde_json::json!({"from": noise_from, "keys": keys});
         if let Some(list) = summary["warnings"].as_array_mut() {
             list.extend(warnings.iter().map(|w| serde_json::json!(w)));
         }
@@ -93,6 +100,13 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
         outln!("no factor for: {}", list.join(", "));
     }
     print_table(&summary, &r.dropped)?;
+    let keys = onebeacon_sim::json::noise_keys(&cfg.noise);
+    let value = |v: &serde_json::Value| {
+        let v = format!("{:.4}", v.as_f64().unwrap_or(f64::NAN));
+        v.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    let keys: Vec<String> = keys.as_object().into_iter().flatten().map(|(k, v)| format!("{k} {}", value(v))).collect();
+    outln!("smoother noise ({noise_from}): {}", keys.join(", "));
     let cal: Vec<String> = s.calibration.iter().map(|(k, v, sigma)| format!("{k} {v:.4} (sigma {sigma:.4})")).collect();
     if !cal.is_empty() {
         outln!("smoother calibration: {}", cal.join(", "));

@@ -459,7 +459,7 @@ fn replay<'py>(
 ) -> PyResult<Bound<'py, PyTuple>> {
     let mut l = Log::load(&log).map_err(input_error)?;
     if let Some(file) = estimators {
-        l.description.estimators = onebeacon_sim::replay::log::load_estimators(&file).map_err(input_error)?;
+        l.description.use_estimators(&file).map_err(input_error)?;
     }
     let known = l.beacon_ids();
     let filter = beacon_filter(beacons, &known).map_err(|e| input_error(format!("beacons {e}")))?;

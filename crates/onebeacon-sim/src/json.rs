@@ -181,6 +181,21 @@ fn per_beacon_fields(p: &onebeacon::nav::diagnosis::PerBeacon) -> Value {
     Value::Object(p.0.iter().map(|(id, b)| (id.to_string(), beacon(b))).collect())
 }
 
+/// A planar noise in the keys of a description (degrees where the key says so).
+pub fn noise_keys(n: &onebeacon::nav::PlanarNoise) -> Value {
+    json!({
+        "range_sigma_m": n.range_sigma_m,
+        "doppler_sigma_m_s": n.doppler_sigma_m_s,
+        "heading_sigma_deg": n.heading_sigma_rad.to_degrees(),
+        "distance_sigma_frac": n.distance_sigma_frac,
+        "heading_change_sigma_frac": n.heading_change_sigma_frac,
+        "heading_walk_deg_per_sqrt_m": n.heading_walk_rad_per_sqrt_m.to_degrees(),
+        "speed_sigma_m_s": n.speed_sigma_m_s,
+        "bias_walk_m_per_sqrt_s": n.bias_walk_m_per_sqrt_s,
+        "position_walk_m_per_sqrt_s": n.position_walk_m_per_sqrt_s,
+    })
+}
+
 /// `replay --json`, the replay's summary.json.
 pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
     let s = &r.session;
@@ -244,6 +259,7 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
         "screened": s.screened,
         "dropped_rows": r.dropped.iter().map(|d| (d.file.clone(), json!(d.dropped))).collect::<serde_json::Map<_, _>>(),
         "warnings": r.warnings(log.has_truth()),
+        "noise": log.description.noise,
         "wall_s": wall_s,
         "estimators": estimators,
     })

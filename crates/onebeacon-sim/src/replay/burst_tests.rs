@@ -239,3 +239,22 @@ fn a_held_out_beacon_is_predicted_by_the_others() {
         }
     }
 }
+
+/// One beacon alone, its first ranges 200 m short, about 500 m away (issue 53: a log's
+/// early false track captured every filter with a range-scale state). The scale's prior
+/// widens each predicted range by sigma_k r: at the old default 0.05, 25 m, and a false
+/// range 200 m short passed the NIS-100 gate (NIS 64); at 0.02 (the ocean's spread of
+/// sound speed) 10 m, NIS 400, rejected. With the default the range-scale filter stays
+/// within a few metres; with sigma_k = 0.05 the burst takes it tens of metres off.
+#[test]
+fn one_beacon_alone_with_an_early_false_track_captures_no_range_scale_filter() {
+    let worst = |scale_sigma: Option<f64>| {
+        let mut log = lbl_log(&format!("alone-{}", scale_sigma.unwrap_or(0.0)), First::False, "");
+        log.description.estimators.iter_mut().for_each(|e| e.range_scale_sigma = scale_sigma);
+        let r = replay(&log, Some([0].into()), |_| Ok::<_, super::LogError>(())).unwrap();
+        let s = &r.session;
+        s.names.iter().zip(&s.stats).find(|(n, _)| *n == "ekf-cal").map(|(_, st)| st.max_m).unwrap()
+    };
+    let (default, wide) = (worst(None), worst(Some(0.05)));
+    assert!(default < 5.0 && wide > 20.0, "max error {default} m by default, {wide} m with 0.05");
+}

@@ -97,6 +97,34 @@ impl LogDescription {
         Ok(d)
     }
 
+    /// Runs the `[[estimators]]` of the TOML file `path` (`replay --estimators`, what
+    /// `tune` writes) instead of the description's, each given the `[noise]` keys it does
+    /// not set, as the description's own are.
+    pub fn use_estimators(&mut self, path: &Path) -> Result<(), LogError> {
+        self.estimators = load_estimators(path)?;
+        let file = path.display().to_string();
+        let invalid = |v| LogError::Description(crate::scenario::load::invalid(&file, v));
+        self.estimators = self.stream_config(Vec::new()).checked().map_err(invalid)?.estimators;
+        Ok(())
+    }
+
+    /// The noise of an estimator that sets no noise key of its own: the defaults with
+    /// `[noise]`'s keys (what `smooth` weighs with, without `--like`).
+    pub fn default_noise(&self) -> onebeacon::nav::PlanarNoise {
+        let mut spec = EstimatorSpec::new(onebeacon::config::estimator::EstimatorKind::RangeEkf);
+        for (key, v) in &self.noise {
+            if let Some(slot) = spec.key_mut(key) {
+                *slot = Some(*v);
+            }
+        }
+        spec.planar_config().noise
+    }
+
+    /// The `[noise]` keys given, "key = value" each, comma-separated (None for none).
+    pub fn noise_keys(&self) -> Option<String> {
+        (!self.noise.is_empty()).then(|| self.noise.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))
+    }
+
     /// The stream configuration the description holds, with the fixed beacons `beacons`
     /// (the log's resolved: [`LogDescription::fixed_beacons`]).
     pub fn stream_config(&self, beacons: Vec<Beacon>) -> StreamConfig {
@@ -212,7 +240,7 @@ struct EstimatorFile {
 
 /// Reads and checks a file of `[[estimators]]` tables, to run on a log instead of its
 /// own (`replay --estimators`).
-pub fn load_estimators(path: &Path) -> Result<Vec<EstimatorSpec>, LogError> {
+fn load_estimators(path: &Path) -> Result<Vec<EstimatorSpec>, LogError> {
     let name = path.display().to_string();
     let text = crate::input_file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
     let f: EstimatorFile = deserialize(&text, &name)?;

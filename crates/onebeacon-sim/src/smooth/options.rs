@@ -21,7 +21,8 @@ pub fn config(
     calibrate: Option<&[String]>,
     kernel: Option<&str>,
 ) -> Result<SmoothConfig, String> {
-    let mut cfg = SmoothConfig::default();
+    // without --like, the default smoother with the log's `[noise]`
+    let mut cfg = SmoothConfig { noise: log.description.default_noise(), ..SmoothConfig::default() };
     if let Some(name) = like {
         let estimators = &log.description.estimators;
         let e = estimators.iter().find(|e| e.name() == name).ok_or_else(|| {

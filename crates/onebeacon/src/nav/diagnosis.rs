@@ -135,7 +135,7 @@ pub fn findings(names: &[String], stats: &[ErrorStats], beacons: &[PerBeacon]) -
     if !overconfident.is_empty() {
         out.push(format!(
             "overconfident, its mean NIS above the 95 % band of a consistent filter's (its sigmas understate \
-             its error; raise its noise, docs/logs.md \"Noise\"): {}",
+             its error; raise its noise: docs/logs.md, \"Tuning a log's noise\"): {}",
             overconfident.join(", ")
         ));
     }

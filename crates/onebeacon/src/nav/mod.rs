@@ -76,58 +76,38 @@ pub(crate) fn gated_update<const N: usize, const M: usize, H: MeasurementModel<N
 /// navigator whose error has outgrown its covariance is not shut out for good.
 pub const LOST_AFTER_REJECTIONS: u32 = 30;
 
-/// The beacons a gate counts rejections of one by one; the rest share one count.
-const GATED_BEACONS: usize = 64;
-
-/// A navigator's NIS gate (infinity: none) with the rule that keeps it from locking the
-/// navigator, or one beacon, out: after [`LOST_AFTER_REJECTIONS`] rejections in a row
-/// (of any beacon: the navigator is lost) the gate opens for every beacon, and after as
-/// many in a row of one beacon's measurements (one beacon reads biased, or the navigator
-/// drifted away from it while the others kept it) it opens for that beacon; it stays
-/// open until a correction falls within it again.
-#[derive(Debug, Clone, PartialEq)]
+/// A navigator's NIS gate (infinity: none) with the one rule that keeps it from
+/// locking the navigator out: after [`LOST_AFTER_REJECTIONS`] rejections in a row the
+/// gate opens, and stays open until a correction falls within it again. A rule per
+/// beacon (one beacon shut out while the others are taken) was tried for issue 53 and
+/// left out: it lets a beacon whose position is wrong pull the navigator kilometres off;
+/// a beacon mostly gated out is named instead ([`diagnosis`]), and a per-beacon offset
+/// state (`estimate_beacon_offsets`) carries a steady bias.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Gate {
     nis: f64,
     rejected_in_row: u32,
-    /// (beacon, its measurements rejected in a row), at most [`GATED_BEACONS`].
-    beacons: Vec<(u32, u32)>,
 }
 
 impl Gate {
     pub(crate) fn new(nis: f64) -> Self {
-        Self { nis, rejected_in_row: 0, beacons: Vec::new() }
+        Self { nis, rejected_in_row: 0 }
     }
 
-    /// [`gated_update`] of a measurement of `beacon` (None: of no beacon) at this gate
-    /// (none while it is open), counting the rejections.
+    /// [`gated_update`] at this gate (none while it is open), counting the rejections.
     pub(crate) fn update<const N: usize, const M: usize, H: MeasurementModel<N, M>>(
         &mut self,
         filter: &mut AnyFilter<N>,
         models: &H,
         z: SVector<f64, M>,
         robust: Option<Robust>,
-        beacon: Option<u32>,
     ) -> Outcome {
-        let slot = beacon.and_then(|id| match self.beacons.iter().position(|(b, _)| *b == id) {
-            Some(k) => Some(k),
-            None if self.beacons.len() < GATED_BEACONS => {
-                self.beacons.push((id, 0));
-                Some(self.beacons.len() - 1)
-            }
-            None => None,
-        });
-        let in_row = slot.map_or(0, |k| self.beacons[k].1);
-        let open = self.rejected_in_row.max(in_row) >= LOST_AFTER_REJECTIONS;
+        let open = self.rejected_in_row >= LOST_AFTER_REJECTIONS;
         let outcome = gated_update(filter, models, z, if open { f64::INFINITY } else { self.nis }, robust);
-        let reset = match outcome {
-            Outcome::Rejected(..) => false,
-            Outcome::Accepted(i) if i.nis <= self.nis => true,
-            _ => return outcome,
-        };
-        let count = |n: &mut u32| *n = if reset { 0 } else { *n + 1 };
-        count(&mut self.rejected_in_row);
-        if let Some(k) = slot {
-            count(&mut self.beacons[k].1);
+        match outcome {
+            Outcome::Rejected(..) => self.rejected_in_row += 1,
+            Outcome::Accepted(i) if i.nis <= self.nis => self.rejected_in_row = 0,
+            _ => {}
         }
         outcome
     }
@@ -356,27 +336,6 @@ mod tests {
         assert!(matches!(outcome, Outcome::Rejected(i) if (i.nis - nis).abs() < 1e-9), "{outcome:?}");
     }
 
-    /// One beacon's measurements shut out while another's are taken: x ~ N(0, 1) measured
-    /// by beacon 1 as 0 and by beacon 2 as 50 (r = 1, gate 100), in turn. Beacon 1's are
-    /// accepted and would keep a navigator-wide count at zero for ever; beacon 2's own
-    /// count opens the gate for it after [`LOST_AFTER_REJECTIONS`] of its rejections in a
-    /// row, and the next of beacon 2's is taken.
-    #[test]
-    fn a_gate_opens_for_one_beacon_shut_out_while_the_others_are_taken() {
-        let mut f = AnyFilter::new(FilterKind::Ekf, Vector1::new(0.0), Matrix1::new(1.0));
-        let model = [StateComponent::value(0, 1.0)];
-        let mut gate = Gate::new(100.0);
-        for k in 0..=LOST_AFTER_REJECTIONS {
-            let a = gate.update(&mut f, &model, Vector1::new(0.0), None, Some(1));
-            assert!(matches!(a, Outcome::Accepted(..)), "{a:?}");
-            let b = gate.update(&mut f, &model, Vector1::new(50.0), None, Some(2));
-            match k < LOST_AFTER_REJECTIONS {
-                true => assert!(matches!(b, Outcome::Rejected(..)), "{k}: {b:?}"),
-                false => assert!(matches!(b, Outcome::Accepted(i) if i.nis > 100.0), "{k}: {b:?}"),
-            }
-        }
-    }
-
     /// The lost rule against the closed form of repeated scalar updates: x ~ N(0, 1),
     /// z = 50 with r = 1, gate 100 (NIS 1250). The first [`LOST_AFTER_REJECTIONS`] are
     /// rejected, the state untouched; then the gate is open: before the k-th accepted
@@ -389,15 +348,15 @@ mod tests {
         let model = [StateComponent::value(0, 1.0)];
         let mut gate = Gate::new(100.0);
         for _ in 0..LOST_AFTER_REJECTIONS {
-            assert!(matches!(gate.update(&mut f, &model, Vector1::new(50.0), None, None), Outcome::Rejected(..)));
+            assert!(matches!(gate.update(&mut f, &model, Vector1::new(50.0), None), Outcome::Rejected(..)));
         }
         assert_eq!(f.mean()[0], 0.0);
         for k in 1..=5 {
-            let Outcome::Accepted(Innovation { nis, .. }) = gate.update(&mut f, &model, Vector1::new(50.0), None, None) else { panic!() };
+            let Outcome::Accepted(Innovation { nis, .. }) = gate.update(&mut f, &model, Vector1::new(50.0), None) else { panic!() };
             assert_abs_diff_eq!(nis, 2500.0 / (k * (k + 1)) as f64, epsilon = 1e-9);
             assert_abs_diff_eq!(f.mean()[0], 50.0 * k as f64 / (k + 1) as f64, epsilon = 1e-9);
         }
-        assert!(matches!(gate.update(&mut f, &model, Vector1::new(-1000.0), None, None), Outcome::Rejected(..)));
+        assert!(matches!(gate.update(&mut f, &model, Vector1::new(-1000.0), None), Outcome::Rejected(..)));
         assert_abs_diff_eq!(f.mean()[0], 50.0 * 5.0 / 6.0, epsilon = 1e-9);
     }
 }

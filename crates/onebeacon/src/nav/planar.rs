@@ -131,7 +131,7 @@ impl Default for PlanarConfig {
             bias_sigma_m: 5.0,
             estimate_beacon_offsets: false,
             estimate_range_scale: false,
-            range_scale_sigma: 0.05,
+            range_scale_sigma: 0.02,
             estimate_distance_scale: false,
             distance_scale_sigma: 0.05,
             estimate_turn_scale: false,
@@ -340,13 +340,12 @@ impl<const N: usize> PlanarNavigator<N> {
         }
     }
 
-    /// A correction gated as a measurement of beacon `gated` (ranges, Doppler speeds),
-    /// or an ungated one (`None`: heading fixes).
-    fn correct(&mut self, model: &dyn ScalarModel<N>, z: f64, gated: Option<u32>) -> Outcome {
+    /// A gated correction (ranges, Doppler speeds), or an ungated one (heading fixes).
+    fn correct(&mut self, model: &dyn ScalarModel<N>, z: f64, gated: bool) -> Outcome {
         let z = Vector1::new(z);
         match gated {
-            Some(beacon) => self.gate.update(&mut self.filter, &[model], z, self.config.robust, Some(beacon)),
-            None => super::gated_update(&mut self.filter, &[model], z, f64::INFINITY, self.config.robust),
+            true => self.gate.update(&mut self.filter, &[model], z, self.config.robust),
+            false => super::gated_update(&mut self.filter, &[model], z, f64::INFINITY, self.config.robust),
         }
     }
 
@@ -528,25 +527,25 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
             }
             Kind::Heading { heading_rad } | Kind::Attitude { heading_rad, .. } => {
                 let var = noise.heading_sigma_rad * noise.heading_sigma_rad;
-                self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, None)
+                self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, false)
             }
             Kind::Range { beacon, range_m } if aiding.range => {
                 let model = self.range_model(&beacon);
-                self.correct(&model, range_m, Some(beacon.id))
+                self.correct(&model, range_m, true)
             }
             Kind::Doppler { beacon, radial_speed_m_s } if aiding.doppler => {
                 let model = self.doppler_model(beacon.position_ned_m);
-                self.correct(&model, radial_speed_m_s, Some(beacon.id))
+                self.correct(&model, radial_speed_m_s, true)
             }
             Kind::RangeDoppler { beacon, range_m, radial_speed_m_s } if aiding.any() => {
                 let range = if aiding.range {
                     let model = self.range_model(&beacon);
-                    self.correct(&model, range_m, Some(beacon.id))
+                    self.correct(&model, range_m, true)
                 } else {
                     Outcome::Skipped
                 };
                 let doppler = if aiding.doppler {
-                    self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, Some(beacon.id))
+                    self.correct(&self.doppler_model(beacon.position_ned_m), radial_speed_m_s, true)
                 } else {
                     Outcome::Skipped
                 };

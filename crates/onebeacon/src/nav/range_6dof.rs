@@ -206,7 +206,7 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
                 // range update (eq. 3.7-3.10) at the receive time
                 self.advance_to(m.t_s);
                 let model = CalibratedRange { range: self.noise.range_model(&beacon), layout: self.calibration.layout };
-                self.gate.update(&mut self.filter, &[model], Vector1::new(range_m), self.robust, Some(beacon.id))
+                self.gate.update(&mut self.filter, &[model], Vector1::new(range_m), self.robust)
             }
             _ => Outcome::Skipped,
         }

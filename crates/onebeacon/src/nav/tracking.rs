@@ -150,7 +150,7 @@ impl Navigator for TrackingNavigator {
                 if self.config.aiding.range =>
             {
                 let model: [&dyn ScalarModel<STATES>; 1] = [&self.range(beacon.position_ned_m)];
-                self.gate.update(&mut self.filter, &model, Vector1::new(range_m), self.config.robust, Some(beacon.id))
+                self.gate.update(&mut self.filter, &model, Vector1::new(range_m), self.config.robust)
             }
             _ => Outcome::Skipped,
         }

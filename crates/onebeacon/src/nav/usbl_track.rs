@@ -301,7 +301,7 @@ impl Navigator for GaussianTracker {
                 let usbl = self.config.noise.usbl(&station, station_heading_rad);
                 let models = [usbl.model(UsblAngle::Azimuth), usbl.model(UsblAngle::Elevation)]; // eq. 1-3
                 let z = Vector2::new(azimuth_rad, elevation_rad);
-                self.gate.update(&mut self.filter, &models, z, self.config.robust, Some(station.id))
+                self.gate.update(&mut self.filter, &models, z, self.config.robust)
             }
             _ => Outcome::Skipped,
         }
