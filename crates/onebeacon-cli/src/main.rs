@@ -475,7 +475,14 @@ fn main() -> ExitCode {
         }
         Command::Replay { log, out, beacons, json, print_stream, estimators, holdout } => replay::replay(
             &log,
-            replay::ReplayArgs { out, beacons, as_json: json, print_stream, estimators: estimators.as_deref(), holdout },
+            replay::ReplayArgs {
+                out,
+                beacons,
+                as_json: json,
+                print_stream,
+                estimators: estimators.as_deref(),
+                holdout,
+            },
         ),
         Command::Smooth { log, out, beacons, like, estimators, calibrate, kernel, json } => {
             smooth::smooth(&log, smooth::SmoothArgs { out, beacons, json, like, estimators, calibrate, kernel })

@@ -7,7 +7,7 @@ use crate::output::Staging;
 use anyhow::Result;
 use onebeacon::nav::evaluation::ErrorStats;
 use onebeacon_sim::replay::Log;
-use onebeacon_sim::replay::tune::{BOUND_FACTOR, DEFAULT_KEYS, TUNABLE, Tuned, tune as fit};
+use onebeacon_sim::replay::tune::{BOUND_FACTOR, DEFAULT_KEYS, TUNABLE, Tuned, at_bound, tune as fit};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 
@@ -33,6 +33,7 @@ pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
         let ids = filter.clone().unwrap_or_else(|| log.beacon_ids());
         sets.extend(ids.into_iter().map(|b| Some(std::collections::BTreeSet::from([b]))));
     }
+    let named = keys.is_some();
     let keys = keys.unwrap_or_else(|| DEFAULT_KEYS.iter().map(|k| k.to_string()).collect());
     for k in &keys {
         if !TUNABLE.iter().any(|(t, _)| t == k) {
@@ -71,7 +72,7 @@ pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
     for &i in &chosen {
         bar.set_message(format!("tuning {}", names[i]));
         let rounds = std::cell::Cell::new(0);
-        let t = fit(&log, &specs[i], &keys, &sets, || {
+        let t = fit(&log, &specs[i], &keys, named, &sets, || {
             rounds.set(rounds.get() + 1);
             bar.set_message(format!("tuning {}, round {}", names[i], rounds.get()));
         })?;
@@ -124,13 +125,19 @@ pub fn tune(path: &Path, args: TuneArgs) -> Result<()> {
             a.nis_count,
             t.evaluations
         );
-        for (k, from, to) in &t.keys {
-            let bound = if at_bound(*from, *to) {
-                format!(" (at its bound, a factor of {BOUND_FACTOR} from the start: the fit wants it further)")
-            } else {
-                String::new()
+        for ((k, from, to), interval) in t.keys.iter().zip(&t.intervals) {
+            let note = match interval {
+                _ if at_bound(*from, *to) => format!(
+                    " (at its bound, a factor of {BOUND_FACTOR} from the start: the fit wants it further, the \
+                     model misses something; docs/logs.md, \"Tuning a log's noise\")"
+                ),
+                Some([lo, hi]) => format!(" (95 % {lo:.4}-{hi:.4})"),
+                None => " (no interval: the likelihood is flat or saddle-shaped there)".to_string(),
             };
-            outln!("  {k:<30} {from:>10.4} -> {to:.4}{bound}");
+            outln!("  {k:<30} {from:>10.4} -> {to:.4}{note}");
+        }
+        if !t.dropped.is_empty() {
+            outln!("  not tuned (unused by this estimator on this log): {}", t.dropped.join(", "));
         }
         if a.rejected > 0 {
             outln!("  {} of {} corrections gated out after the fit", a.rejected, a.nis_count);
@@ -157,20 +164,19 @@ fn stats_json(s: &ErrorStats) -> Value {
     json!({"rmse_m": num(s.rmse_m()), "nees_mean": num(s.nees_mean()), "nis_mean": num(s.nis_mean())})
 }
 
-/// Whether a key tuned from `from` to `to` stopped at its bound.
-fn at_bound(from: f64, to: f64) -> bool {
-    (to / from).ln().abs() >= BOUND_FACTOR.ln() * 0.999
-}
-
 fn tuned_json(name: &str, t: &Tuned) -> Value {
     let keys: serde_json::Map<String, Value> = t
         .keys
         .iter()
-        .map(|(k, a, b)| (k.clone(), json!({"before": a, "after": b, "at_bound": at_bound(*a, *b)})))
+        .zip(&t.intervals)
+        .map(|((k, a, b), i)| {
+            (k.clone(), json!({"before": a, "after": b, "at_bound": at_bound(*a, *b), "interval_95": i}))
+        })
         .collect();
     json!({
         "name": name,
         "keys": keys,
+        "not_tuned": t.dropped,
         "neg_log_likelihood": {"before": t.nll_before, "after": t.nll_after},
         "corrections": t.after.nis_count,
         "gated": t.after.rejected,

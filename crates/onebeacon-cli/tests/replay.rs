@@ -670,6 +670,9 @@ fn the_logs_noise_reaches_estimators_files_and_the_smoother() {
     let (without, default) = smoother(&plaza(2), "s-default");
     assert_eq!(noise["keys"]["range_sigma_m"].as_f64(), Some(3.0));
     assert_eq!(noise["from"], "the log's [noise], the defaults for the rest");
-    assert_eq!((default["keys"]["range_sigma_m"].as_f64(), default["from"].as_str()), (Some(1.5), Some("the defaults")));
+    assert_eq!(
+        (default["keys"]["range_sigma_m"].as_f64(), default["from"].as_str()),
+        (Some(1.5), Some("the defaults"))
+    );
     assert!((with - without).abs() > 0.05, "smoother RMSE {with} m with [noise], {without} m without");
 }

@@ -122,7 +122,8 @@ impl LogDescription {
 
     /// The `[noise]` keys given, "key = value" each, comma-separated (None for none).
     pub fn noise_keys(&self) -> Option<String> {
-        (!self.noise.is_empty()).then(|| self.noise.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))
+        (!self.noise.is_empty())
+            .then(|| self.noise.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))
     }
 
     /// The stream configuration the description holds, with the fixed beacons `beacons`

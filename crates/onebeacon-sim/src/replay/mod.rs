@@ -201,7 +201,8 @@ pub fn stream_setup(config: &std::path::Path, budget: &crate::budget::Budget) ->
 /// on the other beacons of `beacons` (the log's when None), started without it:
 /// `replay --holdout`, a score that needs no ground truth.
 pub fn holdout(log: &Log, beacons: Option<&BTreeSet<u32>>, id: u32) -> Result<Vec<BeaconStats>, LogError> {
-    let others: BTreeSet<u32> = beacons.cloned().unwrap_or_else(|| log.beacon_ids()).into_iter().filter(|b| *b != id).collect();
+    let others: BTreeSet<u32> =
+        beacons.cloned().unwrap_or_else(|| log.beacon_ids()).into_iter().filter(|b| *b != id).collect();
     let (session, start) = session_and_start(log, Some(others))?;
     let r = replay_session(log, session.with_held_out(id), start, |_| Ok::<_, LogError>(()))?;
     Ok(r.session.held_out_stats)

@@ -352,7 +352,10 @@ mod tests {
         }
         assert_eq!(f.mean()[0], 0.0);
         for k in 1..=5 {
-            let Outcome::Accepted(Innovation { nis, .. }) = gate.update(&mut f, &model, Vector1::new(50.0), None) else { panic!() };
+            let Outcome::Accepted(Innovation { nis, .. }) = gate.update(&mut f, &model, Vector1::new(50.0), None)
+            else {
+                panic!()
+            };
             assert_abs_diff_eq!(nis, 2500.0 / (k * (k + 1)) as f64, epsilon = 1e-9);
             assert_abs_diff_eq!(f.mean()[0], 50.0 * k as f64 / (k + 1) as f64, epsilon = 1e-9);
         }
