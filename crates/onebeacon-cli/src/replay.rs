@@ -281,6 +281,16 @@ pub(crate) fn print_table(summary: &serde_json::Value, dropped: &[onebeacon_sim:
         let keys: Vec<String> = noise.iter().map(|(k, v)| format!("{k} = {v}")).collect();
         outln!("noise ([noise], to every estimator that does not set its own): {}", keys.join(", "));
     }
+    let reference = &summary["reference"];
+    if let Some(floor) = reference["rmse_floor_m"].as_f64().filter(|f| *f > 0.0) {
+        outln!(
+            "ground truth with its own error (sigma {:.2} m rms per axis over {} rows): no RMSE below about {floor:.2} m \
+             can be told apart; NEES counts the reference's covariance, rmse_less_reference_m in summary.json takes its \
+             share out",
+            reference["sigma_rms_m"].as_f64().unwrap_or(f64::NAN),
+            reference["rows"]
+        );
+    }
     for d in dropped.iter().filter(|d| d.dropped > 0) {
         outln!("{}: {} rows out of time order dropped (time_order = \"drop\")", d.file, d.dropped);
     }

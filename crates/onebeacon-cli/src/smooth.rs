@@ -49,11 +49,11 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
     let mut names = vec!["smoother".to_string()];
     names.extend(runs.iter().map(|r| format!("{}+rts", r.name)));
     let extra = |record: &mut StepRecord| {
-        let truth = record.truth[0].pos;
-        record.estimates.push(estimate(&smoothed, record.t_s, truth));
+        let (truth, sigma) = (record.truth[0].pos, record.truth[0].sigma_m);
+        record.estimates.push(estimate(&smoothed, record.t_s, truth, sigma));
         for run in &runs {
             // no truth: NaN error and NEES
-            let (error_m, nees) = run.error(record.t_s, truth.x, truth.y);
+            let (error_m, nees) = run.error(record.t_s, truth.x, truth.y, sigma);
             record.estimates.push(row_estimate(run.at(record.t_s), (error_m, nees.unwrap_or(f64::NAN))));
         }
     };
@@ -144,10 +144,11 @@ fn worse_than_the_filters(entries: &[serde_json::Value]) -> Option<String> {
     })
 }
 
-/// The smoother's row at time `t`, scored against the truth `truth` (NaN: none).
-fn estimate(s: &Smoothed, t: f64, truth: Vector3<f64>) -> Estimate {
+/// The smoother's row at time `t`, scored against the truth `truth` with its own error
+/// `sigma_m` (NaN: none).
+fn estimate(s: &Smoothed, t: f64, truth: Vector3<f64>, sigma_m: f64) -> Estimate {
     let (p, cov) = s.at(t);
-    let (error_m, nees) = s.error(t, truth.x, truth.y);
+    let (error_m, nees) = s.error(t, truth.x, truth.y, sigma_m);
     Estimate {
         vehicle: 0,
         pos: Vector3::new(p[0], p[1], 0.0),

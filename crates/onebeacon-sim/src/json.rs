@@ -233,6 +233,11 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
                 v["beacon_offsets"] = Value::Object(per_beacon.collect());
             }
             v["per_beacon"] = per_beacon_fields(per_beacon);
+            // the RMSE less the reference's share (errors independent: rmse^2 = e^2 + floor^2)
+            let floor = s.rmse_floor_m();
+            if floor > 0.0 {
+                v["rmse_less_reference_m"] = num((st.rmse_m().powi(2) - floor * floor).max(0.0).sqrt());
+            }
             v
         })
         .collect();
@@ -260,6 +265,11 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
         "dropped_rows": r.dropped.iter().map(|d| (d.file.clone(), json!(d.dropped))).collect::<serde_json::Map<_, _>>(),
         "warnings": r.warnings(log.has_truth()),
         "noise": log.description.noise,
+        "reference": {
+            "rows": s.reference_rows,
+            "sigma_rms_m": if s.reference_rows > 0 { (s.reference_var_sum_m2 / s.reference_rows as f64).sqrt() } else { 0.0 },
+            "rmse_floor_m": s.rmse_floor_m(),
+        },
         "wall_s": wall_s,
         "estimators": estimators,
     })

@@ -58,6 +58,9 @@ pub struct TruthRecord {
     pub pos: Vector3<f64>,
     pub heading: f64,
     pub speed: f64,
+    /// The reference's own error on each horizontal axis, m (a log's ground truth with
+    /// `sigma_m`; 0 for the simulator's truth).
+    pub sigma_m: f64,
 }
 
 impl TruthRecord {
@@ -66,6 +69,7 @@ impl TruthRecord {
             pos: t.eta.fixed_rows::<3>(0).into_owned(),
             heading: onebeacon::geo::wrap_angle(t.eta[5]),
             speed: t.speed_m_s,
+            sigma_m: 0.0,
         }
     }
 }
@@ -272,7 +276,7 @@ impl Scoring {
 impl Observer for Scoring {
     fn step(&mut self, s: &Step<'_>) {
         for ((a, e), &v) in self.acc.iter_mut().zip(s.estimates).zip(&self.vehicle_of) {
-            let (error_m, nees) = horizontal_error(e, s.truth[v].eta[0], s.truth[v].eta[1]);
+            let (error_m, nees) = horizontal_error(e, s.truth[v].eta[0], s.truth[v].eta[1], 0.0);
             a.push(error_m, nees);
         }
         self.heard += s.heard.iter().flatten().filter(|m| m.kind.beacon().is_some()).count() as u64;
@@ -342,7 +346,7 @@ impl Observer for Recorder {
             .iter()
             .zip(s.vehicle_of)
             .map(|(e, &v)| {
-                let (error_m, nees) = horizontal_error(e, s.truth[v].eta[0], s.truth[v].eta[1]);
+                let (error_m, nees) = horizontal_error(e, s.truth[v].eta[0], s.truth[v].eta[1], 0.0);
                 Estimate::new(v, e, error_m, nees)
             })
             .collect();

@@ -43,7 +43,7 @@ fn item() -> impl Strategy<Value = (f64, Input)> {
         })),
         (0u32..3, value(), value())
             .prop_map(|(id, x, y)| Input::BeaconPosition { beacon_id: id, position: Vector3::new(x, y, 0.0) }),
-        (value(), value()).prop_map(|(n, e)| Input::Truth(TruthPose { north_m: n, east_m: e, heading_rad: None })),
+        (value(), value()).prop_map(|(n, e)| Input::Truth(TruthPose::exact(n, e, None))),
     ];
     // mostly small steps forward, sometimes a jump or a step back
     (prop_oneof![8 => 0.0..2.0f64, 1 => value()], input)

@@ -258,3 +258,45 @@ fn one_beacon_alone_with_an_early_false_track_captures_no_range_scale_filter() {
     let (default, wide) = (worst(None), worst(Some(0.05)));
     assert!(default < 5.0 && wide > 20.0, "max error {default} m by default, {wide} m with 0.05");
 }
+
+/// A ground truth with an error of its own (an LBL fix: each row the true position plus
+/// Gaussian noise of 3 m on each axis, seeded), against filters that end within
+/// centimetres of the true track (exact odometry and ranges). Told nothing, the NEES
+/// takes the reference's error for the filters' (far above 2); told `sigma_m = 3`, it
+/// adds the reference's covariance and the filters' mean NEES is about 2 (the 95 % band
+/// of as many rows, widened by the rows' dependence: a filter's error drifts slowly);
+/// the floor stated is sqrt(2) x 3 m, and the RMSEs sit at it.
+#[test]
+fn a_reference_with_its_own_error_is_scored_as_one() {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    let base = lbl_log("reference", First::True, "");
+    let truth = std::fs::read_to_string(base.base.join("truth.csv")).unwrap();
+    let noise = Normal::new(0.0, 3.0).unwrap();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(53);
+    let mut noisy = String::from("t,x,y\n");
+    for line in truth.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        let (dx, dy): (f64, f64) = (noise.sample(&mut rng), noise.sample(&mut rng));
+        writeln!(noisy, "{},{},{}", v[0], v[1] + dx, v[2] + dy).unwrap();
+    }
+    std::fs::write(base.base.join("truth.csv"), noisy).unwrap();
+    let toml = std::fs::read_to_string(base.base.join("log.toml")).unwrap();
+    let told = toml.replace("file = \"truth.csv\"\n", "file = \"truth.csv\"\nsigma_m = 3.0\n");
+    assert_ne!(told, toml);
+    std::fs::write(base.base.join("told.toml"), told).unwrap();
+    let score = |file: &str| {
+        let log = Log::load(&base.base.join(file)).unwrap();
+        let r = replay(&log, None, |_| Ok::<_, super::LogError>(())).unwrap();
+        let s = r.session;
+        let ekf = s.names.iter().position(|n| n == "ekf").unwrap();
+        (s.stats[ekf], s.rmse_floor_m())
+    };
+    let (untold, floor0) = score("log.toml");
+    let (told, floor) = score("told.toml");
+    assert_eq!(floor0, 0.0);
+    assert!((floor - 3.0 * 2f64.sqrt()).abs() < 1e-12, "floor {floor}");
+    assert!((told.rmse_m() / floor - 1.0).abs() < 0.1, "rmse {} against the floor {floor}", told.rmse_m());
+    assert!(untold.nees_mean() > 20.0, "NEES {} against a reference taken as exact", untold.nees_mean());
+    assert!((told.nees_mean() - 2.0).abs() < 0.3, "NEES {} with the reference's sigma", told.nees_mean());
+}

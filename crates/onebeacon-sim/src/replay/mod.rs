@@ -284,6 +284,7 @@ fn to_record(step: &Step, beacon: Option<Vector3<f64>>, heard: bool) -> StepReco
             pos: truth.map_or(Vector3::repeat(f64::NAN), |p| Vector3::new(p.north_m, p.east_m, 0.0)),
             heading: truth.and_then(|p| p.heading_rad).unwrap_or(f64::NAN),
             speed: f64::NAN,
+            sigma_m: truth.map_or(0.0, |p| p.sigma_m),
         }],
         beacon: beacon.unwrap_or(Vector3::repeat(f64::NAN)),
         frame: heard,

@@ -280,7 +280,17 @@ impl<'a> SourceRows<'a> {
             SourceKind::GroundTruth => {
                 let heading_rad = cols.contains_key("heading").then(|| heading("heading")).transpose()?;
                 let (north_m, east_m) = position()?;
-                Item { t_s: t, input: Input::Truth(TruthPose { north_m, east_m, heading_rad }) }
+                let sigma_m = match cols.get("sigma") {
+                    Some(&c) => {
+                        let v = row.number(c)? * len;
+                        if v < 0.0 || !v.is_finite() {
+                            return Err(row.error(c, format!("{v}: a reference's error, m, is >= 0")));
+                        }
+                        v
+                    }
+                    None => s.sigma_m.unwrap_or(0.0),
+                };
+                Item { t_s: t, input: Input::Truth(TruthPose { north_m, east_m, heading_rad, sigma_m }) }
             }
         };
         self.previous = Some(t);

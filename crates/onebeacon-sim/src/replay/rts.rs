@@ -25,10 +25,10 @@ impl RtsRun {
         &self.estimates[k.saturating_sub(1)]
     }
 
-    /// The horizontal error at `t_s` against a true (north, east), m, and its NEES (NaN
-    /// for no truth).
-    pub fn error(&self, t_s: f64, north_m: f64, east_m: f64) -> (f64, Option<f64>) {
-        horizontal_error(self.at(t_s), north_m, east_m)
+    /// The horizontal error at `t_s` against a reference (north, east) with its own
+    /// error `sigma_m` per axis, m, and its NEES (NaN for no truth).
+    pub fn error(&self, t_s: f64, north_m: f64, east_m: f64, sigma_m: f64) -> (f64, Option<f64>) {
+        horizontal_error(self.at(t_s), north_m, east_m, sigma_m)
     }
 }
 
@@ -41,7 +41,7 @@ pub fn rts(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Vec<RtsRun>, Log
     let mut truth = Vec::new();
     let r = replay_session(log, session.with_history(), start, |rec| {
         if let Some(p) = rec.truth.first().filter(|p| !p.pos.x.is_nan()) {
-            truth.push((rec.t_s, p.pos.x, p.pos.y));
+            truth.push((rec.t_s, p.pos.x, p.pos.y, p.sigma_m));
         }
         Ok::<_, LogError>(())
     })?;
@@ -50,8 +50,8 @@ pub fn rts(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Vec<RtsRun>, Log
         let estimates = session.navigator(i)?.smoothed();
         (!estimates.is_empty()).then(|| {
             let mut run = RtsRun { name: session.names[i].clone(), estimates, stats: ErrorStats::default() };
-            for &(t, north, east) in &truth {
-                let (error_m, nees) = run.error(t, north, east);
+            for &(t, north, east, sigma) in &truth {
+                let (error_m, nees) = run.error(t, north, east, sigma);
                 run.stats.push(error_m, nees);
             }
             run

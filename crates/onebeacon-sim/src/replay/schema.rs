@@ -43,7 +43,7 @@ impl SourceKind {
             SourceKind::Range => (&["beacon", "range"], &[]),
             SourceKind::Doppler => (&["beacon", "radial_speed"], &[]),
             SourceKind::BeaconTrack => (&["beacon"], &["z"]),
-            SourceKind::GroundTruth => (&[], &["heading"]),
+            SourceKind::GroundTruth => (&[], &["heading", "sigma"]),
         }
     }
 
@@ -201,6 +201,12 @@ pub struct Source {
     pub z: Option<String>,
     pub lat: Option<String>,
     pub lon: Option<String>,
+    /// ground_truth: the reference's own error, a standard deviation on each horizontal
+    /// axis, m, per row (`sigma`, in `length_unit`) or for every row (`sigma_m`); an LBL or
+    /// USBL fix is not the truth. NEES then counts it; the summary states the floor it
+    /// puts under RMSE.
+    pub sigma: Option<String>,
+    pub sigma_m: Option<f64>,
 }
 
 impl Source {
@@ -229,12 +235,13 @@ impl Source {
             "z" => self.z.as_ref(),
             "lat" => self.lat.as_ref(),
             "lon" => self.lon.as_ref(),
+            "sigma" => self.sigma.as_ref(),
             _ => None,
         }
     }
 }
 
-pub(crate) const COLUMN_KEYS: [&str; 18] = [
+pub(crate) const COLUMN_KEYS: [&str; 19] = [
     "distance",
     "heading_change",
     "forward",
@@ -253,6 +260,7 @@ pub(crate) const COLUMN_KEYS: [&str; 18] = [
     "z",
     "lat",
     "lon",
+    "sigma",
 ];
 
 /// Fixed beacon positions from a CSV file.

@@ -107,6 +107,16 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
         }
         check_time(i, s)?;
         check(&format!("source[{i}].heading_offset_deg"), s.heading_offset_deg, Rule::Finite)?;
+        if let Some(sigma) = s.sigma_m {
+            if s.kind != SourceKind::GroundTruth || s.sigma.is_some() {
+                return Err(Violation {
+                    key: format!("source[{i}].sigma_m"),
+                    value: sigma.to_string(),
+                    allowed: "applies to a ground_truth source without a `sigma` column (the reference's error)".into(),
+                });
+            }
+            check(&format!("source[{i}].sigma_m"), sigma, Rule::NonNegative)?;
+        }
         let turns = matches!(
             s.kind,
             SourceKind::Odometry

@@ -29,8 +29,8 @@ pub(crate) struct Graph {
     pub x0: Vec<f64>,
     /// Calibration variables: name and index.
     pub calibration: Vec<(String, usize)>,
-    /// Ground-truth (t, north, east) rows.
-    pub truth: Vec<(f64, f64, f64)>,
+    /// Ground-truth (t, north, east, its own sigma) rows.
+    pub truth: Vec<(f64, f64, f64, f64)>,
     /// Measurements used per kind, and items the smoother has no factor for, per kind.
     pub used: BTreeMap<&'static str, usize>,
     pub ignored: BTreeMap<&'static str, usize>,
@@ -83,7 +83,7 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
         }
         last_t = Some(t);
         match item.input.to_ned(log.frame) {
-            Input::Truth(p) => g.truth.push((t, p.north_m, p.east_m)),
+            Input::Truth(p) => g.truth.push((t, p.north_m, p.east_m, p.sigma_m)),
             Input::BeaconPosition { beacon_id, position } => {
                 tracked.insert(beacon_id, position);
             }

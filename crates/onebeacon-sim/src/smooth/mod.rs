@@ -166,8 +166,8 @@ pub struct Smoothed {
     pub used: BTreeMap<&'static str, usize>,
     pub gated: usize,
     pub ignored: BTreeMap<&'static str, usize>,
-    /// Ground-truth rows: (t, north, east).
-    pub truth: Vec<(f64, f64, f64)>,
+    /// Ground-truth rows: (t, north, east, the reference's own sigma per axis).
+    pub truth: Vec<(f64, f64, f64, f64)>,
     /// Seconds to read the log and build the graph, and to solve it (with the marginals).
     pub build_s: f64,
     pub solve_s: f64,
@@ -267,18 +267,18 @@ impl Smoothed {
     }
 
     /// The horizontal error at time `t` against a true (north, east), m, and its NEES.
-    pub fn error(&self, t: f64, north_m: f64, east_m: f64) -> (f64, Option<f64>) {
+    pub fn error(&self, t: f64, north_m: f64, east_m: f64, sigma_m: f64) -> (f64, Option<f64>) {
         let (p, cov) = self.at(t);
         let d = Vector2::new(p[0] - north_m, p[1] - east_m);
-        (d.norm(), nees(&d, &cov))
+        (d.norm(), nees(&d, &(cov + nalgebra::Matrix2::identity() * sigma_m * sigma_m)))
     }
 
     /// The smoothed trajectory's errors and NEES against the ground truth, and dead
     /// reckoning's errors.
     pub fn score(&self) -> (ErrorStats, ErrorStats) {
         let (mut s, mut dr) = (ErrorStats::default(), ErrorStats::default());
-        for &(t, n, e) in &self.truth {
-            let (error_m, nees) = self.error(t, n, e);
+        for &(t, n, e, sigma) in &self.truth {
+            let (error_m, nees) = self.error(t, n, e, sigma);
             s.push(error_m, nees);
             let (q, _) = self.interpolate(&self.dead_reckoning, t);
             dr.push((q[0] - n).hypot(q[1] - e), None);

@@ -125,7 +125,7 @@ fn nees_of_the_final_pose_is_within_its_band() {
     for run in 0..RUNS {
         let log = synthetic(&format!("nees{run}"), 120, 1.0, [0.0, 0.0], Some(run as u64 + 1));
         let s = smooth(&log, None, &cfg).unwrap();
-        let &(t, n, e) = s.truth.last().unwrap();
+        let &(t, n, e, _) = s.truth.last().unwrap();
         let (p, cov) = s.at(t);
         sum += nees(&Vector2::new(p[0] - n, p[1] - e), &cov).unwrap();
     }
@@ -154,11 +154,11 @@ fn rts_of_the_range_ekf_is_consistent_and_agrees_with_the_smoother() {
         let runs = crate::replay::rts::rts(&log, None).unwrap();
         let rts = runs.iter().find(|r| r.name == "ekf").unwrap();
         let s = smooth(&log, None, &cfg).unwrap();
-        let &(t, n, e) = &s.truth[s.truth.len() / 2];
+        let &(t, n, e, _) = &s.truth[s.truth.len() / 2];
         let est = rts.at(t);
-        nees_sum += onebeacon::nav::evaluation::horizontal_error(est, n, e).1.unwrap();
+        nees_sum += onebeacon::nav::evaluation::horizontal_error(est, n, e, 0.0).1.unwrap();
         let with_bias = runs.iter().find(|r| r.name == "bias").unwrap().at(t);
-        bias_nees_sum += onebeacon::nav::evaluation::horizontal_error(with_bias, n, e).1.unwrap();
+        bias_nees_sum += onebeacon::nav::evaluation::horizontal_error(with_bias, n, e, 0.0).1.unwrap();
         let (p, cov) = s.at(t);
         let gap = Vector2::new(est.north_m() - p[0], est.east_m() - p[1]).norm();
         gap_sum += gap / (cov.trace() / 2.0).sqrt();

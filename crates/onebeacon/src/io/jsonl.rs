@@ -84,6 +84,9 @@ pub fn item_json(item: &Item) -> Value {
             if let Some(h) = p.heading_rad {
                 v["heading_rad"] = json!(h);
             }
+            if p.sigma_m > 0.0 {
+                v["sigma_m"] = json!(p.sigma_m);
+            }
             v
         }
     }
@@ -228,7 +231,11 @@ fn parse(
         }
         "ground_truth" => {
             let heading_rad = optional("heading_rad")?;
-            Input::Truth(TruthPose { north_m: num("x_m")?, east_m: num("y_m")?, heading_rad })
+            let sigma_m = optional("sigma_m")?.unwrap_or(0.0);
+            if !(sigma_m >= 0.0 && sigma_m.is_finite()) {
+                return Err(format!("`sigma_m` is {sigma_m}: a reference's error, m, finite and >= 0"));
+            }
+            Input::Truth(TruthPose { north_m: num("x_m")?, east_m: num("y_m")?, heading_rad, sigma_m })
         }
         other => return Err(format!("unknown kind `{other}` (one of {KINDS})")),
     };
@@ -351,10 +358,7 @@ mod tests {
             t_s: 3.0,
             input: Input::BeaconPosition { beacon_id: 7, position: Vector3::new(1.0, 2.0, 0.5) },
         });
-        items.push(Item {
-            t_s: 3.5,
-            input: Input::Truth(TruthPose { north_m: 4.0, east_m: 5.0, heading_rad: Some(0.25) }),
-        });
+        items.push(Item { t_s: 3.5, input: Input::Truth(TruthPose::exact(4.0, 5.0, Some(0.25))) });
         let tracked = BTreeSet::new();
         for item in &items {
             let line = item_json(item).to_string();

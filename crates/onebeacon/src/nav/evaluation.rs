@@ -14,11 +14,15 @@ pub const NEES_95_2DOF: f64 = 5.991464547107982;
 /// The 95 % quantile of chi-square with 1 degree of freedom, 1.96^2.
 pub const NIS_95_1DOF: f64 = 3.841458820694124;
 
-/// The horizontal error of estimate `e` against a true (north, east), m, and its NEES
-/// (None when the horizontal covariance is not positive definite).
-pub fn horizontal_error(e: &Estimate, north_m: f64, east_m: f64) -> (f64, Option<f64>) {
+/// The horizontal error of estimate `e` against a reference (north, east), m, and its
+/// NEES (None when the covariance is not positive definite), the reference's own error
+/// (`reference_sigma_m` on each axis, 0 for the truth) added to the estimate's
+/// covariance: the difference of two independent errors has the sum of their
+/// covariances.
+pub fn horizontal_error(e: &Estimate, north_m: f64, east_m: f64, reference_sigma_m: f64) -> (f64, Option<f64>) {
     let d = Vector2::new(e.position_ned_m.x - north_m, e.position_ned_m.y - east_m);
-    (d.norm(), nees(&d, &e.horizontal_cov_m2))
+    let cov = e.horizontal_cov_m2 + nalgebra::Matrix2::identity() * reference_sigma_m.powi(2);
+    (d.norm(), nees(&d, &cov))
 }
 
 /// Error statistics of one estimator against the truth, time after time.

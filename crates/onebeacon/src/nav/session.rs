@@ -18,6 +18,16 @@ pub struct TruthPose {
     pub north_m: f64,
     pub east_m: f64,
     pub heading_rad: Option<f64>,
+    /// The reference's own error, a standard deviation on each horizontal axis, m (0:
+    /// exact): an LBL or USBL fix used as ground truth has one.
+    pub sigma_m: f64,
+}
+
+impl TruthPose {
+    /// An exact pose.
+    pub fn exact(north_m: f64, east_m: f64, heading_rad: Option<f64>) -> Self {
+        Self { north_m, east_m, heading_rad, sigma_m: 0.0 }
+    }
 }
 
 /// One item of the time-ordered stream.
@@ -105,6 +115,7 @@ impl Input {
                     north_m: n.x,
                     east_m: n.y,
                     heading_rad: p.heading_rad.map(|h| frame.heading_to_ned(h)),
+                    sigma_m: p.sigma_m,
                 })
             }
         }
@@ -378,6 +389,10 @@ pub struct Session {
     beacons: Option<BTreeSet<u32>>,
     tracked: BTreeMap<u32, Vector3<f64>>,
     pub stats: Vec<ErrorStats>,
+    /// The ground-truth rows scored and the sum of their own variances (sigma_m^2 per
+    /// axis): a reference with an error of its own puts a floor under every RMSE.
+    pub reference_rows: usize,
+    pub reference_var_sum_m2: f64,
     /// Each estimator's corrections beacon by beacon (at most `limits.max_beacons`).
     pub beacon_stats: Vec<PerBeacon>,
     /// The beacon held out ([`Session::with_held_out`]) and each estimator's prediction
@@ -435,6 +450,8 @@ impl Session {
             beacons,
             tracked: BTreeMap::new(),
             stats: vec![ErrorStats::default(); n],
+            reference_rows: 0,
+            reference_var_sum_m2: 0.0,
             beacon_stats: vec![PerBeacon::default(); n],
             held_out: None,
             held_out_stats: vec![BeaconStats::default(); n],
@@ -485,6 +502,17 @@ impl Session {
     }
 
     /// What the session waits for before it starts.
+    /// The floor a ground truth with its own error puts under every RMSE, m: a perfect
+    /// estimator scored against it errs sqrt(2 mean sigma^2) (sigma on each axis); 0 for
+    /// an exact truth.
+    pub fn rmse_floor_m(&self) -> f64 {
+        if self.reference_rows == 0 {
+            0.0
+        } else {
+            (2.0 * self.reference_var_sum_m2 / self.reference_rows as f64).sqrt()
+        }
+    }
+
     /// What the estimators' innovations say of the run so far
     /// ([`super::diagnosis::findings`]): one line each.
     pub fn findings(&self) -> Vec<String> {
@@ -639,7 +667,7 @@ impl Session {
         if !self.started() {
             match (self.start, &item.input) {
                 (Start::At { t0_s, pose }, _) if t0_s.is_none_or(|t0| t >= t0) => self.begin(t0_s.unwrap_or(t), pose),
-                (Start::FirstTruth, Input::Truth(TruthPose { north_m, east_m, heading_rad: Some(h) })) => {
+                (Start::FirstTruth, Input::Truth(TruthPose { north_m, east_m, heading_rad: Some(h), .. })) => {
                     self.begin(t, (*north_m, *east_m, *h))
                 }
                 (Start::Track { track_m, from }, Input::Truth(TruthPose { north_m, east_m, .. })) => {
@@ -714,12 +742,16 @@ impl Session {
                 reinitialised.push(i);
             }
         }
+        if let Some(p) = truth {
+            self.reference_rows += 1;
+            self.reference_var_sum_m2 += p.sigma_m * p.sigma_m;
+        }
         let errors = truth.map(|p| {
             estimates
                 .iter()
                 .zip(self.stats.iter_mut())
                 .map(|(e, s)| {
-                    let (err, nees) = horizontal_error(e, p.north_m, p.east_m);
+                    let (err, nees) = horizontal_error(e, p.north_m, p.east_m, p.sigma_m);
                     s.push(err, nees);
                     (err, nees.unwrap_or(f64::NAN))
                 })
@@ -848,8 +880,7 @@ mod tests {
         let step = 0.5 / 2f64.sqrt();
         for k in 0..6 {
             let (n, e) = (10.0 + step * k as f64, -5.0 + step * k as f64);
-            let item =
-                Item { t_s: k as f64, input: Input::Truth(TruthPose { north_m: n, east_m: e, heading_rad: None }) };
+            let item = Item { t_s: k as f64, input: Input::Truth(TruthPose::exact(n, e, None)) };
             assert_eq!(s.push(&item).unwrap().is_some(), k >= 4, "row {k}");
             if k == 4 {
                 let e0 = &s.final_estimates()[0];
@@ -866,10 +897,7 @@ mod tests {
     fn a_truth_without_heading_is_named_once() {
         let est = vec![("dr".to_string(), PlanarConfig::default(), FilterKind::Ekf)];
         let mut s = Session::new(Frame::Ned, planar(est), Start::FirstTruth, (1.0, 0.1), None);
-        let truth = |t: f64, heading_rad| Item {
-            t_s: t,
-            input: Input::Truth(TruthPose { north_m: t, east_m: 0.0, heading_rad }),
-        };
+        let truth = |t: f64, heading_rad| Item { t_s: t, input: Input::Truth(TruthPose::exact(t, 0.0, heading_rad)) };
         let first = s.push(&truth(0.0, None)).unwrap_err();
         assert!(first.reason.contains("heading_from = \"track\""), "{first}");
         assert_eq!(s.push(&truth(1.0, None)), Ok(None));
