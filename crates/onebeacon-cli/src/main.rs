@@ -199,13 +199,14 @@ enum Command {
         /// Use only these beacons (ids, comma-separated), e.g. one at a time.
         #[arg(long, value_delimiter = ',', value_name = "IDS")]
         beacons: Option<Vec<u32>>,
-        /// Print one JSON object (per estimator: rmse_m, mean_error_m, final_error_m,
-        /// max_error_m, rejected, range_bias_m) instead of the table.
+        /// Print one JSON object, summary.json, instead of the table (docs/outputs.md
+        /// lists every key: the start, warnings, noise, reference, holdout, and per
+        /// estimator its errors, NEES, NIS, calibration and per-beacon innovations).
         #[arg(long)]
         json: bool,
         /// Print the merged, time-ordered stream as JSON Lines (the input of `stream`)
-        /// and stop.
-        #[arg(long, conflicts_with_all = ["json", "out", "beacons", "holdout"])]
+        /// and stop; with --beacons, the measurements of those beacons only.
+        #[arg(long, conflicts_with_all = ["json", "out", "holdout"])]
         print_stream: bool,
         /// Run the `[[estimators]]` of this TOML file instead of the log's (what `tune`
         /// writes).

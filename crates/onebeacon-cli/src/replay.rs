@@ -126,9 +126,19 @@ pub fn replay(path: &Path, args: ReplayArgs) -> Result<()> {
         log.description.use_estimators(file)?;
     }
     if args.print_stream {
+        let only = beacon_filter(args.beacons, &log.beacon_ids())?;
         let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
         for item in log.items()? {
-            writeln!(stdout, "{}", jsonl::item_json(&item?))?;
+            let item = item?;
+            let beacon = match &item.input {
+                onebeacon::nav::session::Input::Measurement(m) => m.beacon().map(|b| b.id),
+                onebeacon::nav::session::Input::BeaconPosition { beacon_id, .. } => Some(*beacon_id),
+                onebeacon::nav::session::Input::Truth(_) => None,
+            };
+            if beacon.is_some_and(|b| only.as_ref().is_some_and(|o| !o.contains(&b))) {
+                continue;
+            }
+            writeln!(stdout, "{}", jsonl::item_json(&item))?;
         }
         stdout.flush()?;
         return Ok(());

@@ -300,3 +300,31 @@ fn a_reference_with_its_own_error_is_scored_as_one() {
     assert!(untold.nees_mean() > 20.0, "NEES {} against a reference taken as exact", untold.nees_mean());
     assert!((told.nees_mean() - 2.0).abs() < 0.3, "NEES {} with the reference's sigma", told.nees_mean());
 }
+
+/// The warning on odometry rows that turn more than WIDE_TURN_DEG in one row counts
+/// rows that move: a turn on the spot (no translation) reads the same at either
+/// heading convention. Before issue 53 ten turns on the spot were warned of.
+#[test]
+fn a_turn_on_the_spot_is_not_a_wide_turn() {
+    let wide = |d: f64| {
+        let mut odo = String::from("t,d,dh\n");
+        let mut truth = String::from("t,x,y\n0,0,0\n");
+        for k in 1..=40 {
+            // every fourth row turns 30 deg, moving `d` or not at all
+            let (dist, dh) = if k % 4 == 0 { (d, 30f64.to_radians()) } else { (1.0, 0.0) };
+            writeln!(odo, "{k},{dist},{dh}").unwrap();
+            writeln!(truth, "{k},0,0").unwrap();
+        }
+        let toml = "name = \"spot\"\nframe = \"ned\"\n\
+            [[source]]\nkind = \"odometry\"\nfile = \"odo.csv\"\ntime = \"t\"\ndistance = \"d\"\nheading_change = \"dh\"\n\
+            [[source]]\nkind = \"ground_truth\"\nfile = \"truth.csv\"\ntime = \"t\"\nx = \"x\"\ny = \"y\"\n\
+            [initial]\nfrom = \"given\"\nt0_s = 0.0\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n\
+            [[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n";
+        let files = [("odo.csv", odo.as_str()), ("truth.csv", truth.as_str())];
+        let log = write_log("spot", &format!("spot-{d}"), toml, &files).unwrap();
+        let r = replay(&log, None, |_| Ok::<_, super::LogError>(())).unwrap();
+        (r.wide_turns, r.warnings(true).iter().any(|w| w.contains("turn more than")))
+    };
+    assert_eq!(wide(0.0), ((0, 40), false));
+    assert_eq!(wide(1.0), ((10, 40), true));
+}

@@ -236,12 +236,18 @@ fn replay_session<E: From<LogError>>(
     for item in &mut stream {
         let item = item?;
         items += 1;
-        if let Input::Measurement(
-            Kind::Odometry { heading_change_rad: dpsi, .. } | Kind::BodyOdometry { heading_change_rad: dpsi, .. },
-        ) = item.input
+        // a turn on the spot has no translation to put at either heading: never wide
+        let turn = match item.input {
+            Input::Measurement(Kind::Odometry { distance_m: d, heading_change_rad: dpsi }) => Some((d != 0.0, dpsi)),
+            Input::Measurement(Kind::BodyOdometry { forward_m: f, lateral_m: l, heading_change_rad: dpsi }) => {
+                Some((f != 0.0 || l != 0.0, dpsi))
+            }
+            _ => None,
+        };
+        if let Some((moved, dpsi)) = turn
             && !start_frame
         {
-            wide_turns.0 += usize::from(dpsi.abs() > WIDE_TURN_DEG.to_radians());
+            wide_turns.0 += usize::from(moved && dpsi.abs() > WIDE_TURN_DEG.to_radians());
             wide_turns.1 += 1;
         }
         // a screened item is counted and logged by the session; the replay goes on
