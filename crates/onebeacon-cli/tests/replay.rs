@@ -676,3 +676,36 @@ fn the_logs_noise_reaches_estimators_files_and_the_smoother() {
     );
     assert!((with - without).abs() > 0.05, "smoother RMSE {with} m with [noise], {without} m without");
 }
+
+/// plaza2 starts from the ground truth's track (`heading_from = "track"`): `stream`, which
+/// cannot read ahead, writes one line per input line, `"started": false` until the truth's
+/// track is 2 m long, and starts at that row (computed here from the truth file), where
+/// `replay` starts at the first truth row, with the heading of the track ahead. Before
+/// issue 53 the lines before the start had no output line.
+#[test]
+fn a_track_start_streams_a_line_per_input_line() {
+    let dir = scratch("track-start");
+    let items = run(&["replay", &plaza(2), "--print-stream"]);
+    assert!(items.status.success());
+    let input = text(&items.stdout);
+    let o = stream(&plaza(2), items.stdout.clone());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out: Vec<Value> = text(&o.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(out.len(), input.lines().count());
+    let first = out.iter().position(|l| l.get("estimates").is_some()).unwrap();
+    assert!(out[..first].iter().all(|l| l["started"] == false), "lines before the start");
+    // the first truth row 2 m from the first one
+    let truth =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/plaza/plaza2_ground_truth.csv"))
+            .unwrap();
+    let rows: Vec<Vec<f64>> =
+        truth.lines().skip(1).map(|l| l.split(',').take(3).map(|c| c.parse().unwrap()).collect()).collect();
+    let t_track = rows.iter().find(|r| (r[1] - rows[0][1]).hypot(r[2] - rows[0][2]) >= 2.0).unwrap()[0];
+    assert_eq!(out[first]["t_s"].as_f64().unwrap(), t_track);
+    replay_json(&plaza(2), None, &dir.join("r"));
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("r").join("summary.json")).unwrap()).unwrap();
+    let t_replay = summary["start"]["t_s"].as_f64().unwrap();
+    assert_eq!(t_replay, rows[0][0]);
+    assert!(t_track - t_replay > 10.0, "stream starts at {t_track} s, replay at {t_replay} s");
+}

@@ -627,7 +627,10 @@ impl PyNavigator {
         if let Some(m) = skipped {
             return Err(input_error(m));
         }
-        out.map(|v| to_py(py, &v)).transpose()
+        // before the start (and with no controller's decision to report): None
+        let waiting =
+            |v: &serde_json::Value| v.get("started") == Some(&serde_json::json!(false)) && v.get("decided").is_none();
+        out.filter(|v| !waiting(v)).map(|v| to_py(py, &v)).transpose()
     }
 
     /// Each estimator's estimate (NED, SI): a dict with `name`, `t_s`, `position_ned_m`

@@ -124,9 +124,9 @@ impl Lines {
                 };
                 match out {
                     Some(out) => (item.t_s, kind, out),
-                    // before the start a controller has nothing to decide on
-                    None if !unit.has_controller() => return None,
-                    None => (item.t_s, kind, json!({"line": number, "t_s": item.t_s})),
+                    // before the start: a line all the same, saying so (a controller has
+                    // nothing to decide on yet)
+                    None => (item.t_s, kind, json!({"line": number, "t_s": item.t_s, "started": false})),
                 }
             }
         };
