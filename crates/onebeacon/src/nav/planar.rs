@@ -131,6 +131,9 @@ impl Default for PlanarConfig {
             bias_sigma_m: 5.0,
             estimate_beacon_offsets: false,
             estimate_range_scale: false,
+            // the ocean's surface sound speed against an assumed 1500 m/s: -2.8 % (2 C)
+            // to +3.0 % (30 C) at 35 ppt (Mackenzie 1981); docs/logs.md, "Choosing
+            // range_scale_sigma"
             range_scale_sigma: 0.02,
             estimate_distance_scale: false,
             distance_scale_sigma: 0.05,
