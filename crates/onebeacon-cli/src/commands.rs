@@ -119,6 +119,10 @@ pub fn run(
         .context("cannot draw guidance.png")?;
     }
     let files = staging.commit()?;
+    // what the innovations say without the truth (also summary.json's warnings)
+    for w in result.findings(&names) {
+        eprintln!("warning: {w}");
+    }
 
     out!("{}", report::run_table(&s, seed, run, &cell, &result));
     outln!("wrote:");

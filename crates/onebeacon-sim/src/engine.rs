@@ -133,8 +133,8 @@ pub(crate) trait Observer {
     fn decided(&mut self, _helm: usize, _situation: &Situation, _decided: &Decided) {}
     /// Track `track`'s estimator stopped being sound and started again ([`Restart`]).
     fn restarted(&mut self, _track: usize) {}
-    /// The outcome of track `track`'s processing of one measurement.
-    fn outcome(&mut self, _track: usize, _outcome: &Outcome) {}
+    /// The outcome of track `track`'s processing of measurement `m`.
+    fn outcome(&mut self, _track: usize, _m: &Measurement, _outcome: &Outcome) {}
     /// Every track's navigator as it stands at step `k` (before [`Observer::step`]),
     /// for an observer that records more than estimates (a particle cloud).
     fn inspect(&mut self, _k: usize, _tracks: &[Track]) {}
@@ -191,7 +191,7 @@ pub(crate) fn run(
         for (i, t) in tracks.iter_mut().enumerate() {
             for m in &heard[t.vehicle] {
                 let outcome = t.navigator.process(m);
-                observers.iter_mut().for_each(|o| o.outcome(i, &outcome));
+                observers.iter_mut().for_each(|o| o.outcome(i, m, &outcome));
             }
             // scored at the step's time, also when no message reached it
             t.navigator.predict_to(world.t_s(k));

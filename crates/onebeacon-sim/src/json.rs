@@ -91,6 +91,7 @@ pub fn run_summary(s: &Scenario, seed: u64, run: u64, cell: &Cell, out: &RunOutp
         "distance_m": num(out.distance_m[0]),
         "vehicles": s.vehicle_names().iter().zip(&out.distance_m).map(|(name, d)| json!({"name": name, "distance_m": num(*d)})).collect::<Vec<_>>(),
         "frames_decoded": out.frames_decoded,
+        "warnings": out.findings(&s.track_labels()),
         "estimators": estimators,
     });
     v

@@ -13,8 +13,9 @@ use crate::world::{
 };
 use crate::{factory, helms};
 use nalgebra::{DMatrix, Vector2, Vector3};
-use onebeacon::nav::Outcome;
+use onebeacon::nav::diagnosis::PerBeacon;
 use onebeacon::nav::evaluation::{ErrorStats, horizontal_error};
+use onebeacon::nav::{Measurement, Outcome};
 
 /// One estimator's estimate at one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,6 +107,10 @@ pub struct RunOutput {
     pub distance_m: Vec<f64>,
     /// Acoustic measurements heard (frames decoded, ranges), all vehicles together.
     pub frames_decoded: u64,
+    /// Each track's error and NIS statistics and its corrections beacon by beacon: what
+    /// [`RunOutput::findings`] reads.
+    pub stats: Vec<ErrorStats>,
+    pub per_beacon: Vec<PerBeacon>,
     /// For bounds: the Fisher information H' R^-1 H of each acoustic measurement at
     /// the truth (the world's state size), with the vehicle and the step it was received
     /// in (moving-beacon and passive-USBL runs; empty otherwise).
@@ -142,6 +147,15 @@ pub fn recorded_bytes(s: &Scenario) -> f64 {
         + s.vehicle_names().len() * size_of::<TruthRecord>()
         + s.tracks().len() * size_of::<Estimate>();
     (s.steps() + 1) as f64 * per_step as f64
+}
+
+impl RunOutput {
+    /// What the tracks' innovations say without the truth, one line each, the tracks
+    /// named `labels` ([`onebeacon::nav::diagnosis::findings`]: overconfident filters,
+    /// beacons gated out or reading apart).
+    pub fn findings(&self, labels: &[String]) -> Vec<String> {
+        onebeacon::nav::diagnosis::findings(labels, &self.stats, &self.per_beacon)
+    }
 }
 
 /// Simulates run `run` of `cell` under base seed `seed`; records every step if `record`.
@@ -249,16 +263,23 @@ fn drive(
         trajectory: recorder.trajectory,
         distance_m: scoring.distance_m,
         frames_decoded: scoring.heard,
+        stats: scoring.acc,
+        per_beacon: scoring.per_beacon,
         information: Vec::new(),
         guidance: recorder.guidance,
         belief: recorder.belief,
     }
 }
 
+/// The beacons whose innovations a run counts apart, per track.
+const MAX_BEACONS_COUNTED: usize = 64;
+
 /// Error statistics of every track, failed updates, acoustic measurements heard, and
 /// each vehicle's distance travelled so far.
 struct Scoring {
     acc: Vec<ErrorStats>,
+    /// Each track's corrections beacon by beacon (what the innovations say).
+    per_beacon: Vec<PerBeacon>,
     /// The vehicle of each track.
     vehicle_of: Vec<usize>,
     distance_m: Vec<f64>,
@@ -269,7 +290,8 @@ impl Scoring {
     fn new(vehicle_of: Vec<usize>, steps: usize) -> Self {
         // steps + 1 errors scored, the first half of them apart
         let acc = vec![ErrorStats::with_half(steps.div_ceil(2)); vehicle_of.len()];
-        Self { acc, vehicle_of, distance_m: Vec::new(), heard: 0 }
+        let per_beacon = vec![PerBeacon::default(); vehicle_of.len()];
+        Self { acc, per_beacon, vehicle_of, distance_m: Vec::new(), heard: 0 }
     }
 }
 
@@ -284,8 +306,9 @@ impl Observer for Scoring {
         self.distance_m.extend(s.truth.iter().map(|t| t.distance_m));
     }
 
-    fn outcome(&mut self, track: usize, outcome: &Outcome) {
+    fn outcome(&mut self, track: usize, m: &Measurement, outcome: &Outcome) {
         self.acc[track].push_outcome(outcome, true);
+        self.per_beacon[track].push(&m.kind, outcome, MAX_BEACONS_COUNTED);
     }
 
     fn restarted(&mut self, track: usize) {

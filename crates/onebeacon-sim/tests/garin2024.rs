@@ -141,3 +141,34 @@ fn garin2024_sea_the_clock_state_and_student_t_ranges_beat_the_paper_filter() {
     );
     assert!(upper < 0.0, "paired difference {mean} m, upper bound {upper}");
 }
+
+/// A simulated run says what its innovations say, without the truth: the paper's filter
+/// told ranges and Doppler speeds ten times as precise as the world draws them (sigmas
+/// sqrt(12) / 10 m and sqrt(0.2) / 10 m/s): its innovations keep the world's noise while
+/// it expects a hundredth of its variance, less the state's share of S (so the ratio is
+/// short of 100: 11.5 in this run). The run's findings name it, and its mean NIS is over
+/// 5 times the paper's filter's.
+#[test]
+fn a_run_names_a_filter_told_too_little_noise() {
+    let Scenario::FixedBeacon(mut s) = parse(builtin("garin2024").unwrap().toml, "garin2024").unwrap() else {
+        unreachable!()
+    };
+    let mut told = s.estimators[0].clone();
+    told.name = Some("told-too-little".into());
+    told.range_sigma_m = Some(12f64.sqrt() / 10.0);
+    told.doppler_sigma_m_s = Some(0.2f64.sqrt() / 10.0);
+    s.estimators.push(told);
+    let s = Scenario::FixedBeacon(s);
+    let out = onebeacon_sim::run::simulate(&s, &s.base_cell(), s.seed(), 0, false);
+    let labels = s.track_labels();
+    let findings = out.findings(&labels);
+    let line = findings.iter().find(|l| l.starts_with("overconfident")).expect("an overconfidence line");
+    assert!(line.contains("told-too-little"), "{findings:?}");
+    let nis = |label: &str| out.stats[labels.iter().position(|l| l == label).unwrap()].nis_mean();
+    assert!(
+        nis("told-too-little") > 5.0 * nis("range+doppler"),
+        "{} against {}",
+        nis("told-too-little"),
+        nis("range+doppler")
+    );
+}
