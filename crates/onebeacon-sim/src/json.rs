@@ -200,6 +200,7 @@ pub fn noise_keys(n: &onebeacon::nav::PlanarNoise) -> Value {
 /// `replay --json`, the replay's summary.json.
 pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value {
     let s = &r.session;
+    let floor = s.rmse_floor_m();
     let finals = s.final_estimates();
     let estimators: Vec<Value> = s
         .names
@@ -235,7 +236,6 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
             }
             v["per_beacon"] = per_beacon_fields(per_beacon);
             // the RMSE less the reference's share (errors independent: rmse^2 = e^2 + floor^2)
-            let floor = s.rmse_floor_m();
             if floor > 0.0 {
                 v["rmse_less_reference_m"] = num((st.rmse_m().powi(2) - floor * floor).max(0.0).sqrt());
             }
@@ -268,7 +268,7 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
         "noise": log.description.noise,
         "reference": {
             "rows": s.reference_rows,
-            "sigma_rms_m": if s.reference_rows > 0 { (s.reference_var_sum_m2 / s.reference_rows as f64).sqrt() } else { 0.0 },
+            "sigma_rms_m": s.reference_sigma_m(),
             "rmse_floor_m": s.rmse_floor_m(),
         },
         "wall_s": wall_s,

@@ -111,7 +111,7 @@ impl PerBeacon {
 }
 
 /// Whether an estimator's mean NIS lies above the 95 % band of a consistent filter's:
-/// the factor by which it does, when it does (at least [`MIN_CORRECTIONS`] corrections).
+/// that mean, when it does (at least [`MIN_CORRECTIONS`] corrections).
 pub fn overconfidence(stats: &ErrorStats) -> Option<f64> {
     let n = stats.nis_count;
     let [_, hi] = chi_square_band(n, 1);
@@ -128,8 +128,9 @@ pub fn findings(names: &[String], stats: &[ErrorStats], beacons: &[PerBeacon]) -
         .iter()
         .zip(stats)
         .filter_map(|(name, st)| {
+            let mean = overconfidence(st)?;
             let [_, hi] = chi_square_band(st.nis_count, 1);
-            overconfidence(st).map(|mean| format!("{name} {mean:.2} (band up to {hi:.2})"))
+            Some(format!("{name} {mean:.2} (band up to {hi:.2})"))
         })
         .collect();
     if !overconfident.is_empty() {

@@ -215,16 +215,16 @@ impl Session {
         &self.limits
     }
 
-    /// What the session waits for before it starts.
+    /// The ground truth's own error over the rows scored, the RMS of their sigma_m (per
+    /// axis), m; 0 for an exact truth.
+    pub fn reference_sigma_m(&self) -> f64 {
+        if self.reference_rows == 0 { 0.0 } else { (self.reference_var_sum_m2 / self.reference_rows as f64).sqrt() }
+    }
+
     /// The floor a ground truth with its own error puts under every RMSE, m: a perfect
-    /// estimator scored against it errs sqrt(2 mean sigma^2) (sigma on each axis); 0 for
-    /// an exact truth.
+    /// estimator scored against it errs sqrt(2 mean sigma^2) (sigma on each axis).
     pub fn rmse_floor_m(&self) -> f64 {
-        if self.reference_rows == 0 {
-            0.0
-        } else {
-            (2.0 * self.reference_var_sum_m2 / self.reference_rows as f64).sqrt()
-        }
+        std::f64::consts::SQRT_2 * self.reference_sigma_m()
     }
 
     /// What the estimators' innovations say of the run so far
@@ -233,6 +233,7 @@ impl Session {
         super::diagnosis::findings(&self.names, &self.stats, &self.beacon_stats)
     }
 
+    /// What the session waits for before it starts.
     pub fn waiting_for(&self) -> String {
         match self.start {
             Start::At { t0_s: Some(t0), .. } => format!("the start time {t0} s"),
