@@ -67,7 +67,6 @@ RUNS = {
     "hoff2024-pair": (2, 10),
     # scripts/sea_ablation.py's runs per variant
     "garin2024-sea-ablation": (10, 100),
-    "garin2024-current": (10, 100),
     "sousa-sea-ablation": (2, 10),
     "hoff2024-sea-ablation": (2, 10),
     # scripts/sea_sources.py's runs per cell

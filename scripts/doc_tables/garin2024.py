@@ -2,7 +2,7 @@
 
 import re
 
-from .common import ABLATION, ROOT, RUNS, cli, header, mc, mc_text, paired_cell
+from .common import ABLATION, PAIRED, ROOT, RUNS, cli, header, mc, mc_text, nees_figure, paired_cell
 from .sea import ablation
 
 
@@ -109,57 +109,66 @@ def garin2024_paired(quick):
 def garin2024_sea(quick):
     """docs/reproductions/garin2024.md, garin2024-sea: `onebeacon mc garin2024-sea` (300 runs per
     T_com): mean error over the runs that are not outliers (NEES over them), and for the
-    augmented filter its NEES over every run and its runs over 20 m."""
+    augmented filters their NEES over every run and their runs over 20 m."""
     cells = mc("garin2024-sea", quick)
+    augmented = ("range+doppler-sea", "range+doppler-current")
     rows = header(
         "T_com",
         "paper's filter",
         "its robust form (garin2024.toml)",
         "range+doppler-sea: robust + offset and drift states + Student-t ranges, gated",
-        "its runs over 20 m",
+        "range+doppler-current: the same + the current as two states (UKF)",
+        "their runs over 20 m",
     )
     for t in sorted({c["sweep"]["t_com_s"] for c in cells}):
         by = {c["estimator"]: c for c in cells if c["sweep"]["t_com_s"] == t}
         plain = [f"{by[e]['mean_error_m']:.1f} ({by[e]['nees_mean']:.0f})" for e in ("range+doppler", "range+doppler-robust")]
-        sea = by["range+doppler-sea"]
-        over = sum(m > 20.0 for m in sea["run_mean_errors_m"])
-        rows.append(
-            f"| {t:g} s | {plain[0]} | {plain[1]} | {sea['mean_error_m']:.2f} ({sea['nees_mean']:.2f} / "
-            f"{sea['nees_mean_all_runs']:.2f}) | {over} / {sea['runs']} |"
-        )
+        rich = [f"{by[e]['mean_error_m']:.2f} ({nees_figure(by[e]['nees_mean'])} / {nees_figure(by[e]['nees_mean_all_runs'])})"
+                for e in augmented]
+        over = [str(sum(m > 20.0 for m in by[e]["run_mean_errors_m"])) for e in augmented]
+        rows.append(f"| {t:g} s | " + " | ".join(plain + rich) + f" | {', '.join(over)} of {by[augmented[0]]['runs']} |")
     return rows
 
 
 def garin2024_sea_ablation(quick):
     """docs/reproductions/garin2024.md, garin2024-sea: each error source alone, T_com 3 s, 100 runs."""
     return ablation("garin2024-sea", quick,
-                    [(e, e) for e in ("range+doppler", "range+doppler-robust", "range+doppler-sea")])
+                    [(e, e) for e in ("range+doppler", "range+doppler-robust", "range+doppler-sea",
+                                       "range+doppler-current")])
 
 
-# the current of garin2024-current (docs/reproductions/garin2024.md): unsourced, see there
-GARIN_CURRENT = """
-[sea.current]
-speed_m_s = 0.1
-toward_deg = 45
-speed_sigma_m_s = 0.03
-direction_sigma_deg = 20
-"""
+def ratio_cell(a, b):
+    """mean(a) / mean(b) of two cells' run mean errors paired by run, with the 95 % interval
+    of the ratio of means (delta method: the t interval of the runs' a_i - r b_i, over
+    mean(b))."""
+    x, y = a["run_mean_errors_m"], b["run_mean_errors_m"]
+    n = len(x)
+    r = sum(x) / sum(y)
+    m, h, _ = PAIRED.paired(x, [r * v for v in y])
+    h /= sum(y) / n
+    return f"{r:.2f} [{r - h:.2f}, {r + h:.2f}]"
 
 
 def garin2024_current(quick):
-    """docs/reproductions/garin2024.md: garin2024-sea with GARIN_CURRENT, alone and with the
-    rest of its sea (the base cell, T_com 3 s, 100 runs): each filter's mean error (95 %
-    interval) / mean NEES, and the other two against the paper's filter, paired by run."""
-    parts = ABLATION.blocks((ROOT / "scenarios/garin2024-sea.toml").read_text() + GARIN_CURRENT)
-    sources = [h for h, _ in parts if ABLATION.is_source(h)]
-    runs = RUNS["garin2024-current"][0 if quick else 1]
-    base, others = "range+doppler", ("range+doppler-robust", "range+doppler-sea")
-    rows = header("sources", base, *others, *(f"{e} - {base}" for e in others))
-    for label, keep in (("sea.current", ["sea.current"]), ("all", sources)):
-        toml = ABLATION.variant(parts, keep)
-        by = {c["estimator"]: c for c in mc_text(toml, runs)}
-        rows.append(f"| {label} | " + " | ".join(ABLATION.cell(ABLATION.summary(by[e])) for e in (base, *others))
-                    + " | " + " | ".join(paired_cell(by[e], by[base]) for e in others) + " |")
+    """docs/reproductions/garin2024.md: the filter with a current state in still water
+    (garin2024-sea without its [sea.current]) and in garin2024-sea's current, run by run
+    on the same seeds (300 runs per T_com): mean error over every run (95 % interval) /
+    mean NEES over every run, the ratio of the mean errors (95 % interval, paired by run),
+    its runs over 20 m; and the filter without the state in both."""
+    flowing = mc("garin2024-sea", quick)
+    parts = ABLATION.blocks((ROOT / "scenarios/garin2024-sea.toml").read_text())
+    still_text = "".join("".join(lines) for head, lines in parts if head != "sea.current")
+    still = mc_text(still_text, RUNS["garin2024-sea"][0 if quick else 1])
+    e, plain = "range+doppler-current", "range+doppler-sea"
+    rows = header("T_com", f"{e}, still water", f"{e}, current", "current / still", "its runs over 20 m (still, current)",
+                  f"{plain}, still water", f"{plain}, current")
+    for t in sorted({c["sweep"]["t_com_s"] for c in flowing}):
+        by = {c["estimator"]: c for c in flowing if c["sweep"]["t_com_s"] == t}
+        calm, calm_plain = ([c for c in still if c["estimator"] == x and c["sweep"]["t_com_s"] == t][0] for x in (e, plain))
+        cell = lambda c: ABLATION.cell(ABLATION.summary(c))
+        over = lambda c: sum(m > 20.0 for m in c["run_mean_errors_m"])
+        rows.append(f"| {t:g} s | {cell(calm)} | {cell(by[e])} | {ratio_cell(by[e], calm)} | "
+                    f"{over(calm)}, {over(by[e])} | {cell(calm_plain)} | {cell(by[plain])} |")
     return rows
 
 

@@ -246,7 +246,7 @@ fn the_range_scale_state_finds_the_effective_speed() {
     let eta = SVector::<f64, 6>::from([0.0, 0.0, 50.0, 0.0, 0.0, 0.0]);
     let p0 = SVector::<f64, 6>::from([4.0, 4.0, 0.01, 1e-4, 1e-4, 1e-4]);
     let start = (eta, nalgebra::SMatrix::<f64, 6, 6>::from_diagonal(&p0));
-    let scale = RangeCalibration { offset: None, scale_sigma: Some(0.05) };
+    let scale = RangeCalibration { offset: None, scale_sigma: Some(0.05), current: None };
     let ungated = (f64::INFINITY, None);
     let mut scaled = range_6dof::boxed(noise, Aiding::RANGE, FilterKind::Ekf, 0.0, start, scale, ungated);
     let mut plain =

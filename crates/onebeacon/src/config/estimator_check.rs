@@ -15,6 +15,7 @@ impl EstimatorSpec {
         const USBL: &[Host] = &[PassiveUsbl, Log];
         const CALIBRATING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const CLOCKED: &[Host] = &[FixedBeacon, MovingBeacon];
+        const CARRIED: &[Host] = &[FixedBeacon, MovingBeacon];
         const GATED: &[Host] = &[FixedBeacon, MovingBeacon, PassiveUsbl, Log];
         let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
         let mut keys = vec![
@@ -60,6 +61,9 @@ impl EstimatorSpec {
             ("distance_scale_sigma", self.distance_scale_sigma, Positive, &[Log]),
             ("estimate_turn_scale", flag(self.estimate_turn_scale), Finite, &[Log]),
             ("turn_scale_sigma", self.turn_scale_sigma, Positive, &[Log]),
+            ("estimate_current", flag(self.estimate_current), Finite, CARRIED),
+            ("current_sigma_m_s", self.current_sigma_m_s, Positive, CARRIED),
+            ("current_walk_m_s_per_sqrt_s", self.current_walk_m_s_per_sqrt_s, NonNegative, CARRIED),
         ];
         for q in self.q_diag.iter().flatten() {
             keys.push(("q_diag", Some(*q), NonNegative, &[FixedBeacon]));

@@ -28,7 +28,7 @@ pub use iusbl::{IusblConfig, IusblNavigator};
 pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
 
 pub use range_6dof::{Range6DofNavigator, SensorNoise};
-pub use range_calibration::{OffsetPrior, RangeCalibration};
+pub use range_calibration::{CurrentPrior, OffsetPrior, RangeCalibration};
 pub use single_beacon::{EkfTuning, SingleBeaconNavigator};
 pub use tracking::TrackingNavigator;
 pub use usbl_track::{GaussianTracker, MisalignmentPrior, ParticleTracker, TrackerConfig, TrackerNoise};

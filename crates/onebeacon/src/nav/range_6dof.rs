@@ -82,7 +82,7 @@ impl Range6DofNavigator {
     }
 }
 
-/// The navigator of `spec`'s calibration states (6 to 9 of them), its ranges gated at
+/// The navigator of `spec`'s calibration states (6 to 11 of them), its ranges gated at
 /// `gate` (a NIS; infinity: none) with the update `robust` asks for.
 pub fn boxed(
     noise: SensorNoise,
@@ -109,7 +109,9 @@ pub fn boxed(
         0 => make::<6>(noise, aiding, filter, t0_s, start, calibration, g),
         1 => make::<7>(noise, aiding, filter, t0_s, start, calibration, g),
         2 => make::<8>(noise, aiding, filter, t0_s, start, calibration, g),
-        _ => make::<9>(noise, aiding, filter, t0_s, start, calibration, g),
+        3 => make::<9>(noise, aiding, filter, t0_s, start, calibration, g),
+        4 => make::<10>(noise, aiding, filter, t0_s, start, calibration, g),
+        _ => make::<11>(noise, aiding, filter, t0_s, start, calibration, g),
     }
 }
 
@@ -296,7 +298,7 @@ mod tests {
         let (offset_m, drift_m_s) = (1.5, 1.5e-3);
         let still = SensorNoise { velocity_m_s: 1e-3, ..noise() };
         let prior = OffsetPrior { initial_m: 0.0, sigma_m: 5.0, walk_m_per_sqrt_s: 0.0, drift_sigma_m_s: Some(4.5e-3) };
-        let clock = RangeCalibration { offset: Some(prior), scale_sigma: None };
+        let clock = RangeCalibration { offset: Some(prior), scale_sigma: None, current: None };
         let mut plain = Range6DofNavigator::new(still, Aiding::RANGE, FilterKind::Ekf, 0.0, truth, p0);
         let mut clocked =
             Range6DofNavigator::<8>::calibrated(still, Aiding::RANGE, FilterKind::Ekf, 0.0, (truth, p0), clock);

@@ -1,15 +1,20 @@
 //! Calibration states a range navigator may append to its pose, so that a range reads
-//! (1 + k) r + b: a range offset b (m), its drift b' (m/s) and a range scale k.
+//! (1 + k) r + b: a range offset b (m), its drift b' (m/s) and a range scale k; and the
+//! water's current (c_N, c_E), m/s, which carries the pose over ground.
 //!
 //! What they stand for at sea: a clock offset dt between the beacon's clock and the
 //! vehicle's turns a one-way travel time into a range offset c dt (1 ms: 1.5 m at 1500
 //! m/s); a relative drift of f ppm makes the offset grow by c f 1e-6 m/s (1 ppm: 1.5
 //! mm/s, 5.4 m an hour), the drift state; a sound speed c_eff where the vehicle converts
-//! with c reads every range c_eff / c too long, the scale k = c_eff / c - 1.
+//! with c reads every range c_eff / c too long, the scale k = c_eff / c - 1. A vehicle
+//! that measures its motion through the water (an accelerometer, a propeller's RPM, a
+//! DVL on water track) is carried over ground by the current, which its ranges see and
+//! its motion sensors do not: garin2024 names the current its main limitation
+//! (conclusions: "transverse speed due to current is not estimated").
 
 use crate::filter::ProcessModel;
-use crate::measure::ScalarModel;
-use nalgebra::{SMatrix, SVector};
+use crate::measure::{RadialSpeed2d, ScalarModel};
+use nalgebra::{SMatrix, SVector, Vector2};
 
 /// Which calibration states a navigator estimates, each with its prior.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -18,6 +23,16 @@ pub struct RangeCalibration {
     pub offset: Option<OffsetPrior>,
     /// The range scale k, its prior standard deviation (dimensionless).
     pub scale_sigma: Option<f64>,
+    /// The water's current, two states (north, east), m/s.
+    pub current: Option<CurrentPrior>,
+}
+
+/// The current's prior and motion: zero mean, `sigma_m_s` on each axis, a random walk
+/// of `walk_m_s_per_sqrt_s` on each.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurrentPrior {
+    pub sigma_m_s: f64,
+    pub walk_m_s_per_sqrt_s: f64,
 }
 
 /// The range offset's prior and motion.
@@ -39,11 +54,18 @@ pub(crate) struct Layout {
     pub offset: Option<usize>,
     pub drift: Option<usize>,
     pub scale: Option<usize>,
+    /// The current's north component; its east component follows.
+    pub current: Option<usize>,
 }
 
 impl RangeCalibration {
-    /// How many states it appends: 0 to 3.
+    /// How many states it appends: 0 to 5.
     pub const fn states(&self) -> usize {
+        self.range_states() + if self.current.is_some() { 2 } else { 0 }
+    }
+
+    /// The range's own states: the offset, its drift, the scale (0 to 3).
+    const fn range_states(&self) -> usize {
         let offset = match self.offset {
             Some(OffsetPrior { drift_sigma_m_s: Some(_), .. }) => 2,
             Some(_) => 1,
@@ -59,14 +81,16 @@ impl RangeCalibration {
             inner: (),
             layout: self.layout(B),
             offset_walk_m_per_sqrt_s: self.offset.map_or(0.0, |o| o.walk_m_per_sqrt_s),
+            current_walk_m_s_per_sqrt_s: self.current.map_or(0.0, |c| c.walk_m_s_per_sqrt_s),
         }
     }
 
     pub(crate) fn layout(&self, base: usize) -> Layout {
         let offset = self.offset.map(|_| base);
         let drift = self.offset.and_then(|o| o.drift_sigma_m_s).map(|_| base + 1);
-        let scale = self.scale_sigma.map(|_| base + self.states() - 1);
-        Layout { offset, drift, scale }
+        let scale = self.scale_sigma.map(|_| base + self.range_states() - 1);
+        let current = self.current.map(|_| base + self.range_states());
+        Layout { offset, drift, scale, current }
     }
 
     /// The full state's mean and covariance: the pose's (`x0`, `p0`), then each
@@ -97,27 +121,29 @@ impl RangeCalibration {
             prior.extend(o.drift_sigma_m_s.map(|s| (0.0, s)));
         }
         prior.extend(self.scale_sigma.map(|s| (0.0, s)));
+        if let Some(c) = self.current {
+            prior.extend([(0.0, c.sigma_m_s); 2]);
+        }
         prior
     }
 }
 
-/// A process model of the pose's `B` components (`inner`) with the calibration states
-/// behind them: the offset integrates its drift (b' constant) and walks; the scale is
-/// constant.
+/// A process model of the pose's `B` components (`inner`, north and east its first two)
+/// with the calibration states behind them: the offset integrates its drift (b'
+/// constant) and walks; the scale is constant; the current walks and carries the pose.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Calibrated<P, const B: usize> {
     pub inner: P,
     pub layout: Layout,
     pub offset_walk_m_per_sqrt_s: f64,
+    pub current_walk_m_s_per_sqrt_s: f64,
 }
 
 impl<P: ProcessModel<B>, const B: usize, const N: usize> ProcessModel<N> for Calibrated<P, B> {
     fn propagate(&self, x: &SVector<f64, N>, dt: f64) -> SVector<f64, N> {
         let mut n = *x;
         n.fixed_rows_mut::<B>(0).copy_from(&self.inner.propagate(&x.fixed_rows::<B>(0).into_owned(), dt));
-        if let (Some(o), Some(d)) = (self.layout.offset, self.layout.drift) {
-            n[o] += x[d] * dt; // b(t + dt) = b(t) + b' dt
-        }
+        self.carry(x, &mut n, dt);
         n
     }
 
@@ -129,9 +155,7 @@ impl<P: ProcessModel<B>, const B: usize, const N: usize> ProcessModel<N> for Cal
         let (pose, f) = self.inner.transition(&x.fixed_rows::<B>(0).into_owned(), dt);
         let mut n = *x;
         n.fixed_rows_mut::<B>(0).copy_from(&pose);
-        if let (Some(o), Some(d)) = (self.layout.offset, self.layout.drift) {
-            n[o] += x[d] * dt; // b(t + dt) = b(t) + b' dt
-        }
+        self.carry(x, &mut n, dt);
         (n, self.embed(&f, dt))
     }
 
@@ -155,9 +179,7 @@ impl<P: ProcessModel<B>, const B: usize, const N: usize> ProcessModel<N> for Cal
     fn noise_covariance(&self, x: &SVector<f64, N>, dt: f64) -> SMatrix<f64, N, N> {
         let mut q = SMatrix::<f64, N, N>::zeros();
         q.fixed_view_mut::<B, B>(0, 0).copy_from(&self.inner.noise_covariance(&x.fixed_rows::<B>(0).into_owned(), dt));
-        if let Some(o) = self.layout.offset {
-            q[(o, o)] = self.offset_walk_m_per_sqrt_s.powi(2) * dt;
-        }
+        self.walk(&mut q, dt);
         q
     }
 
@@ -169,18 +191,44 @@ impl<P: ProcessModel<B>, const B: usize, const N: usize> ProcessModel<N> for Cal
 impl<const B: usize> Calibrated<(), B> {
     /// The same calibration states behind the pose model `inner`.
     pub(crate) fn over<P>(self, inner: P) -> Calibrated<P, B> {
-        Calibrated { inner, layout: self.layout, offset_walk_m_per_sqrt_s: self.offset_walk_m_per_sqrt_s }
+        let Self { layout, offset_walk_m_per_sqrt_s, current_walk_m_s_per_sqrt_s, .. } = self;
+        Calibrated { inner, layout, offset_walk_m_per_sqrt_s, current_walk_m_s_per_sqrt_s }
     }
 }
 
 impl<P, const B: usize> Calibrated<P, B> {
+    /// What the calibration states add to the propagated state `n` of `x` over `dt`.
+    fn carry<const N: usize>(&self, x: &SVector<f64, N>, n: &mut SVector<f64, N>, dt: f64) {
+        if let (Some(o), Some(d)) = (self.layout.offset, self.layout.drift) {
+            n[o] += x[d] * dt; // b(t + dt) = b(t) + b' dt
+        }
+        if let Some(c) = self.layout.current {
+            n[0] += x[c] * dt; // p(t + dt) = p(t) + (pose's motion through the water) + c dt
+            n[1] += x[c + 1] * dt;
+        }
+    }
+
+    /// Writes the random walks of the offset and the current over `dt` into `q`.
+    pub(crate) fn walk<const N: usize>(&self, q: &mut SMatrix<f64, N, N>, dt: f64) {
+        if let Some(o) = self.layout.offset {
+            q[(o, o)] = self.offset_walk_m_per_sqrt_s.powi(2) * dt;
+        }
+        if let Some(c) = self.layout.current {
+            let var = self.current_walk_m_s_per_sqrt_s.powi(2) * dt;
+            (q[(c, c)], q[(c + 1, c + 1)]) = (var, var);
+        }
+    }
+
     /// The pose's Jacobian `f` in the full state's, with the offset's dependence on its
-    /// drift.
+    /// drift and the position's on the current.
     fn embed<const N: usize>(&self, f: &SMatrix<f64, B, B>, dt: f64) -> SMatrix<f64, N, N> {
         let mut full = SMatrix::<f64, N, N>::identity();
         full.fixed_view_mut::<B, B>(0, 0).copy_from(f);
         if let (Some(o), Some(d)) = (self.layout.offset, self.layout.drift) {
             full[(o, d)] = dt;
+        }
+        if let Some(c) = self.layout.current {
+            (full[(0, c)], full[(1, c + 1)]) = (dt, dt);
         }
         full
     }
@@ -221,6 +269,49 @@ impl<R: ScalarModel<N>, const N: usize> ScalarModel<N> for CalibratedRange<R> {
     }
 }
 
+/// A Doppler radial speed over ground (closing positive): the vehicle's through the
+/// water (`doppler`, garin2024 eq. 20) plus the current's share toward the beacon, -u.c
+/// with u the unit vector from the beacon to the vehicle, the current read from the state
+/// where the layout puts it (none: still water).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CarriedDoppler {
+    pub doppler: RadialSpeed2d,
+    pub current: Option<usize>,
+}
+
+impl CarriedDoppler {
+    /// The unit vector u, the distance, and the current, when there is one and the
+    /// vehicle is off the beacon.
+    fn geometry<const N: usize>(&self, x: &SVector<f64, N>) -> Option<(Vector2<f64>, f64, Vector2<f64>)> {
+        let i = self.current?;
+        let d = Vector2::new(x[0], x[1]) - self.doppler.beacon;
+        let r = d.norm();
+        (r > 1e-9).then(|| (d / r, r, Vector2::new(x[i], x[i + 1])))
+    }
+}
+
+impl<const N: usize> ScalarModel<N> for CarriedDoppler {
+    fn predict(&self, x: &SVector<f64, N>) -> f64 {
+        let water = ScalarModel::<N>::predict(&self.doppler, x);
+        self.geometry(x).map_or(water, |(u, _, c)| water - u.dot(&c))
+    }
+
+    fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
+        let mut h = ScalarModel::<N>::jacobian(&self.doppler, x);
+        if let (Some((u, r, c)), Some(i)) = (self.geometry(x), self.current) {
+            // d(-u.c)/dp = -(c - u (u.c)) / r; d(-u.c)/dc = -u
+            let dp = -(c - u * u.dot(&c)) / r;
+            (h[0], h[1]) = (h[0] + dp.x, h[1] + dp.y);
+            (h[i], h[i + 1]) = (-u.x, -u.y);
+        }
+        h
+    }
+
+    fn variance(&self, x: &SVector<f64, N>) -> f64 {
+        ScalarModel::<N>::variance(&self.doppler, x)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -232,20 +323,27 @@ mod tests {
     fn full() -> RangeCalibration {
         let offset =
             OffsetPrior { initial_m: 0.5, sigma_m: 2.0, walk_m_per_sqrt_s: 0.01, drift_sigma_m_s: Some(0.003) };
-        RangeCalibration { offset: Some(offset), scale_sigma: Some(0.01) }
+        RangeCalibration { offset: Some(offset), scale_sigma: Some(0.01), current: None }
     }
 
     #[test]
     fn layouts_put_each_state_after_the_pose() {
         let l = full().layout(6);
-        assert_eq!((l.offset, l.drift, l.scale), (Some(6), Some(7), Some(8)));
-        let scale_only = RangeCalibration { offset: None, scale_sigma: Some(0.01) };
-        assert_eq!(scale_only.layout(6), Layout { offset: None, drift: None, scale: Some(6) });
+        assert_eq!((l.offset, l.drift, l.scale, l.current), (Some(6), Some(7), Some(8), None));
+        let scale_only = RangeCalibration { offset: None, scale_sigma: Some(0.01), current: None };
+        assert_eq!(scale_only.layout(6), Layout { offset: None, drift: None, scale: Some(6), current: None });
+        let water = CurrentPrior { sigma_m_s: 0.2, walk_m_s_per_sqrt_s: 1e-3 };
+        let all = RangeCalibration { current: Some(water), ..full() };
+        assert_eq!(all.layout(6), Layout { current: Some(9), ..full().layout(6) });
+        assert_eq!(all.states(), 5);
+        let current_only = RangeCalibration { current: Some(water), ..Default::default() };
+        assert_eq!(current_only.layout(6), Layout { offset: None, drift: None, scale: None, current: Some(6) });
+        assert_eq!(current_only.prior(), vec![(0.0, 0.2), (0.0, 0.2)]);
         let no_drift = RangeCalibration {
             offset: Some(OffsetPrior { drift_sigma_m_s: None, ..full().offset.unwrap() }),
             ..full()
         };
-        assert_eq!(no_drift.layout(6), Layout { offset: Some(6), drift: None, scale: Some(7) });
+        assert_eq!(no_drift.layout(6), Layout { offset: Some(6), drift: None, scale: Some(7), current: None });
         assert_eq!(full().prior(), vec![(0.5, 2.0), (0.0, 0.003), (0.0, 0.01)]);
         assert_eq!(RangeCalibration::default().states(), 0);
     }
@@ -273,7 +371,12 @@ mod tests {
     fn the_offset_integrates_its_drift() {
         let nu = SVector::from([1.0, 0.0, 0.1, 0.0, 0.0, 0.05]);
         let inner = Kinematic6Dof { nu, velocity_sigma_m_s: 0.1, rate_sigma_rad_s: 0.01 };
-        let model = Calibrated::<_, 6> { inner, layout: full().layout(6), offset_walk_m_per_sqrt_s: 0.01 };
+        let model = Calibrated::<_, 6> {
+            inner,
+            layout: full().layout(6),
+            offset_walk_m_per_sqrt_s: 0.01,
+            current_walk_m_s_per_sqrt_s: 0.0,
+        };
         let x = SVector::<f64, 9>::from([1.0, 2.0, 3.0, 0.1, -0.1, 1.0, 2.0, 0.0015, 0.01]);
         let n = ProcessModel::<9>::propagate(&model, &x, 10.0);
         let pose = inner.propagate(&x.fixed_rows::<6>(0).into_owned(), 10.0);
@@ -285,5 +388,59 @@ mod tests {
         let q = ProcessModel::<9>::noise_covariance(&model, &x, 10.0);
         assert_abs_diff_eq!(q[(6, 6)], 1e-4 * 10.0, epsilon = 1e-18);
         assert_eq!((q[(7, 7)], q[(8, 8)]), (0.0, 0.0));
+    }
+
+    /// A current carries the position by c dt on top of the pose's own motion, F has dt
+    /// where the position meets the current, and the current walks: its Q is walk^2 dt
+    /// on each axis.
+    #[test]
+    fn the_current_carries_the_pose() {
+        let nu = SVector::from([1.0, 0.0, 0.1, 0.0, 0.0, 0.05]);
+        let inner = Kinematic6Dof { nu, velocity_sigma_m_s: 0.1, rate_sigma_rad_s: 0.01 };
+        let water = CurrentPrior { sigma_m_s: 0.2, walk_m_s_per_sqrt_s: 2e-3 };
+        let calibration = RangeCalibration { current: Some(water), ..Default::default() };
+        let model = calibration.motion::<6>().over(inner);
+        let x = SVector::<f64, 8>::from([1.0, 2.0, 3.0, 0.1, -0.1, 1.0, 0.3, -0.2]);
+        let n = ProcessModel::<8>::propagate(&model, &x, 10.0);
+        let pose = inner.propagate(&x.fixed_rows::<6>(0).into_owned(), 10.0);
+        assert_abs_diff_eq!(n[0], pose[0] + 3.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(n[1], pose[1] - 2.0, epsilon = 1e-12);
+        assert_eq!(n.fixed_rows::<4>(2).into_owned(), pose.fixed_rows::<4>(2).into_owned());
+        assert_eq!((n[6], n[7]), (0.3, -0.2));
+        let f = ProcessModel::<8>::jacobian(&model, &x, 10.0);
+        for j in 0..8 {
+            let mut xp = x;
+            xp[j] += 1e-6;
+            let fd = (ProcessModel::<8>::propagate(&model, &xp, 10.0) - n) / 1e-6;
+            for i in 0..8 {
+                assert_abs_diff_eq!(f[(i, j)], fd[i], epsilon = 1e-5);
+            }
+        }
+        let q = ProcessModel::<8>::noise_covariance(&model, &x, 10.0);
+        assert_abs_diff_eq!(q[(6, 6)], 4e-6 * 10.0, epsilon = 1e-18);
+        assert_abs_diff_eq!(q[(7, 7)], 4e-6 * 10.0, epsilon = 1e-18);
+    }
+
+    /// The Doppler speed over ground: a vehicle 10 m north of the beacon, still in a
+    /// current of 0.5 m/s toward the south, closes at 0.5 m/s; toward the east, abeam,
+    /// at 0. The Jacobian matches finite differences, and without a current the model is
+    /// the water's.
+    #[test]
+    fn the_doppler_over_ground_has_the_currents_share() {
+        let doppler = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, var: 0.1 };
+        let m = CarriedDoppler { doppler, current: Some(6) };
+        let at = |c: [f64; 2]| SVector::<f64, 8>::from([10.0, 0.0, 0.0, 0.0, 0.0, 0.0, c[0], c[1]]);
+        assert_abs_diff_eq!(ScalarModel::<8>::predict(&m, &at([-0.5, 0.0])), 0.5, epsilon = 1e-12);
+        assert_abs_diff_eq!(ScalarModel::<8>::predict(&m, &at([0.0, 0.5])), 0.0, epsilon = 1e-12);
+        let x = SVector::<f64, 8>::from([30.0, -40.0, 0.7, 1.2, 0.0, 0.0, 0.25, -0.15]);
+        let h = ScalarModel::<8>::jacobian(&m, &x);
+        for j in 0..8 {
+            let mut xp = x;
+            xp[j] += 1e-6;
+            let fd = (ScalarModel::<8>::predict(&m, &xp) - ScalarModel::<8>::predict(&m, &x)) / 1e-6;
+            assert_abs_diff_eq!(h[j], fd, epsilon = 1e-6);
+        }
+        let still = CarriedDoppler { doppler, current: None };
+        assert_eq!(ScalarModel::<8>::predict(&still, &x), ScalarModel::<8>::predict(&doppler, &x));
     }
 }

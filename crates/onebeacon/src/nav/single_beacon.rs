@@ -7,7 +7,7 @@
 //! (eq. 18 left, 22). [`Aiding::RANGE`] is the ROSB baseline: the same filter without
 //! the Doppler speed; [`Aiding::NONE`] is dead reckoning on the inertial sensors.
 
-use super::range_calibration::{Calibrated, CalibratedRange, RangeCalibration};
+use super::range_calibration::{Calibrated, CalibratedRange, CarriedDoppler, RangeCalibration};
 use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::{AnyFilter, FilterError, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
 use crate::measure::{RadialSpeed2d, Range2d, ScalarModel, StateComponent};
@@ -72,7 +72,8 @@ struct Frame {
 /// [`Kind::Range`]), as in garin2024 eq. 18.
 ///
 /// With a [`RangeCalibration`] the state has `N` = 6 + its states components (a range
-/// offset, its drift, a range scale), read by every range.
+/// offset, its drift, a range scale, read by every range; the current, which carries
+/// the position and shows in the Doppler speed over ground).
 #[derive(Debug, Clone)]
 pub struct SingleBeaconNavigator<const N: usize = DIM, P = UnicycleAccel> {
     aiding: Aiding,
@@ -140,7 +141,7 @@ pub struct Guards {
     pub robust: Option<Robust>,
 }
 
-/// The navigator of `calibration`'s states (6 to 9 of them), with its guards.
+/// The navigator of `calibration`'s states (6 to 11 of them), with its guards.
 pub fn boxed(
     aiding: Aiding,
     tuning: EkfTuning,
@@ -172,7 +173,9 @@ pub fn boxed(
         }
         1 => make::<7>(aiding, tuning, filter, t0_s, start, calibration, g),
         2 => make::<8>(aiding, tuning, filter, t0_s, start, calibration, g),
-        _ => make::<9>(aiding, tuning, filter, t0_s, start, calibration, g),
+        3 => make::<9>(aiding, tuning, filter, t0_s, start, calibration, g),
+        4 => make::<10>(aiding, tuning, filter, t0_s, start, calibration, g),
+        _ => make::<11>(aiding, tuning, filter, t0_s, start, calibration, g),
     }
 }
 
@@ -258,8 +261,8 @@ impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
     /// point reflection through the beacon driving backwards (same ranges, same radial
     /// speeds, same heading): the EKF sometimes locks onto that mirror. A survey vehicle
     /// does not drive backwards, so a speed estimate clearly negative (below -0.25 m/s
-    /// and 3 sigma) means the mirror: the state is reflected back, x -> 2b - x, v -> -v,
-    /// P -> J P J' with J = diag(-1, -1, 1, -1, 1, 1).
+    /// and 3 sigma) means the mirror: the state is reflected back, x -> 2b - x, v -> -v
+    /// (and a current c -> -c), P -> J P J' with J = diag(-1, -1, 1, -1, 1, 1, ..., -1, -1).
     fn unmirror(&mut self) {
         let Some(b) = self.beacon.filter(|_| self.unmirror) else { return };
         let (x, p) = (self.filter.mean(), self.filter.covariance());
@@ -267,14 +270,18 @@ impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
         if !(v < -0.25 && v < -3.0 * p[(idx::V, idx::V)].max(0.0).sqrt()) {
             return;
         }
-        let j = SMatrix::<f64, N, N>::from_diagonal(&SVector::from_fn(|i, _| {
-            if matches!(i, idx::X | idx::Y | idx::V) { -1.0 } else { 1.0 }
-        }));
+        // the current, a velocity over ground, is reflected with the speed
+        let current = self.calibration.layout.current.map(|c| [c, c + 1]);
+        let reflected = |i: usize| matches!(i, idx::X | idx::Y | idx::V) || current.is_some_and(|c| c.contains(&i));
+        let j = SMatrix::<f64, N, N>::from_diagonal(&SVector::from_fn(|i, _| if reflected(i) { -1.0 } else { 1.0 }));
         let p = j * p * j;
         let x = self.filter.mean_mut();
         x[idx::X] = 2.0 * b.x - x[idx::X];
         x[idx::Y] = 2.0 * b.y - x[idx::Y];
         x[idx::V] = -v;
+        for c in current.into_iter().flatten() {
+            x[c] = -x[c];
+        }
         *self.filter.covariance_mut() = p;
     }
 
@@ -297,15 +304,9 @@ impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
     fn tick(&mut self, t_s: f64, heading: f64, yaw_rate: f64, accel: f64) -> Result<Gated, FilterError> {
         let dt = t_s - self.t_s;
         if dt > 0.0 {
-            let c = &self.calibration;
-            match c.layout.offset.filter(|_| c.offset_walk_m_per_sqrt_s > 0.0) {
-                None => self.filter.predict(&self.model, dt, &self.q),
-                Some(o) => {
-                    let mut q = self.q;
-                    q[(o, o)] = c.offset_walk_m_per_sqrt_s.powi(2) * dt;
-                    self.filter.predict(&self.model, dt, &q);
-                }
-            }
+            let mut q = self.q;
+            self.calibration.walk(&mut q, dt);
+            self.filter.predict(&self.model, dt, &q);
             self.t_s = t_s;
         }
         let (t, f) = (&self.tuning, &mut self.filter);
@@ -331,6 +332,7 @@ impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
         }
         let range = range_model(r_range);
         let doppler = RadialSpeed2d { beacon: fr.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
+        let doppler = CarriedDoppler { doppler, current: layout.current };
         match (range_m, fr.radial_speed_m_s) {
             (None, None) => update(f, &self.inertial, [heading, yaw_rate, accel]),
             (Some(r), None) => {
