@@ -280,7 +280,7 @@ mod tests {
     }
 
     /// The drift implies the offset; the states follow the pose in the order offset,
-    /// drift, scale; the priors are the keys' or the documented defaults.
+    /// drift, scale, current; the priors are the keys' or the documented defaults.
     #[test]
     fn calibration_keys_make_calibration_states() {
         use crate::nav::OffsetPrior;
@@ -293,6 +293,24 @@ mod tests {
         assert_eq!(all.range_calibration().scale_sigma, Some(0.02));
         assert_eq!(all.range_calibration().states(), 2);
         assert_eq!(spec("kind = \"range-ekf\"").range_calibration().states(), 0);
+        // the current: two states behind the rest, the documented defaults where a key
+        // is absent; a log's navigators have none
+        use crate::nav::CurrentPrior;
+        let water = spec("kind = \"range+doppler\"\nestimate_bias_drift = true\nestimate_current = true");
+        let defaults = CurrentPrior { sigma_m_s: 0.1, walk_m_s_per_sqrt_s: 1e-3 };
+        assert_eq!(water.range_calibration().current, Some(defaults));
+        assert_eq!(water.range_calibration().states(), 4);
+        let own = spec(
+            "kind = \"range-ekf\"\nestimate_current = true\ncurrent_sigma_m_s = 0.3\ncurrent_walk_m_s_per_sqrt_s = 0",
+        );
+        assert_eq!(own.range_calibration().current, Some(CurrentPrior { sigma_m_s: 0.3, walk_m_s_per_sqrt_s: 0.0 }));
+        assert_eq!(
+            error("kind = \"range+doppler\"\nestimate_current = true", Host::Log),
+            "estimators[0].estimate_current = true: does not apply to a log (it applies to: fixed_beacon world, moving_beacon world)"
+        );
+        assert!(
+            error("kind = \"rosb\"\nestimate_current = true\ncurrent_sigma_m_s = 0", Host::FixedBeacon).contains("> 0")
+        );
     }
 
     /// Left out, garin2024's noise keys are eq. 25's variances exactly (no square root
