@@ -14,7 +14,10 @@ its built-in factors on ranges divided by the fitted scale (`--scale fit`, its s
 Usage, from the project root (GTSAM: `pip install gtsam==4.3.0 numpy` in PY's environment):
   python3 scripts/smooth_vs_gtsam.py [--bin target/release/onebeacon] [--python PY]
       [--rounds 3] [--no-est] [--out DIR]
-Writes DIR/results.jsonl (one line per run) and prints two markdown tables.
+Writes DIR/results.jsonl (one line per run) and prints three markdown tables: RMSE, LM
+iterations with the same factors (no kernel; range scale 1, and the scale as a variable
+with GTSAM's prior of 0.1, `--like` an estimator written to DIR/same_factors.toml), and
+time.
 """
 import argparse, json, os, statistics, subprocess, sys
 
@@ -43,6 +46,20 @@ def gtsam(a, log, beacon, *flags):
     return run(cmd)
 
 
+# an estimator whose weighing `smooth --like` copies: the range scale's prior as GTSAM's
+# bench gives it (0.1), every other noise at the log's
+SAME_FACTORS = '''[[estimators]]
+name = "dead-reckoning"
+kind = "dead-reckoning"
+
+[[estimators]]
+name = "gtsam-bench"
+kind = "range-ekf"
+estimate_range_scale = true
+range_scale_sigma = 0.1
+'''
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--bin', default='target/release/onebeacon')
@@ -53,7 +70,10 @@ def main():
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     results = open(os.path.join(a.out, 'results.jsonl'), 'w')
-    rows = []
+    same = os.path.join(a.out, 'same_factors.toml')
+    with open(same, 'w') as f:
+        f.write(SAME_FACTORS)
+    rows, its = [], []
     for log, beacons in LOGS.items():
         for b in beacons:
             print(f'{log} beacons {"all" if b is None else b} ...', file=sys.stderr, flush=True)
@@ -71,6 +91,16 @@ def main():
                    'gtsam_lm': g1['rmse'], 'gtsam_lm_scale_est': ge['rmse'] if ge else None}
             results.write(json.dumps(rec) + '\n')
             rows.append(rec)
+            # LM iterations with the same factors: no kernel, scale 1 / the scale a variable
+            plain = ours(a, log, b, '--calibrate', 'none', '--kernel', 'none')['smoother']
+            scaled = None if a.no_est else ours(a, log, b, '--estimators', same, '--like', 'gtsam-bench',
+                                                 '--calibrate', 'range_scale', '--kernel', 'none')['smoother']
+            it = {'log': log, 'beacons': 'all' if b is None else b,
+                  'ours': (plain['iterations'], plain['cost']['final']), 'gtsam': (g1['iterations'], g1['error']),
+                  'ours_est': scaled and (scaled['iterations'], scaled['cost']['final']),
+                  'gtsam_est': ge and (ge['iterations'], ge['error'])}
+            results.write(json.dumps({'iterations': it}) + '\n')
+            its.append(it)
     f = lambda v: '-' if v is None else f'{v:.2f}'
     print('| log | beacons | dead reckoning | ekf-cal | + RTS | ekf-cal-oos | + RTS | smooth, no calibration (NEES) '
           '| smooth (NEES) | smooth like ekf-cal-oos (NEES) | GTSAM LM | GTSAM LM, scale variable |')
@@ -79,6 +109,15 @@ def main():
         print(f"| {r['log']} | {r['beacons']} | {f(r['dead-reckoning'])} | {f(r['ekf-cal'])} | {f(r['ekf-cal+rts'])} "
               f"| {f(r['ekf-cal-oos'])} | {f(r['ekf-cal-oos+rts'])} | {f(r['smooth_nocal'])} ({r['smooth_nocal_nees']:.1f}) | {f(r['smooth'])} ({r['smooth_nees']:.1f}) "
               f"| {f(r['smooth_oos'])} ({r['smooth_oos_nees']:.1f}) | {f(r['gtsam_lm'])} | {f(r['gtsam_lm_scale_est'])} |")
+    print()
+    print('| log | beacons | smooth, scale 1: iterations (final cost) | GTSAM LM | ratio '
+          '| smooth, scale a variable | GTSAM LM | ratio |')
+    print('|---|---|---|---|---|---|---|---|')
+    g = lambda p: '-' if p is None else f'{p[0]} ({p[1]:.2f})'
+    q = lambda o, t: '-' if o is None or t is None else f'{o[0] / t[0]:.2f}'
+    for r in its:
+        print(f"| {r['log']} | {r['beacons']} | {g(r['ours'])} | {g(r['gtsam'])} | {q(r['ours'], r['gtsam'])} "
+              f"| {g(r['ours_est'])} | {g(r['gtsam_est'])} | {q(r['ours_est'], r['gtsam_est'])} |")
     # time, back to back
     times = {}
     for _ in range(a.rounds):

@@ -194,3 +194,24 @@ fn a_bound_or_a_cap_reached_is_said() {
     assert!((SCALE_BOUNDS.0..=SCALE_BOUNDS.1).contains(&scale), "{scale}");
     assert!(s.warnings.iter().any(|w| w.contains("range_scale ended at its bound")), "{:?}", s.warnings);
 }
+
+/// The retraction moves a pose along the SE(2) exponential of its body-frame increment:
+/// a pose at heading psi stepped by forward distance v and turn w ends where an arc of
+/// length v turning by w ends, R(psi) (sin w / w, (1 - cos w) / w) v (closed form); a
+/// step without turn is x + h exactly; calibration variables move by h.
+#[test]
+fn the_retraction_follows_the_arc_of_a_turn() {
+    use nalgebra::DVector;
+    let (psi, v, w) = (0.7f64, 12.0, 0.9);
+    let x = [3.0, -4.0, psi, 1.05];
+    let h = DVector::from_vec(vec![v * psi.cos(), v * psi.sin(), w, 0.01]);
+    let y = solve::retract(&x, &h, 3);
+    let (f, l) = (v * w.sin() / w, v * (1.0 - w.cos()) / w);
+    let (c, s) = (psi.cos(), psi.sin());
+    let end = [3.0 + c * f - s * l, -4.0 + s * f + c * l];
+    assert!((y[0] - end[0]).abs() < 1e-12 && (y[1] - end[1]).abs() < 1e-12, "{y:?} against {end:?}");
+    assert!((y[2] - (psi + w)).abs() < 1e-15 && (y[3] - 1.06).abs() < 1e-15, "{y:?}");
+    let straight = DVector::from_vec(vec![1.5, -2.5, 0.0, 0.0]);
+    let y = solve::retract(&x, &straight, 3);
+    assert_eq!(&y[..2], &[4.5, -6.5]);
+}
