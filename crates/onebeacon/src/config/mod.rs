@@ -13,6 +13,7 @@ pub mod check;
 pub mod controller;
 pub mod estimator;
 mod estimator_check;
+mod estimator_defaults;
 pub mod iusbl;
 pub mod stream;
 pub mod working_set;
