@@ -18,7 +18,7 @@ use crate::run::{Estimate, StepRecord, TruthRecord, recorded_bytes};
 use crate::scenario::{EstimatorSpec, Host, Scenario};
 use onebeacon::config::stream::StreamConfig;
 use onebeacon::config::working_set::particle_filter_bytes;
-use onebeacon::nav::planar::{STATES, STATES_WITH_OFFSETS};
+use onebeacon::nav::planar::{EXTENDED_STATES, STATES, STATES_WITH_OFFSETS};
 
 /// The environment variable that sets the budget, GiB.
 pub const ENV: &str = "ONEBEACON_MEMORY_GIB";
@@ -153,7 +153,11 @@ impl Budget {
             .iter()
             .filter(|e| e.kind.aiding(Host::Log).any() && !e.kind.tracks_bearings() && !e.kind.iusbl())
             .filter(|e| e.track_accel_sigma_m_s2.is_none())
-            .map(|e| if e.estimate_beacon_offsets == Some(true) { STATES_WITH_OFFSETS } else { STATES })
+            .map(|e| match (e.estimate_beacon_offsets == Some(true), e.planar_config().extended()) {
+                (true, _) => STATES_WITH_OFFSETS,
+                (false, true) => EXTENDED_STATES,
+                (false, false) => STATES,
+            })
             .collect();
         // the rows counted: motion rows make the graph's nodes, the others its factors
         let motion = |k| matches!(k, Odometry | BodyOdometry | BodyVelocity | Speed | SpeedHeading);

@@ -8,6 +8,7 @@ use crate::scenario::estimator::IusblKeys;
 use crate::scenario::fleet::{Fleet, SignalModel};
 use crate::scenario::{EstimatorKind, FixedBeacon, Host, MovingBeacon, PassiveUsbl};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
+use crate::vehicles::sandshark::SandSharkParams;
 use nalgebra::SVector;
 use onebeacon::dsp::beamform::pyramid_8cm;
 use onebeacon::dsp::receiver::{ModeReceiver, ReceiverConfig};
@@ -19,7 +20,9 @@ use onebeacon::models::kinematic6dof::{Cov as Cov6, State as Eta};
 use onebeacon::models::unicycle::{Cov, State};
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
-use onebeacon::nav::{Aiding, IusblNavigator, PlanarConfig, range_6dof, single_beacon};
+use onebeacon::nav::{
+    Aiding, HeadingOffsetPrior, IusblNavigator, PlanarConfig, PlanarNoise, range_6dof, single_beacon,
+};
 use rand::RngExt;
 
 /// Every estimator of a fixed-beacon scenario on its AUV, started at the truth `z_true`
@@ -142,6 +145,8 @@ pub(crate) fn iusbl_keys(s: &Fleet) -> IusblKeys {
         max_range_m: n.max_range_m,
         sigma_speed_m_s: n.sigma_speed_m_s,
         sigma_heading_deg: n.sigma_heading_deg,
+        // the filter reads the AHRS error the simulation draws from
+        heading_bias_sigma_deg: s.sandshark.heading_error_deg,
         beacon_speed_m_s: n.beacon_speed_m_s,
         beacon_depth_m: s.dock.beacon_depth_m,
         confirmations: n.confirmations,
@@ -150,6 +155,36 @@ pub(crate) fn iusbl_keys(s: &Fleet) -> IusblKeys {
         fix_range_sigma_m: s.signal.range_sigma_m.max(0.05),
         fix_angle_sigma_deg: s.signal.angle_sigma_deg.max(0.5),
         sound_speed_m_s: s.signal.sound_speed_m_s,
+    }
+}
+
+/// A fleet AUV's dead reckoning: the planar navigator without aiding whose noise is
+/// the one the simulation draws the SandShark's sensors from (`[sandshark]`): the
+/// RPM speed's scale error as a distance-scale state and its white noise, the AHRS
+/// heading's slow error as a Gauss-Markov heading offset (that no fix can show: its
+/// variance carries the drift it causes) and its white noise; with the propeller
+/// stopped the RPM reads zero while the vehicle coasts on with its coast time constant. The speed input has no
+/// turn rate: the heading between fixes walks by as much as the SandShark can turn in a
+/// metre at 1 m/s (its largest turn rate, per sqrt(m)), so that each fix moves the
+/// heading, not the offset.
+fn fleet_dead_reckoning(p: &SandSharkParams) -> PlanarConfig {
+    let d = PlanarConfig::default();
+    PlanarConfig {
+        aiding: Aiding::NONE,
+        estimate_distance_scale: p.speed_scale_sigma > 0.0,
+        distance_scale_sigma: p.speed_scale_sigma,
+        speed_coast_time_s: Some(p.coast_time_constant_s),
+        heading_offset: (p.heading_error_deg > 0.0).then(|| HeadingOffsetPrior {
+            sigma_rad: p.heading_error_deg.to_radians(),
+            time_s: p.heading_error_time_s,
+        }),
+        noise: PlanarNoise {
+            speed_sigma_m_s: p.speed_white_m_s,
+            heading_sigma_rad: p.heading_white_deg.to_radians().max(1e-4),
+            heading_walk_rad_per_sqrt_m: p.max_turn_rate_deg_s.to_radians(),
+            ..d.noise
+        },
+        ..d
     }
 }
 
@@ -183,8 +218,7 @@ pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
                     Box::new(IusblNavigator::new(config, receiver, filter_seed))
                 })
             } else {
-                let config = PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() };
-                onebeacon::nav::planar::builder(config, FilterKind::Ekf)
+                onebeacon::nav::planar::builder(fleet_dead_reckoning(&s.sandshark), FilterKind::Ekf)
             };
             tracks.push(Track::new(v, builder, pose, (1.0, 0.05)));
         }

@@ -30,6 +30,11 @@ pub fn config(
             format!("like {name}: not an estimator of the log (estimators: {})", names.join(", "))
         })?;
         let p = e.planar_config();
+        if p.extended() || p.speed_coast_time_s.is_some() {
+            return Err(format!(
+                "like {name}: the smoother has no heading offset, current or coasting speed (estimate_heading_offset, estimate_current, speed_coast_time_s); smooth like an estimator without them"
+            ));
+        }
         let offsets = match (p.estimate_beacon_offsets, p.estimate_bias) {
             (true, _) => Offsets::PerBeacon,
             (false, true) => Offsets::Shared,

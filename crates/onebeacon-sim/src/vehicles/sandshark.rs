@@ -67,7 +67,8 @@ impl Default for SandSharkParams {
 pub struct SandShark {
     /// NED position, m.
     pub position_ned_m: Vector3<f64>,
-    /// Heading (rad, not wrapped), speed through the water (m/s), pitch (rad, nose up).
+    /// Heading (rad, not wrapped), speed through the water along the body (m/s), pitch
+    /// (rad, nose up).
     pub heading_rad: f64,
     pub speed_m_s: f64,
     pub pitch_rad: f64,
@@ -84,23 +85,26 @@ impl SandShark {
     pub fn step(&mut self, p: &SandSharkParams, sp: &Setpoint, dt: f64) {
         self.thrusting = sp.speed_m_s > 0.0;
         let depth = self.position_ned_m.z;
-        let depth_rate = if self.thrusting {
+        // under way the vehicle climbs and dives along its axis (pitched); coasting it
+        // floats up level, by its buoyancy
+        let (depth_rate, pitch) = if self.thrusting {
             let turn = (p.heading_gain_per_s * wrap_angle(sp.heading_rad - self.heading_rad))
                 .clamp(-p.max_turn_rate_deg_s.to_radians(), p.max_turn_rate_deg_s.to_radians());
             self.heading_rad += turn * dt;
             self.speed_m_s += (sp.speed_m_s - self.speed_m_s) * (dt / p.speed_time_constant_s).min(1.0);
             // the fins need way on: the depth rate is limited by the speed too
             let most = p.max_depth_rate_m_s.min(self.speed_m_s * 0.35);
-            (p.depth_gain_per_s * (sp.depth_m - depth)).clamp(-most, most)
+            let rate = (p.depth_gain_per_s * (sp.depth_m - depth)).clamp(-most, most);
+            let pitch = if self.speed_m_s > 0.0 { (-rate / self.speed_m_s).asin() } else { 0.0 };
+            (rate, pitch)
         } else {
             self.speed_m_s -= self.speed_m_s * (dt / p.coast_time_constant_s).min(1.0);
-            -p.rise_rate_m_s
+            (-p.rise_rate_m_s, 0.0)
         };
-        let (s, c) = self.heading_rad.sin_cos();
-        self.position_ned_m += Vector3::new(c, s, 0.0) * (self.speed_m_s * dt);
         self.position_ned_m.z = (depth + depth_rate * dt).max(0.0);
-        let v = self.speed_m_s.max(0.05);
-        self.pitch_rad = (-depth_rate).atan2(v) * if self.position_ned_m.z > 0.0 { 1.0 } else { 0.0 };
+        self.pitch_rad = if self.position_ned_m.z > 0.0 { pitch } else { 0.0 };
+        let (s, c) = self.heading_rad.sin_cos();
+        self.position_ned_m += Vector3::new(c, s, 0.0) * (self.speed_m_s * self.pitch_rad.cos() * dt);
     }
 
     /// Body-to-NED rotation (level in roll).
@@ -108,9 +112,10 @@ impl SandShark {
         onebeacon::models::kinematic6dof::rotation(0.0, self.pitch_rad, self.heading_rad)
     }
 
-    /// Speed over ground, m/s.
+    /// Speed over ground (horizontal), m/s: the speed along the body times the cosine
+    /// of the pitch (rypkema eq. 1).
     pub fn speed_over_ground(&self) -> f64 {
-        self.speed_m_s
+        self.speed_m_s * self.pitch_rad.cos()
     }
 }
 
@@ -159,5 +164,30 @@ mod tests {
         }
         assert!((v.speed_m_s - 1.0).abs() < 1e-3 && (v.position_ned_m.z - 2.5).abs() < 0.01);
         assert!((wrap_angle(v.heading_rad) - 1.0).abs() < 1e-3);
+    }
+
+    /// Under way the vehicle dives along its axis: each step covers speed x dt in three
+    /// dimensions, and eq. 1 (speed x cos(pitch)) is the horizontal distance over dt.
+    /// Coasting, it floats up level: the horizontal step is the whole speed's.
+    #[test]
+    fn diving_moves_along_the_body_axis() {
+        let p = SandSharkParams::default();
+        let mut v = SandShark::new(Vector3::new(0.0, 0.0, 2.5), 0.3);
+        v.speed_m_s = 1.0;
+        let dive = Setpoint { heading_rad: 0.3, speed_m_s: 1.0, depth_m: 10.0 };
+        for _ in 0..50 {
+            let before = v.position_ned_m;
+            v.step(&p, &dive, 0.1);
+            let step = v.position_ned_m - before;
+            assert!((step.norm() - 0.1).abs() < 1e-12, "{}", step.norm());
+            assert!((step.xy().norm() - v.speed_over_ground() * 0.1).abs() < 1e-12);
+        }
+        assert!((v.pitch_rad + (p.max_depth_rate_m_s).asin()).abs() < 1e-12, "nose down at the largest rate");
+        let stop = Setpoint { speed_m_s: 0.0, ..dive };
+        let (before, speed) = (v.position_ned_m, v.speed_m_s);
+        v.step(&p, &stop, 0.1);
+        assert_eq!(v.pitch_rad, 0.0);
+        let coasted = speed * (1.0 - 0.1 / p.coast_time_constant_s);
+        assert!(((v.position_ned_m - before).xy().norm() - coasted * 0.1).abs() < 1e-12);
     }
 }

@@ -176,7 +176,7 @@ impl FleetWorld {
         let kind = match sig.model {
             SignalModel::Channel => {
                 let (s, c) = auv.truth.heading_rad.sin_cos();
-                let velocity = Vector3::new(c, s, 0.0) * auv.truth.speed_m_s;
+                let velocity = Vector3::new(c, s, 0.0) * auv.truth.speed_over_ground();
                 let ch = Channel {
                     fs_hz: 37_500.0,
                     capture_len: 8000,
@@ -339,7 +339,7 @@ impl World for FleetWorld {
             if let Some(c) = current {
                 a.truth.position_ned_m += c * dt;
             }
-            a.distance_m += a.truth.speed_m_s * dt;
+            a.distance_m += a.truth.speed_over_ground() * dt;
             a.errors.advance(&params, dt, &mut a.imu_rng);
             let rng = &mut a.imu_rng;
             let white = params.attitude_white_deg.to_radians();

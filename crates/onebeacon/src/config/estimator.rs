@@ -14,8 +14,8 @@ use crate::filter::particle::{ParticleSettings, Resampler};
 use crate::filter::{FilterKind, UkfParams};
 use crate::models::hoff::HoffProcess;
 use crate::nav::{
-    Aiding, CurrentPrior, EkfTuning, MisalignmentPrior, OffsetPrior, PlanarConfig, PlanarNoise, RangeCalibration,
-    Robust, SensorNoise, TrackerConfig, TrackerNoise,
+    Aiding, CurrentPrior, EkfTuning, HeadingOffsetPrior, MisalignmentPrior, OffsetPrior, PlanarConfig, PlanarNoise,
+    RangeCalibration, Robust, SensorNoise, TrackerConfig, TrackerNoise,
 };
 use serde::{Deserialize, Serialize};
 
@@ -290,12 +290,21 @@ pub struct EstimatorSpec {
     pub distance_scale_sigma: Option<f64>,
     pub estimate_turn_scale: Option<bool>,
     pub turn_scale_sigma: Option<f64>,
-    /// The water's current as two states (north, east; fixed_beacon, moving_beacon): zero
-    /// at the start with `current_sigma_m_s` on each axis, walking with
+    /// The water's current as two states (north, east; fixed_beacon, moving_beacon, log):
+    /// zero at the start with `current_sigma_m_s` on each axis, walking with
     /// `current_walk_m_s_per_sqrt_s`.
     pub estimate_current: Option<bool>,
     pub current_sigma_m_s: Option<f64>,
     pub current_walk_m_s_per_sqrt_s: Option<f64>,
+    /// The heading sensor's offset as a state (log): heading fixes read the heading plus
+    /// it; zero at the start with `heading_offset_sigma_deg`, a first-order Gauss-Markov
+    /// process of correlation time `heading_offset_time_s` (none: a constant).
+    /// A speed input of zero is a stopped propeller: the vehicle coasts on with this time
+    /// constant, s (log; none: it stops at once).
+    pub speed_coast_time_s: Option<f64>,
+    pub estimate_heading_offset: Option<bool>,
+    pub heading_offset_sigma_deg: Option<f64>,
+    pub heading_offset_time_s: Option<f64>,
     /// The seed of the estimator's random draws, any 64-bit integer (a particle
     /// filter's; log; default: the vehicle's `[initial]` seed, else 0).
     pub seed: Option<i64>,
@@ -362,6 +371,10 @@ impl EstimatorSpec {
             estimate_current: None,
             current_sigma_m_s: None,
             current_walk_m_s_per_sqrt_s: None,
+            speed_coast_time_s: None,
+            estimate_heading_offset: None,
+            heading_offset_sigma_deg: None,
+            heading_offset_time_s: None,
             seed: None,
             iusbl: None,
         }
@@ -552,6 +565,12 @@ impl EstimatorSpec {
             nis_gate: Some(self.log_gate().0),
             robust: self.gate().1,
             noise,
+            speed_coast_time_s: self.speed_coast_time_s,
+            heading_offset: (self.estimate_heading_offset == Some(true)).then(|| HeadingOffsetPrior {
+                sigma_rad: self.heading_offset_sigma_deg.unwrap_or(DEFAULT_HEADING_OFFSET_SIGMA_DEG).to_radians(),
+                time_s: self.heading_offset_time_s.unwrap_or(f64::INFINITY),
+            }),
+            current: self.range_calibration().current,
             track_accel_sigma_m_s2: self.track_accel_sigma_m_s2,
         }
     }

@@ -15,7 +15,7 @@ impl EstimatorSpec {
         const USBL: &[Host] = &[PassiveUsbl, Log];
         const CALIBRATING: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const CLOCKED: &[Host] = &[FixedBeacon, MovingBeacon];
-        const CARRIED: &[Host] = &[FixedBeacon, MovingBeacon];
+        const CARRIED: &[Host] = &[FixedBeacon, MovingBeacon, Log];
         const GATED: &[Host] = &[FixedBeacon, MovingBeacon, PassiveUsbl, Log];
         let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
         let mut keys = vec![
@@ -64,6 +64,10 @@ impl EstimatorSpec {
             ("estimate_current", flag(self.estimate_current), Finite, CARRIED),
             ("current_sigma_m_s", self.current_sigma_m_s, Positive, CARRIED),
             ("current_walk_m_s_per_sqrt_s", self.current_walk_m_s_per_sqrt_s, NonNegative, CARRIED),
+            ("speed_coast_time_s", self.speed_coast_time_s, Positive, &[Log]),
+            ("estimate_heading_offset", flag(self.estimate_heading_offset), Finite, &[Log]),
+            ("heading_offset_sigma_deg", self.heading_offset_sigma_deg, Positive, &[Log]),
+            ("heading_offset_time_s", self.heading_offset_time_s, Positive, &[Log]),
         ];
         for q in self.q_diag.iter().flatten() {
             keys.push(("q_diag", Some(*q), NonNegative, &[FixedBeacon]));
@@ -109,6 +113,21 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
                 key: key("estimate_beacon_offsets"),
                 value: "true".into(),
                 allowed: "replaces the shared offset of estimate_bias (give one of the two), and does not apply to the tracker (track_accel_sigma_m_s2)".into(),
+            });
+        }
+        // a log's motion states are the planar navigator's
+        let motion = [
+            ("estimate_heading_offset", e.estimate_heading_offset == Some(true)),
+            ("speed_coast_time_s", e.speed_coast_time_s.is_some()),
+            ("estimate_current", host == Host::Log && e.estimate_current == Some(true)),
+        ];
+        if let Some((name, _)) = motion.iter().find(|(_, on)| *on)
+            && (e.kind.tracks_bearings() || e.kind.iusbl() || e.track_accel_sigma_m_s2.is_some())
+        {
+            return Err(Violation {
+                key: key(name),
+                value: "(set)".into(),
+                allowed: "applies to a log's planar navigators (kinds range+doppler, rosb, range-ekf, dead-reckoning), not to a USBL tracker, the iUSBL navigator or the constant-velocity tracker (track_accel_sigma_m_s2)".into(),
             });
         }
         if e.iusbl.is_some() && !e.kind.iusbl() {
@@ -294,7 +313,7 @@ mod tests {
         assert_eq!(all.range_calibration().states(), 2);
         assert_eq!(spec("kind = \"range-ekf\"").range_calibration().states(), 0);
         // the current: two states behind the rest, the documented defaults where a key
-        // is absent; a log's navigators have none
+        // is absent
         use crate::nav::CurrentPrior;
         let water = spec("kind = \"range+doppler\"\nestimate_bias_drift = true\nestimate_current = true");
         let defaults = CurrentPrior { sigma_m_s: 0.1, walk_m_s_per_sqrt_s: 1e-3 };
@@ -304,9 +323,29 @@ mod tests {
             "kind = \"range-ekf\"\nestimate_current = true\ncurrent_sigma_m_s = 0.3\ncurrent_walk_m_s_per_sqrt_s = 0",
         );
         assert_eq!(own.range_calibration().current, Some(CurrentPrior { sigma_m_s: 0.3, walk_m_s_per_sqrt_s: 0.0 }));
+        // a log's planar navigators take the current, and the heading offset (its
+        // extended layout); a tracker does not
+        let log = spec(
+            "kind = \"range+doppler\"\nestimate_current = true\nestimate_heading_offset = true\nheading_offset_time_s = 600",
+        );
+        assert_eq!(error("kind = \"range+doppler\"\nestimate_current = true", Host::Log), "");
+        let p = log.planar_config();
+        assert_eq!(p.current, Some(defaults));
         assert_eq!(
-            error("kind = \"range+doppler\"\nestimate_current = true", Host::Log),
-            "estimators[0].estimate_current = true: does not apply to a log (it applies to: fixed_beacon world, moving_beacon world)"
+            p.heading_offset,
+            Some(crate::nav::HeadingOffsetPrior { sigma_rad: 3f64.to_radians(), time_s: 600.0 })
+        );
+        assert!(p.extended() && !spec("kind = \"range+doppler\"").planar_config().extended());
+        assert_eq!(
+            error("kind = \"bearing\"\nestimate_heading_offset = true", Host::Log),
+            "estimators[0].estimate_heading_offset = (set): applies to a log's planar navigators (kinds range+doppler, rosb, range-ekf, dead-reckoning), not to a USBL tracker, the iUSBL navigator or the constant-velocity tracker (track_accel_sigma_m_s2)"
+        );
+        assert!(
+            error("kind = \"range-ekf\"\nspeed_coast_time_s = 4\ntrack_accel_sigma_m_s2 = 0.1", Host::Log)
+                .contains("planar")
+        );
+        assert!(
+            error("kind = \"range-ekf\"\nestimate_heading_offset = true", Host::FixedBeacon).contains("does not apply")
         );
         assert!(
             error("kind = \"rosb\"\nestimate_current = true\ncurrent_sigma_m_s = 0", Host::FixedBeacon).contains("> 0")

@@ -30,6 +30,11 @@ pub const DEFAULT_CURRENT_SIGMA_M_S: f64 = 0.1;
 /// slow variation of garin2024-sea's current, itself unsourced); on garin2024-sea at seed
 /// 1001 it did as well as 5e-4 and better than 1.7e-3.
 pub const DEFAULT_CURRENT_WALK_M_S_PER_SQRT_S: f64 = 1e-3;
+/// The prior standard deviation of a log estimator's heading offset, deg, when
+/// `heading_offset_sigma_deg` is not given: a calibrated MEMS AHRS against a dual-antenna
+/// GPS, rypkema sec. 2.1 ("one standard deviation of heading error ... approximately
+/// 3 deg").
+pub const DEFAULT_HEADING_OFFSET_SIGMA_DEG: f64 = 3.0;
 /// A `pf` estimator's `min_effective_particles` when not given.
 pub const DEFAULT_MIN_EFFECTIVE: f64 = 20.0;
 

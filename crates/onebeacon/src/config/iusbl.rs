@@ -19,6 +19,9 @@ pub struct IusblKeys {
     pub max_range_m: f64,
     pub sigma_speed_m_s: f64,
     pub sigma_heading_deg: f64,
+    /// The heading's slow error that the covariance carries (IusblConfig's
+    /// `heading_bias_sigma_rad`), deg.
+    pub heading_bias_sigma_deg: f64,
     pub beacon_speed_m_s: f64,
     pub beacon_depth_m: f64,
     pub confirmations: usize,
@@ -39,6 +42,7 @@ impl Default for IusblKeys {
             max_range_m: c.filter.max_range_m,
             sigma_speed_m_s: c.sigma_speed_m_s,
             sigma_heading_deg: c.sigma_heading_rad.to_degrees(),
+            heading_bias_sigma_deg: c.heading_bias_sigma_rad.to_degrees(),
             beacon_speed_m_s: c.beacon_speed_m_s,
             beacon_depth_m: c.beacon_depth_m,
             confirmations: c.confirmations,
@@ -63,6 +67,7 @@ impl IusblKeys {
             factored,
             sigma_speed_m_s: self.sigma_speed_m_s,
             sigma_heading_rad: self.sigma_heading_deg.to_radians(),
+            heading_bias_sigma_rad: self.heading_bias_sigma_deg.to_radians(),
             beacon_speed_m_s: self.beacon_speed_m_s,
             beacon_depth_m: self.beacon_depth_m,
             confirmations: self.confirmations,
@@ -76,13 +81,14 @@ impl IusblKeys {
     }
 
     /// The numeric keys with whether each must be > 0 (else >= 0).
-    pub(crate) fn numbers(&self) -> [(&'static str, f64, bool); 13] {
+    pub(crate) fn numbers(&self) -> [(&'static str, f64, bool); 14] {
         [
             ("particles", self.particles as f64, true),
             ("reinitialised", self.reinitialised as f64, false),
             ("max_range_m", self.max_range_m, true),
             ("sigma_speed_m_s", self.sigma_speed_m_s, true),
             ("sigma_heading_deg", self.sigma_heading_deg, true),
+            ("heading_bias_sigma_deg", self.heading_bias_sigma_deg, false),
             ("beacon_speed_m_s", self.beacon_speed_m_s, false),
             ("beacon_depth_m", self.beacon_depth_m, false),
             ("confirmations", self.confirmations as f64, true),

@@ -31,6 +31,13 @@ pub struct IusblConfig {
     pub sigma_speed_m_s: f64,
     /// Heading noise of the prediction, rad (the SandShark's AHRS: 3 deg).
     pub sigma_heading_rad: f64,
+    /// Standard deviation of the AHRS heading's slow error, rad, that no ping can show:
+    /// every direction is turned into NED with it, so it turns the whole cloud about the
+    /// vehicle and the cloud cannot average it away. It is added to the reported
+    /// covariance as a consider term (sigma^2 (J r)(J r)^T, r the relative position);
+    /// the particles are not moved. Rypkema sec. 2.1: "one standard deviation of
+    /// heading error for these vehicles is approximately 3 deg" (3 deg).
+    pub heading_bias_sigma_rad: f64,
     /// Largest expected speed of the beacon, m/s: its process noise per second (ours: 0.5).
     pub beacon_speed_m_s: f64,
     /// The beacon's depth, m (rypkema: towed at about 1 m).
@@ -69,6 +76,7 @@ impl Default for IusblConfig {
             factored: true,
             sigma_speed_m_s: 0.1,
             sigma_heading_rad: 3f64.to_radians(),
+            heading_bias_sigma_rad: 3f64.to_radians(),
             beacon_speed_m_s: 0.5,
             beacon_depth_m: 1.0,
             surface_depth_m: 0.5,
@@ -340,10 +348,14 @@ impl IusblNavigator {
 
     /// The vehicle's horizontal position relative to the beacon (eq. 17-18), and its
     /// covariance: the filter's, moved on by the displacement dead-reckoned since the
-    /// last ping (the particles move at pings only).
+    /// last ping (the particles move at pings only), with the heading error's consider
+    /// term ([`IusblConfig::heading_bias_sigma_rad`]): a small turn d of every
+    /// direction moves the relative position r by d J r.
     fn relative(&self) -> (Vector2<f64>, Matrix2<f64>) {
         let (mean, cov) = self.filter.mean_covariance();
-        (self.displacement_m - mean, cov)
+        let rel = self.displacement_m - mean;
+        let turned = Vector2::new(-rel.y, rel.x) * self.config.heading_bias_sigma_rad;
+        (rel, cov + turned * turned.transpose())
     }
 }
 

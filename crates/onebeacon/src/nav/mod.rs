@@ -13,8 +13,12 @@ pub mod event;
 pub mod fix;
 pub mod item;
 pub mod iusbl;
+#[cfg(test)]
+mod iusbl_consistency_tests;
 pub mod limits;
 pub mod planar;
+#[cfg(test)]
+mod planar_extended_tests;
 pub mod range_6dof;
 pub mod range_calibration;
 pub mod restart;
@@ -25,7 +29,7 @@ pub mod usbl_track;
 
 pub use event::{BeaconFix, Capture, Kind, Measurement};
 pub use iusbl::{IusblConfig, IusblNavigator};
-pub use planar::{PlanarConfig, PlanarNavigator, PlanarNoise};
+pub use planar::{HeadingOffsetPrior, PlanarConfig, PlanarNavigator, PlanarNoise};
 
 pub use range_6dof::{Range6DofNavigator, SensorNoise};
 pub use range_calibration::{CurrentPrior, OffsetPrior, RangeCalibration};

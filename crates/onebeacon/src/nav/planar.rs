@@ -7,26 +7,35 @@
 //! north toward east (rad), the range sensor's offset b (m) and scale error k_r (ranges
 //! read (1 + k_r) r + b: a latency, a wrong propagation speed), and the odometry's
 //! scale errors: true distance = (1 + k_d) x measured (wheel radius, DVL scale), true
-//! heading change = (1 + k_t) x measured (wheel base, gyro scale). The vehicle's depth is a
+//! heading change = (1 + k_t) x measured (wheel base, gyro scale). The extended state
+//! ([`EXTENDED_STATES`]) adds the heading sensor's offset h (heading fixes read psi + h:
+//! a compass's bias, an AHRS's slow error; a first-order Gauss-Markov process) and the
+//! water's current [c_N, c_E] (a random walk that carries the position: for motion
+//! inputs through the water, a propeller's or a DVL's water track). The vehicle's depth is a
 //! known input (pressure sensor) that enters slant ranges. A component that is not
 //! estimated stays at its configured value with zero variance, so one filter serves
 //! every combination. Doppler speeds are not scaled by k_r (acoustic Doppler speeds share
 //! the sound-speed error; modelling that is left for when a log needs it).
 
+use super::range_calibration::{CarriedDoppler, CurrentPrior};
 use super::{Aiding, BeaconFix, Estimate, Innovation, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::rts::History;
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::geo::wrap_angle;
 use crate::measure::{RadialSpeed2d, ScalarModel, SlantRange, StateComponent};
-use nalgebra::{SMatrix, SVector, Vector1, Vector3};
+use nalgebra::{Matrix2, SMatrix, SVector, Vector1, Vector2, Vector3};
 
 /// Number of state components.
 pub const STATES: usize = 7;
+/// The state size with the heading offset and the current ([`idx::HEADING_OFFSET`],
+/// [`idx::CURRENT_N`], [`idx::CURRENT_E`]).
+pub const EXTENDED_STATES: usize = STATES + 3;
 /// Most beacons with an offset of their own ([`PlanarConfig::estimate_beacon_offsets`]):
-/// the states after the first [`STATES`], taken by beacons in the order they are heard.
+/// the states after the first [`EXTENDED_STATES`], taken by beacons in the order they
+/// are heard.
 pub const BEACON_OFFSETS: usize = 8;
 /// The state size with per-beacon offsets.
-pub const STATES_WITH_OFFSETS: usize = STATES + BEACON_OFFSETS;
+pub const STATES_WITH_OFFSETS: usize = EXTENDED_STATES + BEACON_OFFSETS;
 type State<const N: usize> = SVector<f64, N>;
 type Cov<const N: usize> = SMatrix<f64, N, N>;
 
@@ -39,6 +48,9 @@ pub mod idx {
     pub const RANGE_SCALE: usize = 4;
     pub const DISTANCE_SCALE: usize = 5;
     pub const TURN_SCALE: usize = 6;
+    pub const HEADING_OFFSET: usize = 7;
+    pub const CURRENT_N: usize = 8;
+    pub const CURRENT_E: usize = 9;
 }
 
 /// Noise of the motion inputs and of the measurements.
@@ -115,6 +127,15 @@ pub struct PlanarConfig {
     /// gate, if any); `None`: Gaussian.
     pub robust: Option<Robust>,
     pub noise: PlanarNoise,
+    /// A forward speed of exactly zero is a stopped propeller (a speed from its RPM):
+    /// the vehicle coasts on, its speed decaying from the one held with this time
+    /// constant, s; None: it stops at once.
+    pub speed_coast_time_s: Option<f64>,
+    /// The heading sensor's offset as a state (heading fixes read psi + h); none
+    /// without.
+    pub heading_offset: Option<HeadingOffsetPrior>,
+    /// The water's current as two states that carry the position; none without.
+    pub current: Option<CurrentPrior>,
     /// Track a craft without motion inputs with a constant-velocity model driven by
     /// white acceleration of this standard deviation, m/s^2 per sqrt(s)
     /// ([`super::TrackingNavigator`]: position, velocity, range offset and scale); `None`
@@ -142,8 +163,77 @@ impl Default for PlanarConfig {
             nis_gate: None,
             robust: None,
             noise: PlanarNoise::default(),
+            speed_coast_time_s: None,
+            heading_offset: None,
+            current: None,
             track_accel_sigma_m_s2: None,
         }
+    }
+}
+
+impl PlanarConfig {
+    /// Whether it needs the [`EXTENDED_STATES`] layout (a heading offset or a current).
+    pub fn extended(&self) -> bool {
+        self.heading_offset.is_some() || self.current.is_some()
+    }
+}
+
+/// The heading offset's prior and motion: zero mean, `sigma_rad`, a first-order
+/// Gauss-Markov process of correlation time `time_s` (infinite: a constant).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadingOffsetPrior {
+    pub sigma_rad: f64,
+    pub time_s: f64,
+}
+
+/// Over `dt`: the current carries the position, the heading offset decays toward zero
+/// (exp(-dt / time)); linear.
+#[derive(Debug, Clone, Copy)]
+struct Drift {
+    dt: f64,
+    decay: f64,
+}
+
+impl<const N: usize> ProcessModel<N> for Drift {
+    fn propagate(&self, x: &State<N>, _dt: f64) -> State<N> {
+        let mut n = *x;
+        n[idx::N] += x[idx::CURRENT_N] * self.dt;
+        n[idx::E] += x[idx::CURRENT_E] * self.dt;
+        n[idx::HEADING_OFFSET] *= self.decay;
+        n
+    }
+
+    fn jacobian(&self, _x: &State<N>, _dt: f64) -> Cov<N> {
+        let mut f = Cov::<N>::identity();
+        f[(idx::N, idx::CURRENT_N)] = self.dt;
+        f[(idx::E, idx::CURRENT_E)] = self.dt;
+        f[(idx::HEADING_OFFSET, idx::HEADING_OFFSET)] = self.decay;
+        f
+    }
+
+    fn is_angle(&self, i: usize) -> bool {
+        i == idx::PSI || i == idx::HEADING_OFFSET
+    }
+}
+
+/// A heading fix that reads psi + h (the heading offset state), wrapped.
+#[derive(Debug, Clone, Copy)]
+struct OffsetHeading {
+    var: f64,
+}
+
+impl<const N: usize> ScalarModel<N> for OffsetHeading {
+    fn predict(&self, x: &State<N>) -> f64 {
+        wrap_angle(x[idx::PSI] + x[idx::HEADING_OFFSET])
+    }
+    fn jacobian(&self, _x: &State<N>) -> SMatrix<f64, 1, N> {
+        SMatrix::from_fn(|_, j| if j == idx::PSI || j == idx::HEADING_OFFSET { 1.0 } else { 0.0 })
+    }
+    fn is_angle(&self) -> bool {
+        true
+    }
+    fn variance(&self, _x: &State<N>) -> f64 {
+        self.var
     }
 }
 
@@ -240,18 +330,23 @@ impl<const N: usize> ProcessModel<N> for OdometryStep {
     }
 }
 
-/// The navigator: an EKF or UKF over [N, E, psi, b, k_r, k_d, k_t] (and, with `N` =
-/// [`STATES_WITH_OFFSETS`], an offset per beacon) with the held inputs (speed, depth).
+/// The navigator: an EKF or UKF over [N, E, psi, b, k_r, k_d, k_t] (with `N` =
+/// [`EXTENDED_STATES`], the heading offset and the current too; with
+/// [`STATES_WITH_OFFSETS`], an offset per beacon after them) with the held inputs (speed,
+/// depth).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlanarNavigator<const N: usize = STATES> {
     pub config: PlanarConfig,
     filter: AnyFilter<N>,
-    /// The beacon of each offset state after the first [`STATES`], in the order heard.
+    /// The beacon of each offset state after the first [`EXTENDED_STATES`], in the order
+    /// heard.
     offset_beacons: Vec<u32>,
     t_s: f64,
     /// Latest forward-speed input, and whether it drives the motion between events.
     speed_m_s: f64,
     coasting: bool,
+    /// The last speed input was a stopped propeller's ([`PlanarConfig::speed_coast_time_s`]).
+    propeller_stopped: bool,
     /// With a body velocity (a DVL): its starboard speed and yaw rate, held with the
     /// forward speed.
     lateral_m_s: f64,
@@ -280,8 +375,47 @@ impl PlanarNavigator {
     }
 }
 
+impl PlanarNavigator<EXTENDED_STATES> {
+    /// [`PlanarNavigator::new`] with the heading offset and the current
+    /// ([`PlanarConfig::heading_offset`], [`PlanarConfig::current`]; either one's states
+    /// stay at zero with zero variance when it is None).
+    pub fn extended(
+        config: PlanarConfig,
+        filter: FilterKind,
+        t_s: f64,
+        pose: (f64, f64, f64),
+        sigma_position_m: f64,
+        sigma_heading_rad: f64,
+    ) -> Self {
+        Self::start(config, filter, t_s, pose, (sigma_position_m, sigma_heading_rad))
+    }
+}
+
+impl<const N: usize> PlanarNavigator<N> {
+    /// The heading offset's mean and variance (rad, rad^2; zeros in the core layout).
+    pub fn heading_offset(&self) -> (f64, f64) {
+        if N < EXTENDED_STATES {
+            return (0.0, 0.0);
+        }
+        let i = idx::HEADING_OFFSET;
+        (self.filter.mean()[i], self.filter.covariance()[(i, i)])
+    }
+
+    /// The current's mean and covariance (north, east; m/s; zeros in the core layout).
+    pub fn current(&self) -> (Vector2<f64>, Matrix2<f64>) {
+        if N < EXTENDED_STATES {
+            return (Vector2::zeros(), Matrix2::zeros());
+        }
+        let (x, p) = (self.filter.mean(), self.filter.covariance());
+        (
+            x.fixed_rows::<2>(idx::CURRENT_N).into_owned(),
+            p.fixed_view::<2, 2>(idx::CURRENT_N, idx::CURRENT_N).into_owned(),
+        )
+    }
+}
+
 impl PlanarNavigator<STATES_WITH_OFFSETS> {
-    /// [`PlanarNavigator::new`] with an offset state per beacon
+    /// [`PlanarNavigator::extended`] with an offset state per beacon
     /// ([`PlanarConfig::estimate_beacon_offsets`]), each starting at `bias_m` with
     /// `bias_sigma_m`.
     pub fn with_beacon_offsets(
@@ -305,8 +439,18 @@ impl<const N: usize> PlanarNavigator<N> {
         (sigma_position_m, sigma_heading_rad): (f64, f64),
     ) -> Self {
         let sigma_if = |on: bool, sigma: f64| if on { sigma } else { 0.0 };
-        let offsets = config.estimate_beacon_offsets && N > STATES;
+        debug_assert!(N == STATES || N >= EXTENDED_STATES, "the layouts are 7, {EXTENDED_STATES} and more");
+        debug_assert!(N > STATES || !config.extended(), "a heading offset or a current needs the extended layout");
+        let offsets = config.estimate_beacon_offsets && N > EXTENDED_STATES;
         let mut sigmas = State::<N>::repeat(sigma_if(offsets, config.bias_sigma_m));
+        if N >= EXTENDED_STATES {
+            let current = config.current.map_or(0.0, |c| c.sigma_m_s);
+            sigmas.fixed_rows_mut::<3>(STATES).copy_from_slice(&[
+                config.heading_offset.map_or(0.0, |h| h.sigma_rad),
+                current,
+                current,
+            ]);
+        }
         sigmas.fixed_rows_mut::<STATES>(0).copy_from_slice(&[
             sigma_position_m,
             sigma_position_m,
@@ -318,6 +462,9 @@ impl<const N: usize> PlanarNavigator<N> {
         ]);
         let p = Cov::<N>::from_diagonal(&sigmas.component_mul(&sigmas));
         let mut x = State::<N>::repeat(config.bias_m);
+        if N >= EXTENDED_STATES {
+            x.fixed_rows_mut::<3>(STATES).fill(0.0);
+        }
         x.fixed_rows_mut::<STATES>(0).copy_from_slice(&[
             north_m,
             east_m,
@@ -335,6 +482,7 @@ impl<const N: usize> PlanarNavigator<N> {
             t_s,
             speed_m_s: 0.0,
             coasting: false,
+            propeller_stopped: false,
             lateral_m_s: 0.0,
             yaw_rate_rad_s: 0.0,
             last_odometry_s: None,
@@ -368,7 +516,16 @@ impl<const N: usize> PlanarNavigator<N> {
             let half = self.yaw_rate_rad_s * dt / 2.0;
             let chord = if half.abs() < 1e-9 { 1.0 } else { half.sin() / half };
             let sigma = self.config.noise.speed_sigma_m_s * dt;
-            let (d, lat) = (self.speed_m_s * dt * chord, self.lateral_m_s * dt * chord);
+            // a stopped propeller: the held speed decays over dt, the mean speed is its
+            // integral's
+            let (mut u, mut v) = (self.speed_m_s, self.lateral_m_s);
+            if let Some(tau) = self.config.speed_coast_time_s.filter(|_| self.propeller_stopped) {
+                let keep = (-dt / tau).exp();
+                let mean = tau * (1.0 - keep) / dt;
+                (u, v) = (u * mean, v * mean);
+                (self.speed_m_s, self.lateral_m_s) = (self.speed_m_s * keep, self.lateral_m_s * keep);
+            }
+            let (d, lat) = (u * dt * chord, v * dt * chord);
             self.motion(d, lat, 2.0 * half, sigma, sigma);
         }
         let n = self.config.noise;
@@ -377,14 +534,27 @@ impl<const N: usize> PlanarNavigator<N> {
         if self.config.estimate_bias {
             q[(idx::BIAS, idx::BIAS)] = q_bias;
         }
-        for i in STATES..STATES + self.offset_beacons.len() {
+        for i in EXTENDED_STATES..EXTENDED_STATES + self.offset_beacons.len() {
             q[(i, i)] = q_bias;
         }
         let q_walk = n.position_walk_m_per_sqrt_s.powi(2) * dt;
         (q[(idx::N, idx::N)], q[(idx::E, idx::E)]) = (q_walk, q_walk);
-        if q != Cov::<N>::zeros() {
-            self.diffuse(&q);
+        if !self.config.extended() {
+            if q != Cov::<N>::zeros() {
+                self.diffuse(&q);
+            }
+            return;
         }
+        // the current carries the position; the heading offset decays toward zero
+        let decay = self.config.heading_offset.map_or(1.0, |h| (-dt / h.time_s).exp());
+        if let Some(h) = self.config.heading_offset {
+            q[(idx::HEADING_OFFSET, idx::HEADING_OFFSET)] = h.sigma_rad.powi(2) * (1.0 - decay * decay);
+        }
+        if let Some(c) = self.config.current {
+            let q_current = c.walk_m_s_per_sqrt_s.powi(2) * dt;
+            (q[(idx::CURRENT_N, idx::CURRENT_N)], q[(idx::CURRENT_E, idx::CURRENT_E)]) = (q_current, q_current);
+        }
+        self.predict(&Drift { dt, decay }, &q);
     }
 
     /// Noise `q` added to the covariance, the mean as it was: a prediction through the
@@ -464,20 +634,23 @@ impl<const N: usize> PlanarNavigator<N> {
         if self.config.estimate_beacon_offsets {
             let slot = self.offset_beacons.iter().position(|&b| b == beacon.id);
             let slot = slot.or_else(|| {
-                (STATES + self.offset_beacons.len() < N).then(|| {
+                (EXTENDED_STATES + self.offset_beacons.len() < N).then(|| {
                     self.offset_beacons.push(beacon.id);
                     self.offset_beacons.len() - 1
                 })
             });
-            bias = slot.map_or(idx::BIAS, |i| STATES + i);
+            bias = slot.map_or(idx::BIAS, |i| EXTENDED_STATES + i);
         }
         let beacon = beacon.position_ned_m;
         SlantRange { beacon, depth_m: self.depth_m, bias: Some(bias), scale: Some(idx::RANGE_SCALE), var }
     }
 
-    fn doppler_model(&self, beacon: Vector3<f64>) -> RadialSpeed2d {
+    /// The radial speed toward `beacon` over ground: the held speed along the heading,
+    /// plus the current's share when it is a state.
+    fn doppler_model(&self, beacon: Vector3<f64>) -> CarriedDoppler {
         let var = self.config.noise.doppler_sigma_m_s * self.config.noise.doppler_sigma_m_s;
-        RadialSpeed2d { beacon: beacon.xy(), known_speed_m_s: Some(self.speed_m_s), var }
+        let doppler = RadialSpeed2d { beacon: beacon.xy(), known_speed_m_s: Some(self.speed_m_s), var };
+        CarriedDoppler { doppler, current: self.config.current.map(|_| idx::CURRENT_N) }
     }
 }
 
@@ -486,7 +659,7 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
     /// (none without [`PlanarConfig::estimate_beacon_offsets`]).
     fn beacon_offsets(&self) -> Vec<(u32, f64, f64)> {
         let (x, p) = (self.filter.mean(), self.filter.covariance());
-        let slot = |i: usize| STATES + i;
+        let slot = |i: usize| EXTENDED_STATES + i;
         self.offset_beacons.iter().enumerate().map(|(i, &b)| (b, x[slot(i)], p[(slot(i), slot(i))].sqrt())).collect()
     }
 
@@ -515,13 +688,17 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
                 self.odometry(t_s, forward_m, lateral_m, heading_change_rad)
             }
             Kind::Speed { speed_m_s } => {
-                (self.speed_m_s, self.lateral_m_s, self.yaw_rate_rad_s) = (speed_m_s, 0.0, 0.0);
+                self.propeller_stopped = speed_m_s == 0.0 && self.config.speed_coast_time_s.is_some();
+                if !self.propeller_stopped {
+                    (self.speed_m_s, self.lateral_m_s) = (speed_m_s, 0.0);
+                }
+                self.yaw_rate_rad_s = 0.0;
                 self.coasting = true;
                 Outcome::Applied
             }
             Kind::BodyVelocity { nu } => {
                 (self.speed_m_s, self.lateral_m_s, self.yaw_rate_rad_s) = (nu[0], nu[1], nu[5]);
-                self.coasting = true;
+                (self.coasting, self.propeller_stopped) = (true, false);
                 Outcome::Applied
             }
             Kind::Depth { depth_m } => {
@@ -530,7 +707,10 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
             }
             Kind::Heading { heading_rad } | Kind::Attitude { heading_rad, .. } => {
                 let var = noise.heading_sigma_rad * noise.heading_sigma_rad;
-                self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, false)
+                match self.config.heading_offset {
+                    Some(_) => self.correct(&OffsetHeading { var }, heading_rad, false),
+                    None => self.correct(&StateComponent::angle(idx::PSI, var), heading_rad, false),
+                }
             }
             Kind::Range { beacon, range_m } if aiding.range => {
                 let model = self.range_model(&beacon);
@@ -579,7 +759,7 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
     fn smoothed(&self) -> Vec<Estimate> {
         let Some((history, depths)) = &self.history else { return Vec::new() };
         let last = (*self.filter.mean(), *self.filter.covariance());
-        let smoothed = history.smooth(last, |k| k == idx::PSI);
+        let smoothed = history.smooth(last, |k| k == idx::PSI || (N > STATES && k == idx::HEADING_OFFSET));
         smoothed.iter().zip(depths).map(|((t, (x, p)), d)| Self::estimate_of(*t, x, p, *d)).collect()
     }
 }
@@ -593,6 +773,9 @@ pub fn builder(c: PlanarConfig, f: FilterKind) -> super::restart::Builder {
         Some(a) => Box::new(super::TrackingNavigator::new(c, a, f, t0, (pose.0, pose.1), sigma_position_m)),
         None if c.estimate_beacon_offsets => {
             Box::new(PlanarNavigator::with_beacon_offsets(c, f, t0, pose, sigma_position_m, sigma_heading_rad))
+        }
+        None if c.extended() => {
+            Box::new(PlanarNavigator::extended(c, f, t0, pose, sigma_position_m, sigma_heading_rad))
         }
         None => Box::new(PlanarNavigator::new(c, f, t0, pose, sigma_position_m, sigma_heading_rad)),
     })
