@@ -4,7 +4,7 @@ import functools
 import json
 import re
 
-from .common import RUNS, cli, cli_on_toml, figure, header
+from .common import RUNS, cli, cli_on_toml, figure, header, nees_figure
 
 
 # rypkema Table 3: the 2-norm error's 68 % / 95 %, m, all six missions, real data
@@ -79,8 +79,27 @@ def rypkema_sea(quick):
         fleet_row("dead reckoning in the -sea runs", sea, "fleet/dead-reckoning", digits=2)]
 
 
+def rypkema_nees(quick):
+    """docs/reproductions/rypkema.md, consistency: each estimator's mean NEES against the
+    truth (pooled over every run and AUV), from the runs of the two tables above, with
+    the chi-square band of as many draws (95 %)."""
+    missions = ("rypkema-m1", "rypkema-m6")
+    runs = [fleet(m, "rypkema", quick) for m in missions] + [fleet(f"{m}-sea", "rypkema-sea", quick)
+                                                            for m in missions]
+    n = {k: RUNS[k][1] for k in ("rypkema", "rypkema-sea")}
+    rows = header("", *(f"{m} ({n['rypkema']} runs)" for m in missions),
+                  *(f"{m}-sea ({n['rypkema-sea']} runs)" for m in missions))
+    for label, key in (("iusbl (factored)", "fleet/iusbl"), ("iusbl-joint", "fleet/iusbl-joint"),
+                       ("dead reckoning", "fleet/dead-reckoning")):
+        rows.append(f"| {label} | " + " | ".join(nees_figure(r[key]["nees_mean"]) for r in runs) + " |")
+    rows.append("| band (95 %) | " + " | ".join(
+        f"{figure(r['fleet/iusbl']['nees_band'][0])}-{figure(r['fleet/iusbl']['nees_band'][1])}" for r in runs) + " |")
+    return rows
+
+
 # the tables of this module by the name that marks them in docs/
 TABLES = {
     "rypkema": rypkema,
     "rypkema-sea": rypkema_sea,
+    "rypkema-nees": rypkema_nees,
 }

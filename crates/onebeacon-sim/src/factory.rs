@@ -5,7 +5,7 @@
 
 use crate::engine::Track;
 use crate::scenario::estimator::IusblKeys;
-use crate::scenario::fleet::{Fleet, SignalModel};
+use crate::scenario::fleet::{Fleet, Navigation, SignalModel};
 use crate::scenario::{EstimatorKind, FixedBeacon, Host, MovingBeacon, PassiveUsbl};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use crate::vehicles::sandshark::SandSharkParams;
@@ -21,7 +21,7 @@ use onebeacon::models::unicycle::{Cov, State};
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
 use onebeacon::nav::{
-    Aiding, HeadingOffsetPrior, IusblNavigator, PlanarConfig, PlanarNoise, range_6dof, single_beacon,
+    Aiding, CurrentPrior, HeadingOffsetPrior, IusblNavigator, PlanarConfig, PlanarNoise, range_6dof, single_beacon,
 };
 use rand::RngExt;
 
@@ -166,14 +166,19 @@ pub(crate) fn iusbl_keys(s: &Fleet) -> IusblKeys {
 /// stopped the RPM reads zero while the vehicle coasts on with its coast time constant. The speed input has no
 /// turn rate: the heading between fixes walks by as much as the SandShark can turn in a
 /// metre at 1 m/s (its largest turn rate, per sqrt(m)), so that each fix moves the
-/// heading, not the offset.
-fn fleet_dead_reckoning(p: &SandSharkParams) -> PlanarConfig {
+/// heading, not the offset. The current it believes in (`navigation.current_sigma_m_s`),
+/// if any, is two states.
+fn fleet_dead_reckoning(p: &SandSharkParams, n: &Navigation) -> PlanarConfig {
     let d = PlanarConfig::default();
     PlanarConfig {
         aiding: Aiding::NONE,
         estimate_distance_scale: p.speed_scale_sigma > 0.0,
         distance_scale_sigma: p.speed_scale_sigma,
         speed_coast_time_s: Some(p.coast_time_constant_s),
+        current: (n.current_sigma_m_s > 0.0).then_some(CurrentPrior {
+            sigma_m_s: n.current_sigma_m_s,
+            walk_m_s_per_sqrt_s: n.current_walk_m_s_per_sqrt_s,
+        }),
         heading_offset: (p.heading_error_deg > 0.0).then(|| HeadingOffsetPrior {
             sigma_rad: p.heading_error_deg.to_radians(),
             time_s: p.heading_error_time_s,
@@ -218,7 +223,7 @@ pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
                     Box::new(IusblNavigator::new(config, receiver, filter_seed))
                 })
             } else {
-                onebeacon::nav::planar::builder(fleet_dead_reckoning(&s.sandshark), FilterKind::Ekf)
+                onebeacon::nav::planar::builder(fleet_dead_reckoning(&s.sandshark, &s.navigation), FilterKind::Ekf)
             };
             tracks.push(Track::new(v, builder, pose, (1.0, 0.05)));
         }

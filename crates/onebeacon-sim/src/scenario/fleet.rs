@@ -155,6 +155,10 @@ pub struct Navigation {
     pub floor: f64,
     pub beam_exponent: f64,
     pub confirmations: usize,
+    /// Dead reckoning's belief in a current: its prior standard deviation per axis, m/s,
+    /// and its random walk, m/s per sqrt(s) (0: no current state).
+    pub current_sigma_m_s: f64,
+    pub current_walk_m_s_per_sqrt_s: f64,
 }
 
 impl Default for Navigation {
@@ -171,6 +175,8 @@ impl Default for Navigation {
             floor: k.floor,
             beam_exponent: k.beam_exponent,
             confirmations: k.confirmations,
+            current_sigma_m_s: 0.0,
+            current_walk_m_s_per_sqrt_s: 0.0,
         }
     }
 }
@@ -351,6 +357,8 @@ pub(super) fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
         beacon_speed_m_s: NonNegative,
         floor: Probability,
         beam_exponent: Positive,
+        current_sigma_m_s: NonNegative,
+        current_walk_m_s_per_sqrt_s: NonNegative,
     });
     check_fields!("dock", s.dock, { north_m: Finite, east_m: Finite, beacon_depth_m: NonNegative, gps_sigma_m: NonNegative });
     check_count("boat (waypoints)", s.boat.len(), 1, 100_000)?;

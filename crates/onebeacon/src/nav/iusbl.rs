@@ -427,6 +427,7 @@ impl Navigator for IusblNavigator {
             distance_scale: 0.0,
             turn_scale: 0.0,
             usbl_misalignment_rad: 0.0,
+            current_ned_m_s: [0.0; 2],
         }
     }
 

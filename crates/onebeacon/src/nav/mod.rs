@@ -197,6 +197,8 @@ pub struct Estimate {
     pub turn_scale: f64,
     /// The USBL head's yaw misalignment, rad, where it is a state.
     pub usbl_misalignment_rad: f64,
+    /// The water's current (north, east), m/s, where it is a state.
+    pub current_ned_m_s: [f64; 2],
 }
 
 impl Estimate {
@@ -219,14 +221,16 @@ impl Estimate {
     pub fn sigma_heading_rad(&self) -> f64 {
         self.heading_var_rad2.max(0.0).sqrt()
     }
-    /// The range, odometry and USBL calibration states, as output keys.
-    pub fn calibration(&self) -> [(&'static str, f64); 5] {
+    /// The range, odometry and USBL calibration states and the current, as output keys.
+    pub fn calibration(&self) -> [(&'static str, f64); 7] {
         [
             ("range_bias_m", self.range_bias_m),
             ("range_scale", self.range_scale),
             ("distance_scale", self.distance_scale),
             ("turn_scale", self.turn_scale),
             ("usbl_misalignment_rad", self.usbl_misalignment_rad),
+            ("current_north_m_s", self.current_ned_m_s[0]),
+            ("current_east_m_s", self.current_ned_m_s[1]),
         ]
     }
     /// Body-to-NED rotation of the estimated attitude (roll and pitch zero where they

@@ -371,23 +371,7 @@ impl PlanarNavigator {
         sigma_position_m: f64,
         sigma_heading_rad: f64,
     ) -> Self {
-        Self::start(config, filter, t_s, pose, (sigma_position_m, sigma_heading_rad))
-    }
-}
-
-impl PlanarNavigator<EXTENDED_STATES> {
-    /// [`PlanarNavigator::new`] with the heading offset and the current
-    /// ([`PlanarConfig::heading_offset`], [`PlanarConfig::current`]; either one's states
-    /// stay at zero with zero variance when it is None).
-    pub fn extended(
-        config: PlanarConfig,
-        filter: FilterKind,
-        t_s: f64,
-        pose: (f64, f64, f64),
-        sigma_position_m: f64,
-        sigma_heading_rad: f64,
-    ) -> Self {
-        Self::start(config, filter, t_s, pose, (sigma_position_m, sigma_heading_rad))
+        Self::with_layout(config, filter, t_s, pose, (sigma_position_m, sigma_heading_rad))
     }
 }
 
@@ -414,24 +398,14 @@ impl<const N: usize> PlanarNavigator<N> {
     }
 }
 
-impl PlanarNavigator<STATES_WITH_OFFSETS> {
-    /// [`PlanarNavigator::extended`] with an offset state per beacon
-    /// ([`PlanarConfig::estimate_beacon_offsets`]), each starting at `bias_m` with
-    /// `bias_sigma_m`.
-    pub fn with_beacon_offsets(
-        config: PlanarConfig,
-        filter: FilterKind,
-        t_s: f64,
-        pose: (f64, f64, f64),
-        sigma_position_m: f64,
-        sigma_heading_rad: f64,
-    ) -> Self {
-        Self::start(config, filter, t_s, pose, (sigma_position_m, sigma_heading_rad))
-    }
-}
-
 impl<const N: usize> PlanarNavigator<N> {
-    fn start(
+    /// [`PlanarNavigator::new`] in layout `N`: [`STATES`] (the core), [`EXTENDED_STATES`]
+    /// (with the heading offset and the current, [`PlanarConfig::heading_offset`] and
+    /// [`PlanarConfig::current`]: either one's states stay at zero with zero variance
+    /// when it is None) or [`STATES_WITH_OFFSETS`] (and an offset per beacon,
+    /// [`PlanarConfig::estimate_beacon_offsets`], each starting at `bias_m` with
+    /// `bias_sigma_m`).
+    pub fn with_layout(
         config: PlanarConfig,
         filter: FilterKind,
         t_s: f64,
@@ -600,6 +574,7 @@ impl<const N: usize> PlanarNavigator<N> {
             distance_scale: x[idx::DISTANCE_SCALE],
             turn_scale: x[idx::TURN_SCALE],
             usbl_misalignment_rad: 0.0,
+            current_ned_m_s: if N >= EXTENDED_STATES { [x[idx::CURRENT_N], x[idx::CURRENT_E]] } else { [0.0; 2] },
         }
     }
 
@@ -771,12 +746,20 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
 pub fn builder(c: PlanarConfig, f: FilterKind) -> super::restart::Builder {
     Box::new(move |t0, pose, sigma_position_m, sigma_heading_rad| match c.track_accel_sigma_m_s2 {
         Some(a) => Box::new(super::TrackingNavigator::new(c, a, f, t0, (pose.0, pose.1), sigma_position_m)),
-        None if c.estimate_beacon_offsets => {
-            Box::new(PlanarNavigator::with_beacon_offsets(c, f, t0, pose, sigma_position_m, sigma_heading_rad))
-        }
-        None if c.extended() => {
-            Box::new(PlanarNavigator::extended(c, f, t0, pose, sigma_position_m, sigma_heading_rad))
-        }
+        None if c.estimate_beacon_offsets => Box::new(PlanarNavigator::<STATES_WITH_OFFSETS>::with_layout(
+            c,
+            f,
+            t0,
+            pose,
+            (sigma_position_m, sigma_heading_rad),
+        )),
+        None if c.extended() => Box::new(PlanarNavigator::<EXTENDED_STATES>::with_layout(
+            c,
+            f,
+            t0,
+            pose,
+            (sigma_position_m, sigma_heading_rad),
+        )),
         None => Box::new(PlanarNavigator::new(c, f, t0, pose, sigma_position_m, sigma_heading_rad)),
     })
 }
@@ -1056,8 +1039,13 @@ mod tests {
         };
         let noise = PlanarNoise::default();
         let per_beacon = PlanarConfig { estimate_beacon_offsets: true, noise, ..PlanarConfig::default() };
-        let mut nav =
-            PlanarNavigator::with_beacon_offsets(per_beacon, FilterKind::Ekf, 0.0, (0.0, 0.0, 0.0), 0.5, 0.02);
+        let mut nav = PlanarNavigator::<STATES_WITH_OFFSETS>::with_layout(
+            per_beacon,
+            FilterKind::Ekf,
+            0.0,
+            (0.0, 0.0, 0.0),
+            (0.5, 0.02),
+        );
         let worst = run(&mut nav);
         let offsets = nav.beacon_offsets();
         assert_eq!(offsets.len(), 3);
@@ -1073,8 +1061,13 @@ mod tests {
         let worst_shared = run(&mut one);
         assert!(worst_shared > 2.0, "one shared offset: {worst_shared} m");
         // slots full: a ninth beacon's range uses the shared offset state (fixed at bias_m)
-        let mut full =
-            PlanarNavigator::with_beacon_offsets(per_beacon, FilterKind::Ekf, 0.0, (0.0, 0.0, 0.0), 1.0, 0.02);
+        let mut full = PlanarNavigator::<STATES_WITH_OFFSETS>::with_layout(
+            per_beacon,
+            FilterKind::Ekf,
+            0.0,
+            (0.0, 0.0, 0.0),
+            (1.0, 0.02),
+        );
         for id in 0..=BEACON_OFFSETS as u32 {
             let b = Vector3::new(100.0 * f64::from(id + 1), 0.0, 0.0);
             full.process(&Measurement::new(1.0, Kind::Range { beacon: BeaconFix::fixed(id, b), range_m: b.norm() }));

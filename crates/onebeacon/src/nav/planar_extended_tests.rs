@@ -9,13 +9,12 @@ use approx::assert_abs_diff_eq;
 use nalgebra::{Matrix2, Vector2, Vector3};
 
 fn dead_reckoning(c: PlanarConfig) -> PlanarNavigator<EXTENDED_STATES> {
-    PlanarNavigator::extended(
+    PlanarNavigator::<EXTENDED_STATES>::with_layout(
         PlanarConfig { aiding: Aiding::NONE, ..c },
         FilterKind::Ekf,
         0.0,
         (0.0, 0.0, 0.0),
-        0.0,
-        0.0,
+        (0.0, 0.0),
     )
 }
 
@@ -44,7 +43,13 @@ fn a_heading_offset_carries_a_compass_bias_into_the_covariance() {
             let heading_offset = offset.then_some(HeadingOffsetPrior { sigma_rad: sigma_bias, time_s: f64::INFINITY });
             // the heading unknown at the start (1 rad): the first fix sets it
             let config = PlanarConfig { aiding: Aiding::NONE, heading_offset, noise, ..PlanarConfig::default() };
-            let mut nav = PlanarNavigator::extended(config, FilterKind::Ekf, 0.0, (0.0, 0.0, 0.0), 0.0, 1.0);
+            let mut nav = PlanarNavigator::<EXTENDED_STATES>::with_layout(
+                config,
+                FilterKind::Ekf,
+                0.0,
+                (0.0, 0.0, 0.0),
+                (0.0, 1.0),
+            );
             let bias = gauss(&mut rng, sigma_bias);
             let mut truth = Vector2::zeros();
             for k in 0..400 {
@@ -117,7 +122,13 @@ fn ranges_find_the_current() {
             noise: PlanarNoise { range_sigma_m: 0.5, ..PlanarNoise::default() },
             ..PlanarConfig::default()
         };
-        let mut nav = PlanarNavigator::extended(config, FilterKind::Ekf, 0.0, (50.0, 50.0, 0.0), 2.0, 0.01);
+        let mut nav = PlanarNavigator::<EXTENDED_STATES>::with_layout(
+            config,
+            FilterKind::Ekf,
+            0.0,
+            (50.0, 50.0, 0.0),
+            (2.0, 0.01),
+        );
         let mut rng = rand_pcg::Pcg64::new(3, 9);
         nav.process(&Measurement::new(0.0, Kind::Speed { speed_m_s: 0.0 }));
         let mut worst: f64 = 0.0;
@@ -132,6 +143,8 @@ fn ranges_find_the_current() {
                 worst = worst.max((nav.estimate().position_ned_m.xy() - truth).norm());
             }
         }
+        let shown = nav.estimate().current_ned_m_s;
+        assert_eq!(Vector2::from(shown), nav.current().0, "the estimate shows the current's states");
         (nav.current(), worst)
     };
     let ((c, _), worst) = run(true);
@@ -170,7 +183,8 @@ fn doppler_speeds_see_the_current() {
         noise: PlanarNoise { doppler_sigma_m_s: 0.01, ..PlanarNoise::default() },
         ..PlanarConfig::default()
     };
-    let mut nav = PlanarNavigator::extended(config, FilterKind::Ekf, 0.0, (0.0, 0.0, 0.0), 0.0, 0.0);
+    let mut nav =
+        PlanarNavigator::<EXTENDED_STATES>::with_layout(config, FilterKind::Ekf, 0.0, (0.0, 0.0, 0.0), (0.0, 0.0));
     let beacons = [Vector3::new(-100.0, 0.0, 0.0), Vector3::new(0.0, -100.0, 0.0)];
     nav.process(&Measurement::new(0.0, Kind::Speed { speed_m_s: 0.0 }));
     for k in 0..40 {

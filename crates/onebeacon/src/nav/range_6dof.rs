@@ -230,6 +230,10 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
             distance_scale: 0.0,
             turn_scale: 0.0,
             usbl_misalignment_rad: 0.0,
+            current_ned_m_s: [
+                state(self.calibration.layout.current),
+                state(self.calibration.layout.current.map(|i| i + 1)),
+            ],
         }
     }
 }

@@ -401,6 +401,7 @@ impl<const N: usize, P: ProcessModel<N> + Send> Navigator for SingleBeaconNaviga
             distance_scale: 0.0,
             turn_scale: 0.0,
             usbl_misalignment_rad: 0.0,
+            current_ned_m_s: self.calibration.layout.current.map_or([0.0; 2], |i| [x[i], x[i + 1]]),
         }
     }
 }

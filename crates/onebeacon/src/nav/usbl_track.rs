@@ -122,6 +122,7 @@ fn estimate_of(t_s: f64, x: &TrackState, p: &SMatrix<f64, DIM, DIM>, heading: (f
         distance_scale: 0.0,
         turn_scale: 0.0,
         usbl_misalignment_rad: 0.0,
+        current_ned_m_s: [0.0; 2],
     }
 }
 

@@ -221,6 +221,7 @@ mod tests {
                 distance_scale: 0.0,
                 turn_scale: 0.0,
                 usbl_misalignment_rad: 0.0,
+                current_ned_m_s: [0.0; 2],
             }
         }
         fn command_mode(&self) -> Option<usize> {
