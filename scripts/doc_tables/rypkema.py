@@ -4,7 +4,7 @@ import functools
 import json
 import re
 
-from .common import RUNS, cli, cli_on_toml, figure, header, nees_figure
+from .common import RUNS, cli, cli_on_toml, figure, header
 
 
 # rypkema Table 3: the 2-norm error's 68 % / 95 %, m, all six missions, real data
@@ -91,7 +91,7 @@ def rypkema_nees(quick):
                   *(f"{m}-sea ({n['rypkema-sea']} runs)" for m in missions))
     for label, key in (("iusbl (factored)", "fleet/iusbl"), ("iusbl-joint", "fleet/iusbl-joint"),
                        ("dead reckoning", "fleet/dead-reckoning")):
-        rows.append(f"| {label} | " + " | ".join(nees_figure(r[key]["nees_mean"]) for r in runs) + " |")
+        rows.append(f"| {label} | " + " | ".join(figure(r[key]["nees_mean"]) for r in runs) + " |")
     rows.append("| band (95 %) | " + " | ".join(
         f"{figure(r['fleet/iusbl']['nees_band'][0])}-{figure(r['fleet/iusbl']['nees_band'][1])}" for r in runs) + " |")
     return rows
