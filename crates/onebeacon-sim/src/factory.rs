@@ -163,11 +163,11 @@ pub(crate) fn iusbl_keys(s: &Fleet) -> IusblKeys {
 /// RPM speed's scale error as a distance-scale state and its white noise, the AHRS
 /// heading's slow error as a Gauss-Markov heading offset (that no fix can show: its
 /// variance carries the drift it causes) and its white noise; with the propeller
-/// stopped the RPM reads zero while the vehicle coasts on with its coast time constant. The speed input has no
-/// turn rate: the heading between fixes walks by as much as the SandShark can turn in a
-/// metre at 1 m/s (its largest turn rate, per sqrt(m)), so that each fix moves the
-/// heading, not the offset. The current it believes in (`navigation.current_sigma_m_s`),
-/// if any, is two states.
+/// stopped the RPM reads zero while the vehicle coasts on with its coast time constant.
+/// The speed input has no turn rate: the heading between fixes walks by as much as the
+/// SandShark can turn in a metre at 1 m/s (its largest turn rate, per sqrt(m)), so that
+/// each fix moves the heading, not the offset. The current it believes in
+/// (`navigation.current_sigma_m_s`), if any, is two states.
 fn fleet_dead_reckoning(p: &SandSharkParams, n: &Navigation) -> PlanarConfig {
     let d = PlanarConfig::default();
     PlanarConfig {

@@ -415,6 +415,11 @@ impl<const N: usize> PlanarNavigator<N> {
         let sigma_if = |on: bool, sigma: f64| if on { sigma } else { 0.0 };
         debug_assert!(N == STATES || N >= EXTENDED_STATES, "the layouts are 7, {EXTENDED_STATES} and more");
         debug_assert!(N > STATES || !config.extended(), "a heading offset or a current needs the extended layout");
+        // the core layout has neither ([`builder`] picks the layout a config needs)
+        let mut config = config;
+        if N < EXTENDED_STATES {
+            (config.heading_offset, config.current) = (None, None);
+        }
         let offsets = config.estimate_beacon_offsets && N > EXTENDED_STATES;
         let mut sigmas = State::<N>::repeat(sigma_if(offsets, config.bias_sigma_m));
         if N >= EXTENDED_STATES {
