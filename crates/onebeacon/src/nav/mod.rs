@@ -17,8 +17,10 @@ pub mod iusbl;
 mod iusbl_consistency_tests;
 pub mod limits;
 pub mod planar;
+mod planar_config;
 #[cfg(test)]
 mod planar_extended_tests;
+mod planar_models;
 pub mod range_6dof;
 pub mod range_calibration;
 pub mod restart;
