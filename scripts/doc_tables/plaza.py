@@ -108,16 +108,22 @@ NO_ODOMETRY_MODELS = [
 NO_ODOMETRY_CALIBRATION = {"estimate_bias": "true", "estimate_range_scale": "true", "range_scale_sigma": 0.1}
 
 
+def plaza1_without_odometry():
+    """data/plaza/plaza1.toml without its odometry source and its estimators (ranges and
+    truth only), its files named by absolute path."""
+    data = ROOT / "data/plaza"
+    log = blocks_kept(data / "plaza1.toml", lambda head, text: head != "estimators" and not (
+        head == "source" and 'kind = "odometry"' in text))
+    return re.sub(r'(?m)^file = "([^"/]+)"', lambda m: f'file = "{data / m.group(1)}"', log)
+
+
 def plaza_no_odometry(quick):
     """docs/logs.md: plaza1 with its odometry source left out (ranges and truth only), each
     motion model of NO_ODOMETRY_MODELS as a range EKF and with offset and scale states
     (`onebeacon replay LOG --beacons B`): RMSE, m, [ranges the gate rejected] when any,
     all four beacons, 0 and 1, 5 and 6."""
     del quick  # real data: the same figures at any count
-    data = ROOT / "data/plaza"
-    log = blocks_kept(data / "plaza1.toml", lambda head, text: head != "estimators" and not (
-        head == "source" and 'kind = "odometry"' in text))
-    log = re.sub(r'(?m)^file = "([^"/]+)"', lambda m: f'file = "{data / m.group(1)}"', log)
+    log = plaza1_without_odometry()
     for i, (_, keys) in enumerate(NO_ODOMETRY_MODELS):
         for cal in ("", "-cal"):
             every = {**keys, **(NO_ODOMETRY_CALIBRATION if cal else {})}

@@ -1,7 +1,13 @@
 """docs/smooth.md's tables: the smoother on the plaza logs."""
 
-from .common import header
-from .plaza import PLAZA_SETS, log_paired_rows, log_run, trajectory_errors
+import json
+
+from .common import cli_on_toml, header
+from .plaza import NO_ODOMETRY_CALIBRATION, PLAZA_SETS, log_paired_rows, log_run, plaza1_without_odometry, \
+    trajectory_errors
+
+# the constant-velocity models of smooth-track: the white acceleration, m/s^1.5
+TRACK_ACCELS = (0.05, 0.1, 0.3, 1)
 
 
 def smooth_plaza(quick):
@@ -38,8 +44,33 @@ def smooth_paired(quick):
     return log_paired_rows(pairs, lambda n, b, extra: trajectory_errors("smooth", n, b, *extra))
 
 
+def smooth_track(quick):
+    """docs/smooth.md: plaza1 without its odometry (ranges and truth only), the
+    constant-velocity tracker with offset and scale states at each white acceleration of
+    TRACK_ACCELS, and `onebeacon smooth LOG --like` it: RMSE, m, of the tracker and of the
+    smoother (its mean NEES), all four beacons, 0 and 1, 5 and 6."""
+    del quick  # real data: the same figures at any count
+    log = plaza1_without_odometry()
+    for i, accel in enumerate(TRACK_ACCELS):
+        keys = {"track_accel_sigma_m_s2": accel, **NO_ODOMETRY_CALIBRATION}
+        log += f'\n[[estimators]]\nname = "cv{i}"\nkind = "range-ekf"\n' + "".join(f"{k} = {v}\n" for k, v in keys.items())
+    sets = {"all 4": None, "0 and 1": "0,1", "5 and 6": "5,6"}
+    rows = header("white acceleration, m/s^1.5", *(f"{label}: {f}" for label in sets for f in ("tracker", "smoother (NEES)")))
+    for i, accel in enumerate(TRACK_ACCELS):
+        cells = []
+        for b in sets.values():
+            summary = json.loads(cli_on_toml("smooth", log, "--json", "--like", f"cv{i}",
+                                             *(["--beacons", b] if b else []), out=True))
+            runs = {e["name"]: e for e in summary["estimators"]}
+            s = runs["smoother"]
+            cells += [f"{runs[f'cv{i}']['rmse_m']:.1f}", f"{s['rmse_m']:.1f} ({s['nees_mean']:.0f})"]
+        rows.append(f"| {accel} | " + " | ".join(cells) + " |")
+    return rows
+
+
 # the tables of this module by the name that marks them in docs/
 TABLES = {
+    "smooth-track": smooth_track,
     "smooth-paired": smooth_paired,
     "smooth-plaza": smooth_plaza,
 }

@@ -252,6 +252,12 @@ enum Command {
         /// huber (k 1.345), cauchy (k 2.3849), student_t (4 dof).
         #[arg(long, value_name = "KERNEL")]
         kernel: Option<String>,
+        /// Smooth a craft that sends no motion data with a constant-velocity model:
+        /// the white acceleration's sqrt spectral density, m/s^1.5 (the key
+        /// track_accel_sigma_m_s2; docs/smooth.md). Motion rows and heading fixes are
+        /// then not read.
+        #[arg(long, value_name = "SIGMA")]
+        track_accel: Option<f64>,
         /// Print one JSON object (the summary) instead of the table.
         #[arg(long)]
         json: bool,
@@ -485,8 +491,11 @@ fn main() -> ExitCode {
                 holdout,
             },
         ),
-        Command::Smooth { log, out, beacons, like, estimators, calibrate, kernel, json } => {
-            smooth::smooth(&log, smooth::SmoothArgs { out, beacons, json, like, estimators, calibrate, kernel })
+        Command::Smooth { log, out, beacons, like, estimators, calibrate, kernel, track_accel, json } => {
+            smooth::smooth(
+                &log,
+                smooth::SmoothArgs { out, beacons, json, like, estimators, calibrate, kernel, track_accel },
+            )
         }
         Command::Tune { log, estimators, keys, beacons, each_beacon, out, json } => {
             tune::tune(&log, tune::TuneArgs { estimators, keys, beacons, each_beacon, out, json })

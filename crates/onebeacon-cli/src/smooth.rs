@@ -20,17 +20,24 @@ pub struct SmoothArgs {
     pub estimators: Option<PathBuf>,
     pub calibrate: Option<Vec<String>>,
     pub kernel: Option<String>,
+    pub track_accel: Option<f64>,
 }
 
 /// `onebeacon smooth LOG.toml [--out DIR] [--beacons 0,5] [--like NAME] [--calibrate ...]
-/// [--kernel ...] [--json]`
+/// [--kernel ...] [--track-accel SIGMA] [--json]`
 pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
     let mut log = Log::load(path)?;
     if let Some(file) = &a.estimators {
         log.description.use_estimators(file)?;
     }
-    let cfg = onebeacon_sim::smooth::config(&log, a.like.as_deref(), a.calibrate.as_deref(), a.kernel.as_deref())
-        .map_err(|e| BadInput(format!("--{e}")))?;
+    let cfg = onebeacon_sim::smooth::config(
+        &log,
+        a.like.as_deref(),
+        a.calibrate.as_deref(),
+        a.kernel.as_deref(),
+        a.track_accel,
+    )
+    .map_err(|e| BadInput(format!("--{e}")))?;
     crate::budget().check_smooth(&log).map_err(|e| BadInput(e.to_string()))?;
     let p = Prepared::new(log, a.estimators.as_deref(), a.out.clone(), a.beacons.clone(), "smooth")?;
     // a log that cannot be read or has nothing to smooth is bad input (exit 2)
@@ -62,14 +69,18 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
         (None, Some(_)) => "the log's [noise], the defaults for the rest".to_string(),
         (None, None) => "the defaults".to_string(),
     };
+    // the noise the smoother weighed with, and a track's constant-velocity model
+    let mut noise_keys = onebeacon_sim::json::noise_keys(&cfg.noise);
+    if let Some(a) = cfg.track_accel_sigma_m_s2 {
+        noise_keys["track_accel_sigma_m_s2"] = serde_json::json!(a);
+    }
     let mut warnings = smoothed.warnings.clone();
     let (r, summary, title, _) = p.replay(" smoothed", &names, extra, |summary| {
         let entries = summary["estimators"].as_array_mut().context("the summary lists its estimators")?;
         entries.push(onebeacon_sim::json::smoother_summary("smoother", &smoothed));
         entries.extend(runs.iter().map(onebeacon_sim::json::rts_summary));
         warnings.extend(worse_than_the_filters(entries));
-        let keys = onebeacon_sim::json::noise_keys(&cfg.noise);
-        summary["smoother_noise"] = serde_json::json!({"from": noise_from, "keys": keys});
+        summary["smoother_noise"] = serde_json::json!({"from": noise_from, "keys": noise_keys});
         if let Some(list) = summary["warnings"].as_array_mut() {
             list.extend(warnings.iter().map(|w| serde_json::json!(w)));
         }
@@ -100,12 +111,12 @@ pub fn smooth(path: &std::path::Path, a: SmoothArgs) -> Result<()> {
         outln!("no factor for: {}", list.join(", "));
     }
     print_table(&summary, &r.dropped)?;
-    let keys = onebeacon_sim::json::noise_keys(&cfg.noise);
     let value = |v: &serde_json::Value| {
         let v = format!("{:.4}", v.as_f64().unwrap_or(f64::NAN));
         v.trim_end_matches('0').trim_end_matches('.').to_string()
     };
-    let keys: Vec<String> = keys.as_object().into_iter().flatten().map(|(k, v)| format!("{k} {}", value(v))).collect();
+    let keys: Vec<String> =
+        noise_keys.as_object().into_iter().flatten().map(|(k, v)| format!("{k} {}", value(v))).collect();
     outln!("smoother noise ({noise_from}): {}", keys.join(", "));
     let cal: Vec<String> = s.calibration.iter().map(|(k, v, sigma)| format!("{k} {v:.4} (sigma {sigma:.4})")).collect();
     if !cal.is_empty() {

@@ -493,9 +493,10 @@ fn replay<'py>(
 /// sigma_north_m, sigma_east_m, and dead reckoning's dr_north_m, dr_east_m), the
 /// summary the smoother's line of `smooth --json` (errors, NEES, calibration, solve).
 /// `like`: weigh as this estimator of the log; `calibrate`: calibration variables by
-/// name; `kernel`: none, huber, cauchy or student_t.
+/// name; `kernel`: none, huber, cauchy or student_t; `track_accel`: a constant-velocity
+/// model for a craft without motion rows (m/s^1.5, the key track_accel_sigma_m_s2).
 #[pyfunction]
-#[pyo3(signature = (log, beacons = None, like = None, calibrate = None, kernel = None))]
+#[pyo3(signature = (log, beacons = None, like = None, calibrate = None, kernel = None, track_accel = None))]
 fn smooth<'py>(
     py: Python<'py>,
     log: PathBuf,
@@ -503,10 +504,11 @@ fn smooth<'py>(
     like: Option<String>,
     calibrate: Option<Vec<String>>,
     kernel: Option<String>,
+    track_accel: Option<f64>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let l = Log::load(&log).map_err(input_error)?;
     let filter = beacon_filter(beacons, &l.beacon_ids()).map_err(|e| input_error(format!("beacons {e}")))?;
-    let cfg = onebeacon_sim::smooth::config(&l, like.as_deref(), calibrate.as_deref(), kernel.as_deref())
+    let cfg = onebeacon_sim::smooth::config(&l, like.as_deref(), calibrate.as_deref(), kernel.as_deref(), track_accel)
         .map_err(input_error)?;
     Budget::resolve(None).map_err(input_error)?.check_smooth(&l).map_err(input_error)?;
     let s = interruptible(py, |_| onebeacon_sim::smooth::smooth(&l, filter.as_ref(), &cfg))?.map_err(input_error)?;

@@ -1,9 +1,12 @@
 //! The smoother's factors: what each measurement says about the poses and calibration
 //! variables it touches, as a whitened residual (residual over its standard deviation)
-//! and its Jacobian. Poses are (north, east, heading) at the graph's nodes, the
-//! heading kept continuous (unwrapped) along the trajectory.
+//! and its Jacobian. A node holds a pose (north, east, heading, the heading kept
+//! continuous along the trajectory) for a vehicle that measures its motion, or a
+//! position and velocity (north, east, vN, vE) for a craft tracked with a
+//! constant-velocity model ([`Node`]).
 
 use onebeacon::geo::wrap_angle;
+use onebeacon::nav::tracking::white_acceleration_noise;
 
 /// Most variables one factor touches: two poses and four calibration variables.
 pub(crate) const MAX_VARS: usize = 10;
@@ -28,6 +31,26 @@ pub(crate) struct CalVars {
     pub drift: Option<usize>,
 }
 
+/// What a graph's nodes hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Node {
+    /// North, east, heading: a vehicle whose motion rows join its nodes.
+    Pose,
+    /// North, east, vN, vE: a craft without motion rows, joined by a constant-velocity
+    /// model.
+    Track,
+}
+
+impl Node {
+    /// Variables per node.
+    pub(crate) fn size(self) -> usize {
+        match self {
+            Node::Pose => 3,
+            Node::Track => 4,
+        }
+    }
+}
+
 /// Where an acoustic measurement sits between two nodes: the position at its time is
 /// (1 - alpha) p_k + alpha p_(k+1) (alpha 0 with no later node).
 #[derive(Debug, Clone, Copy)]
@@ -38,13 +61,37 @@ pub(crate) struct At {
     pub next: bool,
     /// Seconds between nodes k and k + 1.
     pub dt_s: f64,
+    pub node: Node,
+}
+
+impl At {
+    /// Pushes the variables a measurement here reads: node k's position, node k + 1's
+    /// when `next`, then node k's velocity when asked and the nodes hold one.
+    fn push_vars(&self, push: &mut dyn FnMut(usize), velocity: bool) {
+        let s = self.node.size();
+        push(s * self.k);
+        push(s * self.k + 1);
+        if self.next {
+            push(s * (self.k + 1));
+            push(s * (self.k + 1) + 1);
+        }
+        if velocity && self.node == Node::Track {
+            push(s * self.k + 2);
+            push(s * self.k + 3);
+        }
+    }
+
+    /// How many local variables the positions take.
+    fn positions(&self) -> usize {
+        if self.next { 4 } else { 2 }
+    }
 }
 
 #[derive(Debug, Clone)]
 pub(crate) enum Factor {
     /// A Gaussian prior on pose k (the start).
     PosePrior { k: usize, mean: [f64; 3], sigma: [f64; 3] },
-    /// A Gaussian prior on one calibration variable.
+    /// A Gaussian prior on one variable (a calibration variable, a track's start).
     Prior { var: usize, mean: f64, sigma: f64 },
     /// Motion from node k to k + 1: body-frame forward and lateral distance along the
     /// mid-step heading (psi_k + psi_(k+1)) / 2, and the heading change (times the turn
@@ -60,11 +107,17 @@ pub(crate) enum Factor {
     },
     /// An absolute heading (compass, AHRS) at node k.
     Heading { k: usize, heading_rad: f64, sigma: f64 },
+    /// Constant velocity from track node k to k + 1 on one axis (0 north, 1 east):
+    /// position and velocity after `dt_s` of white acceleration of spectral density `q`
+    /// ((m/s^2)^2 s), p1 - p0 - dt v0 and v1 - v0 weighed by its covariance, the
+    /// tracker's [`white_acceleration_noise`].
+    ConstantVelocity { k: usize, axis: usize, dt_s: f64, q: f64 },
     /// A range: z = s |p(t) - b| + offset + drift (t - t0), the distance slant with the
     /// vertical offset `dz_m` between vehicle and beacon.
     Range { at: At, beacon: [f64; 2], dz_m: f64, range_m: f64, sigma: f64, cal: CalVars, t_rel_s: f64 },
     /// A Doppler radial speed, positive when closing (garin2024 eq. 13): -u . v, u the
-    /// unit vector from the beacon to p(t), v the velocity over the node interval.
+    /// unit vector from the beacon to p(t), v the velocity over the node interval (a
+    /// track node's own velocity).
     Doppler { at: At, beacon: [f64; 2], dz_m: f64, speed_m_s: f64, sigma: f64 },
     /// A USBL bearing on a station (hoff2024 eq. 1-2): azimuth from the station's
     /// heading and elevation from the vertical.
@@ -95,19 +148,16 @@ impl Factor {
                 pose(&mut push, k + 1);
                 turn_scale.iter().chain(distance_scale).for_each(|&i| push(i));
             }
+            Factor::ConstantVelocity { k, axis, .. } => {
+                let (a, b) = (4 * k + axis, 4 * (k + 1) + axis);
+                [a, a + 2, b, b + 2].into_iter().for_each(push);
+            }
             Factor::Range { at, cal, .. } => {
-                pose(&mut push, at.k);
-                if at.next {
-                    pose(&mut push, at.k + 1);
-                }
+                at.push_vars(&mut push, false);
                 cal.scale.iter().chain(&cal.offset).chain(&cal.drift).for_each(|&i| push(i));
             }
-            Factor::Doppler { at, .. } | Factor::Bearing { at, .. } => {
-                pose(&mut push, at.k);
-                if at.next {
-                    pose(&mut push, at.k + 1);
-                }
-            }
+            Factor::Doppler { at, .. } => at.push_vars(&mut push, true),
+            Factor::Bearing { at, .. } => at.push_vars(&mut push, false),
         }
         (v, n)
     }
@@ -141,10 +191,14 @@ impl Factor {
                     3,
                 )
             }
+            Factor::ConstantVelocity { dt_s, q, .. } => {
+                let (w, _) = white_acceleration(*dt_s, *q, [x[2] - x[0] - dt_s * x[1], x[3] - x[1]]);
+                ([w[0], w[1], 0.0], 2)
+            }
             Factor::Range { at, beacon, dz_m, range_m, sigma, cal, t_rel_s } => {
                 let p = position(at, x);
                 let slant = slant(p, *beacon, *dz_m);
-                let mut i = if at.next { 6 } else { 3 };
+                let mut i = at.positions();
                 let mut take = |on: bool, nominal: f64| {
                     if on {
                         i += 1;
@@ -159,11 +213,12 @@ impl Factor {
                 ([(s * slant + b + d * t_rel_s - range_m) / sigma, 0.0, 0.0], 1)
             }
             Factor::Doppler { at, beacon, dz_m, speed_m_s, sigma } => {
-                if !at.next {
-                    return ([0.0; 3], 1);
-                }
                 let p = position(at, x);
-                let v = [(x[3] - x[0]) / at.dt_s, (x[4] - x[1]) / at.dt_s];
+                let v = match (at.node, at.next) {
+                    (Node::Track, _) => [x[at.positions()], x[at.positions() + 1]],
+                    (Node::Pose, true) => [(x[2] - x[0]) / at.dt_s, (x[3] - x[1]) / at.dt_s],
+                    (Node::Pose, false) => return ([0.0; 3], 1),
+                };
                 let r = slant(p, *beacon, *dz_m);
                 // garin2024 eq. 13: the radial speed, closing positive
                 let radial = -((p[0] - beacon[0]) * v[0] + (p[1] - beacon[1]) * v[1]) / r;
@@ -224,6 +279,15 @@ impl Factor {
             Factor::PosePrior { sigma, .. } => (0..3).for_each(|i| j[i][i] = 1.0 / sigma[i]),
             Factor::Prior { sigma, .. } => j[0][0] = 1.0 / sigma,
             Factor::Heading { sigma, .. } => j[0][2] = 1.0 / sigma,
+            Factor::ConstantVelocity { dt_s, q, .. } => {
+                // d(p1 - p0 - dt v0) and d(v1 - v0) over (p0, v0, p1, v1), whitened
+                let (_, l) = white_acceleration(*dt_s, *q, [0.0, 0.0]);
+                let de = [[-1.0, -dt_s, 1.0, 0.0], [0.0, -1.0, 0.0, 1.0]];
+                for c in 0..4 {
+                    j[0][c] = de[0][c] / l[0];
+                    j[1][c] = (de[1][c] - l[1] * j[0][c]) / l[2];
+                }
+            }
             Factor::Motion { forward_m, lateral_m, turn_rad, sigma, turn_scale, distance_scale, .. } => {
                 let (f, l, _) = body_motion(x);
                 let psi_m = 0.5 * (x[2] + x[5]);
@@ -249,13 +313,13 @@ impl Factor {
             Factor::Range { at, beacon, dz_m, sigma, cal, t_rel_s, .. } => {
                 let p = position(at, x);
                 let slant = slant(p, *beacon, *dz_m);
-                let mut i = if at.next { 6 } else { 3 };
+                let mut i = at.positions();
                 let s = if cal.scale.is_some() { x[i] } else { 1.0 };
                 let u = [(p[0] - beacon[0]) / slant, (p[1] - beacon[1]) / slant];
                 let w = [1.0 - at.alpha, at.alpha];
                 for (node, wn) in w.iter().enumerate().take(if at.next { 2 } else { 1 }) {
-                    j[0][3 * node] = s * wn * u[0] / sigma;
-                    j[0][3 * node + 1] = s * wn * u[1] / sigma;
+                    j[0][2 * node] = s * wn * u[0] / sigma;
+                    j[0][2 * node + 1] = s * wn * u[1] / sigma;
                 }
                 for (on, d) in
                     [(cal.scale.is_some(), slant), (cal.offset.is_some(), 1.0), (cal.drift.is_some(), *t_rel_s)]
@@ -297,13 +361,26 @@ fn body_motion(x: &[f64]) -> (f64, f64, f64) {
     (c * dn + s * de, -s * dn + c * de, x[5] - x[2])
 }
 
-/// The horizontal position at a measurement's time, interpolated between its nodes.
+/// The horizontal position at a measurement's time, interpolated between its nodes
+/// (local x: node k's position, then node k + 1's).
 fn position(at: &At, x: &[f64]) -> [f64; 2] {
     if !at.next {
         return [x[0], x[1]];
     }
     let a = at.alpha;
-    [(1.0 - a) * x[0] + a * x[3], (1.0 - a) * x[1] + a * x[4]]
+    [(1.0 - a) * x[0] + a * x[2], (1.0 - a) * x[1] + a * x[3]]
+}
+
+/// A constant-velocity residual e (position, velocity on one axis) whitened by the
+/// Cholesky factor L = [l11 0; l21 l22] of [`white_acceleration_noise`]: L^-1 e, and
+/// (l11, l21, l22).
+fn white_acceleration(dt_s: f64, q: f64, e: [f64; 2]) -> ([f64; 2], [f64; 3]) {
+    let c = white_acceleration_noise(q, dt_s);
+    let l11 = c[0][0].sqrt();
+    let l21 = c[1][0] / l11;
+    let l22 = (c[1][1] - l21 * l21).sqrt();
+    let w0 = e[0] / l11;
+    ([w0, (e[1] - l21 * w0) / l22], [l11, l21, l22])
 }
 
 fn slant(p: [f64; 2], b: [f64; 2], dz_m: f64) -> f64 {
@@ -318,7 +395,7 @@ mod tests {
     /// every calibration variable on.
     #[test]
     fn analytic_jacobians_match_central_differences() {
-        let at = At { k: 0, alpha: 0.3, next: true, dt_s: 2.0 };
+        let at = At { k: 0, alpha: 0.3, next: true, dt_s: 2.0, node: Node::Pose };
         let cal = CalVars { scale: Some(6), offset: Some(7), drift: Some(8) };
         let factors = [
             Factor::PosePrior { k: 0, mean: [1.0, 2.0, 0.3], sigma: [0.5, 0.4, 0.1] },
@@ -333,6 +410,7 @@ mod tests {
                 distance_scale: Some(7),
             },
             Factor::Range { at, beacon: [10.0, -4.0], dz_m: 3.0, range_m: 12.0, sigma: 1.5, cal, t_rel_s: 40.0 },
+            Factor::ConstantVelocity { k: 0, axis: 1, dt_s: 1.7, q: 0.04 },
         ];
         let x = [1.2, 2.1, 0.35, 2.0, 2.9, 0.8, 1.05, 0.7, 0.01, 0.0];
         for f in &factors {

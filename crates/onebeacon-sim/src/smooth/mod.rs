@@ -17,6 +17,7 @@ pub use options::{CALIBRATION_NAMES, KERNEL_NAMES, config};
 pub use solve::SolveError;
 
 use crate::replay::{Log, LogError};
+use factor::Node;
 use nalgebra::{Matrix2, Vector2};
 use onebeacon::filter::consistency::nees;
 use onebeacon::nav::evaluation::ErrorStats;
@@ -87,6 +88,11 @@ pub struct SmoothConfig {
     /// USBL azimuth and elevation standard deviation, rad.
     pub usbl_sigma_rad: f64,
     pub max_iterations: usize,
+    /// A craft tracked with a constant-velocity model, as the tracker of this key does
+    /// (`track_accel_sigma_m_s2`: the square root of the white acceleration's spectral
+    /// density, m/s^1.5): nodes hold position and velocity at the acoustic measurements'
+    /// times; motion rows and heading fixes are not read. None: the log's motion rows.
+    pub track_accel_sigma_m_s2: Option<f64>,
 }
 
 impl Default for SmoothConfig {
@@ -121,6 +127,7 @@ impl SmoothConfig {
             // the cap ../shared/bench/gtsam_smooth.py gives GTSAM (setMaxIterations); plaza1
             // beacon 1 alone, scale 1 and no kernel, needs 127 (GTSAM 98)
             max_iterations: 200,
+            track_accel_sigma_m_s2: None,
         }
     }
 }
@@ -139,7 +146,9 @@ pub enum SmoothError {
     Log(#[from] LogError),
     #[error(transparent)]
     Solve(#[from] SolveError),
-    #[error("no motion to smooth: the log has no odometry, body_odometry, speed or body_velocity rows after its start")]
+    #[error(
+        "no motion to smooth: the log has no odometry, body_odometry, speed or body_velocity rows after its start; for a craft tracked from outside, give a constant-velocity model (--track-accel SIGMA, or --like an estimator with track_accel_sigma_m_s2)"
+    )]
     NoMotion,
 }
 
@@ -150,7 +159,8 @@ pub struct Smoothed {
     pub t_s: Vec<f64>,
     /// North, east (m), heading (rad, continuous along the trajectory).
     pub poses: Vec<[f64; 3]>,
-    /// Dead reckoning from the same start (the solver's initial values).
+    /// Dead reckoning from the same start (the solver's initial values; a track's: the
+    /// constant-velocity tracker run forward).
     pub dead_reckoning: Vec<[f64; 3]>,
     /// Marginal covariance of (north, east, heading) per pose.
     pub covariances: Vec<[[f64; 3]; 3]>,
@@ -186,9 +196,11 @@ pub fn smooth(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) ->
         .filter(|(name, _)| name.ends_with("scale"))
         .map(|(_, i)| (*i, SCALE_BOUNDS.0, SCALE_BOUNDS.1))
         .collect();
-    let options = solve::SolveOptions { kernel: cfg.kernel, max_iterations: cfg.max_iterations, bounds: &bounds };
+    let options =
+        solve::SolveOptions { kernel: cfg.kernel, max_iterations: cfg.max_iterations, bounds: &bounds, node: g.node };
     let mut active = vec![true; g.factors.len()];
-    let poses = 3 * g.t_s.len();
+    let size = g.node.size();
+    let poses = size * g.t_s.len();
     let mut sol = solve::solve(&g.factors, &active, g.x0.clone(), poses, options)?;
     let mut gated = 0;
     if let Some(gate) = cfg.nis_gate {
@@ -207,7 +219,15 @@ pub fn smooth(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) ->
         }
     }
     let n = g.t_s.len();
-    let pose = |x: &[f64], k: usize| [x[3 * k], x[3 * k + 1], x[3 * k + 2]];
+    let psi0 = g.x0[2];
+    let pose = |x: &[f64], k: usize| match g.node {
+        Node::Pose => [x[3 * k], x[3 * k + 1], x[3 * k + 2]],
+        // a track's heading is its course (the start's heading while at rest)
+        Node::Track => {
+            let v = [x[4 * k + 2], x[4 * k + 3]];
+            [x[4 * k], x[4 * k + 1], if v[0].hypot(v[1]) > 0.0 { v[1].atan2(v[0]) } else { psi0 }]
+        }
+    };
     let mut warnings = Vec::new();
     if !sol.converged {
         warnings.push(format!(
@@ -234,7 +254,12 @@ pub fn smooth(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) ->
             .iter()
             .map(|(name, i)| (name.clone(), sol.x[*i], sol.calibration[(i - poses, i - poses)].sqrt()))
             .collect(),
-        covariances: sol.poses,
+        covariances: sol
+            .nodes
+            .iter()
+            .zip(0..)
+            .map(|(c, k)| pose_covariance(c, &sol.x[size * k..size * (k + 1)]))
+            .collect(),
         iterations: sol.iterations,
         converged: sol.converged,
         cost0: sol.cost0,
@@ -248,6 +273,33 @@ pub fn smooth(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) ->
         build_s,
         solve_s: started.elapsed().as_secs_f64() - build_s,
     })
+}
+
+/// A node's covariance as (north, east, heading): a pose's as it is; a track's course
+/// atan2(vE, vN) linearised, its variance pi^2 (no information) at rest.
+fn pose_covariance(c: &nalgebra::DMatrix<f64>, node: &[f64]) -> [[f64; 3]; 3] {
+    if c.nrows() == 3 {
+        return std::array::from_fn(|a| std::array::from_fn(|b| c[(a, b)]));
+    }
+    let (vn, ve) = (node[2], node[3]);
+    let s2 = vn * vn + ve * ve;
+    // d course / d (n, e, vN, vE)
+    let j = [0.0, 0.0, -ve / s2, vn / s2];
+    let mut out: [[f64; 3]; 3] =
+        std::array::from_fn(|a| std::array::from_fn(|b| if a < 2 && b < 2 { c[(a, b)] } else { 0.0 }));
+    for a in 0..2 {
+        out[a][2] = (0..4).map(|i| c[(a, i)] * j[i]).sum();
+        out[2][a] = out[a][2];
+    }
+    out[2][2] = (0..4).map(|i| (0..4).map(|l| j[i] * c[(i, l)] * j[l]).sum::<f64>()).sum();
+    if !(s2 > 0.0 && out[2][2].is_finite()) {
+        out[0][2] = 0.0;
+        out[1][2] = 0.0;
+        out[2][0] = 0.0;
+        out[2][1] = 0.0;
+        out[2][2] = std::f64::consts::PI.powi(2);
+    }
+    out
 }
 
 impl Smoothed {

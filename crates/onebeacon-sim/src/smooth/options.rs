@@ -13,13 +13,15 @@ pub const CALIBRATION_NAMES: &str =
 pub const KERNEL_NAMES: &str = "none, huber, cauchy, student_t";
 
 /// The defaults, or what the log's estimator `like` reads (its noise, kernel, gate,
-/// calibration), with the variables `calibrate` and the kernel `kernel` over them; the
-/// error names what is wrong and what is allowed.
+/// calibration, a constant-velocity model), with the variables `calibrate`, the kernel
+/// `kernel` and a constant-velocity model of white acceleration `track_accel` (m/s^1.5)
+/// over them; the error names what is wrong and what is allowed.
 pub fn config(
     log: &Log,
     like: Option<&str>,
     calibrate: Option<&[String]>,
     kernel: Option<&str>,
+    track_accel: Option<f64>,
 ) -> Result<SmoothConfig, String> {
     // without --like, the default smoother with the log's `[noise]`
     let mut cfg = SmoothConfig { noise: log.description.default_noise(), ..SmoothConfig::default() };
@@ -47,7 +49,13 @@ pub fn config(
             offsets,
             clock_drift: false,
         };
-        cfg = SmoothConfig::from_planar(&p, c);
+        cfg = SmoothConfig { track_accel_sigma_m_s2: e.track_accel_sigma_m_s2, ..SmoothConfig::from_planar(&p, c) };
+    }
+    if let Some(a) = track_accel {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(format!("track-accel {a}: the white acceleration must be a positive number of m/s^1.5"));
+        }
+        cfg.track_accel_sigma_m_s2 = Some(a);
     }
     if let Some(names) = calibrate {
         cfg.calibrate = calibration(names)?;

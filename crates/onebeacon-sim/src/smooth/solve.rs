@@ -3,14 +3,15 @@
 //! reweighted least squares, and the marginal covariances of the poses by selected
 //! inversion of the factor at the optimum.
 //!
-//! The poses come first, in time: their normal matrix A is a band (each factor touches
+//! The nodes (poses, or a track's positions and velocities) come first, in time: their
+//! normal matrix A is a band (each factor touches
 //! neighbouring nodes) whose Cholesky factor fills in nothing outside it, so no
 //! fill-reducing ordering is needed. The few calibration variables, which every range
 //! or motion factor touches, are a dense border [A B; B^T C] taken out by their Schur
 //! complement S = C - B^T A^-1 B (a sparse factorisation of the whole would be
 //! quadratic in the poses in nalgebra-sparse's symbolic analysis).
 
-use super::factor::{Factor, Linear};
+use super::factor::{Factor, Linear, Node};
 use nalgebra::{DMatrix, DVector};
 use nalgebra_sparse::CscMatrix;
 use nalgebra_sparse::factorization::{CscCholesky, CscSymbolicCholesky};
@@ -38,6 +39,8 @@ pub(crate) struct SolveOptions<'a> {
     pub max_iterations: usize,
     /// Variables kept within (index, low, high): each step is projected on them.
     pub bounds: &'a [(usize, f64, f64)],
+    /// What the nodes hold.
+    pub node: Node,
 }
 
 /// The optimum, how it was reached, and the marginal covariances there.
@@ -50,8 +53,8 @@ pub(crate) struct Solution {
     pub converged: bool,
     pub cost0: f64,
     pub cost: f64,
-    /// (north, east, heading) covariance per pose.
-    pub poses: Vec<[[f64; 3]; 3]>,
+    /// The covariance of each node's variables.
+    pub nodes: Vec<DMatrix<f64>>,
     /// Covariance of the calibration variables.
     pub calibration: DMatrix<f64>,
 }
@@ -64,35 +67,36 @@ pub enum SolveError {
     Singular,
 }
 
-/// The pose block's pattern: every factor touches at most two consecutive nodes, so
-/// with a motion factor between each two it is block tridiagonal (3 x 3 blocks), kept
-/// as the full symmetric matrix (the symbolic factorisation reads its upper half, the
-/// numeric one its lower).
+/// The node block's pattern: every factor touches at most two consecutive nodes, so
+/// with a motion (or constant-velocity) factor between each two it is block tridiagonal
+/// (blocks of a node's size), kept as the full symmetric matrix (the symbolic
+/// factorisation reads its upper half, the numeric one its lower).
 struct Pattern {
     pattern: SparsityPattern,
     nodes: usize,
+    size: usize,
 }
 
 impl Pattern {
-    fn new(poses: usize) -> Self {
-        let nodes = poses / 3;
+    fn new(poses: usize, size: usize) -> Self {
+        let nodes = poses / size;
         let mut offsets = Vec::with_capacity(poses + 1);
-        let mut rows = Vec::with_capacity(9 * poses);
+        let mut rows = Vec::with_capacity(3 * size * poses);
         offsets.push(0);
         for c in 0..poses {
-            let k = c / 3;
-            rows.extend(3 * k.saturating_sub(1)..3 * (k + 2).min(nodes));
+            let k = c / size;
+            rows.extend(size * k.saturating_sub(1)..size * (k + 2).min(nodes));
             offsets.push(rows.len());
         }
         let pattern = SparsityPattern::try_from_offsets_and_indices(poses, poses, offsets, rows)
             .unwrap_or_else(|_| unreachable!("sorted, in range"));
-        Self { pattern, nodes }
+        Self { pattern, nodes, size }
     }
 
-    /// The value index of (row, col), both poses of neighbouring (or the same) nodes.
+    /// The value index of (row, col), both variables of neighbouring (or the same) nodes.
     fn slot(&self, row: usize, col: usize) -> usize {
-        let first = 3 * (col / 3).saturating_sub(1);
-        debug_assert!(row >= first && row < 3 * (col / 3 + 2).min(self.nodes));
+        let first = self.size * (col / self.size).saturating_sub(1);
+        debug_assert!(row >= first && row < self.size * (col / self.size + 2).min(self.nodes));
         self.pattern.major_offsets()[col] + row - first
     }
 }
@@ -236,7 +240,9 @@ pub(crate) fn solve(
     poses: usize,
     opt: SolveOptions,
 ) -> Result<Solution, SolveError> {
-    let problem = Problem { factors, active, pattern: Pattern::new(poses), poses, dim: x0.len(), kernel: opt.kernel };
+    let size = opt.node.size();
+    let problem =
+        Problem { factors, active, pattern: Pattern::new(poses, size), poses, dim: x0.len(), kernel: opt.kernel };
     let mut x = x0;
     let cost0 = total_cost(factors, active, &x, opt.kernel);
     let mut cost = cost0;
@@ -255,7 +261,10 @@ pub(crate) fn solve(
             lambda *= LAMBDA_FACTOR;
             continue;
         };
-        let mut trial = retract(&x, &step, poses);
+        let mut trial = match opt.node {
+            Node::Pose => retract(&x, &step, poses),
+            Node::Track => x.iter().zip(step.iter()).map(|(a, b)| a + b).collect(),
+        };
         for &(i, lo, hi) in opt.bounds {
             trial[i] = trial[i].clamp(lo, hi);
         }
@@ -274,7 +283,7 @@ pub(crate) fn solve(
             break;
         }
     }
-    // the marginals at the optimum: Cov(poses) = A^-1 + W S^-1 W^T, Cov(calibration) = S^-1
+    // the marginals at the optimum: Cov(nodes) = A^-1 + W S^-1 W^T, Cov(calibration) = S^-1
     if !problem.factor(&mut chol, &ne, 0.0) {
         return Err(SolveError::Singular);
     }
@@ -283,19 +292,14 @@ pub(crate) fn solve(
     let s_inv = s.inverse();
     let l = chol.l();
     let z = selected_inverse(l);
-    let mut blocks = marginal_blocks(l, &z, (0..poses / 3).map(|k| 3 * k));
+    let mut blocks = marginal_blocks(l, &z, (0..poses / size).map(|k| size * k), size);
     if s_inv.nrows() > 0 {
         for (k, block) in blocks.iter_mut().enumerate() {
-            let wk = w.rows(3 * k, 3);
-            let extra = wk * &s_inv * wk.transpose();
-            for (a, row) in block.iter_mut().enumerate() {
-                for (b, v) in row.iter_mut().enumerate() {
-                    *v += extra[(a, b)];
-                }
-            }
+            let wk = w.rows(size * k, size);
+            *block += wk * &s_inv * wk.transpose();
         }
     }
-    Ok(Solution { x, iterations, converged, cost0, cost, poses: blocks, calibration: s_inv })
+    Ok(Solution { x, iterations, converged, cost0, cost, nodes: blocks, calibration: s_inv })
 }
 
 /// The state `x` moved by the step `h` (solved in the global coordinates in which the
@@ -347,19 +351,20 @@ pub(crate) fn selected_inverse(l: &CscMatrix<f64>) -> Vec<f64> {
     z
 }
 
-/// The 3 x 3 blocks (row-major) of the inverse at the given first indices.
+/// The `size` x `size` blocks of the inverse at the given first indices.
 pub(crate) fn marginal_blocks(
     l: &CscMatrix<f64>,
     z: &[f64],
     firsts: impl Iterator<Item = usize>,
-) -> Vec<[[f64; 3]; 3]> {
+    size: usize,
+) -> Vec<DMatrix<f64>> {
     let (offsets, rows) = (l.col_offsets(), l.row_indices());
     let at = |r: usize, c: usize| {
         let (r, c) = if r >= c { (r, c) } else { (c, r) };
         let s = offsets[c];
         rows[s..offsets[c + 1]].binary_search(&r).map_or(0.0, |p| z[s + p])
     };
-    firsts.map(|f| std::array::from_fn(|a| std::array::from_fn(|b| at(f + a, f + b)))).collect()
+    firsts.map(|f| DMatrix::from_fn(size, size, |a, b| at(f + a, f + b))).collect()
 }
 
 #[cfg(test)]
@@ -405,7 +410,7 @@ mod tests {
                 assert!((zv - inv[(r, c)]).abs() < 1e-12, "({r}, {c}): {zv} vs {}", inv[(r, c)]);
             }
         }
-        let blocks = marginal_blocks(l, &z, [0, 4].into_iter());
-        assert!((blocks[1][2][1] - inv[(6, 5)]).abs() < 1e-12);
+        let blocks = marginal_blocks(l, &z, [0, 4].into_iter(), 3);
+        assert!((blocks[1][(2, 1)] - inv[(6, 5)]).abs() < 1e-12);
     }
 }

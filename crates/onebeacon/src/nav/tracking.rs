@@ -29,6 +29,15 @@ pub mod idx {
 /// Standard deviation of the initial velocity on each axis, m/s: nothing is known of it.
 pub const INITIAL_VELOCITY_SIGMA_M_S: f64 = 1.0;
 
+/// The covariance of (position, velocity) on one axis after `dt` s of white acceleration
+/// of spectral density `q` ((m/s^2)^2 s): q [dt^3/3, dt^2/2; dt^2/2, dt] (FilterPy's
+/// `Q_continuous_white_noise`; Bar-Shalom, Li and Kirubarajan, sec. 6.2.2). The tracker
+/// predicts with it and the smoother's constant-velocity factors weigh with it.
+pub fn white_acceleration_noise(q: f64, dt: f64) -> [[f64; 2]; 2] {
+    let c = q * dt.powi(2) / 2.0;
+    [[q * dt.powi(3) / 3.0, c], [c, q * dt]]
+}
+
 /// Constant velocity over `dt` with white acceleration of spectral density `q`
 /// ((m/s^2)^2 s): Q = q [dt^3/3, dt^2/2; dt^2/2, dt] on each axis.
 #[derive(Debug, Clone, Copy)]
@@ -53,11 +62,12 @@ impl ProcessModel<STATES> for ConstantVelocity {
 
     fn noise_covariance(&self, _x: &State, dt: f64) -> Cov {
         let mut q = Cov::zeros();
+        let axis = white_acceleration_noise(self.q, dt);
         for (p, v) in [(idx::N, idx::VN), (idx::E, idx::VE)] {
-            q[(p, p)] = self.q * dt.powi(3) / 3.0;
-            q[(p, v)] = self.q * dt.powi(2) / 2.0;
-            q[(v, p)] = q[(p, v)];
-            q[(v, v)] = self.q * dt;
+            q[(p, p)] = axis[0][0];
+            q[(p, v)] = axis[0][1];
+            q[(v, p)] = axis[1][0];
+            q[(v, v)] = axis[1][1];
         }
         q
     }
