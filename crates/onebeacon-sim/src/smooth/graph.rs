@@ -35,6 +35,8 @@ const SAME_NODE_S: f64 = 1e-3;
 pub(crate) struct Graph {
     pub t_s: Vec<f64>,
     pub node: Node,
+    /// The start's heading, rad (a track's course while at rest).
+    pub start_heading_rad: f64,
     pub factors: Vec<Factor>,
     /// Dead reckoning from the start (the initial values of the poses; a track's: the
     /// tracker run forward), then the calibration variables' nominal values.
@@ -63,6 +65,7 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
     let mut g = Graph {
         t_s: vec![start.t0_s],
         node: if track_q.is_some() { Node::Track } else { Node::Pose },
+        start_heading_rad: start.pose.2,
         factors: Vec::new(),
         x0: Vec::new(),
         calibration: Vec::new(),

@@ -219,13 +219,12 @@ pub fn smooth(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) ->
         }
     }
     let n = g.t_s.len();
-    let psi0 = g.x0[2];
     let pose = |x: &[f64], k: usize| match g.node {
         Node::Pose => [x[3 * k], x[3 * k + 1], x[3 * k + 2]],
         // a track's heading is its course (the start's heading while at rest)
         Node::Track => {
             let v = [x[4 * k + 2], x[4 * k + 3]];
-            [x[4 * k], x[4 * k + 1], if v[0].hypot(v[1]) > 0.0 { v[1].atan2(v[0]) } else { psi0 }]
+            [x[4 * k], x[4 * k + 1], if v[0].hypot(v[1]) > 0.0 { v[1].atan2(v[0]) } else { g.start_heading_rad }]
         }
     };
     let mut warnings = Vec::new();
