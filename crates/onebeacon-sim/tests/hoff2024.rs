@@ -20,17 +20,19 @@ fn small(particles: usize, duration_s: f64, guidance: &[GuidanceKind]) -> Scenar
     Scenario::PassiveUsbl(s)
 }
 
-/// Ten minutes: under the det planner the particle filter stays within a metre (a
-/// bearing at 35 m with sigma 0.35 deg and a depth to 0.3 m fix the AUV to a few
-/// decimetres), while from a static ASV the AUV, 900 m around its circle from where it
-/// started, is lost to several metres.
+/// Ten minutes, two runs: under the det planner the particle filter stays within five
+/// times what one bearing resolves (at 35 m with 0.01 deg per metre: 35 m x 0.35 deg =
+/// 0.21 m), while from a static ASV the AUV, 900 m around its 500 m circle from where
+/// it started, is about 780 m away, where one bearing resolves (780 / 35)^2 = 500 times
+/// less (eq. 3: the noise grows with range): at least 3 times worse is a wide margin.
 #[test]
 fn the_planner_beats_a_static_asv() {
     let s = small(20_000, 600.0, &[GuidanceKind::Determinant, GuidanceKind::Static]);
     let r = monte_carlo(&s, 2, 1, None, &|| {}).unwrap();
     let pf = |cell: usize| &r.cells[cell].estimators[0].1;
     let (det, fixed) = (pf(0), pf(1));
-    assert!(det.mean_error_m < 1.0, "det: {det:?}");
+    let one_bearing_m = 35.0 * 0.35f64.to_radians();
+    assert!(det.mean_error_m < 5.0 * one_bearing_m, "det: {det:?}");
     assert!(
         fixed.mean_error_m > 3.0 * det.mean_error_m,
         "static {} against det {}",

@@ -99,8 +99,8 @@ fn sprint_and_drift_respects_the_depth_ceiling() {
 
 /// A 300 s mission-1 opening with abstract pings, one run: every AUV confirms mode 1
 /// within 10 s of its launch (three pings after the dive), and the iUSBL navigation's
-/// fleet-wide 68 % error is within the paper's 7.9 m (Table 3), below dead reckoning's
-/// 95 %.
+/// fleet-wide 68 % error is below dead reckoning's 95 % (3.5 against 7.2 m at seed 1),
+/// with a mean NEES within its chi-square band.
 #[test]
 fn a_short_mission_confirms_its_mode_and_navigates() {
     let text = scenario::builtin("rypkema-m1").unwrap().toml;
@@ -113,7 +113,13 @@ fn a_short_mission_confirms_its_mode_and_navigates() {
     let st = statistics(f, 1, std::slice::from_ref(&out));
     assert!(st.all_confirmed && st.max_delay_s < 10.0, "{:?}", st.confirmations);
     let iusbl = st.fleet.iter().find(|e| e.label == "fleet/iusbl").unwrap();
-    assert!(iusbl.p68_m < 7.9, "{iusbl:?}");
+    let dr = st.fleet.iter().find(|e| e.label == "fleet/dead-reckoning").unwrap();
+    assert!(iusbl.p68_m < dr.p95_m, "{iusbl:?} against {dr:?}");
+    // its errors are what its covariance says: the mean NEES of one run of each AUV within
+    // their chi-square band (the paper's 7.9 m, a whole mission's 68 % against its LBL
+    // reference, is no bound for one 300 s opening)
+    let [lo, hi] = iusbl.nees_band;
+    assert!((lo..=hi).contains(&iusbl.nees_mean), "{iusbl:?}");
     assert!(iusbl.samples > 3 * 1500, "{iusbl:?}");
     // scored against a reference 100 m off per axis, the errors are the reference's
     // (the navigation's few metres add in quadrature): a Rayleigh distribution, whose
@@ -129,7 +135,6 @@ fn a_short_mission_confirms_its_mode_and_navigates() {
     }
     // the NEES is the filter's against the truth, whatever the reference: the same bits,
     // pooled over one run of each AUV (its band that of as many chi-square(2) draws)
-    assert!(iusbl.nees_mean.is_finite() && iusbl.nees_mean > 0.0, "{iusbl:?}");
     assert_eq!(far_iusbl.nees_mean.to_bits(), iusbl.nees_mean.to_bits());
     assert_eq!(iusbl.nees_band, chi_square_band(f.auvs.len(), 2));
 }
