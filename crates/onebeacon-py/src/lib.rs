@@ -4,16 +4,15 @@
 //! the numbers are the CLI's bit for bit; errors are `onebeacon.InputError` (a
 //! `ValueError`) with the CLI's one-line messages.
 
-use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
-use onebeacon::io::stream::{Lines, Note};
-use onebeacon::nav::session::Session;
-use onebeacon::vehicle::unit::Unit;
+mod logs;
+mod navigator;
+
+use numpy::{PyArray1, PyReadonlyArray2};
 use onebeacon_sim::Scenario;
 use onebeacon_sim::budget::{Budget, concurrent_runs};
 use onebeacon_sim::chain::Chain;
 use onebeacon_sim::montecarlo::Progress;
 use onebeacon_sim::montecarlo::monte_carlo;
-use onebeacon_sim::replay::{Log, beacon_filter, replay as run_replay, stream_setup};
 use onebeacon_sim::run::{StepRecord, simulate, trajectory};
 use onebeacon_sim::scenario::{self, BUILTINS, ping::PingConfig};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -445,243 +444,6 @@ fn mc<'py>(
     to_py(py, &v["cells"])
 }
 
-/// A real log through every estimator it configures (`onebeacon replay`):
-/// `(trajectory, summary)` as `run` gives them, the summary that of `replay --json`.
-/// `beacons`: use only these beacon ids; `estimators`: a TOML file of `[[estimators]]`
-/// to run instead of the log's.
-#[pyfunction]
-#[pyo3(signature = (log, beacons = None, estimators = None))]
-fn replay<'py>(
-    py: Python<'py>,
-    log: PathBuf,
-    beacons: Option<Vec<u32>>,
-    estimators: Option<PathBuf>,
-) -> PyResult<Bound<'py, PyTuple>> {
-    let mut l = Log::load(&log).map_err(input_error)?;
-    if let Some(file) = estimators {
-        l.description.use_estimators(&file).map_err(input_error)?;
-    }
-    let known = l.beacon_ids();
-    let filter = beacon_filter(beacons, &known).map_err(|e| input_error(format!("beacons {e}")))?;
-    let used: Vec<u32> = filter.clone().map_or_else(|| known.iter().copied().collect(), |f| f.into_iter().collect());
-    let budget = Budget::resolve(None).map_err(input_error)?;
-    budget.check_replay(&l, true).map_err(input_error)?;
-    let started = std::time::Instant::now();
-    let (records, r) = interruptible(py, |stop| {
-        let mut records = Vec::new();
-        let r = run_replay::<onebeacon_sim::replay::LogError>(&l, filter, |rec| {
-            if stop.stopped() {
-                // what is raised is the KeyboardInterrupt
-                return Err(onebeacon_sim::replay::LogError::File { file: String::new(), message: "stopped".into() });
-            }
-            records.push(rec);
-            Ok(())
-        });
-        (records, r)
-    })?;
-    let r = r.map_err(input_error)?;
-    let summary = onebeacon_sim::json::replay_summary(&l, &used, &r, started.elapsed().as_secs_f64());
-    for w in r.warnings(l.has_truth()) {
-        user_warning(py, w)?;
-    }
-    let columns = trajectory_dict(py, &["auv".to_string()], &r.session.names, &records)?;
-    PyTuple::new(py, [columns.into_any(), to_py(py, &summary)?])
-}
-
-/// A log smoothed over every pose after the dive (`onebeacon smooth`): `(poses,
-/// summary)`, poses a dict of arrays per node (t_s, north_m, east_m, heading_rad,
-/// sigma_north_m, sigma_east_m, and dead reckoning's dr_north_m, dr_east_m), the
-/// summary the smoother's line of `smooth --json` (errors, NEES, calibration, solve).
-/// `like`: weigh as this estimator of the log; `calibrate`: calibration variables by
-/// name; `kernel`: none, huber, cauchy or student_t; `track_accel`: a constant-velocity
-/// model for a craft without motion rows (m/s^1.5, the key track_accel_sigma_m_s2).
-#[pyfunction]
-#[pyo3(signature = (log, beacons = None, like = None, calibrate = None, kernel = None, track_accel = None))]
-fn smooth<'py>(
-    py: Python<'py>,
-    log: PathBuf,
-    beacons: Option<Vec<u32>>,
-    like: Option<String>,
-    calibrate: Option<Vec<String>>,
-    kernel: Option<String>,
-    track_accel: Option<f64>,
-) -> PyResult<Bound<'py, PyTuple>> {
-    let l = Log::load(&log).map_err(input_error)?;
-    let filter = beacon_filter(beacons, &l.beacon_ids()).map_err(|e| input_error(format!("beacons {e}")))?;
-    let cfg = onebeacon_sim::smooth::config(&l, like.as_deref(), calibrate.as_deref(), kernel.as_deref(), track_accel)
-        .map_err(input_error)?;
-    Budget::resolve(None).map_err(input_error)?.check_smooth(&l).map_err(input_error)?;
-    let s = interruptible(py, |_| onebeacon_sim::smooth::smooth(&l, filter.as_ref(), &cfg))?.map_err(input_error)?;
-    let d = PyDict::new(py);
-    let column = |f: &dyn Fn(usize) -> f64| (0..s.t_s.len()).map(f).collect::<Vec<f64>>();
-    let columns: [(&str, Vec<f64>); 8] = [
-        ("t_s", s.t_s.clone()),
-        ("north_m", column(&|k| s.poses[k][0])),
-        ("east_m", column(&|k| s.poses[k][1])),
-        ("heading_rad", column(&|k| onebeacon::geo::wrap_angle(s.poses[k][2]))),
-        ("sigma_north_m", column(&|k| s.covariances[k][0][0].sqrt())),
-        ("sigma_east_m", column(&|k| s.covariances[k][1][1].sqrt())),
-        ("dr_north_m", column(&|k| s.dead_reckoning[k][0])),
-        ("dr_east_m", column(&|k| s.dead_reckoning[k][1])),
-    ];
-    for (name, c) in columns {
-        d.set_item(name, PyArray1::from_vec(py, c))?;
-    }
-    let summary = onebeacon_sim::json::smoother_summary("smoother", &s);
-    PyTuple::new(py, [d.into_any(), to_py(py, &summary)?])
-}
-
-/// The Rauch-Tung-Striebel pass over each Gaussian filter of a log (the `+rts` lines of
-/// `onebeacon smooth`): a dict from each smoothed estimator's name to `(estimates,
-/// summary)`, estimates a dict of arrays, one row per interval between the filter's
-/// predictions (t_s its start, north_m, east_m, heading_rad, sigma_north_m,
-/// sigma_east_m; NED), the summary its line of `smooth --json`.
-#[pyfunction]
-#[pyo3(signature = (log, beacons = None))]
-fn rts<'py>(py: Python<'py>, log: PathBuf, beacons: Option<Vec<u32>>) -> PyResult<Bound<'py, PyDict>> {
-    let l = Log::load(&log).map_err(input_error)?;
-    let filter = beacon_filter(beacons, &l.beacon_ids()).map_err(|e| input_error(format!("beacons {e}")))?;
-    Budget::resolve(None).map_err(input_error)?.check_smooth(&l).map_err(input_error)?;
-    let runs = interruptible(py, |_| onebeacon_sim::replay::rts::rts(&l, filter))?.map_err(input_error)?;
-    let out = PyDict::new(py);
-    for run in &runs {
-        let d = PyDict::new(py);
-        let column = |f: &dyn Fn(&onebeacon::nav::Estimate) -> f64| run.estimates.iter().map(f).collect::<Vec<f64>>();
-        let columns: [(&str, Vec<f64>); 6] = [
-            ("t_s", column(&|e| e.t_s)),
-            ("north_m", column(&|e| e.north_m())),
-            ("east_m", column(&|e| e.east_m())),
-            ("heading_rad", column(&|e| e.heading_rad())),
-            ("sigma_north_m", column(&|e| e.sigma_north_m())),
-            ("sigma_east_m", column(&|e| e.sigma_east_m())),
-        ];
-        for (name, c) in columns {
-            d.set_item(name, PyArray1::from_vec(py, c))?;
-        }
-        let summary = to_py(py, &onebeacon_sim::json::rts_summary(run))?;
-        out.set_item(&run.name, PyTuple::new(py, [d.into_any(), summary])?)?;
-    }
-    Ok(out)
-}
-
-/// The estimators of a stream configuration, step by step: what `onebeacon stream`
-/// runs, for a Python backseat node (ROS 2, MOOS). `feed` takes one measurement (a dict
-/// or a JSON line, docs/logs.md) and returns the estimates line `stream` would print
-/// (None before the start); `estimates()` gives each estimator's state with its
-/// covariance as arrays. A bad item raises InputError and leaves the filters as they were.
-#[pyclass(name = "Navigator", module = "onebeacon")]
-struct PyNavigator {
-    /// Behind a lock: a navigator's filters are sent between threads, never shared.
-    unit: std::sync::Mutex<Unit>,
-    lines: Lines,
-}
-
-impl PyNavigator {
-    /// The setup (a panic of another thread left it as it was).
-    fn unit(&self) -> std::sync::MutexGuard<'_, Unit> {
-        self.unit.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
-    }
-}
-
-#[pymethods]
-impl PyNavigator {
-    /// The navigator of a stream configuration (a log description's TOML file: frame,
-    /// beacons, initial state, estimators; its sources are ignored).
-    #[new]
-    fn new(config: PathBuf) -> PyResult<Self> {
-        let budget = Budget::resolve(None).map_err(input_error)?;
-        let unit = stream_setup(&config, &budget).map_err(input_error)?;
-        Ok(Self { unit: std::sync::Mutex::new(unit), lines: Lines::default() })
-    }
-
-    /// The estimators' names.
-    #[getter]
-    fn names(&self) -> Vec<String> {
-        self.unit().session(0).names.clone()
-    }
-
-    /// Whether the estimators have started (a given pose, or the first ground truth).
-    #[getter]
-    fn started(&self) -> bool {
-        self.unit().sessions().iter().all(|s| s.started())
-    }
-
-    /// Feeds one item (a dict or a JSON string, in the configuration's frame, SI units):
-    /// the `stream` output line as a dict, or None before the start. Raises InputError for
-    /// an item that is not valid or is screened out; notes (waiting for the start, an
-    /// estimator restarted) are Python warnings.
-    fn feed<'py>(&mut self, py: Python<'py>, item: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let line = match item.cast::<PyString>() {
-            Ok(s) => s.to_str()?.to_string(),
-            Err(_) => from_py(item, "item")?.to_string(),
-        };
-        let mut unit = self.unit.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        let max = unit.session(0).limits().max_line_bytes;
-        let mut skipped = None;
-        let mut infos = Vec::new();
-        let out = self.lines.push(&mut unit, line.as_bytes(), line.len() > max, |_, note| match note {
-            Note::Skipped(m) => skipped = Some(m),
-            Note::Info(m) => infos.push(m),
-        });
-        for m in infos {
-            user_warning(py, m)?;
-        }
-        if let Some(m) = skipped {
-            return Err(input_error(m));
-        }
-        // before the start (and with no controller's decision to report): None
-        let waiting =
-            |v: &serde_json::Value| v.get("started") == Some(&serde_json::json!(false)) && v.get("decided").is_none();
-        out.filter(|v| !waiting(v)).map(|v| to_py(py, &v)).transpose()
-    }
-
-    /// Each estimator's estimate (NED, SI): a dict with `name`, `t_s`, `position_ned_m`
-    /// (array of 3), `covariance_m2` (2 x 2 array, north and east), `heading_rad`,
-    /// `sigma_heading_rad`, `speed_m_s` (None without the state) and the calibration
-    /// states.
-    fn estimates<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        estimates(py, self.unit().session(0))
-    }
-
-    /// The controller's current command (`[controller]`), as the `command` of a `stream`
-    /// line (a dict, in the configuration's frame), or None before its first decision or
-    /// without a controller.
-    fn command<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let unit = self.unit();
-        unit.command().map(|c| to_py(py, &onebeacon::io::jsonl::command_json(&c, unit.plan(), unit.frame))).transpose()
-    }
-
-    fn __repr__(&self) -> String {
-        let unit = self.unit();
-        let s = unit.session(0);
-        format!("Navigator({:?}, started={})", s.names, s.started())
-    }
-}
-
-fn estimates<'py>(py: Python<'py>, session: &Session) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    session
-        .names
-        .iter()
-        .zip(session.final_estimates())
-        .map(|(name, e)| {
-            let d = PyDict::new(py);
-            d.set_item("name", name)?;
-            d.set_item("t_s", e.t_s)?;
-            d.set_item("position_ned_m", PyArray1::from_slice(py, e.position_ned_m.as_slice()))?;
-            let p = e.horizontal_cov_m2;
-            let cov = PyArray2::from_vec2(py, &[vec![p[(0, 0)], p[(0, 1)]], vec![p[(1, 0)], p[(1, 1)]]])?;
-            d.set_item("covariance_m2", cov)?;
-            d.set_item("heading_rad", e.heading_rad())?;
-            d.set_item("sigma_heading_rad", e.sigma_heading_rad())?;
-            d.set_item("speed_m_s", e.speed_m_s)?;
-            for (k, x) in e.calibration() {
-                d.set_item(k, x)?;
-            }
-            Ok(d)
-        })
-        .collect()
-}
-
 /// The receiver chain on one capture (`onebeacon dsp process`): `samples` is a 2-d
 /// array, one row per array element, starting at the transmit epoch, sampled at `fs`
 /// Hz; `config` a ping configuration (a TOML file's path or a dict; defaults as `dsp
@@ -741,13 +503,13 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("InputError", m.py().get_type::<InputError>())?;
     m.add_class::<PyScenario>()?;
-    m.add_class::<PyNavigator>()?;
+    m.add_class::<navigator::PyNavigator>()?;
     m.add_function(wrap_pyfunction!(scenarios, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(mc, m)?)?;
-    m.add_function(wrap_pyfunction!(replay, m)?)?;
-    m.add_function(wrap_pyfunction!(smooth, m)?)?;
-    m.add_function(wrap_pyfunction!(rts, m)?)?;
+    m.add_function(wrap_pyfunction!(logs::replay, m)?)?;
+    m.add_function(wrap_pyfunction!(logs::smooth, m)?)?;
+    m.add_function(wrap_pyfunction!(logs::rts, m)?)?;
     m.add_function(wrap_pyfunction!(dsp_process, m)?)?;
     Ok(())
 }

@@ -61,10 +61,10 @@ struct Heard {
 pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConfig) -> Result<Graph, SmoothError> {
     let start = log.initial_start(beacons)?;
     let noise = &cfg.noise;
-    let track_q = cfg.track_accel_sigma_m_s2.map(|s| s * s);
+    let track = cfg.track_accel_sigma_m_s2.is_some();
     let mut g = Graph {
         t_s: vec![start.t0_s],
-        node: if track_q.is_some() { Node::Track } else { Node::Pose },
+        node: if track { Node::Track } else { Node::Pose },
         start_heading_rad: start.pose.2,
         factors: Vec::new(),
         x0: Vec::new(),
@@ -106,7 +106,7 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
             }
             _ if t < start.t0_s => {}
             // a track reads the acoustic measurements and the depth only
-            Input::Measurement(m) if track_q.is_some() && m.beacon().is_none() => match m {
+            Input::Measurement(m) if track && m.beacon().is_none() => match m {
                 Kind::Depth { depth_m: d } => depth_m = d,
                 _ => count(&mut g.ignored, m.name()),
             },
@@ -173,7 +173,7 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
             },
         }
     }
-    if track_q.is_some() {
+    if track {
         for h in &heard {
             if h.t_s - g.t_s[g.t_s.len() - 1] > SAME_NODE_S {
                 g.t_s.push(h.t_s);
@@ -196,7 +196,7 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
     };
     let Calibrate { range_scale, turn_scale, distance_scale, offsets, clock_drift } = cfg.calibrate;
     // a track has no motion to scale
-    let (turn_scale, distance_scale) = (turn_scale && track_q.is_none(), distance_scale && track_q.is_none());
+    let (turn_scale, distance_scale) = (turn_scale && !track, distance_scale && !track);
     let p = &cfg.priors;
     let turn_var = var(&mut g, turn_scale, "turn_scale".into(), 1.0, p.turn_scale_sigma);
     let dist_var = var(&mut g, distance_scale, "distance_scale".into(), 1.0, p.distance_scale_sigma);
@@ -223,8 +223,8 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
     let (n0, e0, psi0) = start.pose;
     let heading_sigma = log.description.initial.heading_sigma_deg.to_radians();
     let ps = start.position_sigma_m;
-    if let Some(q) = track_q {
-        let v = INITIAL_VELOCITY_SIGMA_M_S;
+    if let Some(accel) = cfg.track_accel_sigma_m_s2 {
+        let (q, v) = (accel * accel, INITIAL_VELOCITY_SIGMA_M_S);
         for (var, mean, sigma) in [(0, n0, ps), (1, e0, ps), (2, 0.0, v), (3, 0.0, v)] {
             g.factors.push(Factor::Prior { var, mean, sigma });
         }
@@ -232,6 +232,7 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
             let dt_s = g.t_s[k + 1] - g.t_s[k];
             g.factors.extend((0..2).map(|axis| Factor::ConstantVelocity { k, axis, dt_s, q }));
         }
+        g.x0 = track_initial(&g.t_s, &heard, [n0, e0], ps, accel, cfg);
     } else {
         g.factors.push(Factor::PosePrior { k: 0, mean: [n0, e0, psi0], sigma: [ps, ps, heading_sigma] });
     }
@@ -252,9 +253,6 @@ pub(crate) fn build(log: &Log, beacons: Option<&BTreeSet<u32>>, cfg: &SmoothConf
         let k = nearest(&g.t_s, t);
         fixed_heading.insert(k, h);
         g.factors.push(Factor::Heading { k, heading_rad: h, sigma: noise.heading_sigma_rad });
-    }
-    if let Some(accel) = cfg.track_accel_sigma_m_s2 {
-        g.x0 = track_initial(&g.t_s, &heard, [n0, e0], ps, accel, cfg);
     }
     let t0 = start.t0_s;
     for h in heard {

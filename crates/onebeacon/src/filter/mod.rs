@@ -11,6 +11,7 @@ pub mod ekf;
 pub mod factored;
 pub mod lanes;
 pub mod particle;
+mod resample;
 pub mod rts;
 pub mod truncated;
 pub mod ukf;
