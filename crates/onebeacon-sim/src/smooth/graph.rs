@@ -18,7 +18,7 @@ use onebeacon::geo::wrap_angle;
 use onebeacon::nav::Kind;
 use onebeacon::nav::session::Input;
 use onebeacon::nav::tracking::INITIAL_VELOCITY_SIGMA_M_S;
-use onebeacon::nav::{Measurement, Navigator, PlanarConfig, TrackingNavigator};
+use onebeacon::nav::{Measurement, PlanarConfig, planar};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Standard deviation of the heading change between two nodes when nothing measures
@@ -336,9 +336,15 @@ fn track_initial(
     accel: f64,
     cfg: &SmoothConfig,
 ) -> Vec<f64> {
-    let config =
-        PlanarConfig { noise: cfg.noise, nis_gate: cfg.nis_gate, robust: cfg.kernel, ..PlanarConfig::default() };
-    let mut filter = TrackingNavigator::new(config, accel, FilterKind::Ekf, t_s[0], (start[0], start[1]), sigma_m);
+    let config = PlanarConfig {
+        noise: cfg.noise,
+        nis_gate: cfg.nis_gate,
+        robust: cfg.kernel,
+        track_accel_sigma_m_s2: Some(accel),
+        ..PlanarConfig::default()
+    };
+    // the navigators' own factory: this config makes it the constant-velocity tracker
+    let mut filter = planar::builder(config, FilterKind::Ekf)(t_s[0], (start[0], start[1], 0.0), sigma_m, 0.0);
     let mut x = [start[0], start[1], 0.0, 0.0].repeat(t_s.len());
     for h in heard {
         let mut kind = h.kind.clone();

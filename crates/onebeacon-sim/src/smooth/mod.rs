@@ -107,8 +107,8 @@ impl Default for SmoothConfig {
 }
 
 impl SmoothConfig {
-    /// The smoother an estimator of the log describes: its noise, kernel, gate and
-    /// calibration priors, with the variables `calibrate`.
+    /// The smoother an estimator of the log describes: its noise, kernel, gate,
+    /// calibration priors and constant-velocity model, with the variables `calibrate`.
     pub fn from_planar(c: &PlanarConfig, calibrate: Calibrate) -> Self {
         Self {
             noise: c.noise,
@@ -127,7 +127,7 @@ impl SmoothConfig {
             // the cap ../shared/bench/gtsam_smooth.py gives GTSAM (setMaxIterations); plaza1
             // beacon 1 alone, scale 1 and no kernel, needs 127 (GTSAM 98)
             max_iterations: 200,
-            track_accel_sigma_m_s2: None,
+            track_accel_sigma_m_s2: c.track_accel_sigma_m_s2,
         }
     }
 }

@@ -49,7 +49,7 @@ pub fn config(
             offsets,
             clock_drift: false,
         };
-        cfg = SmoothConfig { track_accel_sigma_m_s2: e.track_accel_sigma_m_s2, ..SmoothConfig::from_planar(&p, c) };
+        cfg = SmoothConfig::from_planar(&p, c);
     }
     if let Some(a) = track_accel {
         if !(a.is_finite() && a > 0.0) {

@@ -10,28 +10,12 @@
 //! stream, derived from (seed, step, chunk), and sums are reduced in chunk order, so a
 //! result depends neither on the thread count nor on the feature.
 
+pub use super::resample::{CHUNK, Resampler};
 use super::resample::{chunk_ancestors, cumulative_in_place, drawn_ancestors, weight_before_chunks};
 use crate::par::*;
 use nalgebra::{SMatrix, SVector};
 use rand::RngExt;
 use rand_pcg::Pcg64;
-
-/// Particles per chunk: the unit of parallel work and of random streams.
-pub const CHUNK: usize = 8192;
-
-/// How particles are drawn again in proportion to their weights.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum Resampler {
-    /// N independent draws (hoff2024 eq. 9).
-    Multinomial,
-    /// One uniform offset, N evenly spaced points.
-    #[default]
-    Systematic,
-    /// One uniform draw in each of N strata.
-    Stratified,
-    /// floor(N w_i) copies of each, the rest multinomially on the residual weights.
-    Residual,
-}
 
 /// The motion of the particles over a step.
 pub trait ParticleProcess: Sync {

@@ -1,12 +1,28 @@
 //! Resampling's ancestors (hoff2024 eq. 9 and its systematic, stratified and residual
 //! variants): the cumulative weights, the draws shared by the chunks, and each chunk's
 //! walk through them, so that the picked ancestors are the same whatever the thread
-//! count ([`super::particle`]'s chunked streams).
+//! count ([`super::particle`]'s chunked streams, [`CHUNK`] particles each).
 
-use super::particle::{CHUNK, Resampler};
 use crate::par::*;
 use rand::RngExt;
 use rand_pcg::Pcg64;
+
+/// Particles per chunk: the unit of parallel work and of random streams.
+pub const CHUNK: usize = 8192;
+
+/// How particles are drawn again in proportion to their weights.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Resampler {
+    /// N independent draws (hoff2024 eq. 9).
+    Multinomial,
+    /// One uniform offset, N evenly spaced points.
+    #[default]
+    Systematic,
+    /// One uniform draw in each of N strata.
+    Stratified,
+    /// floor(N w_i) copies of each, the rest multinomially on the residual weights.
+    Residual,
+}
 
 /// The sum of the `totals` before each (in order: the same whatever the thread count
 /// that computed them).
