@@ -35,7 +35,8 @@ fn bench(c: &mut Criterion) {
     c.bench_function("plaza1 load (TOML, beacons, CSV headers)", |b| b.iter(|| black_box(Log::load(&path).unwrap())));
 
     // a started stream: plaza1's first 2000 items
-    let mut unit = stream_setup(&path, &onebeacon_sim::budget::Budget::resolve(None).unwrap()).unwrap();
+    let mut unit =
+        stream_setup(&path, |s| onebeacon_sim::budget::Budget::resolve(None).unwrap().check_stream(s)).unwrap();
     let mut lines = Lines::default();
     let mut t0 = 0.0;
     for item in full.items().unwrap().take(2000) {

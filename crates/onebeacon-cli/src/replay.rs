@@ -365,7 +365,7 @@ fn rejected_csv(s: &Session) -> Result<Vec<u8>> {
 /// with a `[controller]`, the command) on stdout, flushed after each; bad lines are
 /// reported on stderr and skipped.
 pub fn stream(config: &Path) -> Result<()> {
-    let mut unit = stream_setup(config, &crate::budget())?;
+    let mut unit = stream_setup(config, |s| crate::budget().check_stream(s))?;
     onebeacon::io::stream::run(&mut unit, std::io::stdin().lock(), std::io::stdout().lock(), |line, m| {
         eprintln!("stdin line {line}: {m}")
     })

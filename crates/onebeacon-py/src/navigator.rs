@@ -38,7 +38,7 @@ impl PyNavigator {
     #[new]
     fn new(config: PathBuf) -> PyResult<Self> {
         let budget = Budget::resolve(None).map_err(input_error)?;
-        let unit = stream_setup(&config, &budget).map_err(input_error)?;
+        let unit = stream_setup(&config, |s| budget.check_stream(s)).map_err(input_error)?;
         Ok(Self { unit: std::sync::Mutex::new(unit), lines: Lines::default() })
     }
 

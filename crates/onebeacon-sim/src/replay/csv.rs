@@ -1,6 +1,6 @@
 //! CSV files read row by row with their header, with a bound on the length of a line.
 
-use super::log::LogError;
+use super::error::LogError;
 use std::path::Path;
 
 /// A CSV file being read, with its header.

@@ -3,9 +3,10 @@
 //! what was expected.
 
 use super::csv::Table;
+use super::error::LogError;
 use super::geodesy::{Geodetic, check_latlon};
 use super::merge::{Items, Rows};
-use super::rows::SourceRows;
+use super::rows::{Site, SourceRows};
 pub use super::schema::*;
 use crate::scenario::EstimatorSpec;
 use crate::scenario::load::deserialize;
@@ -18,17 +19,6 @@ use onebeacon::nav::{Aiding, Kind, Measurement, Navigator, PlanarConfig, PlanarN
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
-
-/// Why a log could not be loaded: one line each.
-#[derive(Debug, thiserror::Error)]
-pub enum LogError {
-    #[error(transparent)]
-    Description(#[from] crate::ScenarioError),
-    #[error("{file}: {message}")]
-    File { file: String, message: String },
-    #[error("{file} line {line}, column `{column}`: {message}")]
-    Cell { file: String, line: u64, column: String, message: String },
-}
 
 /// Where and when a log's estimators start.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -268,7 +258,7 @@ impl Log {
         let mut log = Self { description, frame, beacons, tracked, geodetic, base, path };
         let mut tracked = BTreeSet::new();
         for s in log.description.sources.iter().filter(|s| s.kind == SourceKind::BeaconTrack) {
-            let mut rows = SourceRows::open(&log, s)?;
+            let mut rows = SourceRows::open(log.site(), s)?;
             while let Some(item) = rows.next_item()? {
                 if let Input::BeaconPosition { beacon_id, .. } = item.input {
                     tracked.insert(beacon_id);
@@ -280,12 +270,19 @@ impl Log {
         Ok(log)
     }
 
+    /// What its rows are read against.
+    fn site(&self) -> Site<'_> {
+        let (base, frame, beacons, tracked, geodetic) =
+            (&self.base, self.frame, &self.beacons, &self.tracked, self.geodetic);
+        Site { base, frame, beacons, tracked, geodetic }
+    }
+
     /// The merged, time-ordered stream of every source. At equal times: beacon
     /// positions, then measurements, then the truth; then in the order of the sources.
     pub fn items(&self) -> Result<Items<'_>, LogError> {
         let (mut heads, mut rows) = (Vec::new(), Vec::new());
         for s in &self.description.sources {
-            let mut source = SourceRows::open(self, s)?;
+            let mut source = SourceRows::open(self.site(), s)?;
             let head = source
                 .next_item()?
                 .ok_or_else(|| LogError::File { file: source.table.file.clone(), message: "no rows".into() })?;

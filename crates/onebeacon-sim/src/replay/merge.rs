@@ -1,7 +1,7 @@
 //! The merge of a log's sources into one time-ordered stream of items, each source read
 //! as the merge needs its next row.
 
-use super::log::LogError;
+use super::error::LogError;
 use super::rows::{Dropped, SourceRows};
 use super::schema::TimeOrder;
 use onebeacon::nav::session::Item;

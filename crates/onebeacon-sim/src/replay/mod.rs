@@ -4,6 +4,7 @@
 //! and keeps what the outputs need.
 
 mod csv;
+mod error;
 pub(crate) mod geodesy;
 pub mod log;
 mod merge;
@@ -16,11 +17,12 @@ pub(crate) mod validate;
 #[cfg(test)]
 mod burst_tests;
 
-pub use log::{InitialStart, Log, LogDescription, LogError};
+pub use error::LogError;
+pub use log::{InitialStart, Log, LogDescription};
 pub use rows::Dropped;
 
 use log::IncrementFrame;
-use onebeacon::config::stream::Beacon;
+use onebeacon::config::stream::{Beacon, StreamConfig};
 use onebeacon::nav::Kind;
 use onebeacon::nav::diagnosis::BeaconStats;
 use onebeacon::nav::session::{Input, Session, Start, Step};
@@ -184,16 +186,19 @@ pub fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Opt
 
 /// The vehicle's computer `onebeacon stream CONFIG` (and the Python `Navigator`) runs,
 /// from a log description: its stream configuration with the fixed beacons of its files
-/// ([`onebeacon::config::stream::StreamConfig::unit`]), refused where its filters would
-/// not fit in `budget`.
-pub fn stream_setup(config: &std::path::Path, budget: &crate::budget::Budget) -> Result<Unit, LogError> {
+/// ([`onebeacon::config::stream::StreamConfig::unit`]), refused where `fits` refuses it
+/// (where its filters would not fit in the memory budget: [`crate::budget::Budget::check_stream`]).
+pub fn stream_setup<E: std::fmt::Display>(
+    config: &std::path::Path,
+    fits: impl FnOnce(&StreamConfig) -> Result<(), E>,
+) -> Result<Unit, LogError> {
     let d = LogDescription::load(config)?;
     let base = config.parent().unwrap_or(std::path::Path::new("."));
     let beacons =
         d.fixed_beacons(base)?.into_iter().map(|(id, p)| Beacon { id, x_m: p.x, y_m: p.y, z_m: p.z }).collect();
     let file = config.display().to_string();
     let stream = d.stream_config(beacons);
-    budget.check_stream(&stream).map_err(|e| LogError::File { file: file.clone(), message: e.to_string() })?;
+    fits(&stream).map_err(|e| LogError::File { file: file.clone(), message: e.to_string() })?;
     stream.unit().map_err(|v| LogError::File { file, message: v.to_string() })
 }
 

@@ -2,14 +2,15 @@
 //! frame to SI and the log's frame, and the rows dropped out of time order.
 
 use super::csv::Table;
+use super::error::LogError;
 use super::geodesy::Geodetic;
-use super::log::{Log, LogError};
 use super::schema::{COLUMN_KEYS, IncrementFrame, Source, SourceKind, TimeOrder};
 use nalgebra::Vector3;
 use onebeacon::geo::Frame;
 use onebeacon::nav::Kind;
 use onebeacon::nav::session::{Input, Item, TruthPose, resolve_beacon};
 use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
 
 /// One source read row by row into stream items (the log's frame, SI units).
 pub(super) struct SourceRows<'a> {
@@ -129,9 +130,19 @@ impl Clock {
     }
 }
 
+/// What a log's rows are read against: where its files are, its frame, its beacons
+/// (fixed, and those with a track) and its geodetic origin.
+pub(super) struct Site<'a> {
+    pub(super) base: &'a Path,
+    pub(super) frame: Frame,
+    pub(super) beacons: &'a BTreeMap<u32, Vector3<f64>>,
+    pub(super) tracked: &'a BTreeSet<u32>,
+    pub(super) geodetic: Option<Geodetic>,
+}
+
 impl<'a> SourceRows<'a> {
-    pub(super) fn open(log: &'a Log, source: &'a Source) -> Result<Self, LogError> {
-        let table = Table::open(&log.base, &source.file)?;
+    pub(super) fn open(log: Site<'a>, source: &'a Source) -> Result<Self, LogError> {
+        let table = Table::open(log.base, &source.file)?;
         let time = table.index(&source.time)?;
         let cols = COLUMN_KEYS
             .iter()
@@ -144,8 +155,8 @@ impl<'a> SourceRows<'a> {
             table,
             time,
             cols,
-            beacons: &log.beacons,
-            tracked: &log.tracked,
+            beacons: log.beacons,
+            tracked: log.tracked,
             geodetic: log.geodetic,
             clock: Clock::new(source),
             order: source.time_order(),

@@ -5,7 +5,7 @@ pub use super::geodesy::{LatLonUnit, Origin};
 use onebeacon::config::controller::ControllerSpec;
 use onebeacon::config::estimator::EstimatorSpec;
 pub use onebeacon::config::stream::{FrameKey, HeadingFrom, Initial, InitialFrom};
-use onebeacon::nav::session::Limits;
+use onebeacon::nav::limits::Limits;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;

@@ -3,7 +3,7 @@
 //! are checked by [`onebeacon::config::stream::StreamConfig::check`]). The first
 //! violation is reported with its key.
 
-use super::log::{COLUMN_KEYS, IncrementFrame, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
+use super::schema::{COLUMN_KEYS, IncrementFrame, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
 use crate::scenario::validate::{Rule, Violation, check};
 
 /// A position given as exactly one pair: `x`/`y` or `lat`/`lon` (the keys named by

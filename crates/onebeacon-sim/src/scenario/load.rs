@@ -98,7 +98,7 @@ pub fn parse(text: &str, source_name: &str) -> Result<Scenario, ScenarioError> {
     };
     let canonical: toml::Table = toml::from_str(&scenario.to_toml()).expect("canonical TOML parses");
     tables_where_tables_belong(&table, &canonical, "").map_err(|v| invalid(source_name, v))?;
-    validate::validate(&scenario).map_err(|v| invalid(source_name, v))?;
+    scenario.validate().map_err(|v| invalid(source_name, v))?;
     Ok(scenario)
 }
 

@@ -131,6 +131,16 @@ impl Cell {
 }
 
 impl Scenario {
+    /// Its checks: each world's are beside its schema.
+    pub(crate) fn validate(&self) -> Result<(), validate::Violation> {
+        match self {
+            Scenario::FixedBeacon(s) => fixed_beacon::validate_fixed(s),
+            Scenario::MovingBeacon(s) => moving_beacon::validate_moving(s),
+            Scenario::PassiveUsbl(s) => passive_usbl::validate_passive(s),
+            Scenario::Fleet(s) => fleet::validate_fleet(s),
+        }
+    }
+
     pub fn name(&self) -> &str {
         match self {
             Scenario::FixedBeacon(s) => &s.name,

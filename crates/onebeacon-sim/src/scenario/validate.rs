@@ -1,12 +1,12 @@
-//! Range checks on a parsed scenario. The first violation is reported with its key.
+//! The range checks each world's schema makes on a parsed scenario (the first violation
+//! is reported with its key).
 //! The rules a number or a name obeys are shared with the log descriptions'
 //! ([`crate::replay::validate`]).
 
-use super::Scenario;
 pub(crate) use onebeacon::config::check::{
     NAME_RULE, Rule, Violation, check, check_count, check_file_name, check_names, valid_name,
 };
-pub(crate) use onebeacon::config::estimator::check_estimators;
+pub(crate) use onebeacon::config::check_estimators;
 
 /// Checks fields of one section; the key is built from the section and the field
 /// name, so it cannot drift from the schema.
@@ -16,16 +16,6 @@ macro_rules! check_fields_impl {
     };
 }
 pub(crate) use check_fields_impl as check_fields;
-
-/// A scenario's checks: each world's are beside its type.
-pub(super) fn validate(s: &Scenario) -> Result<(), Violation> {
-    match s {
-        Scenario::FixedBeacon(s) => super::fixed_beacon::validate_fixed(s),
-        Scenario::MovingBeacon(s) => super::moving_beacon::validate_moving(s),
-        Scenario::PassiveUsbl(s) => super::passive_usbl::validate_passive(s),
-        Scenario::Fleet(s) => super::fleet::validate_fleet(s),
-    }
-}
 
 pub(super) fn violation(key: impl Into<String>, value: impl std::fmt::Debug, allowed: impl Into<String>) -> Violation {
     Violation { key: key.into(), value: format!("{value:?}"), allowed: allowed.into() }

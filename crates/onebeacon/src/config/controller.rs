@@ -7,7 +7,7 @@
 use super::check::Violation;
 use crate::geo::Frame;
 use crate::guidance::bearing::{BearingPlanner, SpreadMetric, planner_too_slow};
-use crate::nav::session::Limits;
+use crate::nav::limits::Limits;
 use crate::vehicle::autonomy::{Autonomy, AutonomySettings, Behaviour};
 use crate::vehicle::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
 use crate::vehicle::behaviours::Behaviours;

@@ -6,8 +6,6 @@
 //! 3-7), 6-DOF kinematics in `moving_beacon` worlds (sousa 3.1), the stochastic
 //! unicycle of hoff2024 eq. 4 in `passive_usbl` worlds, planar odometry on logs.
 
-pub use super::builder::TrackerStart;
-pub use super::estimator_check::check_estimators;
 pub use super::estimator_defaults::*;
 pub use super::iusbl::IusblKeys;
 use crate::filter::particle::{ParticleSettings, Resampler};

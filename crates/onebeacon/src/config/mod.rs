@@ -17,3 +17,5 @@ mod estimator_defaults;
 pub mod iusbl;
 pub mod stream;
 pub mod working_set;
+
+pub use estimator_check::check_estimators;

@@ -5,11 +5,14 @@
 //! (docs/logs.md) without its CSV sources: a log description is a stream configuration
 //! plus where its files are, and the simulator's replay reads it into this type.
 
+use super::builder::TrackerStart;
 use super::check::{Rule, Violation, check, check_count, check_file_name};
 use super::controller::ControllerSpec;
-use super::estimator::{EstimatorSpec, Host, NOISE_KEYS, TrackerStart, check_estimators};
+use super::estimator::{EstimatorSpec, Host, NOISE_KEYS};
+use super::estimator_check::check_estimators;
 use crate::geo::Frame;
-use crate::nav::session::{Limits, Session, Start};
+use crate::nav::limits::Limits;
+use crate::nav::session::{Session, Start};
 use crate::vehicle::unit::Unit;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};

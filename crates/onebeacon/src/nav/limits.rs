@@ -2,7 +2,7 @@
 //! estimator sees it: the session screens an item out of them with its reason.
 
 use super::Kind;
-use super::session::Input;
+use super::item::Input;
 
 /// Physical limits every item must respect before any estimator sees it. An item out
 /// of them (a faulty sensor, a corrupt line) is screened out with its reason, and the

@@ -31,7 +31,8 @@ pub mod usbl_track;
 
 pub use event::{BeaconFix, Capture, Kind, Measurement};
 pub use iusbl::{IusblConfig, IusblNavigator};
-pub use planar::{HeadingOffsetPrior, PlanarConfig, PlanarNavigator, PlanarNoise};
+pub use planar::PlanarNavigator;
+pub use planar_config::{HeadingOffsetPrior, PlanarConfig, PlanarNoise};
 
 pub use range_6dof::{Range6DofNavigator, SensorNoise};
 pub use range_calibration::{CurrentPrior, OffsetPrior, RangeCalibration};

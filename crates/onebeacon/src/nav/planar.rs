@@ -41,19 +41,7 @@ pub const STATES_WITH_OFFSETS: usize = EXTENDED_STATES + BEACON_OFFSETS;
 type State<const N: usize> = SVector<f64, N>;
 type Cov<const N: usize> = SMatrix<f64, N, N>;
 
-/// Index of each state component.
-pub mod idx {
-    pub const N: usize = 0;
-    pub const E: usize = 1;
-    pub const PSI: usize = 2;
-    pub const BIAS: usize = 3;
-    pub const RANGE_SCALE: usize = 4;
-    pub const DISTANCE_SCALE: usize = 5;
-    pub const TURN_SCALE: usize = 6;
-    pub const HEADING_OFFSET: usize = 7;
-    pub const CURRENT_N: usize = 8;
-    pub const CURRENT_E: usize = 9;
-}
+pub use super::planar_models::idx;
 
 /// The navigator: an EKF or UKF over [N, E, psi, b, k_r, k_d, k_t] (with `N` =
 /// [`EXTENDED_STATES`], the heading offset and the current too; with

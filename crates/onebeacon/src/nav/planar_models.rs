@@ -2,7 +2,6 @@
 //! its extended states (the current carrying the position, the heading offset decaying)
 //! and the heading fix that reads the heading plus its offset.
 
-use super::planar::idx;
 use super::planar_config::PlanarNoise;
 use crate::filter::ProcessModel;
 use crate::geo::wrap_angle;
@@ -11,6 +10,20 @@ use nalgebra::{SMatrix, SVector, Vector3};
 
 type State<const N: usize> = SVector<f64, N>;
 type Cov<const N: usize> = SMatrix<f64, N, N>;
+
+/// Index of each state component.
+pub mod idx {
+    pub const N: usize = 0;
+    pub const E: usize = 1;
+    pub const PSI: usize = 2;
+    pub const BIAS: usize = 3;
+    pub const RANGE_SCALE: usize = 4;
+    pub const DISTANCE_SCALE: usize = 5;
+    pub const TURN_SCALE: usize = 6;
+    pub const HEADING_OFFSET: usize = 7;
+    pub const CURRENT_N: usize = 8;
+    pub const CURRENT_E: usize = 9;
+}
 
 /// Over `dt`: the current carries the position, the heading offset decays toward zero
 /// (exp(-dt / time)); linear.

@@ -7,7 +7,7 @@ use crate::geo::Frame;
 use crate::nav::diagnosis::{BeaconStats, PerBeacon};
 use crate::nav::evaluation::{ErrorStats, horizontal_error};
 pub use crate::nav::item::{Input, Item, TruthPose, resolve_beacon};
-pub use crate::nav::limits::Limits;
+use crate::nav::limits::Limits;
 use crate::nav::restart::Restart;
 use crate::nav::{Estimate, Kind, Measurement, Navigator, Outcome};
 use nalgebra::Vector3;

@@ -1,0 +1,12 @@
+//! Why a log could not be loaded, for every file of the replay that reads one.
+
+/// Why a log could not be loaded: one line each.
+#[derive(Debug, thiserror::Error)]
+pub enum LogError {
+    #[error(transparent)]
+    Description(#[from] crate::ScenarioError),
+    #[error("{file}: {message}")]
+    File { file: String, message: String },
+    #[error("{file} line {line}, column `{column}`: {message}")]
+    Cell { file: String, line: u64, column: String, message: String },
+}
