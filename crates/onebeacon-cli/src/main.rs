@@ -100,7 +100,8 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
         /// Also write each vehicle computer's side of the run (passive_usbl: the surface
-        /// vehicle; fleet with the abstract signal model: each AUV): NAME.stream.toml (its
+        /// vehicle; moving_beacon: the beacon vehicle; fleet with the abstract signal
+        /// model: each AUV): NAME.stream.toml (its
         /// `stream` configuration), NAME.input.jsonl (what it heard) and
         /// NAME.decisions.jsonl (the simulator's commands), for `onebeacon stream
         /// NAME.stream.toml < NAME.input.jsonl`.

@@ -102,6 +102,29 @@ fn the_stream_gives_the_simulated_surface_vehicles_waypoints() {
     assert_eq!(served.len(), 2, "the planner serves both AUVs: {served:?}");
 }
 
+/// sousa's beacon vehicle (600 s, 60 pings; its FIM guidance, `kind = "fim"`): fed its
+/// own fixes and what the vehicle it serves measures, the stream's 6-DOF filters
+/// (`model = "6dof"`) and planner give the simulator's waypoints, decision for decision
+/// and bit for bit.
+#[test]
+fn the_stream_gives_the_simulated_beacon_vehicles_waypoints() {
+    let dir = scratch("fim");
+    let scenario = edited(&dir, "sousa", &[("duration_s", "duration_s = 600")]);
+    let run = run_messages(&scenario, &dir);
+    let config = std::fs::read_to_string(run.join("asv.stream.toml")).unwrap();
+    assert!(config.contains("model = \"6dof\"") && config.contains("kind = \"fim\""), "{config}");
+    let (stream, stderr) = stream_decisions(&run, "asv");
+    assert!(stderr.is_empty(), "{stderr}");
+    let sim = simulator_decisions(&run, "asv");
+    // one decision per ping: 600 s / 10 s
+    assert_eq!(sim.len(), 60);
+    assert_eq!(stream.len(), sim.len());
+    for (s, d) in stream.iter().zip(&sim) {
+        assert_eq!(s["t_s"], d["t_s"]);
+        assert_eq!(s["command"], d["command"], "at {} s", d["t_s"]);
+    }
+}
+
 /// rypkema-m1's quokka (the abstract signal model, the whole mission): fed its sensors
 /// and the beacon's pings, the stream confirms the simulator's modes and gives its
 /// behaviours' setpoints. The simulator decides at the start of a step on what was
@@ -134,7 +157,7 @@ fn messages_of_a_world_without_a_streamable_computer_are_refused() {
     let o = bin().args(["run", "garin2024", "--messages", "--out", "/nonexistent/x"]).output().unwrap();
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("--messages: garin2024") && e.contains("passive_usbl"), "{e}");
+    assert!(e.contains("--messages: garin2024") && e.contains("moving_beacon"), "{e}");
 }
 
 /// `stream` and its memory budget: hoff2024's surface vehicle with 2e6 particles in its

@@ -10,18 +10,19 @@ use crate::scenario::{EstimatorKind, FixedBeacon, Host, MovingBeacon, PassiveUsb
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use crate::vehicles::sandshark::SandSharkParams;
 use nalgebra::SVector;
+use onebeacon::config::builder::TrackerStart;
 use onebeacon::dsp::beamform::pyramid_8cm;
 use onebeacon::dsp::receiver::{ModeReceiver, ReceiverConfig};
 use onebeacon::dsp::waveform::rypkema_modes;
 use onebeacon::filter::FilterKind;
 use onebeacon::geo::wrap_angle;
 use onebeacon::models::hoff::{DIM, idx};
-use onebeacon::models::kinematic6dof::{Cov as Cov6, State as Eta};
+use onebeacon::models::kinematic6dof::State as Eta;
 use onebeacon::models::unicycle::{Cov, State};
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
 use onebeacon::nav::{
-    Aiding, CurrentPrior, HeadingOffsetPrior, IusblNavigator, PlanarConfig, PlanarNoise, range_6dof, single_beacon,
+    Aiding, CurrentPrior, HeadingOffsetPrior, IusblNavigator, PlanarConfig, PlanarNoise, single_beacon,
 };
 use rand::RngExt;
 
@@ -63,28 +64,38 @@ pub(crate) fn fixed_beacon(s: &FixedBeacon, z_true: State, seed: u64, run: u64) 
         .collect()
 }
 
-/// Every estimator of a moving-beacon scenario on every vehicle, each vehicle's started
-/// at its truth `truth0[v]` plus one draw (the same for all its estimators).
-pub(crate) fn moving_beacon(s: &MovingBeacon, truth0: &[Eta], seed: u64, run: u64) -> Vec<Track> {
+/// Where a moving-beacon scenario's estimators of each vehicle start: its truth
+/// `truth0[v]` plus one draw (the same for all its estimators).
+pub(crate) fn moving_beacon_starts(s: &MovingBeacon, truth0: &[Eta], seed: u64, run: u64) -> Vec<Eta> {
     let i = &s.initial;
     let a0 = i.attitude_sigma_deg.to_radians();
     let sigma0 = SVector::<f64, 6>::from([i.position_sigma_m, i.position_sigma_m, i.depth_sigma_m, a0, a0, a0]);
-    let p0 = Cov6::from_diagonal(&sigma0.component_mul(&sigma0));
+    truth0
+        .iter()
+        .enumerate()
+        .map(|(v, eta)| {
+            let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
+            eta + sigma0.map(|sd| gauss(&mut init_rng, sd))
+        })
+        .collect()
+}
+
+/// Every estimator of a moving-beacon scenario on every vehicle, each vehicle's started
+/// at `starts[v]` ([`moving_beacon_starts`]) as a stream's 6-DOF filter starts.
+pub(crate) fn moving_beacon(s: &MovingBeacon, starts: &[Eta]) -> Vec<Track> {
+    let i = &s.initial;
+    let a0 = i.attitude_sigma_deg.to_radians();
     let mut tracks = Vec::new();
-    for (v, eta) in truth0.iter().enumerate() {
-        let mut init_rng = vehicle_rng(seed, run, v, Stream::Initial);
-        let eta0 = eta + sigma0.map(|sd| gauss(&mut init_rng, sd));
-        let pose = (eta0[0], eta0[1], eta0[5]);
+    for (v, eta0) in starts.iter().enumerate() {
+        let start = TrackerStart {
+            state: [eta0[2], eta0[4], 0.0, 0.0, 0.0],
+            sigma: [i.depth_sigma_m, a0, 0.0, 0.0],
+            roll_rad: eta0[3],
+            seed: None,
+        };
         tracks.extend(s.estimators.iter().map(|e| {
-            let (noise, aiding, filter) =
-                (e.sensor_noise(s.sensor_noise()), e.aiding(Host::MovingBeacon), e.filter_kind());
-            let (calibration, gate) = (e.range_calibration(), e.gate());
-            let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
-                let mut eta = eta0;
-                (eta[0], eta[1], eta[5]) = (north, east, heading);
-                range_6dof::boxed(noise, aiding, filter, t0, (eta, p0), calibration, gate)
-            });
-            Track::new(v, builder, pose, (i.position_sigma_m, a0))
+            let builder = e.range_6dof_builder(s.sensor_noise(), start);
+            Track::new(v, builder, (eta0[0], eta0[1], eta0[5]), (i.position_sigma_m, a0))
         }));
     }
     tracks

@@ -10,10 +10,11 @@ use crate::scenario::moving_beacon::GuidanceKind as FimKind;
 use crate::scenario::passive_usbl::GuidanceKind as BearingKind;
 use crate::scenario::{MovingBeacon, MovingBeaconCell, PassiveUsbl, PassiveUsblCell};
 use nalgebra::Vector2;
-use onebeacon::config::controller::{BearingModeName, BearingSpec, BehavioursSpec, ControllerSpec, MetricName};
+use onebeacon::config::controller::{
+    BearingModeName, BearingSpec, BehavioursSpec, ControllerSpec, FimMetricName, FimModeName, FimSpec, MetricName,
+};
 use onebeacon::geo::Frame;
-use onebeacon::guidance::{FimPlanner, Metric, PolarGrid, best_standoff};
-use onebeacon::vehicle::fim::{FimGuidance, FimGuidanceConfig, FimMode};
+use onebeacon::guidance::{PolarGrid, best_standoff};
 
 /// The controller of a passive-USBL world's ASV, starting at `home`, as a stream
 /// configuration gives it (the planner knows the USBL as the first estimator assumes it).
@@ -64,30 +65,36 @@ pub(crate) fn initial_asv_position(s: &MovingBeacon, cell: &MovingBeaconCell) ->
     Vector2::new(s.vehicle.start_north_m, s.vehicle.start_east_m) + Vector2::new(b.cos(), b.sin()) * d
 }
 
-/// The beacon-carrying ASV of a moving-beacon world, starting at `home`: it serves the
-/// first vehicle.
-pub(crate) fn moving_beacon(s: &MovingBeacon, cell: &MovingBeaconCell, home: Vector2<f64>) -> Vec<Helm> {
+/// The controller of a moving-beacon world's ASV, starting at `home`, as a stream
+/// configuration gives it.
+pub(crate) fn moving_beacon_spec(s: &MovingBeacon, cell: &MovingBeaconCell, home: Vector2<f64>) -> ControllerSpec {
     let g = &s.guidance;
     let mode = match cell.guidance {
-        FimKind::ApproachA | FimKind::ApproachB => FimMode::Planner,
-        FimKind::Static => FimMode::Static,
-        FimKind::Circle => FimMode::Circle,
+        FimKind::ApproachA | FimKind::ApproachB => FimModeName::Planner,
+        FimKind::Static => FimModeName::Static,
+        FimKind::Circle => FimModeName::Circle,
     };
-    let planner = FimPlanner {
-        metric: if cell.guidance == FimKind::ApproachB { Metric::ApproachB } else { Metric::ApproachA },
-        grid: PolarGrid { radial: g.grid_radial, angular: g.grid_angular, refinements: 12 },
-        range_var_m2: s.acoustics.range_noise_m.powi(2),
-        beacon_depth_m: s.asv.transducer_depth_m,
-    };
-    let config = FimGuidanceConfig {
+    ControllerSpec::Fim(FimSpec {
         mode,
-        planner,
+        metric: if cell.guidance == FimKind::ApproachB { FimMetricName::ApproachB } else { FimMetricName::ApproachA },
+        grid_radial: g.grid_radial,
+        grid_angular: g.grid_angular,
+        range_sigma_m: s.acoustics.range_noise_m,
+        beacon_depth_m: s.asv.transducer_depth_m,
         period_s: s.acoustics.ping_period_s,
         max_speed_m_s: s.asv.max_speed_m_s,
         circle_radius_m: g.circle_radius_m,
-        home_m: home,
-    };
-    vec![Helm { controller: Box::new(FimGuidance::new(config)), serves: vec![0] }]
+        home_x_m: home.x,
+        home_y_m: home.y,
+        ..FimSpec::default()
+    })
+}
+
+/// The beacon-carrying ASV of a moving-beacon world, starting at `home`: it serves the
+/// first vehicle.
+pub(crate) fn moving_beacon(s: &MovingBeacon, cell: &MovingBeaconCell, home: Vector2<f64>) -> Vec<Helm> {
+    let controller = moving_beacon_spec(s, cell, home).build(Frame::Ned).controller;
+    vec![Helm { controller, serves: vec![0] }]
 }
 
 /// The controller of fleet AUV `v`, as a stream configuration gives it: its behaviours

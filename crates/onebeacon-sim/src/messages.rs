@@ -1,6 +1,6 @@
 //! What each vehicle's computer heard and decided in a simulated run, as `onebeacon
 //! stream` reads and writes it: per controller (a passive-USBL world's surface vehicle,
-//! each fleet AUV), its stream configuration (the scenario's estimators and controller,
+//! a moving-beacon world's beacon vehicle, each fleet AUV), its stream configuration (the scenario's estimators and controller,
 //! the run's initial states and seeds), its JSON Lines input (its own fixes, the beacon
 //! positions and the measurements of the vehicles it estimates) and the commands the
 //! simulator's controller gave. Feeding the input to `stream` with the configuration
@@ -8,15 +8,17 @@
 
 use crate::engine::{Observer, Step};
 use crate::scenario::fleet::{Fleet, SignalModel};
-use crate::scenario::{EstimatorKind, PassiveUsbl, PassiveUsblCell};
+use crate::scenario::{EstimatorKind, MovingBeacon, MovingBeaconCell, PassiveUsbl, PassiveUsblCell};
 use crate::{factory, helms};
 use nalgebra::{Vector2, Vector3};
+use onebeacon::config::builder::VehicleModel;
 use onebeacon::config::controller::ControllerSpec;
 use onebeacon::config::estimator::EstimatorSpec;
 use onebeacon::config::stream::{FrameKey, Initial, InitialFrom, StreamConfig};
 use onebeacon::geo::Frame;
 use onebeacon::io::jsonl::{command_json, item_json, own_fix_json};
 use onebeacon::models::hoff::idx;
+use onebeacon::models::kinematic6dof::State as Eta;
 use onebeacon::nav::session::{Input, Item};
 use onebeacon::nav::usbl_track::TrackState;
 use onebeacon::vehicle::unit::Plan;
@@ -98,13 +100,14 @@ impl Observer for Messages {
     }
 }
 
-/// A stream configuration of `estimators` and `controller`, NED, its vehicles yet to
-/// be given.
+/// A stream configuration of `estimators` and `controller`, NED, planar, its vehicles
+/// yet to be given.
 fn config(name: &str, description: String, estimators: Vec<EstimatorSpec>, controller: ControllerSpec) -> StreamConfig {
     StreamConfig {
         name: name.into(),
         description,
         frame: FrameKey::Ned,
+        model: VehicleModel::Planar,
         beacons: Vec::new(),
         initial: Initial::default(),
         tracked: Vec::new(),
@@ -175,6 +178,52 @@ pub(crate) fn passive_usbl_computer(
         format!("The surface vehicle's computer of a simulated {} run (onebeacon run --messages)", s.name);
     let config =
         StreamConfig { tracked, ..config("asv", description, estimators, helms::passive_usbl_spec(s, cell, home)) };
+    computer("asv", &config)
+}
+
+/// The beacon vehicle's computer of a moving-beacon run: the estimators of the vehicle
+/// it serves (the first), fed what that vehicle measures, started at `eta0` as the
+/// simulator started them, with the world's sensor noise written out; its FIM guidance,
+/// starting at `home`.
+pub(crate) fn moving_beacon_computer(
+    s: &MovingBeacon,
+    cell: &MovingBeaconCell,
+    home: Vector2<f64>,
+    eta0: &Eta,
+) -> Computer {
+    let i = &s.initial;
+    let initial = Initial {
+        depth_m: eta0[2],
+        roll_deg: eta0[3].to_degrees(),
+        pitch_deg: eta0[4].to_degrees(),
+        position_sigma_m: i.position_sigma_m,
+        heading_sigma_deg: i.attitude_sigma_deg,
+        depth_sigma_m: i.depth_sigma_m,
+        pitch_sigma_deg: i.attitude_sigma_deg,
+        ..given(eta0[0], eta0[1], eta0[5].to_degrees())
+    };
+    let estimators = s
+        .estimators
+        .iter()
+        .map(|e| {
+            let n = e.sensor_noise(s.sensor_noise());
+            let mut e = e.clone();
+            e.range_sigma_m = Some(n.range_m);
+            e.depth_sigma_m = Some(n.depth_m);
+            e.velocity_sigma_m_s = Some(n.velocity_m_s);
+            e.rate_sigma_rad_s = Some(n.rate_rad_s);
+            e.attitude_sigma_deg = Some(n.attitude_rad.to_degrees());
+            e.name = Some(e.name());
+            e
+        })
+        .collect();
+    let description = format!("The beacon vehicle's computer of a simulated {} run (onebeacon run --messages)", s.name);
+    let controller = helms::moving_beacon_spec(s, cell, home);
+    let config = StreamConfig {
+        initial,
+        model: VehicleModel::Kinematic6Dof,
+        ..config("asv", description, estimators, controller)
+    };
     computer("asv", &config)
 }
 

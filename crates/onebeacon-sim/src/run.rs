@@ -4,7 +4,7 @@
 //! cell, seed, run index).
 
 use crate::engine::{self, Helm, Observer, Step, Track, VehicleTruth, World};
-use crate::messages::{Computer, Messages, fleet_computers, passive_usbl_computer};
+use crate::messages::{Computer, Messages, fleet_computers, moving_beacon_computer, passive_usbl_computer};
 use crate::metrics::RunMetrics;
 use crate::scenario::{Cell, Scenario};
 use crate::world::{
@@ -173,8 +173,8 @@ pub fn simulate_with_belief(s: &Scenario, cell: &Cell, seed: u64, run: u64, step
 
 /// [`simulate`] recording every step (and the belief at `belief`: step, samples), with
 /// what each vehicle's computer heard and decided ([`crate::messages`]); None for a
-/// world whose vehicles' computers a stream cannot run (fixed and moving beacon; a fleet
-/// with the channel model, whose captures are not JSON lines).
+/// world whose vehicles' computers a stream cannot run (fixed beacon, whose vehicle has
+/// no controller; a fleet with the channel model, whose captures are not JSON lines).
 pub fn simulate_messages(
     s: &Scenario,
     cell: &Cell,
@@ -202,12 +202,17 @@ fn simulate_recording(
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let asv0 = helms::initial_asv_position(s, c);
             let mut world = MovingBeaconWorld::new(s, c, asv0, seed, run);
-            let mut tracks = factory::moving_beacon(s, &world.states(), seed, run);
+            let starts = factory::moving_beacon_starts(s, &world.states(), seed, run);
+            let mut tracks = factory::moving_beacon(s, &starts);
             let mut helms = helms::moving_beacon(s, c, asv0);
             let mut info = Information::new(range_information(s.sensor_noise()));
-            let mut out = drive(&mut world, &mut tracks, &mut helms, vec![&mut info], recorder);
+            let computers = messages.then(|| vec![moving_beacon_computer(s, c, asv0, &starts[0])]);
+            let mut m = computers.map(|c| Messages::new(c, helms.iter().map(|h| h.serves.clone()).collect()));
+            let mut extra: Vec<&mut dyn Observer> = vec![&mut info];
+            extra.extend(m.as_mut().map(|m| m as &mut dyn Observer));
+            let mut out = drive(&mut world, &mut tracks, &mut helms, extra, recorder);
             out.information = info.into_inner();
-            (out, None)
+            (out, m.map(Messages::into_inner))
         }
         (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(c)) => {
             let mut world = PassiveUsblWorld::new(s, seed, run);

@@ -123,6 +123,7 @@ impl LogDescription {
             name: self.name.clone(),
             description: self.description.clone(),
             frame: self.frame,
+            model: self.model,
             beacons,
             initial: self.initial.clone(),
             tracked: self.tracked.clone(),

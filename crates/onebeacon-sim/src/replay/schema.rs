@@ -2,6 +2,7 @@
 //! units, clocks, beacons, start and limits), deserialised and documented.
 
 pub use super::geodesy::{LatLonUnit, Origin};
+use onebeacon::config::builder::VehicleModel;
 use onebeacon::config::controller::ControllerSpec;
 use onebeacon::config::estimator::EstimatorSpec;
 pub use onebeacon::config::stream::{FrameKey, HeadingFrom, Initial, InitialFrom};
@@ -307,6 +308,11 @@ pub struct LogDescription {
     pub description: String,
     #[serde(default)]
     pub frame: FrameKey,
+    /// The estimators' vehicle model: `"planar"` (default; a log's sources are planar
+    /// odometry) or `"6dof"` (stream: sousa's filter on body_velocity, attitude and depth
+    /// lines).
+    #[serde(default)]
+    pub model: VehicleModel,
     /// Where latitudes and longitudes are 0 m north and east.
     pub origin: Option<Origin>,
     #[serde(default, rename = "source")]

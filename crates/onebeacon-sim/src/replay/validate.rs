@@ -72,6 +72,13 @@ fn check_time(i: usize, s: &Source) -> Result<(), Violation> {
 
 /// A log description's own keys: each source's column keys, the beacons, the origin.
 pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
+    if !d.model.is_planar() && !d.sources.is_empty() {
+        return Err(Violation {
+            key: "model".into(),
+            value: "\"6dof\"".into(),
+            allowed: "\"planar\" for a log with [[source]] tables (their rows are planar odometry); \"6dof\" is for `stream` on body_velocity, attitude and depth lines".into(),
+        });
+    }
     if let Some(o) = &d.origin
         && !crate::replay::geodesy::on_earth(o.lat_deg, o.lon_deg)
     {

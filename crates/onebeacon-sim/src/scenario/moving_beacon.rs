@@ -141,7 +141,14 @@ pub struct Sensors {
 
 impl Default for Sensors {
     fn default() -> Self {
-        Self { velocity_noise_m_s: 0.2, rate_noise_rad_s: 0.002, depth_noise_m: 0.05, attitude_noise_deg: 1.0 }
+        // the onboard filter's defaults (one table of them)
+        let d = onebeacon::nav::SensorNoise::default();
+        Self {
+            velocity_noise_m_s: d.velocity_m_s,
+            rate_noise_rad_s: d.rate_rad_s,
+            depth_noise_m: d.depth_m,
+            attitude_noise_deg: d.attitude_rad.to_degrees(),
+        }
     }
 }
 
@@ -233,7 +240,14 @@ pub struct Guidance {
 
 impl Default for Guidance {
     fn default() -> Self {
-        Self { kind: GuidanceKind::ApproachA, grid_radial: 100, grid_angular: 72, circle_radius_m: 30.0 }
+        // the onboard controller's defaults (one table of them)
+        let d = onebeacon::config::controller::FimSpec::default();
+        Self {
+            kind: GuidanceKind::ApproachA,
+            grid_radial: d.grid_radial,
+            grid_angular: d.grid_angular,
+            circle_radius_m: d.circle_radius_m,
+        }
     }
 }
 

@@ -274,16 +274,18 @@ pub struct Guidance {
 
 impl Default for Guidance {
     fn default() -> Self {
+        // the onboard controller's defaults (one table of them)
+        let d = onebeacon::config::controller::BearingSpec::default();
         Self {
             kind: GuidanceKind::Determinant,
-            r1_m: 16.0,
-            r2_m: 26.0,
-            radii: 3,
-            angles: 19,
-            planner_particles: 20_000,
-            lead_periods: 2.0,
-            circle_radius_m: 20.0,
-            offset_m: 20.0,
+            r1_m: d.r1_m,
+            r2_m: d.r2_m,
+            radii: d.radii,
+            angles: d.angles,
+            planner_particles: d.planner_particles,
+            lead_periods: d.lead_periods,
+            circle_radius_m: d.circle_radius_m,
+            offset_m: d.offset_m,
         }
     }
 }

@@ -1,22 +1,55 @@
 //! From an estimator spec to its navigator on a log or a stream (replay, `stream`, the
-//! Python `Navigator`): a USBL tracker, the iUSBL navigator or the planar family. The
-//! simulator's passive-USBL worlds build their trackers here too; its other worlds
-//! build theirs in its factory, on their own process models.
+//! Python `Navigator`): a USBL tracker, the iUSBL navigator, sousa's 6-DOF filter or the
+//! planar family. The simulator's passive-USBL and moving-beacon worlds build their
+//! navigators here too; its fixed-beacon and fleet worlds build theirs in its factory.
 
-use super::estimator::{EstimatorKind, EstimatorSpec};
+use super::estimator::{EstimatorKind, EstimatorSpec, Host};
 use crate::models::hoff::{DIM, idx};
+use crate::models::kinematic6dof::{Cov as Cov6, State as Eta};
 use crate::nav::restart::Builder;
-use crate::nav::{GaussianTracker, IusblNavigator, ParticleTracker, TrackerNoise};
+use crate::nav::{GaussianTracker, IusblNavigator, ParticleTracker, SensorNoise, TrackerNoise, range_6dof};
 use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
 
-/// What a log's or a stream's USBL tracker starts from besides its pose (hoff2024's
-/// state order): depth, pitch, speed and the two rate biases (m, rad, m/s, rad/s), the
-/// standard deviations of depth, pitch, speed and biases, and the seed of the vehicle's
-/// particle filters.
+/// The motion model of a stream's (or a log's) estimators (`model`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum VehicleModel {
+    /// A planar vehicle on odometry (speed and heading, or increments): the planar
+    /// family, or a USBL tracker or the iUSBL navigator by kind.
+    #[default]
+    #[serde(rename = "planar")]
+    Planar,
+    /// sousa's 6-DOF kinematic vehicle on body velocities, depth and attitude (sec. 3.2):
+    /// the estimators are those of a moving_beacon world.
+    #[serde(rename = "6dof")]
+    Kinematic6Dof,
+}
+
+impl VehicleModel {
+    /// The host whose estimator vocabulary applies.
+    pub fn host(self) -> Host {
+        match self {
+            VehicleModel::Planar => Host::Log,
+            VehicleModel::Kinematic6Dof => Host::MovingBeacon,
+        }
+    }
+
+    pub fn is_planar(&self) -> bool {
+        *self == VehicleModel::Planar
+    }
+}
+
+/// What a log's or a stream's estimators start from besides their pose: for a USBL
+/// tracker (hoff2024's state order) depth, pitch, speed and the two rate biases (m, rad,
+/// m/s, rad/s) and the standard deviations of depth, pitch, speed and biases; for the
+/// 6-DOF filter depth, pitch and `roll_rad` with the depth's and pitch's standard
+/// deviations (the roll's is the pitch's); and the seed of the vehicle's particle
+/// filters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrackerStart {
     pub state: [f64; 5],
     pub sigma: [f64; 4],
+    pub roll_rad: f64,
     pub seed: Option<i64>,
 }
 
@@ -24,8 +57,12 @@ impl EstimatorSpec {
     /// The estimator on a log or a stream, on a vehicle whose trackers start as `start`
     /// says, built by the session at its start and again from its last sound pose: a USBL
     /// tracker (pf, bearing: hoff2024's eight states), the iUSBL navigator (which starts
-    /// from its first fix), or the planar family.
-    pub fn builder(&self, start: TrackerStart) -> Builder {
+    /// from its first fix), or the planar family; with `model` 6dof, sousa's filter on
+    /// [`SensorNoise::default`] where the spec sets none.
+    pub fn builder(&self, start: TrackerStart, model: VehicleModel) -> Builder {
+        if model == VehicleModel::Kinematic6Dof {
+            return self.range_6dof_builder(SensorNoise::default(), start);
+        }
         // the seed's 64 bits (TOML integers are signed)
         let seed = self.seed.or(start.seed).unwrap_or(0) as u64;
         if self.kind.tracks_bearings() {
@@ -41,6 +78,23 @@ impl EstimatorSpec {
             return Box::new(move |_, _, _, _| Box::new(IusblNavigator::new(config, None, seed)));
         }
         crate::nav::planar::builder(self.planar_config(), self.filter_kind())
+    }
+
+    /// sousa's 6-DOF filter (range-ekf, dead-reckoning, with the calibration states asked
+    /// for) assuming `sensors` where the spec sets none, starting from `start` (depth,
+    /// roll, pitch), its pose (north, east, heading) and their sigmas the builder's
+    /// arguments. Streams and the moving-beacon worlds build theirs here.
+    pub fn range_6dof_builder(&self, sensors: SensorNoise, start: TrackerStart) -> Builder {
+        let (noise, aiding, filter) = (self.sensor_noise(sensors), self.aiding(Host::MovingBeacon), self.filter_kind());
+        let (calibration, gate) = (self.range_calibration(), self.gate());
+        let [depth, pitch, ..] = start.state;
+        let [s_depth, s_attitude, ..] = start.sigma;
+        Box::new(move |t0, (north, east, heading), s_position, s_heading| {
+            let eta = Eta::from([north, east, depth, start.roll_rad, pitch, heading]);
+            let sigma = Eta::from([s_position, s_position, s_depth, s_attitude, s_attitude, s_heading]);
+            let p0 = Cov6::from_diagonal(&sigma.component_mul(&sigma));
+            range_6dof::boxed(noise, aiding, filter, t0, (eta, p0), calibration, gate)
+        })
     }
 
     /// A USBL tracker (kinds pf and bearing: hoff2024's eight states) assuming `noise`

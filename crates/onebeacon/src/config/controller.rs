@@ -1,16 +1,19 @@
 //! A controller as a configuration file describes it (the `[controller]` table of a
 //! stream configuration; feature `serde`): hoff2024's surface vehicle (`kind =
-//! "bearing"`) or rypkema's AUV (`kind = "behaviours"`). Positions are in the file's
+//! "bearing"`), sousa's beacon vehicle (`kind = "fim"`) or rypkema's AUV (`kind =
+//! "behaviours"`). Positions are in the file's
 //! frame, angles in degrees in keys named `*_deg`; [`ControllerSpec::build`] gives the
 //! controller in NED.
 
 use super::check::Violation;
 use crate::geo::Frame;
 use crate::guidance::bearing::{BearingPlanner, SpreadMetric, planner_too_slow};
+use crate::guidance::{FimPlanner, Metric, PolarGrid};
 use crate::nav::limits::Limits;
 use crate::vehicle::autonomy::{Autonomy, AutonomySettings, Behaviour};
 use crate::vehicle::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
 use crate::vehicle::behaviours::Behaviours;
+use crate::vehicle::fim::{FimGuidance, FimGuidanceConfig, FimMode};
 use crate::vehicle::unit::{DecideOn, Helm};
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
@@ -22,6 +25,9 @@ pub enum ControllerSpec {
     /// hoff2024's surface vehicle: it tracks AUVs by their USBL bearings and plans where
     /// to go next (sec. 3); decides on each `own_fix` line.
     Bearing(BearingSpec),
+    /// sousa's beacon vehicle: at each ping it goes where the next range tells the
+    /// vehicle it serves the most (sec. 3.3); decides on each `own_fix` line.
+    Fim(FimSpec),
     /// rypkema's AUV: the command mode its iUSBL navigator confirmed selects a
     /// beacon-relative behaviour (sec. 4.1-4.2); decides on each `depth` line.
     Behaviours(BehavioursSpec),
@@ -88,6 +94,82 @@ impl Default for BearingSpec {
             lead_periods: 2.0,
             circle_radius_m: 20.0,
             offset_m: 20.0,
+            home_x_m: 0.0,
+            home_y_m: 0.0,
+            decide_on: "own_fix".into(),
+        }
+    }
+}
+
+/// Where the beacon vehicle goes (`mode` of `kind = "fim"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FimModeName {
+    /// The FIM planner with its `metric`.
+    Planner,
+    /// Hold `home_x_m`, `home_y_m` (baseline).
+    Static,
+    /// Circle the vehicle's estimate at `circle_radius_m` (baseline).
+    Circle,
+}
+
+/// How the FIM planner scores a candidate (`metric` of `kind = "fim"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FimMetricName {
+    /// det FIM of the previous and the next range (eq. 3.15).
+    ApproachA,
+    /// det FIM now plus det FIM at the vehicle's predicted position (eq. 3.16-3.19).
+    ApproachB,
+}
+
+/// `kind = "fim"`: defaults are the built-in sousa scenario's (scenarios/sousa.toml,
+/// which gives each its source or says it has none).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FimSpec {
+    pub mode: FimModeName,
+    pub metric: FimMetricName,
+    /// The polar search grid over the reaching set: rings, directions and the
+    /// refinements about the best cell.
+    pub grid_radial: usize,
+    pub grid_angular: usize,
+    pub grid_refinements: usize,
+    /// The vehicle's range noise the planner assumes, m (its FIM's variance).
+    pub range_sigma_m: f64,
+    /// The beacon transducer's depth, m.
+    pub beacon_depth_m: f64,
+    /// The ping period, s, and the beacon vehicle's top speed, m/s: the reaching set's
+    /// radius is their product.
+    pub period_s: f64,
+    pub max_speed_m_s: f64,
+    pub circle_radius_m: f64,
+    /// The point a static beacon vehicle holds (the file's frame).
+    pub home_x_m: f64,
+    pub home_y_m: f64,
+    /// The line kind after which it decides.
+    pub decide_on: String,
+}
+
+impl Default for FimSpec {
+    fn default() -> Self {
+        Self {
+            mode: FimModeName::Planner,
+            metric: FimMetricName::ApproachA,
+            // no source: the simulator's search grid since it was built
+            grid_radial: 100,
+            grid_angular: 72,
+            grid_refinements: 12,
+            // unstated in the thesis: a modem's OWTT noise
+            range_sigma_m: 1.0,
+            // eq. 3.7: the beacon at the surface
+            beacon_depth_m: 0.0,
+            // unstated in the thesis
+            period_s: 10.0,
+            // sec. 4.2.1: the ASV's top speed
+            max_speed_m_s: 2.0,
+            // no source: the circling baseline's radius
+            circle_radius_m: 30.0,
             home_x_m: 0.0,
             home_y_m: 0.0,
             decide_on: "own_fix".into(),
@@ -221,6 +303,7 @@ impl ControllerSpec {
     pub fn decide_on(&self) -> &str {
         match self {
             ControllerSpec::Bearing(b) => &b.decide_on,
+            ControllerSpec::Fim(f) => &f.decide_on,
             ControllerSpec::Behaviours(b) => &b.decide_on,
         }
     }
@@ -281,6 +364,38 @@ impl ControllerSpec {
                     ("home_x_m", b.home_x_m),
                     ("home_y_m", b.home_y_m),
                 ] {
+                    within(key, v, limits.max_range_m, "max_range_m")?;
+                }
+            }
+            ControllerSpec::Fim(f) => {
+                for (key, v) in [
+                    ("range_sigma_m", f.range_sigma_m),
+                    ("period_s", f.period_s),
+                    ("max_speed_m_s", f.max_speed_m_s),
+                    ("circle_radius_m", f.circle_radius_m),
+                ] {
+                    positive(key, v)?;
+                }
+                // the planner scores radial x angular cells, refinements times over
+                for (key, n, most) in [
+                    ("grid_radial", f.grid_radial, 10_000),
+                    ("grid_angular", f.grid_angular, 10_000),
+                    ("grid_refinements", f.grid_refinements, 100),
+                ] {
+                    if !(1..=most).contains(&n) {
+                        return bad(key, n.to_string(), &format!("must be a count in 1..={most}"));
+                    }
+                }
+                if f.grid_radial * f.grid_angular * f.grid_refinements > 10_000_000 {
+                    let allowed =
+                        "grid_radial x grid_angular x grid_refinements must be at most 1e7 (a decision's work)";
+                    return bad("grid_radial", f.grid_radial.to_string(), allowed);
+                }
+                within("max_speed_m_s", f.max_speed_m_s, limits.max_speed_m_s, "max_speed_m_s")?;
+                within("beacon_depth_m", f.beacon_depth_m, limits.max_depth_m, "max_depth_m")?;
+                for (key, v) in
+                    [("circle_radius_m", f.circle_radius_m), ("home_x_m", f.home_x_m), ("home_y_m", f.home_y_m)]
+                {
                     within(key, v, limits.max_range_m, "max_range_m")?;
                 }
             }
@@ -357,6 +472,33 @@ impl ControllerSpec {
                     home_m: home.xy(),
                 }))
             }
+            ControllerSpec::Fim(f) => {
+                let home = frame.to_ned(f.home_x_m, f.home_y_m, 0.0);
+                Box::new(FimGuidance::new(FimGuidanceConfig {
+                    mode: match f.mode {
+                        FimModeName::Planner => FimMode::Planner,
+                        FimModeName::Static => FimMode::Static,
+                        FimModeName::Circle => FimMode::Circle,
+                    },
+                    planner: FimPlanner {
+                        metric: match f.metric {
+                            FimMetricName::ApproachA => Metric::ApproachA,
+                            FimMetricName::ApproachB => Metric::ApproachB,
+                        },
+                        grid: PolarGrid {
+                            radial: f.grid_radial,
+                            angular: f.grid_angular,
+                            refinements: f.grid_refinements,
+                        },
+                        range_var_m2: f.range_sigma_m.powi(2),
+                        beacon_depth_m: f.beacon_depth_m,
+                    },
+                    period_s: f.period_s,
+                    max_speed_m_s: f.max_speed_m_s,
+                    circle_radius_m: f.circle_radius_m,
+                    home_m: home.xy(),
+                }))
+            }
             ControllerSpec::Behaviours(b) => {
                 let settings = AutonomySettings { speed_m_s: b.speed_m_s, depth_m: b.depth_m, ..Default::default() };
                 Box::new(Behaviours::new(Autonomy::new(settings, mode_bank(&b.modes))))
@@ -392,6 +534,13 @@ mod tests {
         refused("kind = \"bearing\"\nlead_periods = 1e9", "lead_periods", "from 0 to 100");
         refused("kind = \"bearing\"\nhome_x_m = 1e308", "home_x_m", "limits.max_range_m");
         refused("kind = \"bearing\"\nnominal_speed_m_s = 1e308", "nominal_speed_m_s", "limits.max_speed_m_s");
+        let asv = "kind = \"fim\"\n";
+        assert!(checked(asv).is_ok());
+        refused(&format!("{asv}grid_radial = 10000\ngrid_angular = 10000"), "grid_radial", "at most 1e7");
+        refused(&format!("{asv}grid_refinements = 0"), "grid_refinements", "1..=100");
+        refused(&format!("{asv}max_speed_m_s = 1e308"), "max_speed_m_s", "limits.max_speed_m_s");
+        refused(&format!("{asv}home_y_m = 1e308"), "home_y_m", "limits.max_range_m");
+        refused(&format!("{asv}range_sigma_m = 0"), "range_sigma_m", "> 0");
         let auv = "kind = \"behaviours\"\n";
         assert!(checked(auv).is_ok());
         refused(&format!("{auv}depth_m = 1e9"), "depth_m", "limits.max_depth_m");

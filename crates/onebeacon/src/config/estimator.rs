@@ -220,8 +220,14 @@ pub struct EstimatorSpec {
     pub usbl_misalignment_walk_deg_per_sqrt_s: Option<f64>,
     /// The station's compass error, deg (passive_usbl).
     pub compass_sigma_deg: Option<f64>,
-    /// The vehicle's reported depth, m (passive_usbl).
+    /// The vehicle's reported depth, m (passive_usbl; moving_beacon: its depth sensor).
     pub depth_sigma_m: Option<f64>,
+    /// The 6-DOF filter's sensors (moving_beacon): body velocity (u, v, w), m/s; body
+    /// rates (p, q, r), rad/s; roll, pitch and heading, deg. Absent: the world's sensors,
+    /// or on a stream [`SensorNoise::default`].
+    pub velocity_sigma_m_s: Option<f64>,
+    pub rate_sigma_rad_s: Option<f64>,
+    pub attitude_sigma_deg: Option<f64>,
     /// Scales every process noise standard deviation of hoff2024 eq. 4 (passive_usbl).
     pub process_noise_scale: Option<f64>,
     /// The process noise standard deviations of eq. 4 per second, state order [x, y, z,
@@ -331,6 +337,9 @@ impl EstimatorSpec {
             usbl_misalignment_walk_deg_per_sqrt_s: None,
             compass_sigma_deg: None,
             depth_sigma_m: None,
+            velocity_sigma_m_s: None,
+            rate_sigma_rad_s: None,
+            attitude_sigma_deg: None,
             process_noise_scale: None,
             process_sigma: None,
             particles: None,
@@ -431,10 +440,17 @@ impl EstimatorSpec {
         }
     }
 
-    /// The noise the 6-DOF filter assumes (moving_beacon): the sensors', with
-    /// `range_sigma_m` when given.
+    /// The noise the 6-DOF filter assumes (moving_beacon): `sensors`, but for the keys
+    /// given (`range_sigma_m`, `depth_sigma_m`, `velocity_sigma_m_s`,
+    /// `rate_sigma_rad_s`, `attitude_sigma_deg`).
     pub fn sensor_noise(&self, sensors: SensorNoise) -> SensorNoise {
-        SensorNoise { range_m: self.range_sigma_m.unwrap_or(sensors.range_m), ..sensors }
+        SensorNoise {
+            velocity_m_s: self.velocity_sigma_m_s.unwrap_or(sensors.velocity_m_s),
+            rate_rad_s: self.rate_sigma_rad_s.unwrap_or(sensors.rate_rad_s),
+            depth_m: self.depth_sigma_m.unwrap_or(sensors.depth_m),
+            attitude_rad: self.attitude_sigma_deg.map_or(sensors.attitude_rad, f64::to_radians),
+            range_m: self.range_sigma_m.unwrap_or(sensors.range_m),
+        }
     }
 
     /// The calibration states of garin2024's and the 6-DOF filter (fixed_beacon,

@@ -8,7 +8,7 @@
 //! ([`check`]). A vehicle reads its configuration with this
 //! crate alone; the simulator reads its scenarios and logs into the same types.
 
-mod builder;
+pub mod builder;
 pub mod check;
 pub mod controller;
 pub mod estimator;

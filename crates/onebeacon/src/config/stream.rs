@@ -5,10 +5,10 @@
 //! (docs/logs.md) without its CSV sources: a log description is a stream configuration
 //! plus where its files are, and the simulator's replay reads it into this type.
 
-use super::builder::TrackerStart;
+use super::builder::{TrackerStart, VehicleModel};
 use super::check::{Rule, Violation, check, check_count, check_file_name};
 use super::controller::ControllerSpec;
-use super::estimator::{EstimatorSpec, Host, NOISE_KEYS};
+use super::estimator::{EstimatorSpec, NOISE_KEYS};
 use super::estimator_check::check_estimators;
 use crate::geo::Frame;
 use crate::nav::limits::Limits;
@@ -92,10 +92,14 @@ pub struct Initial {
     pub seed: Option<i64>,
     /// The rest of a USBL tracker's state (kinds pf and bearing: hoff2024's eight
     /// states) and its standard deviations; the rate biases start at 0 unless given.
+    /// The 6-DOF filter (`model = "6dof"`) reads depth, pitch and roll, with the
+    /// depth's and pitch's standard deviations (the roll's is the pitch's).
     #[serde(default)]
     pub depth_m: f64,
     #[serde(default)]
     pub pitch_deg: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub roll_deg: f64,
     #[serde(default)]
     pub speed_m_s: f64,
     #[serde(default)]
@@ -129,6 +133,7 @@ impl Default for Initial {
             seed: None,
             depth_m: 0.0,
             pitch_deg: 0.0,
+            roll_deg: 0.0,
             speed_m_s: 0.0,
             pitch_rate_bias_deg_s: 0.0,
             heading_rate_bias_deg_s: 0.0,
@@ -141,7 +146,7 @@ impl Default for Initial {
 }
 
 impl Initial {
-    /// What a USBL tracker starts from besides the pose.
+    /// What a USBL tracker or the 6-DOF filter starts from besides the pose.
     pub fn tracker_start(&self) -> TrackerStart {
         TrackerStart {
             state: [
@@ -157,6 +162,7 @@ impl Initial {
                 self.speed_sigma_m_s,
                 self.rate_bias_sigma_deg_s.to_radians(),
             ],
+            roll_rad: self.roll_deg.to_radians(),
             seed: self.seed,
         }
     }
@@ -191,6 +197,7 @@ impl Initial {
             ("ranges_window_s", self.ranges_window_s, Rule::Positive),
             ("depth_m", self.depth_m, Rule::Finite),
             ("pitch_deg", self.pitch_deg, Rule::Finite),
+            ("roll_deg", self.roll_deg, Rule::Finite),
             ("speed_m_s", self.speed_m_s, Rule::Finite),
             ("pitch_rate_bias_deg_s", self.pitch_rate_bias_deg_s, Rule::Finite),
             ("heading_rate_bias_deg_s", self.heading_rate_bias_deg_s, Rule::Finite),
@@ -203,6 +210,10 @@ impl Initial {
         }
         Ok(())
     }
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn default_track_m() -> f64 {
@@ -251,6 +262,10 @@ pub struct StreamConfig {
     pub description: String,
     #[serde(default)]
     pub frame: FrameKey,
+    /// The estimators' vehicle model: `"planar"` (default) or sousa's `"6dof"`, whose
+    /// estimators take a moving_beacon world's keys.
+    #[serde(default, skip_serializing_if = "VehicleModel::is_planar")]
+    pub model: VehicleModel,
     /// Fixed beacons (`[[beacon]]`), in the file's frame.
     #[serde(default, rename = "beacon", skip_serializing_if = "Vec::is_empty")]
     pub beacons: Vec<Beacon>,
@@ -316,7 +331,7 @@ impl StreamConfig {
             };
             check(&format!("noise.{key}"), *v, if *positive { Rule::Positive } else { Rule::NonNegative })?;
         }
-        check_estimators(&self.estimators, Host::Log)?;
+        check_estimators(&self.estimators, self.model.host())?;
         self.initial.check("initial")?;
         for (v, init) in self.tracked.iter().enumerate() {
             init.check(&format!("tracked[{v}]"))?;
@@ -344,11 +359,12 @@ impl StreamConfig {
     /// A session of the estimators on a vehicle that starts as `initial` says, starting
     /// at `start`, restricted to `beacons` when given (replay and stream).
     pub fn session(&self, initial: &Initial, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
-        let estimators = self.estimators.iter().map(|e| (e.name(), e.builder(initial.tracker_start()))).collect();
+        let from = initial.tracker_start();
+        let estimators = self.estimators.iter().map(|e| (e.name(), e.builder(from, self.model))).collect();
         let sigmas = (initial.position_sigma_m, initial.heading_sigma_deg.to_radians());
         let mut session = Session::new(self.frame.into(), estimators, start, sigmas, beacons).with_limits(self.limits);
         for (stats, e) in session.stats.iter_mut().zip(&self.estimators) {
-            let (gate, kernel) = e.log_gate();
+            let (gate, kernel) = if self.model.is_planar() { e.log_gate() } else { e.gate() };
             *stats = stats.weighed_as(Some(gate), kernel);
         }
         session

@@ -24,6 +24,26 @@ pub struct SensorNoise {
     pub range_m: f64,
 }
 
+/// The sensors of sousa's simulated vehicle (scenarios/sousa.toml's `[sensors]`, each
+/// with its source there): none of these is stated in the thesis.
+impl Default for SensorNoise {
+    fn default() -> Self {
+        Self {
+            // an ROV's body velocity without a DVL (with 0.05 the errors are far below
+            // the thesis's 0.5-3.5 m)
+            velocity_m_s: 0.2,
+            // gyro rates
+            rate_rad_s: 0.002,
+            // a pressure sensor ("low uncertainty", sec. 3.2)
+            depth_m: 0.05,
+            // a MEMS AHRS: heading 1-2 deg RMS
+            attitude_rad: 1f64.to_radians(),
+            // a modem's OWTT range (scenarios/sousa.toml's `[acoustics]`)
+            range_m: 1.0,
+        }
+    }
+}
+
 impl SensorNoise {
     /// The process model of body velocities `nu` with this noise.
     pub fn process_model(&self, nu: BodyVelocity) -> Kinematic6Dof {
