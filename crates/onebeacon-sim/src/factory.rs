@@ -6,24 +6,21 @@
 use crate::engine::Track;
 use crate::scenario::estimator::IusblKeys;
 use crate::scenario::fleet::{Fleet, Navigation, SignalModel};
-use crate::scenario::{EstimatorKind, FixedBeacon, Host, MovingBeacon, PassiveUsbl};
+use crate::scenario::{EstimatorKind, EstimatorSpec, FixedBeacon, Host, MovingBeacon, PassiveUsbl};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use crate::vehicles::sandshark::SandSharkParams;
 use nalgebra::SVector;
-use onebeacon::config::builder::TrackerStart;
+use onebeacon::config::builder::{TrackerStart, VehicleModel};
 use onebeacon::dsp::beamform::pyramid_8cm;
 use onebeacon::dsp::receiver::{ModeReceiver, ReceiverConfig};
 use onebeacon::dsp::waveform::rypkema_modes;
-use onebeacon::filter::FilterKind;
 use onebeacon::geo::wrap_angle;
 use onebeacon::models::hoff::{DIM, idx};
 use onebeacon::models::kinematic6dof::State as Eta;
 use onebeacon::models::unicycle::{Cov, State};
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
-use onebeacon::nav::{
-    Aiding, CurrentPrior, HeadingOffsetPrior, IusblNavigator, PlanarConfig, PlanarNoise, single_beacon,
-};
+use onebeacon::nav::{IusblNavigator, single_beacon};
 use rand::RngExt;
 
 /// Every estimator of a fixed-beacon scenario on its AUV, started at the truth `z_true`
@@ -169,39 +166,58 @@ pub(crate) fn iusbl_keys(s: &Fleet) -> IusblKeys {
     }
 }
 
-/// A fleet AUV's dead reckoning: the planar navigator without aiding whose noise is
-/// the one the simulation draws the SandShark's sensors from (`[sandshark]`): the
-/// RPM speed's scale error as a distance-scale state and its white noise, the AHRS
-/// heading's slow error as a Gauss-Markov heading offset (that no fix can show: its
-/// variance carries the drift it causes) and its white noise; with the propeller
-/// stopped the RPM reads zero while the vehicle coasts on with its coast time constant.
-/// The speed input has no turn rate: the heading between fixes walks by as much as the
-/// SandShark can turn in a metre at 1 m/s (its largest turn rate, per sqrt(m)), so that
-/// each fix moves the heading, not the offset. The current it believes in
-/// (`navigation.current_sigma_m_s`), if any, is two states.
-fn fleet_dead_reckoning(p: &SandSharkParams, n: &Navigation) -> PlanarConfig {
-    let d = PlanarConfig::default();
-    PlanarConfig {
-        aiding: Aiding::NONE,
-        estimate_distance_scale: p.speed_scale_sigma > 0.0,
-        distance_scale_sigma: p.speed_scale_sigma,
-        speed_coast_time_s: Some(p.coast_time_constant_s),
-        current: (n.current_sigma_m_s > 0.0).then_some(CurrentPrior {
-            sigma_m_s: n.current_sigma_m_s,
-            walk_m_s_per_sqrt_s: n.current_walk_m_s_per_sqrt_s,
-        }),
-        heading_offset: (p.heading_error_deg > 0.0).then(|| HeadingOffsetPrior {
-            sigma_rad: p.heading_error_deg.to_radians(),
-            time_s: p.heading_error_time_s,
-        }),
-        noise: PlanarNoise {
-            speed_sigma_m_s: p.speed_white_m_s,
-            heading_sigma_rad: p.heading_white_deg.to_radians().max(1e-4),
-            heading_walk_rad_per_sqrt_m: p.max_turn_rate_deg_s.to_radians(),
-            ..d.noise
-        },
-        ..d
+/// A fleet AUV's dead reckoning as its stream configuration describes it: the planar
+/// navigator without aiding whose noise is the one the simulation draws the SandShark's
+/// sensors from (`[sandshark]`): the RPM speed's scale error as a distance-scale state
+/// and its white noise, the AHRS heading's slow error as a Gauss-Markov heading offset
+/// (that no fix can show: its variance carries the drift it causes) and its white noise
+/// (at least 1e-4 rad); with the propeller stopped the RPM reads zero while the vehicle
+/// coasts on with its coast time constant. The speed input has no turn rate: the heading
+/// between fixes walks by as much as the SandShark can turn in a metre at 1 m/s (its
+/// largest turn rate, per sqrt(m)), so that each fix moves the heading, not the offset.
+/// The current it believes in (`navigation.current_sigma_m_s`), if any, is two states.
+/// Nothing is gated.
+fn fleet_dead_reckoning(p: &SandSharkParams, n: &Navigation) -> EstimatorSpec {
+    let mut e = EstimatorSpec::new(EstimatorKind::DeadReckoning);
+    if p.speed_scale_sigma > 0.0 {
+        (e.estimate_distance_scale, e.distance_scale_sigma) = (Some(true), Some(p.speed_scale_sigma));
     }
+    e.speed_coast_time_s = Some(p.coast_time_constant_s);
+    if n.current_sigma_m_s > 0.0 {
+        e.estimate_current = Some(true);
+        (e.current_sigma_m_s, e.current_walk_m_s_per_sqrt_s) =
+            (Some(n.current_sigma_m_s), Some(n.current_walk_m_s_per_sqrt_s));
+    }
+    if p.heading_error_deg > 0.0 {
+        e.estimate_heading_offset = Some(true);
+        (e.heading_offset_sigma_deg, e.heading_offset_time_s) =
+            (Some(p.heading_error_deg), Some(p.heading_error_time_s));
+    }
+    e.speed_sigma_m_s = Some(p.speed_white_m_s);
+    e.heading_sigma_deg = Some(p.heading_white_deg.max(1e-4f64.to_degrees()));
+    e.heading_walk_deg_per_sqrt_m = Some(p.max_turn_rate_deg_s);
+    e.nis_gate = Some(f64::INFINITY);
+    e
+}
+
+/// Each estimator of a fleet AUV as its computer's stream configuration describes it,
+/// with the run's seeds (`seeds`, [`fleet_seeds`]): the iUSBL navigators with the
+/// scenario's settings ([`iusbl_keys`]), the dead reckoning ([`fleet_dead_reckoning`]).
+pub(crate) fn fleet_estimators(s: &Fleet, seeds: &[u64]) -> Vec<EstimatorSpec> {
+    let keys = iusbl_keys(s);
+    s.estimators
+        .iter()
+        .zip(seeds)
+        .map(|(&kind, &seed)| {
+            let mut e = match kind {
+                EstimatorKind::DeadReckoning => fleet_dead_reckoning(&s.sandshark, &s.navigation),
+                _ => EstimatorSpec { iusbl: Some(keys.clone()), ..EstimatorSpec::new(kind) },
+            };
+            // the seed's 64 bits as TOML's signed integer
+            e.seed = Some(seed as i64);
+            e
+        })
+        .collect()
 }
 
 /// The seeds of each estimator of every AUV of a fleet scenario's run, in track order.
@@ -215,26 +231,27 @@ pub(crate) fn fleet_seeds(s: &Fleet, seed: u64, run: u64) -> Vec<Vec<u64>> {
 }
 
 /// Every AUV's estimators of a fleet scenario, in the scenario's order.
+/// built as a stream builds them from [`fleet_estimators`]; with the channel model the
+/// iUSBL navigators take the captures through their receiver.
 pub(crate) fn fleet(s: &Fleet, seed: u64, run: u64) -> Vec<Track> {
     let (waveforms, elements) = (rypkema_modes(), pyramid_8cm());
-    let keys = iusbl_keys(s);
+    let channel = s.signal.model == SignalModel::Channel;
+    // the pose and its sigmas are the builder's arguments; the rest is a tracker's
+    let start = TrackerStart { state: [0.0; 5], sigma: [0.0; 4], roll_rad: 0.0, seed: None };
     let mut tracks = Vec::new();
     for ((v, a), seeds) in s.auvs.iter().enumerate().zip(fleet_seeds(s, seed, run)) {
-        for (e, filter_seed) in s.estimators.iter().zip(seeds) {
+        for e in fleet_estimators(s, &seeds) {
             let pose = (a.start_north_m, a.start_east_m, a.start_heading_deg.to_radians());
-            let builder: Builder = if e.iusbl() {
-                let config = keys.config(*e == EstimatorKind::Iusbl);
-                let channel = s.signal.model == SignalModel::Channel;
-                let (elements, sound) = (elements.clone(), s.signal.sound_speed_m_s);
+            let builder: Builder = if channel && e.kind.iusbl() {
+                let config = e.iusbl.clone().unwrap_or_default().config(e.kind == EstimatorKind::Iusbl);
+                let (elements, sound, filter_seed) = (elements.clone(), s.signal.sound_speed_m_s, e.seed.unwrap_or(0));
                 Box::new(move |_, _, _, _| {
-                    let receiver = channel.then(|| {
-                        let rc = ReceiverConfig { sound_speed_m_s: sound, ..Default::default() };
-                        ModeReceiver::new(&waveforms, &elements, rc)
-                    });
-                    Box::new(IusblNavigator::new(config, receiver, filter_seed))
+                    let rc = ReceiverConfig { sound_speed_m_s: sound, ..Default::default() };
+                    let receiver = ModeReceiver::new(&waveforms, &elements, rc);
+                    Box::new(IusblNavigator::new(config, Some(receiver), filter_seed as u64))
                 })
             } else {
-                onebeacon::nav::planar::builder(fleet_dead_reckoning(&s.sandshark, &s.navigation), FilterKind::Ekf)
+                e.builder(start, VehicleModel::Planar)
             };
             tracks.push(Track::new(v, builder, pose, (1.0, 0.05)));
         }

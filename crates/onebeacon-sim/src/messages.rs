@@ -8,7 +8,7 @@
 
 use crate::engine::{Observer, Step};
 use crate::scenario::fleet::{Fleet, SignalModel};
-use crate::scenario::{EstimatorKind, MovingBeacon, MovingBeaconCell, PassiveUsbl, PassiveUsblCell};
+use crate::scenario::{MovingBeacon, MovingBeaconCell, PassiveUsbl, PassiveUsblCell};
 use crate::{factory, helms};
 use nalgebra::{Vector2, Vector3};
 use onebeacon::config::builder::VehicleModel;
@@ -227,32 +227,19 @@ pub(crate) fn moving_beacon_computer(
     computer("asv", &config)
 }
 
-/// Each AUV's computer of a fleet run: its estimators with the run's seeds, its
-/// behaviours. The channel model's captures are not JSON lines: None.
+/// Each AUV's computer of a fleet run: its estimators with the run's seeds, as the
+/// simulator builds them ([`factory::fleet_estimators`]), its behaviours. The channel model's captures are not JSON lines: None.
 pub(crate) fn fleet_computers(s: &Fleet, seed: u64, run: u64) -> Option<Vec<Computer>> {
     if s.signal.model == SignalModel::Channel {
         return None;
     }
-    let keys = factory::iusbl_keys(s);
     let seeds = factory::fleet_seeds(s, seed, run);
     Some(
         s.auvs
             .iter()
             .enumerate()
             .map(|(v, a)| {
-                let estimators = s
-                    .estimators
-                    .iter()
-                    .zip(&seeds[v])
-                    .map(|(&kind, &seed)| {
-                        let mut e = EstimatorSpec::new(kind);
-                        e.seed = Some(seed as i64);
-                        if kind != EstimatorKind::DeadReckoning {
-                            e.iusbl = Some(keys.clone());
-                        }
-                        e
-                    })
-                    .collect();
+                let estimators = factory::fleet_estimators(s, &seeds[v]);
                 let description =
                     format!("{}'s computer in a simulated {} run (onebeacon run --messages)", a.name, s.name);
                 let config = StreamConfig {
