@@ -77,11 +77,51 @@ pub(crate) fn moving_beacon_starts(s: &MovingBeacon, truth0: &[Eta], seed: u64, 
         .collect()
 }
 
-/// Every estimator of a moving-beacon scenario on every vehicle, each vehicle's started
-/// at `starts[v]` ([`moving_beacon_starts`]) as a stream's 6-DOF filter starts.
+/// Each estimator of a moving-beacon scenario as a stream configuration describes it:
+/// the scenario's, with the world's sensor noise written out where it gives none.
+pub(crate) fn moving_beacon_estimators(s: &MovingBeacon) -> Vec<EstimatorSpec> {
+    let (n, a) = (&s.sensors, &s.acoustics);
+    s.estimators
+        .iter()
+        .map(|e| {
+            let mut e = e.clone();
+            e.range_sigma_m = e.range_sigma_m.or(Some(a.range_noise_m));
+            e.depth_sigma_m = e.depth_sigma_m.or(Some(n.depth_noise_m));
+            e.velocity_sigma_m_s = e.velocity_sigma_m_s.or(Some(n.velocity_noise_m_s));
+            e.rate_sigma_rad_s = e.rate_sigma_rad_s.or(Some(n.rate_noise_rad_s));
+            e.attitude_sigma_deg = e.attitude_sigma_deg.or(Some(n.attitude_noise_deg));
+            e.name = Some(e.name());
+            e
+        })
+        .collect()
+}
+
+/// Each estimator of a passive-USBL scenario as the surface vehicle's stream
+/// configuration describes it: the scenario's, with the world's noise (which the
+/// trackers assume unless told otherwise) written out.
+pub(crate) fn passive_usbl_estimators(s: &PassiveUsbl) -> Vec<EstimatorSpec> {
+    s.estimators
+        .iter()
+        .map(|e| {
+            let mut e = e.clone();
+            e.usbl_sigma_deg_per_m = e.usbl_sigma_deg_per_m.or(Some(s.usbl.noise_deg_per_m));
+            e.compass_sigma_deg = e.compass_sigma_deg.or(Some(s.asv.compass_noise_deg));
+            e.heading_sigma_deg = e.heading_sigma_deg.or(Some(s.reports.heading_noise_deg));
+            e.speed_sigma_m_s = e.speed_sigma_m_s.or(Some(s.reports.speed_noise_m_s));
+            e.depth_sigma_m = e.depth_sigma_m.or(Some(s.reports.depth_noise_m));
+            e.name = Some(e.name());
+            e
+        })
+        .collect()
+}
+
+/// Every estimator of a moving-beacon scenario on every vehicle
+/// ([`moving_beacon_estimators`], built as a stream builds them), each vehicle's started
+/// at `starts[v]` ([`moving_beacon_starts`]).
 pub(crate) fn moving_beacon(s: &MovingBeacon, starts: &[Eta]) -> Vec<Track> {
     let i = &s.initial;
     let a0 = i.attitude_sigma_deg.to_radians();
+    let estimators = moving_beacon_estimators(s);
     let mut tracks = Vec::new();
     for (v, eta0) in starts.iter().enumerate() {
         let start = TrackerStart {
@@ -90,8 +130,8 @@ pub(crate) fn moving_beacon(s: &MovingBeacon, starts: &[Eta]) -> Vec<Track> {
             roll_rad: eta0[3],
             seed: None,
         };
-        tracks.extend(s.estimators.iter().map(|e| {
-            let builder = e.range_6dof_builder(s.sensor_noise(), start);
+        tracks.extend(estimators.iter().map(|e| {
+            let builder = e.builder(start, VehicleModel::Kinematic6Dof);
             Track::new(v, builder, (eta0[0], eta0[1], eta0[5]), (i.position_sigma_m, a0))
         }));
     }
@@ -130,14 +170,23 @@ pub(crate) fn tracker_starts(s: &PassiveUsbl, truth0: &[TrackState], seed: u64, 
         .collect()
 }
 
-/// Every estimator of a passive-USBL scenario on every AUV, each AUV's started as
-/// [`tracker_starts`] says (the same for all its estimators).
+/// Every estimator of a passive-USBL scenario on every AUV
+/// ([`passive_usbl_estimators`]), each AUV's started as [`tracker_starts`] says (the same
+/// for all its estimators).
 pub(crate) fn passive_usbl(s: &PassiveUsbl, starts: &[(TrackState, u64)]) -> Vec<Track> {
     let sigma0 = tracker_sigma(s);
+    let estimators = passive_usbl_estimators(s);
     let mut tracks = Vec::new();
     for (v, &(x0, pf_seed)) in starts.iter().enumerate() {
-        for e in &s.estimators {
-            let builder = e.tracker_builder(s.tracker_noise(), x0, sigma0, pf_seed);
+        let start = TrackerStart {
+            state: [x0[idx::Z], x0[idx::THETA], x0[idx::U], x0[idx::B_THETA], x0[idx::B_PSI]],
+            sigma: [sigma0[idx::Z], sigma0[idx::THETA], sigma0[idx::U], sigma0[idx::B_THETA]],
+            roll_rad: 0.0,
+            // the seed's 64 bits as TOML's signed integer
+            seed: Some(pf_seed as i64),
+        };
+        for e in &estimators {
+            let builder = e.builder(start, VehicleModel::Planar);
             tracks.push(Track::new(v, builder, (x0[idx::X], x0[idx::Y], x0[idx::PSI]), (sigma0[0], sigma0[idx::PSI])));
         }
     }

@@ -159,21 +159,7 @@ pub(crate) fn passive_usbl_computer(
             ..given(x0[idx::X], x0[idx::Y], x0[idx::PSI].to_degrees())
         })
         .collect();
-    // the world's noise, which the trackers assume unless told otherwise, written out
-    let estimators = s
-        .estimators
-        .iter()
-        .map(|e| {
-            let mut e = e.clone();
-            e.usbl_sigma_deg_per_m = e.usbl_sigma_deg_per_m.or(Some(s.usbl.noise_deg_per_m));
-            e.compass_sigma_deg = e.compass_sigma_deg.or(Some(s.asv.compass_noise_deg));
-            e.heading_sigma_deg = e.heading_sigma_deg.or(Some(s.reports.heading_noise_deg));
-            e.speed_sigma_m_s = e.speed_sigma_m_s.or(Some(s.reports.speed_noise_m_s));
-            e.depth_sigma_m = e.depth_sigma_m.or(Some(s.reports.depth_noise_m));
-            e.name = Some(e.name());
-            e
-        })
-        .collect();
+    let estimators = factory::passive_usbl_estimators(s);
     let description =
         format!("The surface vehicle's computer of a simulated {} run (onebeacon run --messages)", s.name);
     let config =
@@ -182,9 +168,8 @@ pub(crate) fn passive_usbl_computer(
 }
 
 /// The beacon vehicle's computer of a moving-beacon run: the estimators of the vehicle
-/// it serves (the first), fed what that vehicle measures, started at `eta0` as the
-/// simulator started them, with the world's sensor noise written out; its FIM guidance,
-/// starting at `home`.
+/// it serves (the first) as the simulator builds them, fed what that vehicle measures,
+/// started at `eta0` as the simulator started them; its FIM guidance, starting at `home`.
 pub(crate) fn moving_beacon_computer(
     s: &MovingBeacon,
     cell: &MovingBeaconCell,
@@ -202,21 +187,7 @@ pub(crate) fn moving_beacon_computer(
         pitch_sigma_deg: i.attitude_sigma_deg,
         ..given(eta0[0], eta0[1], eta0[5].to_degrees())
     };
-    let estimators = s
-        .estimators
-        .iter()
-        .map(|e| {
-            let n = e.sensor_noise(s.sensor_noise());
-            let mut e = e.clone();
-            e.range_sigma_m = Some(n.range_m);
-            e.depth_sigma_m = Some(n.depth_m);
-            e.velocity_sigma_m_s = Some(n.velocity_m_s);
-            e.rate_sigma_rad_s = Some(n.rate_rad_s);
-            e.attitude_sigma_deg = Some(n.attitude_rad.to_degrees());
-            e.name = Some(e.name());
-            e
-        })
-        .collect();
+    let estimators = factory::moving_beacon_estimators(s);
     let description = format!("The beacon vehicle's computer of a simulated {} run (onebeacon run --messages)", s.name);
     let controller = helms::moving_beacon_spec(s, cell, home);
     let config = StreamConfig {

@@ -8,14 +8,14 @@ use super::geodesy::{Geodetic, check_latlon};
 use super::merge::{Items, Rows};
 use super::rows::{Site, SourceRows};
 pub use super::schema::*;
-use crate::scenario::EstimatorSpec;
 use crate::scenario::load::deserialize;
+use crate::scenario::{EstimatorKind, EstimatorSpec};
 use nalgebra::{Vector2, Vector3};
+use onebeacon::config::builder::VehicleModel;
 use onebeacon::config::stream::{Beacon, StreamConfig};
-use onebeacon::filter::FilterKind;
 use onebeacon::geo::Frame;
 use onebeacon::nav::session::Input;
-use onebeacon::nav::{Aiding, Kind, Measurement, Navigator, PlanarConfig, PlanarNavigator};
+use onebeacon::nav::{Kind, Measurement, Navigator};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -344,9 +344,9 @@ impl Log {
         // ranges: (beacon id, its position, range, dead-reckoned (north, east, heading)
         // since the first range)
         let (mut ranges, mut heading, mut depth, mut window) = (Vec::new(), None, 0.0, None::<(f64, f64)>);
-        let mut dr: Option<PlanarNavigator> = None;
+        let mut dr: Option<Box<dyn Navigator>> = None;
         // the dead-reckoned pose at t (a depth item moves a navigator's clock on)
-        let dr_pose = |dr: &mut PlanarNavigator, t: f64, depth_m: f64| {
+        let dr_pose = |dr: &mut Box<dyn Navigator>, t: f64, depth_m: f64| {
             dr.process(&Measurement::new(t, Kind::Depth { depth_m }));
             let e = dr.estimate();
             (e.north_m(), e.east_m(), e.heading_rad())
@@ -496,11 +496,17 @@ impl Log {
     }
 }
 
-/// A dead-reckoning navigator at the origin, heading 0, from `t0_s`: the displacement
-/// of a vehicle through a window of ranges ([`Log::initial_start`]).
-fn dead_reckoning(t0_s: f64) -> PlanarNavigator {
-    let config = PlanarConfig { aiding: Aiding::NONE, ..PlanarConfig::default() };
-    PlanarNavigator::new(config, FilterKind::Ekf, t0_s, (0.0, 0.0, 0.0), 0.0, 0.0)
+/// A dead-reckoning navigator at the origin, heading 0, from `t0_s` (the planar
+/// default): the displacement of a vehicle through a window of ranges
+/// ([`Log::initial_start`]).
+fn dead_reckoning(t0_s: f64) -> Box<dyn Navigator> {
+    let start = Initial::default().tracker_start();
+    EstimatorSpec::new(EstimatorKind::DeadReckoning).builder(start, VehicleModel::Planar)(
+        t0_s,
+        (0.0, 0.0, 0.0),
+        0.0,
+        0.0,
+    )
 }
 
 #[cfg(test)]

@@ -54,14 +54,17 @@ pub struct TrackerStart {
 }
 
 impl EstimatorSpec {
-    /// The estimator on a log or a stream, on a vehicle whose trackers start as `start`
-    /// says, built by the session at its start and again from its last sound pose: a USBL
-    /// tracker (pf, bearing: hoff2024's eight states), the iUSBL navigator (which starts
-    /// from its first fix), or the planar family; with `model` 6dof, sousa's filter on
-    /// [`SensorNoise::default`] where the spec sets none.
+    /// The estimator on a vehicle whose estimators start as `start` says, built by the
+    /// session (or the simulator's track) at its start and again from its last sound
+    /// pose: a USBL tracker (pf, bearing: hoff2024's eight states), the iUSBL navigator
+    /// (which starts from its first fix), or the planar family; with `model` 6dof, sousa's
+    /// filter. The one place navigators are built from specs, for logs, streams and the
+    /// simulator's passive-USBL, moving-beacon and fleet worlds; the noise a spec does not
+    /// give is [`TrackerNoise::default`] and [`SensorNoise::default`] (a world writes its
+    /// own into the specs).
     pub fn builder(&self, start: TrackerStart, model: VehicleModel) -> Builder {
         if model == VehicleModel::Kinematic6Dof {
-            return self.range_6dof_builder(SensorNoise::default(), start);
+            return self.range_6dof_builder(start);
         }
         // the seed's 64 bits (TOML integers are signed)
         let seed = self.seed.or(start.seed).unwrap_or(0) as u64;
@@ -71,7 +74,7 @@ impl EstimatorSpec {
             // the pose and its sigmas are the builder's arguments
             let x0 = SVector::<f64, DIM>::from([0.0, 0.0, depth, pitch, 0.0, speed, pitch_bias, heading_bias]);
             let sigma0 = SVector::<f64, DIM>::from([0.0, 0.0, s_depth, s_pitch, 0.0, s_speed, s_bias, s_bias]);
-            return self.tracker_builder(TrackerNoise::default(), x0, sigma0, seed);
+            return self.tracker_builder(x0, sigma0, seed);
         }
         if self.kind.iusbl() {
             let config = self.iusbl.clone().unwrap_or_default().config(self.kind == EstimatorKind::Iusbl);
@@ -81,11 +84,11 @@ impl EstimatorSpec {
     }
 
     /// sousa's 6-DOF filter (range-ekf, dead-reckoning, with the calibration states asked
-    /// for) assuming `sensors` where the spec sets none, starting from `start` (depth,
-    /// roll, pitch), its pose (north, east, heading) and their sigmas the builder's
-    /// arguments. Streams and the moving-beacon worlds build theirs here.
-    pub fn range_6dof_builder(&self, sensors: SensorNoise, start: TrackerStart) -> Builder {
-        let (noise, aiding, filter) = (self.sensor_noise(sensors), self.aiding(Host::MovingBeacon), self.filter_kind());
+    /// for), starting from `start` (depth, roll, pitch), its pose (north, east, heading)
+    /// and their sigmas the builder's arguments.
+    fn range_6dof_builder(&self, start: TrackerStart) -> Builder {
+        let noise = self.sensor_noise(SensorNoise::default());
+        let (aiding, filter) = (self.aiding(Host::MovingBeacon), self.filter_kind());
         let (calibration, gate) = (self.range_calibration(), self.gate());
         let [depth, pitch, ..] = start.state;
         let [s_depth, s_attitude, ..] = start.sigma;
@@ -97,19 +100,11 @@ impl EstimatorSpec {
         })
     }
 
-    /// A USBL tracker (kinds pf and bearing: hoff2024's eight states) assuming `noise`
-    /// where the spec sets none, starting from `x0` with standard deviations `sigma0`,
-    /// their pose (north, east, heading) and its sigmas the builder's arguments; `seed`
-    /// seeds a particle filter. Logs, streams and the passive-USBL worlds build theirs
-    /// here.
-    pub fn tracker_builder(
-        &self,
-        noise: TrackerNoise,
-        x0: SVector<f64, DIM>,
-        sigma0: SVector<f64, DIM>,
-        seed: u64,
-    ) -> Builder {
-        let (config, filter) = (self.tracker_config(noise), self.filter_kind());
+    /// A USBL tracker (kinds pf and bearing: hoff2024's eight states) starting from `x0`
+    /// with standard deviations `sigma0`, their pose (north, east, heading) and its
+    /// sigmas the builder's arguments; `seed` seeds a particle filter.
+    fn tracker_builder(&self, x0: SVector<f64, DIM>, sigma0: SVector<f64, DIM>, seed: u64) -> Builder {
+        let (config, filter) = (self.tracker_config(TrackerNoise::default()), self.filter_kind());
         let particle = (self.kind == EstimatorKind::Particle).then(|| self.particle_settings());
         Box::new(move |t0, (north, east, heading), sigma_position, sigma_heading| {
             let (mut x, mut sigma) = (x0, sigma0);
