@@ -3,9 +3,12 @@
 //! and its Jacobian. A node holds a pose (north, east, heading, the heading kept
 //! continuous along the trajectory) for a vehicle that measures its motion, or a
 //! position and velocity (north, east, vN, vE) for a craft tracked with a
-//! constant-velocity model ([`Node`]).
+//! constant-velocity model ([`Node`]). Ranges, Doppler speeds and bearings are the
+//! filters' measurement models (`onebeacon::measure`), read at the factor's variables.
 
+use nalgebra::{SVector, Vector3};
 use onebeacon::geo::wrap_angle;
+use onebeacon::measure::{LineOfSightSpeed, ScalarModel, SlantRange, Usbl};
 use onebeacon::nav::tracking::white_acceleration_noise;
 
 /// Most variables one factor touches: two poses and four calibration variables.
@@ -113,14 +116,15 @@ pub(crate) enum Factor {
     /// tracker's [`white_acceleration_noise`].
     ConstantVelocity { k: usize, axis: usize, dt_s: f64, q: f64 },
     /// A range: z = s |p(t) - b| + offset + drift (t - t0), the distance slant with the
-    /// vertical offset `dz_m` between vehicle and beacon.
+    /// vertical offset `dz_m` between vehicle and beacon: the filters' [`SlantRange`]
+    /// (scale s = 1 + k) with the offset's drift.
     Range { at: At, beacon: [f64; 2], dz_m: f64, range_m: f64, sigma: f64, cal: CalVars, t_rel_s: f64 },
     /// A Doppler radial speed, positive when closing (garin2024 eq. 13): -u . v, u the
     /// unit vector from the beacon to p(t), v the velocity over the node interval (a
-    /// track node's own velocity).
+    /// track node's own velocity): [`LineOfSightSpeed`].
     Doppler { at: At, beacon: [f64; 2], dz_m: f64, speed_m_s: f64, sigma: f64 },
     /// A USBL bearing on a station (hoff2024 eq. 1-2): azimuth from the station's
-    /// heading and elevation from the vertical.
+    /// heading and elevation from the vertical, as [`Usbl::angles`] gives them.
     Bearing { at: At, station: [f64; 3], station_heading_rad: f64, depth_m: f64, az_el: [f64; 2], sigma: f64 },
 }
 
@@ -196,49 +200,26 @@ impl Factor {
                 ([w[0], w[1], 0.0], 2)
             }
             Factor::Range { at, beacon, dz_m, range_m, sigma, cal, t_rel_s } => {
-                let p = position(at, x);
-                let slant = slant(p, *beacon, *dz_m);
-                let mut i = at.positions();
-                let mut take = |on: bool, nominal: f64| {
-                    if on {
-                        i += 1;
-                        x[i - 1]
-                    } else {
-                        nominal
-                    }
-                };
-                let s = take(cal.scale.is_some(), 1.0);
-                let b = take(cal.offset.is_some(), 0.0);
-                let d = take(cal.drift.is_some(), 0.0);
-                ([(s * slant + b + d * t_rel_s - range_m) / sigma, 0.0, 0.0], 1)
+                let r = range(at, *beacon, *dz_m, cal, x);
+                ([(r.predicted + r.drift * t_rel_s - range_m) / sigma, 0.0, 0.0], 1)
             }
-            Factor::Doppler { at, beacon, dz_m, speed_m_s, sigma } => {
-                let p = position(at, x);
-                let v = match (at.node, at.next) {
-                    (Node::Track, _) => [x[at.positions()], x[at.positions() + 1]],
-                    (Node::Pose, true) => [(x[2] - x[0]) / at.dt_s, (x[3] - x[1]) / at.dt_s],
-                    (Node::Pose, false) => return ([0.0; 3], 1),
-                };
-                let r = slant(p, *beacon, *dz_m);
-                // garin2024 eq. 13: the radial speed, closing positive
-                let radial = -((p[0] - beacon[0]) * v[0] + (p[1] - beacon[1]) * v[1]) / r;
-                ([(radial - speed_m_s) / sigma, 0.0, 0.0], 1)
-            }
+            Factor::Doppler { at, beacon, dz_m, speed_m_s, sigma } => match closing_speed(at, *beacon, *dz_m, x) {
+                Some((radial, _)) => ([(radial - speed_m_s) / sigma, 0.0, 0.0], 1),
+                None => ([0.0; 3], 1),
+            },
             Factor::Bearing { at, station, station_heading_rad, depth_m, az_el, sigma } => {
                 let p = position(at, x);
-                let (dn, de) = (p[0] - station[0], p[1] - station[1]);
-                // hoff2024 eq. 1: azimuth from the station's heading
-                let az = de.atan2(dn) - station_heading_rad;
-                // hoff2024 eq. 2: elevation from the vertical
-                let el = dn.hypot(de).atan2(depth_m - station[2]);
+                let usbl = Usbl::exact(Vector3::from(*station), *station_heading_rad, 0.0);
+                // hoff2024 eq. 1-2: azimuth from the station's heading, elevation from the vertical
+                let (az, el, _) = usbl.angles(&Vector3::new(p[0], p[1], *depth_m));
                 ([wrap_angle(az - az_el[0]) / sigma, (el - az_el[1]) / sigma, 0.0], 2)
             }
         }
     }
 
     /// The whitened residuals and Jacobian at the global state `x`: analytic for the
-    /// priors, motion and ranges (all but a few factors of a log), central differences
-    /// for Doppler speeds and bearings.
+    /// priors, motion, ranges and Doppler speeds (all but a few factors of a log),
+    /// central differences for bearings.
     pub(crate) fn linearize(&self, x: &[f64]) -> Linear {
         let (vars, n, mut local) = self.local(x);
         let (r, m) = self.residual(&local[..n]);
@@ -260,7 +241,8 @@ impl Factor {
     pub(crate) fn range_slant(&self, x: &[f64]) -> Option<(f64, f64, f64)> {
         let Factor::Range { at, beacon, dz_m, range_m, sigma, .. } = self else { return None };
         let (_, _, local) = self.local(x);
-        Some((slant(position(at, &local), *beacon, *dz_m), *range_m, *sigma))
+        let slant = range(at, *beacon, *dz_m, &CalVars::default(), &local).predicted;
+        Some((slant, *range_m, *sigma))
     }
 
     /// This factor's variables and their values gathered from the global state.
@@ -311,26 +293,29 @@ impl Factor {
                 }
             }
             Factor::Range { at, beacon, dz_m, sigma, cal, t_rel_s, .. } => {
-                let p = position(at, x);
-                let slant = slant(p, *beacon, *dz_m);
+                let r = range(at, *beacon, *dz_m, cal, x);
                 let mut i = at.positions();
-                let s = if cal.scale.is_some() { x[i] } else { 1.0 };
-                let u = [(p[0] - beacon[0]) / slant, (p[1] - beacon[1]) / slant];
-                let w = [1.0 - at.alpha, at.alpha];
-                for (node, wn) in w.iter().enumerate().take(if at.next { 2 } else { 1 }) {
-                    j[0][2 * node] = s * wn * u[0] / sigma;
-                    j[0][2 * node + 1] = s * wn * u[1] / sigma;
+                for (c, gc) in r.gradient.iter().enumerate().take(i) {
+                    j[0][c] = gc / sigma;
                 }
-                for (on, d) in
-                    [(cal.scale.is_some(), slant), (cal.offset.is_some(), 1.0), (cal.drift.is_some(), *t_rel_s)]
-                {
+                // d/d offset: 1; d/d drift: t
+                let d_cal =
+                    [(cal.scale.is_some(), r.d_scale), (cal.offset.is_some(), 1.0), (cal.drift.is_some(), *t_rel_s)];
+                for (on, d) in d_cal {
                     if on {
                         j[0][i] = d / sigma;
                         i += 1;
                     }
                 }
             }
-            Factor::Doppler { .. } | Factor::Bearing { .. } => return false,
+            Factor::Doppler { at, beacon, dz_m, sigma, .. } => {
+                if let Some((_, g)) = closing_speed(at, *beacon, *dz_m, x) {
+                    for (c, gc) in g.iter().enumerate() {
+                        j[0][c] = gc / sigma;
+                    }
+                }
+            }
+            Factor::Bearing { .. } => return false,
         }
         true
     }
@@ -383,8 +368,83 @@ fn white_acceleration(dt_s: f64, q: f64, e: [f64; 2]) -> ([f64; 2], [f64; 3]) {
     ([w0, (e[1] - l21 * w0) / l22], [l11, l21, l22])
 }
 
-fn slant(p: [f64; 2], b: [f64; 2], dz_m: f64) -> f64 {
-    ((p[0] - b[0]).powi(2) + (p[1] - b[1]).powi(2) + dz_m * dz_m).sqrt().max(1e-6)
+/// The gradient over the local variables of a quantity read at the interpolated
+/// position ([`position`]), from its gradient `h` over the position.
+fn through_position(at: &At, h: [f64; 2]) -> [f64; MAX_VARS] {
+    let mut g = [0.0; MAX_VARS];
+    for (node, w) in [1.0 - at.alpha, at.alpha].into_iter().enumerate().take(if at.next { 2 } else { 1 }) {
+        g[2 * node] = w * h[0];
+        g[2 * node + 1] = w * h[1];
+    }
+    g
+}
+
+/// A range factor's reading of the filters' range model.
+struct RangeReading {
+    /// s |p - b| + offset, the scale and offset the estimated variables or their
+    /// nominal 1 and 0.
+    predicted: f64,
+    /// Its gradient over the local position variables.
+    gradient: [f64; MAX_VARS],
+    /// Its derivative in the scale (the slant).
+    d_scale: f64,
+    /// The offset's drift read (0 when not estimated).
+    drift: f64,
+}
+
+/// A range factor's reading of the filters' [`SlantRange`] at the local values `x`.
+fn range(at: &At, beacon: [f64; 2], dz_m: f64, cal: &CalVars, x: &[f64]) -> RangeReading {
+    let mut i = at.positions();
+    let mut take = |on: bool, nominal: f64| {
+        if on {
+            i += 1;
+            x[i - 1]
+        } else {
+            nominal
+        }
+    };
+    let (s, b, drift) =
+        (take(cal.scale.is_some(), 1.0), take(cal.offset.is_some(), 0.0), take(cal.drift.is_some(), 0.0));
+    let p = position(at, x);
+    // the vehicle dz_m below a beacon at 0
+    let model = SlantRange {
+        beacon: Vector3::new(beacon[0], beacon[1], 0.0),
+        depth_m: dz_m,
+        bias: Some(3),
+        scale: Some(2),
+        var: 1.0,
+    };
+    let state = SVector::<f64, 4>::from([p[0], p[1], s - 1.0, b]);
+    let h = ScalarModel::<4>::jacobian(&model, &state);
+    let predicted = ScalarModel::<4>::predict(&model, &state);
+    RangeReading { predicted, gradient: through_position(at, [h[0], h[1]]), d_scale: h[2], drift }
+}
+
+/// A Doppler factor's reading of the filters' [`LineOfSightSpeed`] at the local values
+/// `x`: the closing speed at the interpolated position with the interval's velocity (a
+/// track node's own), and its gradient over the local variables; None for a pose
+/// without a later node (no velocity).
+fn closing_speed(at: &At, beacon: [f64; 2], dz_m: f64, x: &[f64]) -> Option<(f64, [f64; MAX_VARS])> {
+    let np = at.positions();
+    let v = match (at.node, at.next) {
+        (Node::Track, _) => [x[np], x[np + 1]],
+        (Node::Pose, true) => [(x[2] - x[0]) / at.dt_s, (x[3] - x[1]) / at.dt_s],
+        (Node::Pose, false) => return None,
+    };
+    let p = position(at, x);
+    let model = LineOfSightSpeed { beacon: Vector3::new(beacon[0], beacon[1], 0.0), depth_m: dz_m, var: 1.0 };
+    let state = SVector::<f64, 4>::from([p[0], p[1], v[0], v[1]]);
+    let h = ScalarModel::<4>::jacobian(&model, &state);
+    let mut g = through_position(at, [h[0], h[1]]);
+    match at.node {
+        Node::Track => (g[np], g[np + 1]) = (h[2], h[3]),
+        Node::Pose => {
+            // v = (p_(k+1) - p_k) / dt
+            let (gn, ge) = (h[2] / at.dt_s, h[3] / at.dt_s);
+            (g[0], g[1], g[2], g[3]) = (g[0] - gn, g[1] - ge, g[2] + gn, g[3] + ge);
+        }
+    }
+    Some((ScalarModel::<4>::predict(&model, &state), g))
 }
 
 #[cfg(test)]
@@ -392,7 +452,8 @@ mod tests {
     use super::*;
 
     /// Every analytic Jacobian against central differences, at a generic state with
-    /// every calibration variable on.
+    /// every calibration variable on (Doppler speeds' too, analytic since they read the
+    /// filters' model).
     #[test]
     fn analytic_jacobians_match_central_differences() {
         let at = At { k: 0, alpha: 0.3, next: true, dt_s: 2.0, node: Node::Pose };
@@ -411,6 +472,9 @@ mod tests {
             },
             Factor::Range { at, beacon: [10.0, -4.0], dz_m: 3.0, range_m: 12.0, sigma: 1.5, cal, t_rel_s: 40.0 },
             Factor::ConstantVelocity { k: 0, axis: 1, dt_s: 1.7, q: 0.04 },
+            // the interval's velocity between two poses, and a track node's own
+            Factor::Doppler { at, beacon: [10.0, -4.0], dz_m: 3.0, speed_m_s: 0.3, sigma: 0.1 },
+            Factor::Doppler { at: At { node: Node::Track, ..at }, beacon: [10.0, -4.0], dz_m: 3.0, speed_m_s: 0.3, sigma: 0.1 },
         ];
         let x = [1.2, 2.1, 0.35, 2.0, 2.9, 0.8, 1.05, 0.7, 0.01, 0.0];
         for f in &factors {

@@ -3,11 +3,14 @@
 //!
 //! Sign: positive when the vehicle closes on the beacon. The vehicle moves along its
 //! heading at its forward speed (no sideslip): v_r = v cos(omega_b - psi) with
-//! omega_b = atan2(y - y_ref, x - x_ref) + pi the bearing from the vehicle to the beacon.
+//! omega_b = atan2(y - y_ref, x - x_ref) + pi the bearing from the vehicle to the beacon
+//! ([`RadialSpeed2d`], the paper's horizontal geometry). [`LineOfSightSpeed`] is the same
+//! speed along the slant line of sight, for a state that holds the velocity itself (the
+//! smoother's tracks and the interval velocities of its poses).
 
 use super::ScalarModel;
 use crate::models::unicycle::idx;
-use nalgebra::{SMatrix, SVector, Vector2};
+use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
 /// Radial speed of the vehicle toward `beacon` (NED, m), read from the unicycle state
 /// layout (position, heading, forward speed), or with the forward speed a known input
@@ -56,6 +59,49 @@ impl RadialSpeed2d {
     }
 }
 
+/// The closing speed along the slant line of sight of a vehicle at depth `depth_m` whose
+/// horizontal position and velocity are the state's components 0, 1 (N, E) and 2, 3
+/// (vN, vE) toward `beacon` (NED, m): -(d . v) / |d| with d the vehicle's offset from the
+/// beacon (garin2024 eq. 13 with the line of sight in 3-D; with the beacon at the
+/// vehicle's depth it is [`RadialSpeed2d`] with v cos(psi), v sin(psi) for the velocity).
+/// Noise variance `var` ((m/s)^2).
+#[derive(Debug, Clone, Copy)]
+pub struct LineOfSightSpeed {
+    pub beacon: Vector3<f64>,
+    pub depth_m: f64,
+    pub var: f64,
+}
+
+impl LineOfSightSpeed {
+    /// The offset from the beacon and its length (at least 1e-6 m).
+    fn offset<const N: usize>(&self, x: &SVector<f64, N>) -> (Vector3<f64>, f64) {
+        let d = Vector3::new(x[0], x[1], self.depth_m) - self.beacon;
+        (d, d.norm().max(1e-6))
+    }
+}
+
+impl<const N: usize> ScalarModel<N> for LineOfSightSpeed {
+    fn predict(&self, x: &SVector<f64, N>) -> f64 {
+        let (d, r) = self.offset(x);
+        -(d.x * x[2] + d.y * x[3]) / r // eq. 13: closing positive
+    }
+
+    fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
+        let (d, r) = self.offset(x);
+        let along = (d.x * x[2] + d.y * x[3]) / (r * r * r);
+        let mut h = SMatrix::<f64, 1, N>::zeros();
+        h[0] = -x[2] / r + along * d.x;
+        h[1] = -x[3] / r + along * d.y;
+        h[2] = -d.x / r;
+        h[3] = -d.y / r;
+        h
+    }
+
+    fn variance(&self, _x: &SVector<f64, N>) -> f64 {
+        self.var
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -79,6 +125,29 @@ mod tests {
         // 45 deg off the line of sight
         let v = ScalarModel::<6>::predict(&m, &state(10.0, 10.0, -FRAC_PI_2, 2.0));
         assert_abs_diff_eq!(v, 2.0 * (PI / 4.0).cos(), epsilon = 1e-12);
+    }
+
+    /// The line-of-sight speed: its Jacobian against central differences, and with the
+    /// beacon at the vehicle's depth, the horizontal model's speed (closed form).
+    #[test]
+    fn line_of_sight_speed_is_the_horizontal_one_at_the_beacons_depth() {
+        let m = LineOfSightSpeed { beacon: Vector3::new(50.0, 100.0, 3.0), depth_m: 40.0, var: 0.1 };
+        for x in [[10.0, 20.0, 0.4, 1.1], [80.0, 230.0, -2.5, 0.9], [49.0, 101.0, 3.0, -1.2]] {
+            let x = SVector::<f64, 4>::from(x);
+            let (h, fd) = (ScalarModel::<4>::jacobian(&m, &x), finite_difference::<4>(&m, &x));
+            assert_abs_diff_eq!(h, fd, epsilon = 1e-7);
+        }
+        let level = LineOfSightSpeed { beacon: Vector3::new(0.0, 0.0, 0.0), depth_m: 0.0, var: 0.1 };
+        let flat = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, var: 0.1 };
+        for (n, e, psi, v) in [(10.0, 10.0, -FRAC_PI_2, 2.0), (-30.0, 4.0, 0.3, 1.1)] {
+            let x = SVector::<f64, 4>::from([n, e, v * f64::cos(psi), v * f64::sin(psi)]);
+            let horizontal = ScalarModel::<6>::predict(&flat, &state(n, e, psi, v));
+            assert_abs_diff_eq!(ScalarModel::<4>::predict(&level, &x), horizontal, epsilon = 1e-12);
+        }
+        // 30 m above a vehicle 40 m away horizontally, closing at 1 m/s horizontally: 4/5
+        let above = LineOfSightSpeed { beacon: Vector3::new(0.0, 0.0, 0.0), depth_m: 30.0, var: 0.1 };
+        let x = SVector::<f64, 4>::from([40.0, 0.0, -1.0, 0.0]);
+        assert_abs_diff_eq!(ScalarModel::<4>::predict(&above, &x), 0.8, epsilon = 1e-12);
     }
 
     #[test]

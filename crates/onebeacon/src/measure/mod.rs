@@ -18,7 +18,7 @@ pub mod robust;
 pub mod state;
 pub mod usbl;
 
-pub use doppler::RadialSpeed2d;
+pub use doppler::{LineOfSightSpeed, RadialSpeed2d};
 pub use range::{Range2d, Range3d, SlantRange};
 pub use robust::Robust;
 pub use state::StateComponent;
