@@ -25,6 +25,7 @@ mod engine;
 mod factory;
 pub mod fleet;
 mod helms;
+mod information;
 pub mod input_file;
 pub mod json;
 pub mod messages;

@@ -4,13 +4,11 @@
 //! cell, seed, run index).
 
 use crate::engine::{self, Helm, Observer, Step, Track, VehicleTruth, World};
+use crate::information::{Information, bearing_information, range_information};
 use crate::messages::{Computer, Messages, fleet_computers, moving_beacon_computer, passive_usbl_computer};
 use crate::metrics::RunMetrics;
 use crate::scenario::{Cell, Scenario};
-use crate::world::{
-    FixedBeaconWorld, FleetWorld, Information, MovingBeaconWorld, PassiveUsblWorld, bearing_information,
-    range_information,
-};
+use crate::world::{FixedBeaconWorld, FleetWorld, MovingBeaconWorld, PassiveUsblWorld};
 use crate::{factory, helms};
 use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::nav::diagnosis::PerBeacon;

@@ -1,13 +1,17 @@
 //! onebeacon: the onboard part of single-beacon underwater navigation.
 //!
-//! What runs on a vehicle lives here, with lean dependencies (nalgebra, thiserror):
+//! What runs on a vehicle lives here, with the dependencies of its numbers (nalgebra,
+//! rand and its distributions, rustfft and realfft for the receiver, statrs for one
+//! quantile, thiserror; rayon, serde and serde_json behind features):
 //!
 //! - [`geo`]: NED frame conventions and angle wrapping;
 //! - [`dsp`]: receiver signal processing: matched filter, beamforming, modes;
 //! - [`models`]: process models used by the estimators;
 //! - [`measure`]: measurement models `h(x)` with their Jacobians;
-//! - [`filter`]: the Gaussian filters (EKF, UKF) behind one trait, consistency statistics;
-//! - [`guidance`]: where a beacon vehicle should go next (Fisher information);
+//! - [`filter`]: the Gaussian filters (EKF, UKF) behind one trait, the particle filters
+//!   (hoff2024's, rypkema's factored one), the RTS pass, consistency statistics;
+//! - [`guidance`]: where a surface vehicle should go next: sousa's beacon vehicle by
+//!   Fisher information, hoff2024's listening vehicle by the spread of its bearings;
 //! - [`nav`]: the navigator interface, measurement events, the papers' navigators and
 //!   the onboard [`nav::session`] that a vehicle's computer runs;
 //! - [`vehicle`]: the vehicle's own decisions: controllers that turn the navigators'

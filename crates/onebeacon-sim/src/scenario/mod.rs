@@ -1,8 +1,8 @@
 //! Scenario files: schema, defaults, loading, validation and the built-in scenarios.
 //!
 //! A scenario is a TOML file whose `kind` names the world it describes:
-//! `fixed_beacon` (the default; garin2024), `moving_beacon` (sousa) or `passive_usbl`
-//! (hoff2024). Every key is
+//! `fixed_beacon` (the default; garin2024), `moving_beacon` (sousa), `passive_usbl`
+//! (hoff2024) or `fleet` (rypkema). Every key is
 //! optional except `name` and has a documented default (the built-in files in
 //! `scenarios/` spell every key out with where its value comes from). Keys carry their
 //! unit in their name; angles in config are degrees (`*_deg`), radians inside.

@@ -474,7 +474,13 @@ mod tests {
             Factor::ConstantVelocity { k: 0, axis: 1, dt_s: 1.7, q: 0.04 },
             // the interval's velocity between two poses, and a track node's own
             Factor::Doppler { at, beacon: [10.0, -4.0], dz_m: 3.0, speed_m_s: 0.3, sigma: 0.1 },
-            Factor::Doppler { at: At { node: Node::Track, ..at }, beacon: [10.0, -4.0], dz_m: 3.0, speed_m_s: 0.3, sigma: 0.1 },
+            Factor::Doppler {
+                at: At { node: Node::Track, ..at },
+                beacon: [10.0, -4.0],
+                dz_m: 3.0,
+                speed_m_s: 0.3,
+                sigma: 0.1,
+            },
         ];
         let x = [1.2, 2.1, 0.35, 2.0, 2.9, 0.8, 1.05, 0.7, 0.01, 0.0];
         for f in &factors {

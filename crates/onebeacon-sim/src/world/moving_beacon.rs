@@ -17,7 +17,7 @@ use crate::vehicles::asv::{AsvLimits, AsvState};
 use crate::vehicles::autopilot::{Command, MAX_STEP_S, step_over};
 use crate::vehicles::otter::OtterPilot;
 use crate::vehicles::rov::{body_velocity, rk4_step};
-use nalgebra::{DMatrix, Vector2, Vector3};
+use nalgebra::{Vector2, Vector3};
 use onebeacon::measure::ScalarModel;
 use onebeacon::models::kinematic6dof::{BodyVelocity, State, idx};
 use onebeacon::nav::{BeaconFix, Kind, Measurement, SensorNoise};
@@ -307,18 +307,6 @@ impl World for MovingBeaconWorld<'_> {
             ));
         }
         self.in_flight.retain(|f| f.heard.iter().any(|h| !h));
-    }
-}
-
-/// For the bound: the Fisher information H' R^-1 H of a range, from the navigators' own
-/// range model, at the truth (None for another kind).
-pub(crate) fn range_information(noise: SensorNoise) -> impl FnMut(&Kind, &VehicleTruth) -> Option<DMatrix<f64>> {
-    move |kind, truth| {
-        let Kind::Range { beacon, .. } = kind else { return None };
-        let model = noise.range_model(beacon);
-        let h = ScalarModel::<6>::jacobian(&model, &truth.eta);
-        let info = h.transpose() * h / model.variance(&truth.eta);
-        Some(DMatrix::from_column_slice(6, 6, info.as_slice()))
     }
 }
 

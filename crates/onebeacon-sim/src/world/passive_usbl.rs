@@ -27,11 +27,11 @@ use crate::vehicles::ilos::{self, CircleFollower, Ilos};
 use crate::vehicles::otter::OtterPilot;
 use crate::vehicles::remus100::{Remus100, Remus100Pilot};
 use crate::water::Water;
-use nalgebra::{DMatrix, SMatrix, SVector, Vector2, Vector3};
+use nalgebra::{SVector, Vector2, Vector3};
 use onebeacon::geo::wrap_angle;
-use onebeacon::measure::{ScalarModel, Usbl, UsblAngle};
+use onebeacon::measure::Usbl;
 use onebeacon::models::hoff::{DIM, idx};
-use onebeacon::nav::{BeaconFix, Kind, Measurement, TrackerNoise};
+use onebeacon::nav::{BeaconFix, Kind, Measurement};
 use onebeacon::vehicle::{Command as VehicleCommand, OwnFix, Situation};
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::FRAC_PI_2;
@@ -436,24 +436,6 @@ impl World for PassiveUsblWorld<'_> {
                 },
             ));
         }
-    }
-}
-
-/// For the bound: the Fisher information H' R^-1 H of a bearing, from the world's USBL
-/// noise (the matched trackers'), at the truth (None for another kind).
-pub(crate) fn bearing_information(noise: TrackerNoise) -> impl FnMut(&Kind, &VehicleTruth) -> Option<DMatrix<f64>> {
-    move |kind, truth| {
-        let Kind::Bearing { station, station_heading_rad, .. } = *kind else { return None };
-        let usbl = noise.usbl(&station, station_heading_rad);
-        let mut x = SVector::<f64, DIM>::zeros();
-        x.fixed_rows_mut::<3>(0).copy_from(&truth.eta.fixed_rows::<3>(0));
-        let info =
-            [UsblAngle::Azimuth, UsblAngle::Elevation].iter().fold(SMatrix::<f64, DIM, DIM>::zeros(), |acc, &a| {
-                let model = usbl.model(a);
-                let h = ScalarModel::<DIM>::jacobian(&model, &x);
-                acc + h.transpose() * h / model.variance(&x)
-            });
-        Some(DMatrix::from_column_slice(DIM, DIM, info.as_slice()))
     }
 }
 

@@ -1,10 +1,13 @@
-//! Estimators: the extended and unscented Kalman filters behind one interface, and
-//! consistency statistics.
+//! Estimators: the extended and unscented Kalman filters behind one interface, the
+//! particle filters, the Rauch-Tung-Striebel pass, and consistency statistics.
 //!
 //! [`GaussianFilter`] is what a navigator asks of a filter: predict through a
 //! [`ProcessModel`], update with a [`MeasurementModel`] (gated by the NIS), and read or
 //! adjust the mean and covariance. The navigators in [`crate::nav`] are written once
-//! against it, so [`Ekf`] and [`Ukf`] run in every one of them.
+//! against it, so [`Ekf`] and [`Ukf`] run in every one of them. Beside them:
+//! [`particle`] (hoff2024's filter, generic over its models, with [`truncated`] draws and
+//! single-precision [`lanes`]), [`factored`] (rypkema's factored filter), [`rts`] (the
+//! backward pass over a Gaussian filter's run) and [`consistency`] (NEES).
 
 pub mod consistency;
 pub mod ekf;

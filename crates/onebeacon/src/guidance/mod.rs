@@ -1,5 +1,6 @@
-//! Guidance of the beacon vehicle: where an ASV carrying the beacon should be at the
-//! next ping so that the ranges tell the underwater vehicle the most.
+//! Guidance of a surface vehicle: where it should be next so that what it gives the
+//! underwater vehicles tells the most: the ranges of the beacon it carries (sousa), or
+//! the USBL bearings it hears (hoff2024).
 //!
 //! - [`bearing`]: hoff2024's planner for a surface vehicle listening with a USBL: the
 //!   point of a half-annulus around the particle belief whose bearing spreads the
