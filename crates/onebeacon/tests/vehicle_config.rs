@@ -79,3 +79,26 @@ fn bad_keys_are_named_and_a_config_reads_back() {
     let c = config(CONFIG);
     assert_eq!(config(&toml::to_string(&c).unwrap()), c);
 }
+
+/// A controller given a navigator without what it reads is refused when the
+/// configuration is read, by the key that chooses the navigator: behaviours without an
+/// iUSBL navigator first (they fell back on the beacon's own position before), FIM
+/// approach B without the 6-DOF filter's body velocity; the pairs that work are taken.
+#[test]
+fn a_controller_refuses_a_navigator_without_what_it_reads() {
+    let behaviours = format!("{CONFIG}\n[controller]\nkind = \"behaviours\"\n");
+    let e = config(&behaviours).checked().unwrap_err();
+    assert_eq!(e.key, "estimators[0].kind");
+    assert!(e.to_string().contains("\"rosb\"") && e.allowed.contains("iusbl"), "{e}");
+    let iusbl = behaviours.replace("kind = \"rosb\"", "kind = \"iusbl\"");
+    assert!(config(&iusbl).checked().is_ok());
+    let fim_b = format!("{CONFIG}\n[controller]\nkind = \"fim\"\nmetric = \"approach_b\"\n");
+    let e = config(&fim_b).checked().unwrap_err();
+    assert_eq!(e.key, "estimators[0].kind");
+    assert!(e.allowed.contains("body velocity") && e.allowed.contains("model = \"6dof\""), "{e}");
+    let six = fim_b
+        .replace("frame = \"ned\"", "frame = \"ned\"\nmodel = \"6dof\"")
+        .replace("kind = \"rosb\"", "kind = \"range-ekf\"");
+    assert!(config(&six).checked().is_ok(), "{:?}", config(&six).checked());
+    assert!(config(&fim_b.replace("approach_b", "approach_a")).checked().is_ok());
+}

@@ -8,8 +8,10 @@
 //! ENU offsets (x east, y north), converted in the built-in files.
 
 use super::validate::*;
-use super::{EstimatorKind, World, default_runs, default_seed};
+use super::{EstimatorKind, EstimatorSpec, World, default_runs, default_seed};
 use crate::vehicles::sandshark::SandSharkParams;
+use onebeacon::config::builder::VehicleModel;
+use onebeacon::nav::capability::Capability;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -435,8 +437,10 @@ pub(super) fn validate_fleet(s: &Fleet) -> Result<(), Violation> {
             "a fleet world runs `iusbl`, `iusbl-joint` and `dead-reckoning` (the others need what it does not give)",
         ));
     }
+    // the behaviours read the first navigator's beacon-relative position (as a stream checks it)
+    let flies = |e: &EstimatorKind| EstimatorSpec::new(*e).provides(Capability::BeaconRelative, VehicleModel::Planar);
     match s.estimators.first() {
-        Some(e) if e.iusbl() => {}
+        Some(e) if flies(e) => {}
         other => {
             return Err(violation(
                 "estimators",

@@ -6,6 +6,7 @@
 use super::estimator::{EstimatorKind, EstimatorSpec, Host};
 use crate::models::hoff::{DIM, idx};
 use crate::models::kinematic6dof::{Cov as Cov6, State as Eta};
+use crate::nav::capability::Capability;
 use crate::nav::restart::Builder;
 use crate::nav::{GaussianTracker, IusblNavigator, ParticleTracker, SensorNoise, TrackerNoise, range_6dof};
 use nalgebra::SVector;
@@ -54,6 +55,16 @@ pub struct TrackerStart {
 }
 
 impl EstimatorSpec {
+    /// Whether the navigator [`EstimatorSpec::builder`] makes for `model` gives
+    /// `capability`: the iUSBL navigator its beacon-relative position, the 6-DOF filter
+    /// its body velocity.
+    pub fn provides(&self, capability: Capability, model: VehicleModel) -> bool {
+        match capability {
+            Capability::BeaconRelative => model.is_planar() && self.kind.iusbl(),
+            Capability::BodyVelocity => model == VehicleModel::Kinematic6Dof,
+        }
+    }
+
     /// The estimator on a vehicle whose estimators start as `start` says, built by the
     /// session (or the simulator's track) at its start and again from its last sound
     /// pose: a USBL tracker (pf, bearing: hoff2024's eight states), the iUSBL navigator

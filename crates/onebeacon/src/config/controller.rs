@@ -9,6 +9,7 @@ use super::check::Violation;
 use crate::geo::Frame;
 use crate::guidance::bearing::{BearingPlanner, SpreadMetric, planner_too_slow};
 use crate::guidance::{FimPlanner, Metric, PolarGrid};
+use crate::nav::capability::Capability;
 use crate::nav::limits::Limits;
 use crate::vehicle::autonomy::{Autonomy, AutonomySettings, Behaviour};
 use crate::vehicle::bearing::{BearingGuidance, BearingGuidanceConfig, BearingMode};
@@ -299,6 +300,19 @@ pub fn mode_bank(modes: &[ModeBehaviour]) -> Vec<Option<Behaviour>> {
 }
 
 impl ControllerSpec {
+    /// What it reads of its first estimator's navigator beyond the estimate (checked
+    /// when a configuration is read: [`super::builder::VehicleModel`] and the kind must
+    /// give it).
+    pub fn needs(&self) -> Option<Capability> {
+        match self {
+            ControllerSpec::Behaviours(_) => Some(Capability::BeaconRelative),
+            ControllerSpec::Fim(f) if f.mode == FimModeName::Planner && f.metric == FimMetricName::ApproachB => {
+                Some(Capability::BodyVelocity)
+            }
+            _ => None,
+        }
+    }
+
     /// The line kind after which the controller decides.
     pub fn decide_on(&self) -> &str {
         match self {

@@ -11,6 +11,7 @@ use super::controller::ControllerSpec;
 use super::estimator::{EstimatorSpec, NOISE_KEYS};
 use super::estimator_check::check_estimators;
 use crate::geo::Frame;
+use crate::nav::capability::Capability;
 use crate::nav::limits::Limits;
 use crate::nav::session::{Session, Start};
 use crate::vehicle::unit::Unit;
@@ -350,10 +351,24 @@ impl StreamConfig {
         check_count("limits.max_rejections", l.max_rejections, 0, 100_000_000)?;
         check_count("limits.max_line_bytes", l.max_line_bytes, 64, 1 << 26)?;
         // the controller's setpoints within the limits, checked first
-        match &self.controller {
-            Some(c) => c.check(&crate::io::kinds(), l),
-            None => Ok(()),
+        let Some(c) = &self.controller else { return Ok(()) };
+        c.check(&crate::io::kinds(), l)?;
+        // what it reads of its first estimator
+        if let Some(need) = c.needs() {
+            let first = self.estimators.first();
+            if !first.is_some_and(|e| e.provides(need, self.model)) {
+                let hint = match need {
+                    Capability::BeaconRelative => "kind \"iusbl\" or \"iusbl-joint\" first among [[estimators]]",
+                    Capability::BodyVelocity => "model = \"6dof\"",
+                };
+                return Err(Violation {
+                    key: "estimators[0].kind".into(),
+                    value: first.map_or("(none)".into(), |e| format!("{:?}", e.kind.label())),
+                    allowed: format!("the [controller] reads {} of its first estimator: {hint}", need.label()),
+                });
+            }
         }
+        Ok(())
     }
 
     /// A session of the estimators on a vehicle that starts as `initial` says, starting

@@ -11,6 +11,7 @@
 //! offset by the beacon's position as the ping reports it (its GPS; the beacon-centred
 //! frame when unknown).
 
+use super::capability::BeaconRelative;
 use super::{Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::dsp::beamform::direction;
 use crate::dsp::modes::ModeConfirmation;
@@ -447,17 +448,23 @@ impl Navigator for IusblNavigator {
         )
     }
 
-    fn beacon_relative_ned_m(&self) -> Option<Vector3<f64>> {
-        let (rel, _) = self.relative();
-        Some(Vector3::new(rel.x, rel.y, self.depth_m.unwrap_or(0.0)))
-    }
-
-    fn command_mode(&self) -> Option<usize> {
-        self.confirmation.confirmed()
+    fn beacon_relative(&self) -> Option<&dyn BeaconRelative> {
+        Some(self)
     }
 
     fn factored_sets(&self) -> Option<FactoredSets> {
         self.config.factored.then(|| self.filter.sets().clone())
+    }
+}
+
+impl BeaconRelative for IusblNavigator {
+    fn beacon_relative_ned_m(&self) -> Vector3<f64> {
+        let (rel, _) = self.relative();
+        Vector3::new(rel.x, rel.y, self.depth_m.unwrap_or(0.0))
+    }
+
+    fn command_mode(&self) -> Option<usize> {
+        self.confirmation.confirmed()
     }
 }
 

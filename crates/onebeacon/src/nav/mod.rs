@@ -7,6 +7,7 @@
 //! replay and the live stream drive them through this interface alone, and score them
 //! with one [`evaluation`].
 
+pub mod capability;
 pub mod diagnosis;
 pub mod evaluation;
 pub mod event;
@@ -260,14 +261,13 @@ pub trait Navigator: Send {
     fn position_sample(&self, _m: usize) -> Option<Vec<Vector3<f64>>> {
         None
     }
-    /// The vehicle's position relative to the beacon it navigates on (NED, depth as
-    /// measured), for beacon-relative behaviours; None for an absolute navigator.
-    fn beacon_relative_ned_m(&self) -> Option<Vector3<f64>> {
+    /// Its position relative to the beacon it navigates on and the confirmed command
+    /// mode, for beacon-relative behaviours; None for an absolute navigator.
+    fn beacon_relative(&self) -> Option<&dyn capability::BeaconRelative> {
         None
     }
-    /// The body-frame linear velocity (u, v, w) the navigator last dead-reckoned on, m/s,
-    /// for a beacon vehicle predicting where the vehicle will be; None if it has none.
-    fn body_velocity_m_s(&self) -> Option<Vector3<f64>> {
+    /// The body velocity it dead-reckons on; None if it has none.
+    fn body_velocity(&self) -> Option<&dyn capability::BodyVelocity> {
         None
     }
     /// The innovation a range `m` would have, without taking it (the navigator moved to
@@ -280,10 +280,6 @@ pub trait Navigator: Send {
     /// for a navigator that estimates one per beacon.
     fn beacon_offsets(&self) -> Vec<(u32, f64, f64)> {
         Vec::new()
-    }
-    /// The command mode the beacon's pings confirmed last (rypkema sec. 4.2), if any.
-    fn command_mode(&self) -> Option<usize> {
-        None
     }
     /// Keeps, from now on, what a Rauch-Tung-Striebel pass over this navigator's run
     /// needs (memory grows with the run: for a log, not a stream); whether it can (the

@@ -192,9 +192,15 @@ impl<const N: usize> Range6DofNavigator<N> {
     }
 }
 
+impl<const N: usize> super::capability::BodyVelocity for Range6DofNavigator<N> {
+    fn body_velocity_m_s(&self) -> nalgebra::Vector3<f64> {
+        self.nu.fixed_rows::<3>(0).into_owned()
+    }
+}
+
 impl<const N: usize> Navigator for Range6DofNavigator<N> {
-    fn body_velocity_m_s(&self) -> Option<nalgebra::Vector3<f64>> {
-        Some(self.nu.fixed_rows::<3>(0).into_owned())
+    fn body_velocity(&self) -> Option<&dyn super::capability::BodyVelocity> {
+        Some(self)
     }
 
     fn process(&mut self, m: &Measurement) -> Outcome {

@@ -6,6 +6,7 @@
 use super::{Command, Controller, DecideError, Decided, FimSnapshot, GuidanceSnapshot, Situation, need, own_fix};
 use crate::guidance::{FimPlanner, Metric, ReachingSet};
 use crate::nav::Navigator;
+use crate::nav::capability::Capability;
 use nalgebra::Vector2;
 
 /// Where the beacon vehicle goes.
@@ -48,8 +49,9 @@ impl FimGuidance {
 
 impl Controller for FimGuidance {
     /// The waypoint for the next ping, from the vehicle's estimate now and predicted one
-    /// period ahead on its last measured body velocity; the situation's fix is the
-    /// beacon's position at this ping.
+    /// period ahead on its last measured body velocity (approach B needs it:
+    /// [`DecideError::Lacks`] without; the others predict no motion); the situation's fix
+    /// is the beacon's position at this ping.
     fn decide(&mut self, situation: &Situation, beliefs: &[&dyn Navigator]) -> Result<Decided, DecideError> {
         need(beliefs, 1)?;
         let c = &self.config;
@@ -57,7 +59,13 @@ impl Controller for FimGuidance {
         let reach = c.max_speed_m_s * c.period_s;
         let report = beliefs[0].estimate();
         let target = report.position_ned_m;
-        let lin = beliefs[0].body_velocity_m_s().unwrap_or_default();
+        let lin = match beliefs[0].body_velocity() {
+            Some(b) => b.body_velocity_m_s(),
+            None if c.mode == FimMode::Planner && c.planner.metric == Metric::ApproachB => {
+                return Err(DecideError::Lacks(Capability::BodyVelocity));
+            }
+            None => nalgebra::Vector3::zeros(),
+        };
         let target_next = target + report.body_to_ned() * lin * c.period_s;
         let waypoint = match c.mode {
             FimMode::Planner => {

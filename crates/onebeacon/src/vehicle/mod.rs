@@ -24,6 +24,7 @@ pub mod unit;
 
 use crate::guidance::FimPlanner;
 use crate::nav::Navigator;
+use crate::nav::capability::Capability;
 use nalgebra::{Vector2, Vector3};
 
 /// What a vehicle knows of itself when it decides.
@@ -146,6 +147,10 @@ pub enum DecideError {
     /// The navigators it reads have not started (no initial state yet).
     #[error("the navigators have not started yet")]
     NotStarted,
+    /// The navigator it reads cannot tell what it needs (a configuration check refuses
+    /// such a pair before it runs).
+    #[error("the controller needs {}, which its navigator does not give", .0.label())]
+    Lacks(Capability),
 }
 
 /// What turns beliefs into a command.
@@ -224,14 +229,26 @@ mod tests {
                 current_ned_m_s: [0.0; 2],
             }
         }
+        fn beacon_relative(&self) -> Option<&dyn crate::nav::capability::BeaconRelative> {
+            self.relative.map(|_| self as &dyn crate::nav::capability::BeaconRelative)
+        }
+        fn body_velocity(&self) -> Option<&dyn crate::nav::capability::BodyVelocity> {
+            self.body_velocity.map(|_| self as &dyn crate::nav::capability::BodyVelocity)
+        }
+    }
+
+    impl crate::nav::capability::BeaconRelative for Fixed {
+        fn beacon_relative_ned_m(&self) -> Vector3<f64> {
+            self.relative.unwrap_or_default()
+        }
         fn command_mode(&self) -> Option<usize> {
             self.mode
         }
-        fn beacon_relative_ned_m(&self) -> Option<Vector3<f64>> {
-            self.relative
-        }
-        fn body_velocity_m_s(&self) -> Option<Vector3<f64>> {
-            self.body_velocity
+    }
+
+    impl crate::nav::capability::BodyVelocity for Fixed {
+        fn body_velocity_m_s(&self) -> Vector3<f64> {
+            self.body_velocity.unwrap_or_default()
         }
     }
 
@@ -309,7 +326,9 @@ mod tests {
     }
 
     /// A surface vehicle's guidance without its own fix, or without the beliefs it
-    /// reads, is an error (not a panic).
+    /// reads, is an error (not a panic); so is a controller whose navigator lacks what
+    /// it reads (behaviours without a beacon-relative position, approach B without a
+    /// body velocity), where these fell back on zeros before.
     #[test]
     fn missing_inputs_are_errors() {
         let auv = Fixed::at(1.0, 1.0);
@@ -319,6 +338,13 @@ mod tests {
             bearing(BearingMode::Planner).decide(&surface(0.0, 0.0), &[]).unwrap_err(),
             DecideError::Beliefs { needed: 1, given: 0 }
         );
+        let mut behaviours = Behaviours::new(Autonomy::new(AutonomySettings::default(), vec![None]));
+        let lacks = DecideError::Lacks(Capability::BeaconRelative);
+        assert_eq!(behaviours.decide(&blind, &[&auv]).unwrap_err(), lacks);
+        let lacks = DecideError::Lacks(Capability::BodyVelocity);
+        assert_eq!(fim(FimMode::Planner).decide(&surface(0.0, 0.0), &[&auv]).unwrap_err(), lacks);
+        // approach A's baselines predict no motion without it
+        assert!(fim(FimMode::Static).decide(&surface(0.0, 0.0), &[&auv]).is_ok());
     }
 
     fn fim(mode: FimMode) -> FimGuidance {
