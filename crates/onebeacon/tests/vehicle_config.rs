@@ -36,14 +36,10 @@ fn config(text: &str) -> StreamConfig {
     toml::from_str(text).expect("a stream configuration")
 }
 
-/// A still vehicle hearing the beacon 100 m away: the range filter's position ends on
-/// the 100 m circle about the beacon (within 10 of the filter's range sigmas, 0.5 m /
-/// sqrt(60) each), dead reckoning stays exactly where it started.
-#[test]
-fn a_configured_unit_estimates_from_its_lines() {
-    let c = config(CONFIG).checked().unwrap();
-    assert_eq!(c.estimators[0].range_sigma_m, Some(0.5), "[noise] is handed to the estimators");
-    let mut unit = c.unit().unwrap();
+/// The last output line of a unit of `config` fed a still vehicle's lines 100 m from
+/// beacon 7 for 60 s.
+fn last_line(config: StreamConfig) -> Value {
+    let mut unit = config.unit().unwrap();
     let mut input = String::new();
     for k in 1..=60 {
         let t = f64::from(k);
@@ -55,7 +51,32 @@ fn a_configured_unit_estimates_from_its_lines() {
     let mut notes = Vec::new();
     stream::run(&mut unit, Cursor::new(input), &mut out, |line, m| notes.push(format!("{line}: {m}"))).unwrap();
     assert!(notes.is_empty(), "{notes:?}");
-    let last: Value = serde_json::from_str(std::str::from_utf8(&out).unwrap().lines().last().unwrap()).unwrap();
+    serde_json::from_str(std::str::from_utf8(&out).unwrap().lines().last().unwrap()).unwrap()
+}
+
+/// A calibration state is written where the estimator estimates it and left out where
+/// it does not (absent is not zero): the range filter's offset with `estimate_bias`,
+/// none of dead reckoning's.
+#[test]
+fn calibration_not_estimated_is_absent() {
+    let calibrated = CONFIG.replacen("kind = \"rosb\"", "kind = \"rosb\"\nestimate_bias = true", 1);
+    let last = last_line(config(&calibrated).checked().unwrap());
+    assert!(last["estimates"][0]["range_bias_m"].is_f64(), "{last}");
+    for key in ["range_scale", "distance_scale", "turn_scale", "usbl_misalignment_rad", "current_north_m_s"] {
+        assert!(last["estimates"][0].get(key).is_none(), "{key}: {last}");
+    }
+    let plain = last_line(config(CONFIG).checked().unwrap());
+    assert!(plain["estimates"][0].get("range_bias_m").is_none() && plain["estimates"][1].get("range_bias_m").is_none());
+}
+
+/// A still vehicle hearing the beacon 100 m away: the range filter's position ends on
+/// the 100 m circle about the beacon (within 10 of the filter's range sigmas, 0.5 m /
+/// sqrt(60) each), dead reckoning stays exactly where it started.
+#[test]
+fn a_configured_unit_estimates_from_its_lines() {
+    let c = config(CONFIG).checked().unwrap();
+    assert_eq!(c.estimators[0].range_sigma_m, Some(0.5), "[noise] is handed to the estimators");
+    let last = last_line(c);
     let estimate = |i: usize| {
         let e = &last["estimates"][i];
         (e["x_m"].as_f64().unwrap(), e["y_m"].as_f64().unwrap())

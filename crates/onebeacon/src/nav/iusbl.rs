@@ -423,12 +423,12 @@ impl Navigator for IusblNavigator {
             heading_var_rad2: self.config.sigma_heading_rad.powi(2),
             roll_pitch_rad: [roll, pitch],
             speed_m_s: Some(self.speed_m_s),
-            range_bias_m: 0.0,
-            range_scale: 0.0,
-            distance_scale: 0.0,
-            turn_scale: 0.0,
-            usbl_misalignment_rad: 0.0,
-            current_ned_m_s: [0.0; 2],
+            range_bias_m: None,
+            range_scale: None,
+            distance_scale: None,
+            turn_scale: None,
+            usbl_misalignment_rad: None,
+            current_ned_m_s: None,
         }
     }
 

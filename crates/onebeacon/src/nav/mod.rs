@@ -178,7 +178,8 @@ impl Outcome {
 }
 
 /// A navigator's estimate at one time: the part every navigator has (position, heading,
-/// their uncertainty) and the sensor calibration states some estimate (zero otherwise).
+/// their uncertainty) and the sensor calibration states some estimate (None where it
+/// does not: a state not estimated is absent, not zero).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
     pub t_s: f64,
@@ -194,15 +195,16 @@ pub struct Estimate {
     pub(crate) roll_pitch_rad: [f64; 2],
     /// Forward speed, m/s, when it is a state.
     pub speed_m_s: Option<f64>,
-    /// Range offset b (m) and scale error k_r, odometry distance and turn scale errors.
-    pub range_bias_m: f64,
-    pub range_scale: f64,
-    pub distance_scale: f64,
-    pub turn_scale: f64,
+    /// Range offset b (m) and scale error k_r, odometry distance and turn scale errors,
+    /// where they are estimated.
+    pub range_bias_m: Option<f64>,
+    pub range_scale: Option<f64>,
+    pub distance_scale: Option<f64>,
+    pub turn_scale: Option<f64>,
     /// The USBL head's yaw misalignment, rad, where it is a state.
-    pub usbl_misalignment_rad: f64,
+    pub usbl_misalignment_rad: Option<f64>,
     /// The water's current (north, east), m/s, where it is a state.
-    pub current_ned_m_s: [f64; 2],
+    pub current_ned_m_s: Option<[f64; 2]>,
 }
 
 impl Estimate {
@@ -225,17 +227,22 @@ impl Estimate {
     pub fn sigma_heading_rad(&self) -> f64 {
         self.heading_var_rad2.max(0.0).sqrt()
     }
-    /// The range, odometry and USBL calibration states and the current, as output keys.
-    pub fn calibration(&self) -> [(&'static str, f64); 7] {
+    /// The range, odometry and USBL calibration states and the current the navigator
+    /// estimates, as output keys (those it does not estimate left out).
+    pub fn calibration(&self) -> Vec<(&'static str, f64)> {
+        let current = self.current_ned_m_s;
         [
             ("range_bias_m", self.range_bias_m),
             ("range_scale", self.range_scale),
             ("distance_scale", self.distance_scale),
             ("turn_scale", self.turn_scale),
             ("usbl_misalignment_rad", self.usbl_misalignment_rad),
-            ("current_north_m_s", self.current_ned_m_s[0]),
-            ("current_east_m_s", self.current_ned_m_s[1]),
+            ("current_north_m_s", current.map(|c| c[0])),
+            ("current_east_m_s", current.map(|c| c[1])),
         ]
+        .into_iter()
+        .filter_map(|(k, v)| Some((k, v?)))
+        .collect()
     }
     /// Body-to-NED rotation of the estimated attitude (roll and pitch zero where they
     /// are not states).

@@ -278,7 +278,7 @@ impl<const N: usize> PlanarNavigator<N> {
     }
 
     /// The estimate of mean `x` and covariance `p` at `t_s` and depth `depth_m`.
-    fn estimate_of(t_s: f64, x: &State<N>, p: &Cov<N>, depth_m: f64) -> Estimate {
+    fn estimate_of(c: &PlanarConfig, t_s: f64, x: &State<N>, p: &Cov<N>, depth_m: f64) -> Estimate {
         Estimate {
             t_s,
             position_ned_m: Vector3::new(x[idx::N], x[idx::E], depth_m),
@@ -287,12 +287,13 @@ impl<const N: usize> PlanarNavigator<N> {
             heading_var_rad2: p[(idx::PSI, idx::PSI)],
             roll_pitch_rad: [0.0; 2],
             speed_m_s: None,
-            range_bias_m: x[idx::BIAS],
-            range_scale: x[idx::RANGE_SCALE],
-            distance_scale: x[idx::DISTANCE_SCALE],
-            turn_scale: x[idx::TURN_SCALE],
-            usbl_misalignment_rad: 0.0,
-            current_ned_m_s: if N >= EXTENDED_STATES { [x[idx::CURRENT_N], x[idx::CURRENT_E]] } else { [0.0; 2] },
+            range_bias_m: c.estimate_bias.then_some(x[idx::BIAS]),
+            range_scale: c.estimate_range_scale.then_some(x[idx::RANGE_SCALE]),
+            distance_scale: c.estimate_distance_scale.then_some(x[idx::DISTANCE_SCALE]),
+            turn_scale: c.estimate_turn_scale.then_some(x[idx::TURN_SCALE]),
+            usbl_misalignment_rad: None,
+            current_ned_m_s: (c.current.is_some() && N >= EXTENDED_STATES)
+                .then(|| [x[idx::CURRENT_N], x[idx::CURRENT_E]]),
         }
     }
 
@@ -438,7 +439,7 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
     }
 
     fn estimate(&self) -> Estimate {
-        Self::estimate_of(self.t_s, self.filter.mean(), self.filter.covariance(), self.depth_m)
+        Self::estimate_of(&self.config, self.t_s, self.filter.mean(), self.filter.covariance(), self.depth_m)
     }
 
     /// Dead reckoning (no beacon aiding) has no correction to carry back: it keeps none.
@@ -453,7 +454,7 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
         let Some((history, depths)) = &self.history else { return Vec::new() };
         let last = (*self.filter.mean(), *self.filter.covariance());
         let smoothed = history.smooth(last, |k| k == idx::PSI || (N > STATES && k == idx::HEADING_OFFSET));
-        smoothed.iter().zip(depths).map(|((t, (x, p)), d)| Self::estimate_of(*t, x, p, *d)).collect()
+        smoothed.iter().zip(depths).map(|((t, (x, p)), d)| Self::estimate_of(&self.config, *t, x, p, *d)).collect()
     }
 }
 
@@ -651,7 +652,7 @@ mod tests {
         let e = nav.estimate();
         assert_abs_diff_eq!(e.north_m(), truth.x, epsilon = 0.1);
         assert_abs_diff_eq!(e.east_m(), truth.y, epsilon = 0.1);
-        assert_abs_diff_eq!(e.range_bias_m, bias, epsilon = 0.1);
+        assert_abs_diff_eq!(e.range_bias_m.expect("estimated"), bias, epsilon = 0.1);
         let outlier = Kind::Range { beacon: BeaconFix::fixed(0, beacons[0]), range_m: truth.norm() + bias + 20.0 };
         let before = nav.estimate();
         assert!(matches!(nav.process(&Measurement::new(t, outlier.clone())), Outcome::Rejected(i) if i.nis > 10.83));
@@ -708,9 +709,9 @@ mod tests {
             ..PlanarConfig::default()
         };
         let (est, worst) = run(calibrated);
-        assert_abs_diff_eq!(est.turn_scale, k_t, epsilon = 0.001);
-        assert_abs_diff_eq!(est.range_scale, k_r, epsilon = 0.002);
-        assert_abs_diff_eq!(est.range_bias_m, offset, epsilon = 0.1);
+        assert_abs_diff_eq!(est.turn_scale.expect("estimated"), k_t, epsilon = 0.001);
+        assert_abs_diff_eq!(est.range_scale.expect("estimated"), k_r, epsilon = 0.002);
+        assert_abs_diff_eq!(est.range_bias_m.expect("estimated"), offset, epsilon = 0.1);
         assert!(worst < 0.1, "calibrated: worst error over the second half {worst} m");
         let (_, worst_plain) = run(PlanarConfig { estimate_bias: true, ..PlanarConfig::default() });
         assert!(worst_plain > 5.0, "uncalibrated: {worst_plain} m");

@@ -242,7 +242,7 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
 
     fn estimate(&self) -> Estimate {
         let (x, p) = (self.filter.mean(), self.filter.covariance());
-        let state = |i: Option<usize>| i.map_or(0.0, |i| x[i]);
+        let state = |i: Option<usize>| i.map(|i| x[i]);
         Estimate {
             t_s: self.t_s,
             position_ned_m: x.fixed_rows::<3>(0).into_owned(),
@@ -253,13 +253,10 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
             speed_m_s: None,
             range_bias_m: state(self.calibration.layout.offset),
             range_scale: state(self.calibration.layout.scale),
-            distance_scale: 0.0,
-            turn_scale: 0.0,
-            usbl_misalignment_rad: 0.0,
-            current_ned_m_s: [
-                state(self.calibration.layout.current),
-                state(self.calibration.layout.current.map(|i| i + 1)),
-            ],
+            distance_scale: None,
+            turn_scale: None,
+            usbl_misalignment_rad: None,
+            current_ned_m_s: self.calibration.layout.current.map(|i| [x[i], x[i + 1]]),
         }
     }
 }
@@ -356,7 +353,9 @@ mod tests {
         let e = err(&x.fixed_rows::<2>(0).into_owned());
         assert!(e < 0.05 && e < 3.0 * p.fixed_view::<2, 2>(0, 0).trace().sqrt(), "with the clock: {e} m");
         assert!((x[7] - drift_m_s).abs() < 3.0 * p[(7, 7)].sqrt() + 1e-6, "drift {} against {drift_m_s}", x[7]);
-        assert!((clocked.estimate().range_bias_m - (offset_m + drift_m_s * 3600.0)).abs() < 0.05);
+        let bias = clocked.estimate().range_bias_m.expect("estimated");
+        assert!((bias - (offset_m + drift_m_s * 3600.0)).abs() < 0.05);
+        assert_eq!(plain.estimate().range_bias_m, None, "not estimated: absent");
         let e_plain = err(&plain.state().fixed_rows::<2>(0).into_owned());
         assert!(e_plain > 3.0, "without the clock: {e_plain} m");
     }

@@ -396,12 +396,12 @@ impl<const N: usize, P: ProcessModel<N> + Send> Navigator for SingleBeaconNaviga
             heading_var_rad2: p[(idx::PSI, idx::PSI)],
             roll_pitch_rad: [0.0; 2],
             speed_m_s: Some(x[idx::V]),
-            range_bias_m: self.calibration.layout.offset.map_or(0.0, |i| x[i]),
-            range_scale: self.calibration.layout.scale.map_or(0.0, |i| x[i]),
-            distance_scale: 0.0,
-            turn_scale: 0.0,
-            usbl_misalignment_rad: 0.0,
-            current_ned_m_s: self.calibration.layout.current.map_or([0.0; 2], |i| [x[i], x[i + 1]]),
+            range_bias_m: self.calibration.layout.offset.map(|i| x[i]),
+            range_scale: self.calibration.layout.scale.map(|i| x[i]),
+            distance_scale: None,
+            turn_scale: None,
+            usbl_misalignment_rad: None,
+            current_ned_m_s: self.calibration.layout.current.map(|i| [x[i], x[i + 1]]),
         }
     }
 }

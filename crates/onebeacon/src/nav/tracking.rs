@@ -178,12 +178,12 @@ impl Navigator for TrackingNavigator {
             heading_var_rad2: (p[(idx::VN, idx::VN)] + p[(idx::VE, idx::VE)]) / speed.max(0.1).powi(2),
             roll_pitch_rad: [0.0; 2],
             speed_m_s: Some(speed),
-            range_bias_m: x[idx::BIAS],
-            range_scale: x[idx::RANGE_SCALE],
-            distance_scale: 0.0,
-            turn_scale: 0.0,
-            usbl_misalignment_rad: 0.0,
-            current_ned_m_s: [0.0; 2],
+            range_bias_m: self.config.estimate_bias.then_some(x[idx::BIAS]),
+            range_scale: self.config.estimate_range_scale.then_some(x[idx::RANGE_SCALE]),
+            distance_scale: None,
+            turn_scale: None,
+            usbl_misalignment_rad: None,
+            current_ned_m_s: None,
         }
     }
 }

@@ -221,12 +221,12 @@ mod tests {
                 heading_var_rad2: 0.01,
                 roll_pitch_rad: [0.0; 2],
                 speed_m_s: Some(1.5),
-                range_bias_m: 0.0,
-                range_scale: 0.0,
-                distance_scale: 0.0,
-                turn_scale: 0.0,
-                usbl_misalignment_rad: 0.0,
-                current_ned_m_s: [0.0; 2],
+                range_bias_m: None,
+                range_scale: None,
+                distance_scale: None,
+                turn_scale: None,
+                usbl_misalignment_rad: None,
+                current_ned_m_s: None,
             }
         }
         fn beacon_relative(&self) -> Option<&dyn crate::nav::capability::BeaconRelative> {
