@@ -122,7 +122,7 @@ fn estimates<'py>(py: Python<'py>, session: &Session) -> PyResult<Vec<Bound<'py,
             d.set_item("heading_rad", e.heading_rad())?;
             d.set_item("sigma_heading_rad", e.sigma_heading_rad())?;
             d.set_item("speed_m_s", e.speed_m_s)?;
-            for (k, x) in e.calibration() {
+            for (k, x) in e.calibration.keys() {
                 d.set_item(k, x)?;
             }
             Ok(d)

@@ -157,7 +157,7 @@ pub fn rts_summary(run: &crate::replay::rts::RtsRun) -> Value {
     let mut v = error_fields(&format!("{}+rts", run.name), &run.stats);
     v["rts_of"] = json!(run.name);
     if let Some(e) = run.estimates.first() {
-        for (k, x) in e.calibration() {
+        for (k, x) in e.calibration.keys() {
             v[k] = num(x);
         }
     }
@@ -226,7 +226,7 @@ pub fn replay_summary(log: &Log, used: &[u32], r: &Replay, wall_s: f64) -> Value
             ] {
                 v[k] = val;
             }
-            for (k, x) in e.calibration() {
+            for (k, x) in e.calibration.keys() {
                 v[k] = num(x);
             }
             if !offsets.is_empty() {

@@ -279,7 +279,7 @@ fn the_range_scale_state_finds_the_effective_speed() {
     let mean_k = k_truth.iter().sum::<f64>() / k_truth.len() as f64;
     let spread = k_truth.iter().map(|k| (k - mean_k).abs()).fold(0.0, f64::max);
     let (e, ep) = (scaled.estimate(), plain.estimate());
-    let k = e.range_scale.expect("the scale is estimated");
+    let k = e.calibration.range_scale.expect("the scale is estimated");
     // the scale's sigma is not in the estimate: its bound from the ranges, 0.5 m over
     // 360 ranges of about 80 m, 0.5 / (80 sqrt(360)) = 3.3e-4, times 3
     let bound = 3.0 * 0.5 / (80.0 * 360f64.sqrt()) + spread;

@@ -260,7 +260,7 @@ pub fn step_json(line: usize, step: &Step, names: &[String], frame: Frame) -> Va
                 "sigma_x_m": sx.abs(),
                 "sigma_y_m": sy.abs(),
             });
-            for (k, x) in e.calibration() {
+            for (k, x) in e.calibration.keys() {
                 v[k] = json!(x);
             }
             if let Some(o) = step.outcomes[i] {

@@ -11,6 +11,7 @@
 //! offset by the beacon's position as the ping reports it (its GPS; the beacon-centred
 //! frame when unknown).
 
+use super::Calibration;
 use super::capability::BeaconRelative;
 use super::{Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::dsp::beamform::direction;
@@ -423,12 +424,7 @@ impl Navigator for IusblNavigator {
             heading_var_rad2: self.config.sigma_heading_rad.powi(2),
             roll_pitch_rad: [roll, pitch],
             speed_m_s: Some(self.speed_m_s),
-            range_bias_m: None,
-            range_scale: None,
-            distance_scale: None,
-            turn_scale: None,
-            usbl_misalignment_rad: None,
-            current_ned_m_s: None,
+            calibration: Calibration::default(),
         }
     }
 

@@ -195,16 +195,42 @@ pub struct Estimate {
     pub(crate) roll_pitch_rad: [f64; 2],
     /// Forward speed, m/s, when it is a state.
     pub speed_m_s: Option<f64>,
-    /// Range offset b (m) and scale error k_r, odometry distance and turn scale errors,
-    /// where they are estimated.
+    /// The sensor calibration states it estimates.
+    pub calibration: Calibration,
+}
+
+/// The sensor calibration states a navigator estimates: None where it does not (a state
+/// not estimated is absent, not zero).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Calibration {
+    /// Range offset b (m) and scale error k_r, odometry distance and turn scale errors.
     pub range_bias_m: Option<f64>,
     pub range_scale: Option<f64>,
     pub distance_scale: Option<f64>,
     pub turn_scale: Option<f64>,
-    /// The USBL head's yaw misalignment, rad, where it is a state.
+    /// The USBL head's yaw misalignment, rad.
     pub usbl_misalignment_rad: Option<f64>,
-    /// The water's current (north, east), m/s, where it is a state.
+    /// The water's current (north, east), m/s.
     pub current_ned_m_s: Option<[f64; 2]>,
+}
+
+impl Calibration {
+    /// The states estimated, as output keys (those not estimated left out).
+    pub fn keys(&self) -> Vec<(&'static str, f64)> {
+        let current = self.current_ned_m_s;
+        [
+            ("range_bias_m", self.range_bias_m),
+            ("range_scale", self.range_scale),
+            ("distance_scale", self.distance_scale),
+            ("turn_scale", self.turn_scale),
+            ("usbl_misalignment_rad", self.usbl_misalignment_rad),
+            ("current_north_m_s", current.map(|c| c[0])),
+            ("current_east_m_s", current.map(|c| c[1])),
+        ]
+        .into_iter()
+        .filter_map(|(k, v)| Some((k, v?)))
+        .collect()
+    }
 }
 
 impl Estimate {
@@ -226,23 +252,6 @@ impl Estimate {
     }
     pub fn sigma_heading_rad(&self) -> f64 {
         self.heading_var_rad2.max(0.0).sqrt()
-    }
-    /// The range, odometry and USBL calibration states and the current the navigator
-    /// estimates, as output keys (those it does not estimate left out).
-    pub fn calibration(&self) -> Vec<(&'static str, f64)> {
-        let current = self.current_ned_m_s;
-        [
-            ("range_bias_m", self.range_bias_m),
-            ("range_scale", self.range_scale),
-            ("distance_scale", self.distance_scale),
-            ("turn_scale", self.turn_scale),
-            ("usbl_misalignment_rad", self.usbl_misalignment_rad),
-            ("current_north_m_s", current.map(|c| c[0])),
-            ("current_east_m_s", current.map(|c| c[1])),
-        ]
-        .into_iter()
-        .filter_map(|(k, v)| Some((k, v?)))
-        .collect()
     }
     /// Body-to-NED rotation of the estimated attitude (roll and pitch zero where they
     /// are not states).

@@ -17,6 +17,7 @@
 //! every combination. Doppler speeds are not scaled by k_r (acoustic Doppler speeds share
 //! the sound-speed error; modelling that is left for when a log needs it).
 
+use super::Calibration;
 pub use super::planar_config::{HeadingOffsetPrior, PlanarConfig, PlanarNoise};
 use super::planar_models::{Drift, OdometryStep, OffsetHeading};
 use super::range_calibration::CarriedDoppler;
@@ -287,13 +288,15 @@ impl<const N: usize> PlanarNavigator<N> {
             heading_var_rad2: p[(idx::PSI, idx::PSI)],
             roll_pitch_rad: [0.0; 2],
             speed_m_s: None,
-            range_bias_m: c.estimate_bias.then_some(x[idx::BIAS]),
-            range_scale: c.estimate_range_scale.then_some(x[idx::RANGE_SCALE]),
-            distance_scale: c.estimate_distance_scale.then_some(x[idx::DISTANCE_SCALE]),
-            turn_scale: c.estimate_turn_scale.then_some(x[idx::TURN_SCALE]),
-            usbl_misalignment_rad: None,
-            current_ned_m_s: (c.current.is_some() && N >= EXTENDED_STATES)
-                .then(|| [x[idx::CURRENT_N], x[idx::CURRENT_E]]),
+            calibration: Calibration {
+                range_bias_m: c.estimate_bias.then_some(x[idx::BIAS]),
+                range_scale: c.estimate_range_scale.then_some(x[idx::RANGE_SCALE]),
+                distance_scale: c.estimate_distance_scale.then_some(x[idx::DISTANCE_SCALE]),
+                turn_scale: c.estimate_turn_scale.then_some(x[idx::TURN_SCALE]),
+                usbl_misalignment_rad: None,
+                current_ned_m_s: (c.current.is_some() && N >= EXTENDED_STATES)
+                    .then(|| [x[idx::CURRENT_N], x[idx::CURRENT_E]]),
+            },
         }
     }
 
@@ -652,7 +655,7 @@ mod tests {
         let e = nav.estimate();
         assert_abs_diff_eq!(e.north_m(), truth.x, epsilon = 0.1);
         assert_abs_diff_eq!(e.east_m(), truth.y, epsilon = 0.1);
-        assert_abs_diff_eq!(e.range_bias_m.expect("estimated"), bias, epsilon = 0.1);
+        assert_abs_diff_eq!(e.calibration.range_bias_m.expect("estimated"), bias, epsilon = 0.1);
         let outlier = Kind::Range { beacon: BeaconFix::fixed(0, beacons[0]), range_m: truth.norm() + bias + 20.0 };
         let before = nav.estimate();
         assert!(matches!(nav.process(&Measurement::new(t, outlier.clone())), Outcome::Rejected(i) if i.nis > 10.83));
@@ -709,9 +712,9 @@ mod tests {
             ..PlanarConfig::default()
         };
         let (est, worst) = run(calibrated);
-        assert_abs_diff_eq!(est.turn_scale.expect("estimated"), k_t, epsilon = 0.001);
-        assert_abs_diff_eq!(est.range_scale.expect("estimated"), k_r, epsilon = 0.002);
-        assert_abs_diff_eq!(est.range_bias_m.expect("estimated"), offset, epsilon = 0.1);
+        assert_abs_diff_eq!(est.calibration.turn_scale.expect("estimated"), k_t, epsilon = 0.001);
+        assert_abs_diff_eq!(est.calibration.range_scale.expect("estimated"), k_r, epsilon = 0.002);
+        assert_abs_diff_eq!(est.calibration.range_bias_m.expect("estimated"), offset, epsilon = 0.1);
         assert!(worst < 0.1, "calibrated: worst error over the second half {worst} m");
         let (_, worst_plain) = run(PlanarConfig { estimate_bias: true, ..PlanarConfig::default() });
         assert!(worst_plain > 5.0, "uncalibrated: {worst_plain} m");

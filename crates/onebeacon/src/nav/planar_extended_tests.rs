@@ -144,7 +144,7 @@ fn ranges_find_the_current() {
             }
         }
         // the estimate shows the current's states, and no current without them
-        let shown = nav.estimate().current_ned_m_s;
+        let shown = nav.estimate().calibration.current_ned_m_s;
         assert_eq!(shown.is_some(), with);
         assert_eq!(Vector2::from(shown.unwrap_or_default()), nav.current().0);
         (nav.current(), worst)

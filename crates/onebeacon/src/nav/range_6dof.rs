@@ -3,6 +3,7 @@
 //! (eq. 3.3-3.6), and OWTT range updates to a beacon whose position travels with the
 //! measurement (eq. 3.7-3.10).
 
+use super::Calibration;
 use super::range_calibration::{Calibrated, CalibratedRange, RangeCalibration};
 use super::{Aiding, BeaconFix, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
@@ -251,12 +252,14 @@ impl<const N: usize> Navigator for Range6DofNavigator<N> {
             heading_var_rad2: p[(idx::YAW, idx::YAW)],
             roll_pitch_rad: [x[idx::ROLL], x[idx::PITCH]],
             speed_m_s: None,
-            range_bias_m: state(self.calibration.layout.offset),
-            range_scale: state(self.calibration.layout.scale),
-            distance_scale: None,
-            turn_scale: None,
-            usbl_misalignment_rad: None,
-            current_ned_m_s: self.calibration.layout.current.map(|i| [x[i], x[i + 1]]),
+            calibration: Calibration {
+                range_bias_m: state(self.calibration.layout.offset),
+                range_scale: state(self.calibration.layout.scale),
+                distance_scale: None,
+                turn_scale: None,
+                usbl_misalignment_rad: None,
+                current_ned_m_s: self.calibration.layout.current.map(|i| [x[i], x[i + 1]]),
+            },
         }
     }
 }
@@ -353,9 +356,9 @@ mod tests {
         let e = err(&x.fixed_rows::<2>(0).into_owned());
         assert!(e < 0.05 && e < 3.0 * p.fixed_view::<2, 2>(0, 0).trace().sqrt(), "with the clock: {e} m");
         assert!((x[7] - drift_m_s).abs() < 3.0 * p[(7, 7)].sqrt() + 1e-6, "drift {} against {drift_m_s}", x[7]);
-        let bias = clocked.estimate().range_bias_m.expect("estimated");
+        let bias = clocked.estimate().calibration.range_bias_m.expect("estimated");
         assert!((bias - (offset_m + drift_m_s * 3600.0)).abs() < 0.05);
-        assert_eq!(plain.estimate().range_bias_m, None, "not estimated: absent");
+        assert_eq!(plain.estimate().calibration.range_bias_m, None, "not estimated: absent");
         let e_plain = err(&plain.state().fixed_rows::<2>(0).into_owned());
         assert!(e_plain > 3.0, "without the clock: {e_plain} m");
     }

@@ -7,6 +7,7 @@
 //! (eq. 18 left, 22). [`Aiding::RANGE`] is the ROSB baseline: the same filter without
 //! the Doppler speed; [`Aiding::NONE`] is dead reckoning on the inertial sensors.
 
+use super::Calibration;
 use super::range_calibration::{Calibrated, CalibratedRange, CarriedDoppler, RangeCalibration};
 use super::{Aiding, Estimate, Kind, Measurement, Navigator, Outcome, Robust};
 use crate::filter::{AnyFilter, FilterError, FilterKind, Gated, GaussianFilter, MeasurementModel, ProcessModel};
@@ -396,12 +397,14 @@ impl<const N: usize, P: ProcessModel<N> + Send> Navigator for SingleBeaconNaviga
             heading_var_rad2: p[(idx::PSI, idx::PSI)],
             roll_pitch_rad: [0.0; 2],
             speed_m_s: Some(x[idx::V]),
-            range_bias_m: self.calibration.layout.offset.map(|i| x[i]),
-            range_scale: self.calibration.layout.scale.map(|i| x[i]),
-            distance_scale: None,
-            turn_scale: None,
-            usbl_misalignment_rad: None,
-            current_ned_m_s: self.calibration.layout.current.map(|i| [x[i], x[i + 1]]),
+            calibration: Calibration {
+                range_bias_m: self.calibration.layout.offset.map(|i| x[i]),
+                range_scale: self.calibration.layout.scale.map(|i| x[i]),
+                distance_scale: None,
+                turn_scale: None,
+                usbl_misalignment_rad: None,
+                current_ned_m_s: self.calibration.layout.current.map(|i| [x[i], x[i + 1]]),
+            },
         }
     }
 }

@@ -6,6 +6,7 @@
 //! State [N, E, vN, vE, b, k_r]: horizontal NED position (m) and velocity (m/s), the
 //! range offset b (m) and scale error k_r (ranges read (1 + k_r) r + b).
 
+use super::Calibration;
 use super::{Estimate, Innovation, Kind, Measurement, Navigator, Outcome, PlanarConfig};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::measure::{ScalarModel, SlantRange};
@@ -178,12 +179,14 @@ impl Navigator for TrackingNavigator {
             heading_var_rad2: (p[(idx::VN, idx::VN)] + p[(idx::VE, idx::VE)]) / speed.max(0.1).powi(2),
             roll_pitch_rad: [0.0; 2],
             speed_m_s: Some(speed),
-            range_bias_m: self.config.estimate_bias.then_some(x[idx::BIAS]),
-            range_scale: self.config.estimate_range_scale.then_some(x[idx::RANGE_SCALE]),
-            distance_scale: None,
-            turn_scale: None,
-            usbl_misalignment_rad: None,
-            current_ned_m_s: None,
+            calibration: Calibration {
+                range_bias_m: self.config.estimate_bias.then_some(x[idx::BIAS]),
+                range_scale: self.config.estimate_range_scale.then_some(x[idx::RANGE_SCALE]),
+                distance_scale: None,
+                turn_scale: None,
+                usbl_misalignment_rad: None,
+                current_ned_m_s: None,
+            },
         }
     }
 }

@@ -5,6 +5,7 @@
 //! or a UKF ([`GaussianTracker`]), both behind [`Navigator`], so that they run on the
 //! same measurements.
 
+use super::Calibration;
 use super::{Aiding, Estimate, Gate, Kind, Measurement, Navigator, Outcome, Robust, gated_update};
 use crate::filter::particle::{ParticleFilter, ParticleSettings};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
@@ -117,12 +118,7 @@ fn estimate_of(t_s: f64, x: &TrackState, p: &SMatrix<f64, DIM, DIM>, heading: (f
         heading_var_rad2: heading.1,
         roll_pitch_rad: [0.0, x[idx::THETA]],
         speed_m_s: Some(x[idx::U]),
-        range_bias_m: None,
-        range_scale: None,
-        distance_scale: None,
-        turn_scale: None,
-        usbl_misalignment_rad: None,
-        current_ned_m_s: None,
+        calibration: Calibration::default(),
     }
 }
 
@@ -242,7 +238,7 @@ impl Navigator for ParticleTracker {
                 let (x, p) = pf.mean_covariance_with_angle(Some(idx::PSI));
                 let (v, c) = (x.fixed_rows::<DIM>(0).into_owned(), p.fixed_view::<DIM, DIM>(0, 0).into_owned());
                 let mut e = estimate_of(self.t_s, &v, &c, (v[idx::PSI], c[(idx::PSI, idx::PSI)]));
-                e.usbl_misalignment_rad = x.as_slice().get(idx::MISALIGNMENT).copied();
+                e.calibration.usbl_misalignment_rad = x.as_slice().get(idx::MISALIGNMENT).copied();
                 e
             })
         })
@@ -424,11 +420,11 @@ mod tests {
             }
         }
         let e = pf.estimate();
-        let found = e.usbl_misalignment_rad.expect("a misalignment state");
+        let found = e.calibration.usbl_misalignment_rad.expect("a misalignment state");
         let err = (e.position_ned_m - truth.fixed_rows::<3>(0)).xy().norm();
         assert!((found - misaligned).abs() < 0.25f64.to_radians(), "{} deg", found.to_degrees());
         assert!(err < 0.5, "{err} m");
-        assert_eq!(aligned.estimate().usbl_misalignment_rad, None, "no state: absent, not zero");
+        assert_eq!(aligned.estimate().calibration.usbl_misalignment_rad, None, "no state: absent, not zero");
     }
 
     /// With no message for 12 s, both trackers move their estimate on along the believed

@@ -221,12 +221,7 @@ mod tests {
                 heading_var_rad2: 0.01,
                 roll_pitch_rad: [0.0; 2],
                 speed_m_s: Some(1.5),
-                range_bias_m: None,
-                range_scale: None,
-                distance_scale: None,
-                turn_scale: None,
-                usbl_misalignment_rad: None,
-                current_ned_m_s: None,
+                calibration: crate::nav::Calibration::default(),
             }
         }
         fn beacon_relative(&self) -> Option<&dyn crate::nav::capability::BeaconRelative> {
