@@ -381,7 +381,19 @@ def test_the_navigators_memory_budget_refuses_before_any_filter(monkeypatch, tmp
         onebeacon.Navigator(PLAZA)
 
 
-def test_ctrl_c_stops_mc_and_raises_keyboard_interrupt():
+@pytest.fixture
+def sigint():
+    """Python's own Ctrl-C handler for the test: a process started in the background
+    of a shell inherits SIGINT ignored, and `_thread.interrupt_main` then does nothing
+    (the test would wait for 100000 runs)."""
+    import signal
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_ctrl_c_stops_mc_and_raises_keyboard_interrupt(sigint):
     import _thread
 
     long = dict(SHORT, mission={"duration_s": 1500.0})
@@ -414,7 +426,7 @@ def long_log(tmp_path, rows):
 
 
 @pytest.mark.parametrize("call", ["replay", "smooth"])
-def test_ctrl_c_during_a_log_raises_keyboard_interrupt(tmp_path, call):
+def test_ctrl_c_during_a_log_raises_keyboard_interrupt(tmp_path, call, sigint):
     # cfb7f93 ignored Ctrl-C here, then raised a PanicException after the whole work
     import _thread
 
