@@ -201,10 +201,12 @@ impl Factor {
             }
             Factor::Range { at, beacon, dz_m, range_m, sigma, cal, t_rel_s } => {
                 let r = range(at, *beacon, *dz_m, cal, x);
-                ([(r.predicted + r.drift * t_rel_s - range_m) / sigma, 0.0, 0.0], 1)
+                ([(r.predicted() + r.drift * t_rel_s - range_m) / sigma, 0.0, 0.0], 1)
             }
             Factor::Doppler { at, beacon, dz_m, speed_m_s, sigma } => match closing_speed(at, *beacon, *dz_m, x) {
-                Some((radial, _)) => ([(radial - speed_m_s) / sigma, 0.0, 0.0], 1),
+                Some((model, state)) => {
+                    ([(ScalarModel::<4>::predict(&model, &state) - speed_m_s) / sigma, 0.0, 0.0], 1)
+                }
                 None => ([0.0; 3], 1),
             },
             Factor::Bearing { at, station, station_heading_rad, depth_m, az_el, sigma } => {
@@ -241,7 +243,7 @@ impl Factor {
     pub(crate) fn range_slant(&self, x: &[f64]) -> Option<(f64, f64, f64)> {
         let Factor::Range { at, beacon, dz_m, range_m, sigma, .. } = self else { return None };
         let (_, _, local) = self.local(x);
-        let slant = range(at, *beacon, *dz_m, &CalVars::default(), &local).predicted;
+        let slant = range(at, *beacon, *dz_m, &CalVars::default(), &local).predicted();
         Some((slant, *range_m, *sigma))
     }
 
@@ -293,14 +295,14 @@ impl Factor {
                 }
             }
             Factor::Range { at, beacon, dz_m, sigma, cal, t_rel_s, .. } => {
-                let r = range(at, *beacon, *dz_m, cal, x);
+                let (gradient, d_scale) = range(at, *beacon, *dz_m, cal, x).gradient(at);
                 let mut i = at.positions();
-                for (c, gc) in r.gradient.iter().enumerate().take(i) {
+                for (c, gc) in gradient.iter().enumerate().take(i) {
                     j[0][c] = gc / sigma;
                 }
                 // d/d offset: 1; d/d drift: t
                 let d_cal =
-                    [(cal.scale.is_some(), r.d_scale), (cal.offset.is_some(), 1.0), (cal.drift.is_some(), *t_rel_s)];
+                    [(cal.scale.is_some(), d_scale), (cal.offset.is_some(), 1.0), (cal.drift.is_some(), *t_rel_s)];
                 for (on, d) in d_cal {
                     if on {
                         j[0][i] = d / sigma;
@@ -309,8 +311,8 @@ impl Factor {
                 }
             }
             Factor::Doppler { at, beacon, dz_m, sigma, .. } => {
-                if let Some((_, g)) = closing_speed(at, *beacon, *dz_m, x) {
-                    for (c, gc) in g.iter().enumerate() {
+                if let Some((model, state)) = closing_speed(at, *beacon, *dz_m, x) {
+                    for (c, gc) in closing_speed_gradient(at, &model, &state).iter().enumerate() {
                         j[0][c] = gc / sigma;
                     }
                 }
@@ -379,20 +381,31 @@ fn through_position(at: &At, h: [f64; 2]) -> [f64; MAX_VARS] {
     g
 }
 
-/// A range factor's reading of the filters' range model.
+/// A range factor's reading of the filters' [`SlantRange`] at its local values: the
+/// model at the state (position, scale error s - 1, offset; the scale and offset the
+/// estimated variables or their nominal 1 and 0), and the offset's drift read (0 when
+/// not estimated).
 struct RangeReading {
-    /// s |p - b| + offset, the scale and offset the estimated variables or their
-    /// nominal 1 and 0.
-    predicted: f64,
-    /// Its gradient over the local position variables.
-    gradient: [f64; MAX_VARS],
-    /// Its derivative in the scale (the slant).
-    d_scale: f64,
-    /// The offset's drift read (0 when not estimated).
+    model: SlantRange,
+    state: SVector<f64, 4>,
     drift: f64,
 }
 
-/// A range factor's reading of the filters' [`SlantRange`] at the local values `x`.
+impl RangeReading {
+    /// s |p - b| + offset.
+    fn predicted(&self) -> f64 {
+        ScalarModel::<4>::predict(&self.model, &self.state)
+    }
+
+    /// Its gradient over the local position variables, and its derivative in the scale
+    /// (the slant).
+    fn gradient(&self, at: &At) -> ([f64; MAX_VARS], f64) {
+        let h = ScalarModel::<4>::jacobian(&self.model, &self.state);
+        (through_position(at, [h[0], h[1]]), h[2])
+    }
+}
+
+/// A range factor's reading at the local values `x`.
 fn range(at: &At, beacon: [f64; 2], dz_m: f64, cal: &CalVars, x: &[f64]) -> RangeReading {
     let mut i = at.positions();
     let mut take = |on: bool, nominal: f64| {
@@ -414,17 +427,13 @@ fn range(at: &At, beacon: [f64; 2], dz_m: f64, cal: &CalVars, x: &[f64]) -> Rang
         scale: Some(2),
         var: 1.0,
     };
-    let state = SVector::<f64, 4>::from([p[0], p[1], s - 1.0, b]);
-    let h = ScalarModel::<4>::jacobian(&model, &state);
-    let predicted = ScalarModel::<4>::predict(&model, &state);
-    RangeReading { predicted, gradient: through_position(at, [h[0], h[1]]), d_scale: h[2], drift }
+    RangeReading { model, state: SVector::<f64, 4>::from([p[0], p[1], s - 1.0, b]), drift }
 }
 
 /// A Doppler factor's reading of the filters' [`LineOfSightSpeed`] at the local values
-/// `x`: the closing speed at the interpolated position with the interval's velocity (a
-/// track node's own), and its gradient over the local variables; None for a pose
-/// without a later node (no velocity).
-fn closing_speed(at: &At, beacon: [f64; 2], dz_m: f64, x: &[f64]) -> Option<(f64, [f64; MAX_VARS])> {
+/// `x`: the model at the interpolated position with the interval's velocity (a track
+/// node's own); None for a pose without a later node (no velocity).
+fn closing_speed(at: &At, beacon: [f64; 2], dz_m: f64, x: &[f64]) -> Option<(LineOfSightSpeed, SVector<f64, 4>)> {
     let np = at.positions();
     let v = match (at.node, at.next) {
         (Node::Track, _) => [x[np], x[np + 1]],
@@ -433,9 +442,15 @@ fn closing_speed(at: &At, beacon: [f64; 2], dz_m: f64, x: &[f64]) -> Option<(f64
     };
     let p = position(at, x);
     let model = LineOfSightSpeed { beacon: Vector3::new(beacon[0], beacon[1], 0.0), depth_m: dz_m, var: 1.0 };
-    let state = SVector::<f64, 4>::from([p[0], p[1], v[0], v[1]]);
-    let h = ScalarModel::<4>::jacobian(&model, &state);
+    Some((model, SVector::<f64, 4>::from([p[0], p[1], v[0], v[1]])))
+}
+
+/// The closing speed's gradient over the local variables, through the interpolated
+/// position and the velocity ([`closing_speed`]).
+fn closing_speed_gradient(at: &At, model: &LineOfSightSpeed, state: &SVector<f64, 4>) -> [f64; MAX_VARS] {
+    let h = ScalarModel::<4>::jacobian(model, state);
     let mut g = through_position(at, [h[0], h[1]]);
+    let np = at.positions();
     match at.node {
         Node::Track => (g[np], g[np + 1]) = (h[2], h[3]),
         Node::Pose => {
@@ -444,7 +459,7 @@ fn closing_speed(at: &At, beacon: [f64; 2], dz_m: f64, x: &[f64]) -> Option<(f64
             (g[0], g[1], g[2], g[3]) = (g[0] - gn, g[1] - ge, g[2] + gn, g[3] + ge);
         }
     }
-    Some((ScalarModel::<4>::predict(&model, &state), g))
+    g
 }
 
 #[cfg(test)]

@@ -216,7 +216,7 @@ pub struct Calibration {
 
 impl Calibration {
     /// The states estimated, as output keys (those not estimated left out).
-    pub fn keys(&self) -> Vec<(&'static str, f64)> {
+    pub fn keys(&self) -> impl Iterator<Item = (&'static str, f64)> + use<> {
         let current = self.current_ned_m_s;
         [
             ("range_bias_m", self.range_bias_m),
@@ -229,7 +229,6 @@ impl Calibration {
         ]
         .into_iter()
         .filter_map(|(k, v)| Some((k, v?)))
-        .collect()
     }
 }
 
