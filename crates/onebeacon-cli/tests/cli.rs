@@ -432,7 +432,10 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["fly"], &["fly"]),
         (vec!["run", &escape], &["escape.toml", "name", "a name, not a path"]),
         (vec!["run", &huge, "--out", out], &["huge.toml", "100000000 steps", "GB"]),
-        (vec!["run", &estimator, "--out", out], &["est.toml", "estimators[0].distance_sigma_frac", "applies to: log"]),
+        (
+            vec!["run", &estimator, "--out", out],
+            &["est.toml", "estimators[0].distance_sigma_frac", "applies to: log or planar stream"],
+        ),
         (vec!["run", "hoff2024", "--message", "0", "--out", out], &["--message 0", "messages 1 to 900"]),
     ];
     for (args, needles) in cases {

@@ -7,9 +7,12 @@
 //! - [`pcrb`]: the posterior Cramer-Rao bound of the range-only moving-beacon case;
 //! - [`scenario`]: the TOML scenario schema, its validation and the built-in scenarios;
 //! - [`engine`](crate::engine): the one simulation loop, its worlds and its observers;
-//! - `factory`: every estimator spec to its navigator, the one place that builds them;
-//! - `helms`: each scenario's onboard controllers (the vehicles' decisions are the
-//!   onboard crate's [`onebeacon::vehicle`]; the worlds move the truth under them);
+//! - `computers`: each vehicle's computer in a world as the stream configuration a
+//!   vehicle reads, the one description the engine's tracks and helms and
+//!   `run --messages` come from (the vehicles' decisions are the onboard crate's
+//!   [`onebeacon::vehicle`]; the worlds move the truth under them);
+//! - `factory`: where each vehicle's estimators start in a run, and the navigators no
+//!   stream configuration describes (garin2024's fixed-beacon filters, a receiver);
 //! - [`run`]: one simulated run, a pure function of (scenario, sweep cell, seed, run);
 //! - [`metrics`]: per-run error statistics and their Monte Carlo aggregation;
 //! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count;
@@ -21,10 +24,10 @@
 pub mod acoustics;
 pub mod budget;
 pub mod chain;
+mod computers;
 mod engine;
 mod factory;
 pub mod fleet;
-mod helms;
 mod information;
 pub mod input_file;
 pub mod json;

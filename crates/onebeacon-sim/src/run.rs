@@ -3,13 +3,15 @@
 //! paired comparison), scored and recorded by observers. A pure function of (scenario,
 //! cell, seed, run index).
 
-use crate::engine::{self, Helm, Observer, Step, Track, VehicleTruth, World};
+use crate::computers::{self, OnBoard};
+use crate::engine::{self, Observer, Step, Track, VehicleTruth, World};
+use crate::factory;
 use crate::information::{Information, bearing_information, range_information};
-use crate::messages::{Computer, Messages, fleet_computers, moving_beacon_computer, passive_usbl_computer};
+use crate::messages::{Computer, Messages};
 use crate::metrics::RunMetrics;
+use crate::scenario::fleet::SignalModel;
 use crate::scenario::{Cell, Scenario};
 use crate::world::{FixedBeaconWorld, FleetWorld, MovingBeaconWorld, PassiveUsblWorld};
-use crate::{factory, helms};
 use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::nav::diagnosis::PerBeacon;
 use onebeacon::nav::evaluation::{ErrorStats, horizontal_error};
@@ -195,68 +197,76 @@ fn simulate_recording(
         (Scenario::FixedBeacon(s), Cell::FixedBeacon(c)) => {
             let mut world = FixedBeaconWorld::new(s, c, seed, run);
             let mut tracks = factory::fixed_beacon(s, world.unicycle_state(), seed, run);
-            (drive(&mut world, &mut tracks, &mut [], vec![], recorder), None)
+            drive(&mut world, &mut tracks, &[], Vec::new(), recorder, false)
         }
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
-            let asv0 = helms::initial_asv_position(s, c);
+            let asv0 = factory::initial_asv_position(s, c);
             let mut world = MovingBeaconWorld::new(s, c, asv0, seed, run);
             let starts = factory::moving_beacon_starts(s, &world.states(), seed, run);
-            let mut tracks = factory::moving_beacon(s, &starts);
-            let mut helms = helms::moving_beacon(s, c, asv0);
+            let on_board = computers::moving_beacon(s, c, asv0, &starts);
+            let mut tracks = computers::tracks(&on_board);
             let mut info = Information::new(range_information(s.sensor_noise()));
-            let computers = messages.then(|| vec![moving_beacon_computer(s, c, asv0, &starts[0])]);
-            let mut m = computers.map(|c| Messages::new(c, helms.iter().map(|h| h.serves.clone()).collect()));
-            let mut extra: Vec<&mut dyn Observer> = vec![&mut info];
-            extra.extend(m.as_mut().map(|m| m as &mut dyn Observer));
-            let mut out = drive(&mut world, &mut tracks, &mut helms, extra, recorder);
+            let extra: Vec<&mut dyn Observer> = vec![&mut info];
+            let (mut out, m) = drive(&mut world, &mut tracks, &on_board, extra, recorder, messages);
             out.information = info.into_inner();
-            (out, m.map(Messages::into_inner))
+            (out, m)
         }
         (Scenario::PassiveUsbl(s), Cell::PassiveUsbl(c)) => {
             let mut world = PassiveUsblWorld::new(s, seed, run);
             let starts = factory::tracker_starts(s, &world.initial_states(), seed, run);
-            let mut tracks = factory::passive_usbl(s, &starts);
-            let mut helms = helms::passive_usbl(s, c, world.asv_start());
+            let on_board = vec![computers::passive_usbl(s, c, world.asv_start(), &starts)];
+            let mut tracks = computers::tracks(&on_board);
             let mut info = Information::new(bearing_information(s.tracker_noise()));
-            let computers = messages.then(|| vec![passive_usbl_computer(s, c, world.asv_start(), &starts)]);
-            let mut m = computers.map(|c| Messages::new(c, helms.iter().map(|h| h.serves.clone()).collect()));
-            let mut extra: Vec<&mut dyn Observer> = vec![&mut info];
-            extra.extend(m.as_mut().map(|m| m as &mut dyn Observer));
-            let mut out = drive(&mut world, &mut tracks, &mut helms, extra, recorder);
+            let extra: Vec<&mut dyn Observer> = vec![&mut info];
+            let (mut out, m) = drive(&mut world, &mut tracks, &on_board, extra, recorder, messages);
             out.information = info.into_inner();
-            (out, m.map(Messages::into_inner))
+            (out, m)
         }
         (Scenario::Fleet(s), Cell::Fleet) => {
             let mut world = FleetWorld::new(s, seed, run);
-            let mut tracks = factory::fleet(s, seed, run);
-            let mut helms = helms::fleet(s);
-            let computers = messages.then(|| fleet_computers(s, seed, run)).flatten();
-            let mut m = computers.map(|c| Messages::new(c, helms.iter().map(|h| h.serves.clone()).collect()));
-            let extra = m.as_mut().map(|m| m as &mut dyn Observer).into_iter().collect();
-            let out = drive(&mut world, &mut tracks, &mut helms, extra, recorder);
-            (out, m.map(Messages::into_inner))
+            let on_board = computers::fleet(s, &factory::fleet_seeds(s, seed, run));
+            let build = factory::fleet_builder(s);
+            let mut tracks: Vec<Track> = on_board.iter().flat_map(|c| c.tracks(&build)).collect();
+            // the channel model's captures are not JSON lines
+            let messages = messages && s.signal.model != SignalModel::Channel;
+            drive(&mut world, &mut tracks, &on_board, Vec::new(), recorder, messages)
         }
         _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),
     }
 }
 
-/// Runs the engine with the scoring and recording observers (and `extra`).
+/// Runs the engine on `tracks` and the helms of the vehicles' `computers`, with the
+/// scoring and recording observers (and `extra`); with what each computer with a
+/// controller heard and decided when `messages`.
 fn drive(
     world: &mut dyn World,
     tracks: &mut [Track],
-    helms: &mut [Helm],
+    computers: &[OnBoard],
     extra: Vec<&mut dyn Observer>,
     mut recorder: Recorder,
-) -> RunOutput {
+    messages: bool,
+) -> (RunOutput, Option<Vec<Computer>>) {
     let mut scoring = Scoring::new(tracks.iter().map(|t| t.vehicle).collect(), world.steps());
+    let mut helms = computers::helms(computers);
+    let mut m = messages.then(|| {
+        let with_helm = computers.iter().filter(|c| c.config.controller.is_some());
+        Messages::new(
+            with_helm.map(crate::messages::computer).collect(),
+            helms.iter().map(|h| h.serves.clone()).collect(),
+        )
+    });
     {
         let mut observers: Vec<&mut dyn Observer> = vec![&mut scoring, &mut recorder];
+        // each pushed reborrowed, for as long as the run
         for o in extra {
             observers.push(o);
         }
-        engine::run(world, tracks, helms, &mut observers);
+        if let Some(m) = m.as_mut() {
+            observers.push(m);
+        }
+        engine::run(world, tracks, &mut helms, &mut observers);
     }
-    RunOutput {
+    let out = RunOutput {
         metrics: scoring
             .acc
             .iter()
@@ -271,7 +281,8 @@ fn drive(
         information: Vec::new(),
         guidance: recorder.guidance,
         belief: recorder.belief,
-    }
+    };
+    (out, m.map(Messages::into_inner))
 }
 
 /// The beacons whose innovations a run counts apart, per track.

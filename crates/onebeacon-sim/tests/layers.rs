@@ -5,8 +5,8 @@
 //! - truth (`vehicles`, `acoustics`, `sensors`) names no configuration, world, engine,
 //!   record or evaluation: only truth and the seeded random streams;
 //! - the worlds name no vehicle's mind: not `onebeacon::guidance`, nor the controllers
-//!   and behaviours of `onebeacon::vehicle`, nor the simulator's `helms` that build them;
-//!   and build no navigator (the simulator's `factory` does);
+//!   and behaviours of `onebeacon::vehicle`, nor the simulator's `computers` that
+//!   describe them; and build no navigator (the simulator's `computers` and `factory` do);
 //! - the engine names no world, record, configuration or controller factory;
 //! - within each crate the top-level modules import each other without a cycle.
 //!
@@ -305,7 +305,7 @@ const SIM_RULES: &[Rule] = &[
             "crate::world",
             "crate::engine",
             "crate::run",
-            "crate::helms",
+            "crate::computers",
             "crate::metrics",
             "crate::montecarlo",
             "crate::chain",
@@ -317,6 +317,7 @@ const SIM_RULES: &[Rule] = &[
         within: &["world"],
         forbidden: &[
             "crate::factory",
+            "crate::computers",
             "onebeacon::nav::GaussianTracker",
             "onebeacon::nav::IusblNavigator",
             "onebeacon::nav::ParticleTracker",
@@ -339,13 +340,13 @@ const SIM_RULES: &[Rule] = &[
             "onebeacon::vehicle::behaviours",
             "onebeacon::vehicle::bearing",
             "onebeacon::vehicle::fim",
-            "crate::helms",
+            "crate::computers",
         ],
     },
     Rule {
         name: "the engine imports a world, records, configuration or controllers",
         within: &["engine"],
-        forbidden: &["crate::world", "crate::run", "crate::scenario", "crate::helms", "onebeacon::guidance"],
+        forbidden: &["crate::world", "crate::run", "crate::scenario", "crate::computers", "onebeacon::guidance"],
     },
 ];
 

@@ -81,12 +81,14 @@ pub enum Host {
 }
 
 impl Host {
+    /// How a refusal names the host: a planar stream's estimators take a log's keys, a
+    /// 6-DOF stream's (`model = "6dof"`) a moving_beacon world's.
     pub fn label(self) -> &'static str {
         match self {
             Host::FixedBeacon => "fixed_beacon world",
-            Host::MovingBeacon => "moving_beacon world",
+            Host::MovingBeacon => "moving_beacon world or 6-DOF stream",
             Host::PassiveUsbl => "passive_usbl world",
-            Host::Log => "log",
+            Host::Log => "log or planar stream",
         }
     }
 

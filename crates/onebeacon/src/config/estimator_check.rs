@@ -272,16 +272,16 @@ mod tests {
 
         assert_eq!(
             error("kind = \"pf\"\nrange_sigma_m = 3.0", Host::PassiveUsbl),
-            "estimators[0].range_sigma_m = 3.0: does not apply to a passive_usbl world (it applies to: fixed_beacon world, moving_beacon world, log)"
+            "estimators[0].range_sigma_m = 3.0: does not apply to a passive_usbl world (it applies to: fixed_beacon world, moving_beacon world or 6-DOF stream, log or planar stream)"
         );
         assert_eq!(
             error("kind = \"range+doppler\"", Host::MovingBeacon),
-            "estimators[0].kind = \"range+doppler\": uses Doppler speeds; a moving_beacon world gives ranges only"
+            "estimators[0].kind = \"range+doppler\": uses Doppler speeds; a moving_beacon world or 6-DOF stream gives ranges only"
         );
         assert!(error("kind = \"rosb\"\nq_diag = [1, 1, 1, 1, -1, 1]", Host::FixedBeacon).contains(">= 0"));
         assert_eq!(
             error("kind = \"rosb\"\nestimate_bias_drift = true", Host::Log),
-            "estimators[0].estimate_bias_drift = true: does not apply to a log (it applies to: fixed_beacon world, moving_beacon world)"
+            "estimators[0].estimate_bias_drift = true: does not apply to a log or planar stream (it applies to: fixed_beacon world, moving_beacon world or 6-DOF stream)"
         );
         assert_eq!(
             error("kind = \"range-ekf\"\nestimate_bias_drift = true\nrobust = \"huber\"", Host::MovingBeacon),
