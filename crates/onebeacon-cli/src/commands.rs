@@ -51,13 +51,12 @@ pub fn run(
     crate::check_memory(name, &s, 1, 1)?;
     let seed = seed.unwrap_or(s.seed());
     let streamable = match &s {
-        Scenario::PassiveUsbl(_) | Scenario::MovingBeacon(_) => true,
         Scenario::Fleet(f) => f.signal.model == onebeacon_sim::scenario::fleet::SignalModel::Abstract,
-        Scenario::FixedBeacon(_) => false,
+        _ => true,
     };
     if messages && !streamable {
         return Err(BadInput(format!(
-            "--messages: {}: the vehicles' computers that `stream` runs are a passive_usbl or moving_beacon world's surface vehicle and a fleet's AUVs with signal.model = \"abstract\" (a fixed_beacon world's vehicle has no controller)",
+            "--messages: {}: a fleet's AUVs are streamed with signal.model = \"abstract\" (the channel model's captures are not JSON lines)",
             s.name()
         ))
         .into());

@@ -182,13 +182,60 @@ fn the_stream_gives_the_simulated_auvs_modes_and_commands() {
     }
 }
 
-/// A scenario whose vehicles' computers the stream cannot run is refused by its name.
+/// garin2024's AUV (200 s of it; no controller): fed what it heard, the stream's
+/// estimators (`model = "unicycle"`, built from the configuration the simulator built
+/// its own from) give the simulator's estimates: at every step's last line each
+/// estimator's position is the one trajectory.csv gives, to the file's 4 decimals.
+#[test]
+fn the_stream_gives_the_simulated_auvs_estimates() {
+    let dir = scratch("garin");
+    let scenario = edited(&dir, "garin2024", &[("# duration_s", "duration_s = 200")]);
+    let run = run_messages(&scenario, &dir);
+    let config = std::fs::read_to_string(run.join("auv.stream.toml")).unwrap();
+    assert!(config.contains("model = \"unicycle\"") && !config.contains("[controller]"), "{config}");
+    let (lines, stderr) = stream_lines(&run, "auv");
+    assert!(stderr.is_empty(), "{stderr}");
+    let csv = std::fs::read_to_string(run.join("trajectory.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    // each step's time (to the file's 2 decimals) to its row
+    let rows: std::collections::BTreeMap<i64, Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect();
+            ((c[0] * 100.0).round() as i64, c)
+        })
+        .collect();
+    // the last line at each time
+    let mut last = std::collections::BTreeMap::new();
+    for l in &lines {
+        last.insert((l["t_s"].as_f64().unwrap() * 100.0).round() as i64, l);
+    }
+    let mut compared = 0;
+    for (t, l) in &last {
+        let Some(row) = rows.get(t) else { continue };
+        for e in l["estimates"].as_array().unwrap() {
+            let name = e["name"].as_str().unwrap();
+            let (n, east) = (row[column(&format!("{name}_north_m"))], row[column(&format!("{name}_east_m"))]);
+            let off = (e["x_m"].as_f64().unwrap() - n).abs().max((e["y_m"].as_f64().unwrap() - east).abs());
+            // half the last decimal, and a rounding of the value itself
+            assert!(off <= 0.5e-4 + 1e-9, "at {} s the stream's {name} is {off} m off", l["t_s"]);
+            compared += 1;
+        }
+    }
+    // 4 estimators at 4 steps a second for 200 s, less the steps without a line
+    assert!(compared > 4 * 700, "{compared} estimates compared");
+}
+
+/// A fleet on the channel model, whose captures are not JSON lines, is refused by its
+/// name.
 #[test]
 fn messages_of_a_world_without_a_streamable_computer_are_refused() {
-    let o = bin().args(["run", "garin2024", "--messages", "--out", "/nonexistent/x"]).output().unwrap();
+    let o = bin().args(["run", "rypkema-m1", "--messages", "--out", "/nonexistent/x"]).output().unwrap();
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("--messages: garin2024") && e.contains("moving_beacon"), "{e}");
+    assert!(e.contains("--messages: rypkema-m1") && e.contains("signal.model = \"abstract\""), "{e}");
 }
 
 /// `stream` and its memory budget: hoff2024's surface vehicle with 2e6 particles in its

@@ -2,7 +2,8 @@
 //! vehicle reads (`onebeacon stream CONFIG`: estimators, controller, where each vehicle
 //! it estimates starts), with the run's exact starts. The engine's tracks and helms are
 //! built from it ([`OnBoard::tracks`], [`OnBoard::helm`]) and `run --messages` writes
-//! it ([`crate::messages`]): a passive-USBL world's surface vehicle (tracking every AUV,
+//! it ([`crate::messages`]): a fixed-beacon world's AUV (garin2024's filters, no
+//! controller), a passive-USBL world's surface vehicle (tracking every AUV,
 //! its bearing planner), a moving-beacon world's beacon vehicle (the estimators of the
 //! vehicle it serves, its FIM guidance) and the vehicles it does not serve, each fleet
 //! AUV (its iUSBL navigators and dead reckoning, its behaviours).
@@ -12,7 +13,9 @@ use crate::scenario::estimator::IusblKeys;
 use crate::scenario::fleet::{Fleet, Navigation};
 use crate::scenario::moving_beacon::GuidanceKind as FimKind;
 use crate::scenario::passive_usbl::GuidanceKind as BearingKind;
-use crate::scenario::{EstimatorKind, EstimatorSpec, MovingBeacon, MovingBeaconCell, PassiveUsbl, PassiveUsblCell};
+use crate::scenario::{
+    EstimatorKind, EstimatorSpec, FixedBeacon, MovingBeacon, MovingBeaconCell, PassiveUsbl, PassiveUsblCell,
+};
 use crate::vehicles::sandshark::SandSharkParams;
 use nalgebra::Vector2;
 use onebeacon::config::builder::{TrackerStart, VehicleModel};
@@ -23,6 +26,7 @@ use onebeacon::config::stream::{FrameKey, Initial, InitialFrom, StreamConfig};
 use onebeacon::geo::Frame;
 use onebeacon::models::hoff::idx;
 use onebeacon::models::kinematic6dof::State as Eta;
+use onebeacon::models::unicycle::State as UnicycleState;
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
 
@@ -117,6 +121,43 @@ fn given((x_m, y_m, heading_rad): (f64, f64, f64), (position_sigma_m, heading_si
     }
 }
 
+/// The AUV's computer of a fixed-beacon run: garin2024's filters (`model =
+/// "unicycle"`), no controller, started at `z0` (the truth plus one draw,
+/// [`crate::factory::fixed_beacon_start`]) with the scenario's standard deviations.
+pub(crate) fn fixed_beacon(s: &FixedBeacon, z0: &UnicycleState) -> OnBoard {
+    let i = &s.initial;
+    let start = Start {
+        vehicle: 0,
+        pose: (z0[0], z0[1], z0[2]),
+        sigmas: (i.position_sigma_m, i.heading_sigma_deg.to_radians()),
+        tracker: TrackerStart {
+            state: [0.0, 0.0, z0[3], 0.0, 0.0],
+            sigma: [0.0, 0.0, i.speed_sigma_m_s, 0.0],
+            yaw_rate_accel: [z0[4], z0[5]],
+            yaw_rate_accel_sigma: [i.yaw_rate_sigma_rad_s, i.accel_sigma_m_s2],
+            ..TrackerStart::default()
+        },
+    };
+    let initial = Initial {
+        speed_m_s: z0[3],
+        yaw_rate_deg_s: z0[4].to_degrees(),
+        accel_m_s2: z0[5],
+        heading_sigma_deg: i.heading_sigma_deg,
+        speed_sigma_m_s: i.speed_sigma_m_s,
+        yaw_rate_sigma_deg_s: i.yaw_rate_sigma_rad_s.to_degrees(),
+        accel_sigma_m_s2: i.accel_sigma_m_s2,
+        ..given(start.pose, start.sigmas)
+    };
+    let description = format!("The AUV's computer of a simulated {} run", s.name);
+    let config = StreamConfig {
+        name: "auv".into(),
+        initial,
+        model: VehicleModel::Unicycle,
+        ..config(description, s.estimators.clone(), None)
+    };
+    OnBoard { name: "auv".into(), config, starts: vec![start] }
+}
+
 /// Each estimator of a passive-USBL scenario as the surface vehicle's stream
 /// configuration describes it: the scenario's, with the world's noise (which the
 /// trackers assume unless told otherwise) written out.
@@ -188,9 +229,9 @@ pub(crate) fn passive_usbl(
             tracker: TrackerStart {
                 state: [x0[idx::Z], x0[idx::THETA], x0[idx::U], x0[idx::B_THETA], x0[idx::B_PSI]],
                 sigma: [sigma0[idx::Z], sigma0[idx::THETA], sigma0[idx::U], sigma0[idx::B_THETA]],
-                roll_rad: 0.0,
                 // the seed's 64 bits as TOML's signed integer
                 seed: Some(seed as i64),
+                ..TrackerStart::default()
             },
         })
         .collect();
@@ -291,7 +332,7 @@ pub(crate) fn moving_beacon(
                     state: [eta0[2], eta0[4], 0.0, 0.0, 0.0],
                     sigma: [i.depth_sigma_m, a0, 0.0, 0.0],
                     roll_rad: eta0[3],
-                    seed: None,
+                    ..TrackerStart::default()
                 },
             };
             let initial = Initial {
@@ -415,7 +456,7 @@ pub(crate) fn fleet(s: &Fleet, seeds: &[Vec<u64>]) -> Vec<OnBoard> {
                 vehicle: v,
                 pose: (a.start_north_m, a.start_east_m, a.start_heading_deg.to_radians()),
                 sigmas: (1.0, 0.05),
-                tracker: TrackerStart { state: [0.0; 5], sigma: [0.0; 4], roll_rad: 0.0, seed: None },
+                tracker: TrackerStart::default(),
             };
             let description = format!("{}'s computer in a simulated {} run (onebeacon run --messages)", a.name, s.name);
             let config = StreamConfig {

@@ -1,14 +1,12 @@
-//! Where each vehicle's estimators start in a run, and the tracks no stream
+//! Where each vehicle's estimators start in a run, and the one navigator no stream
 //! configuration describes. Each vehicle's estimators start at its truth plus one draw
 //! from the run's seeded initial stream (the same draw for all of them), so comparisons
 //! are paired. A world gives its vehicles' initial truth; the vehicles' computers
-//! ([`crate::computers`]) start from these draws. The fixed-beacon world's AUV runs
-//! garin2024's filters, built here; a fleet with the channel model gives its iUSBL
-//! navigators their receiver.
+//! ([`crate::computers`]) start from these draws. A fleet with the channel model gives
+//! its iUSBL navigators their receiver, which no stream configuration describes.
 
-use crate::engine::Track;
 use crate::scenario::fleet::{Fleet, SignalModel};
-use crate::scenario::{EstimatorKind, EstimatorSpec, FixedBeacon, Host, MovingBeacon, MovingBeaconCell, PassiveUsbl};
+use crate::scenario::{EstimatorKind, EstimatorSpec, FixedBeacon, MovingBeacon, MovingBeaconCell, PassiveUsbl};
 use crate::seed::{Stream, gauss, rng, vehicle_rng};
 use nalgebra::{SVector, Vector2};
 use onebeacon::config::builder::{TrackerStart, VehicleModel};
@@ -19,15 +17,15 @@ use onebeacon::geo::wrap_angle;
 use onebeacon::guidance::{PolarGrid, best_standoff};
 use onebeacon::models::hoff::{DIM, idx};
 use onebeacon::models::kinematic6dof::State as Eta;
-use onebeacon::models::unicycle::{Cov, State};
+use onebeacon::models::unicycle::State;
+use onebeacon::nav::IusblNavigator;
 use onebeacon::nav::restart::Builder;
 use onebeacon::nav::usbl_track::TrackState;
-use onebeacon::nav::{IusblNavigator, single_beacon};
 use rand::RngExt;
 
-/// Every estimator of a fixed-beacon scenario on its AUV, started at the truth `z_true`
-/// plus one draw (the same for all).
-pub(crate) fn fixed_beacon(s: &FixedBeacon, z_true: State, seed: u64, run: u64) -> Vec<Track> {
+/// Where a fixed-beacon scenario's estimators start: the AUV's truth `z_true` plus one
+/// draw of the scenario's initial standard deviations (the same for all estimators).
+pub(crate) fn fixed_beacon_start(s: &FixedBeacon, z_true: State, seed: u64, run: u64) -> State {
     let i = &s.initial;
     let sigma0 = SVector::<f64, 6>::from([
         i.position_sigma_m,
@@ -38,29 +36,7 @@ pub(crate) fn fixed_beacon(s: &FixedBeacon, z_true: State, seed: u64, run: u64) 
         i.accel_sigma_m_s2,
     ]);
     let mut init_rng = rng(seed, run, Stream::Initial);
-    let z0 = z_true + sigma0.map(|sd| gauss(&mut init_rng, sd));
-    let p0 = Cov::from_diagonal(&sigma0.component_mul(&sigma0));
-    let pose = (z0[0], z0[1], z0[2]);
-    s.estimators
-        .iter()
-        .map(|e| {
-            let (aiding, tuning, filter) = (e.aiding(Host::FixedBeacon), e.ekf_tuning(), e.filter_kind());
-            let (gate, robust) = e.gate();
-            let guards = single_beacon::Guards {
-                min_speed_m_s: e.min_speed_m_s,
-                mirror: e.mirror_recovery.unwrap_or(true),
-                gate,
-                robust,
-            };
-            let calibration = e.range_calibration();
-            let builder: Builder = Box::new(move |t0, (north, east, heading), _, _| {
-                let mut z = z0;
-                (z[0], z[1], z[2]) = (north, east, heading);
-                single_beacon::boxed(aiding, tuning, filter, t0, (z, p0), calibration, guards)
-            });
-            Track::new(0, builder, pose, (i.position_sigma_m, sigma0[2]))
-        })
-        .collect()
+    z_true + sigma0.map(|sd| gauss(&mut init_rng, sd))
 }
 
 /// Where a moving-beacon scenario's estimators of each vehicle start: its truth

@@ -1,7 +1,8 @@
 //! What each vehicle's computer heard and decided in a simulated run, as `onebeacon
-//! stream` reads and writes it: per computer with a controller (a passive-USBL world's
-//! surface vehicle, a moving-beacon world's beacon vehicle, each fleet AUV), its stream
-//! configuration ([`crate::computers`]), its JSON Lines input (its own fixes, the beacon
+//! stream` reads and writes it: per computer (a fixed-beacon world's AUV, a
+//! passive-USBL world's surface vehicle, a moving-beacon world's beacon vehicle and
+//! other vehicles, each fleet AUV), its stream configuration ([`crate::computers`]), its
+//! JSON Lines input (its own fixes, the beacon
 //! positions and the measurements of the vehicles it estimates) and the commands the
 //! simulator's controller gave. Feeding the input to `stream` with the configuration
 //! gives the same commands: the simulator and the vehicle run the same code.
@@ -32,20 +33,29 @@ pub struct Computer {
 
 /// The observer that writes each computer's input and decisions.
 pub(crate) struct Messages {
-    /// Per helm: the vehicles it serves, and what it heard and decided.
+    /// Per computer: the vehicles it estimates, and what it heard and decided.
     serves: Vec<Vec<usize>>,
     computers: Vec<Computer>,
-    /// Per helm: the beacons' positions its input last gave, and the planner's last plan.
+    /// The computer of each helm (those with a controller, in order).
+    of_helm: Vec<usize>,
+    /// Per computer: the beacons' positions its input last gave, and the planner's last
+    /// plan.
     beacons: Vec<Vec<(u32, Vector3<f64>)>>,
     plans: Vec<Option<Plan>>,
 }
 
 impl Messages {
-    /// For computers `computers` (their names and configurations), helm `h` serving
-    /// `serves[h]`.
-    pub(crate) fn new(computers: Vec<Computer>, serves: Vec<Vec<usize>>) -> Self {
+    /// For a run's `computers` (the engine's helms are those with a controller, in
+    /// order).
+    pub(crate) fn new(computers: &[OnBoard]) -> Self {
         let n = computers.len();
-        Self { serves, computers, beacons: vec![Vec::new(); n], plans: vec![None; n] }
+        Self {
+            serves: computers.iter().map(|c| c.starts.iter().map(|s| s.vehicle).collect()).collect(),
+            of_helm: (0..n).filter(|&i| computers[i].config.controller.is_some()).collect(),
+            computers: computers.iter().map(computer).collect(),
+            beacons: vec![Vec::new(); n],
+            plans: vec![None; n],
+        }
     }
 
     pub(crate) fn into_inner(self) -> Vec<Computer> {
@@ -79,7 +89,8 @@ impl Observer for Messages {
         }
     }
 
-    fn decided(&mut self, h: usize, situation: &Situation, d: &Decided) {
+    fn decided(&mut self, helm: usize, situation: &Situation, d: &Decided) {
+        let h = self.of_helm[helm];
         let c = &mut self.computers[h];
         if let Some(fix) = &situation.fix {
             c.input.push(own_fix_json(situation.t_s, fix).to_string());
@@ -92,7 +103,7 @@ impl Observer for Messages {
 }
 
 /// What computer `c` heard and decided, yet to be run: its name and configuration.
-pub(crate) fn computer(c: &OnBoard) -> Computer {
+fn computer(c: &OnBoard) -> Computer {
     Computer {
         name: c.name.clone(),
         config: toml::to_string(&c.config).expect("a stream configuration is TOML"),

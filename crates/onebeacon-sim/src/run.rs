@@ -173,8 +173,7 @@ pub fn simulate_with_belief(s: &Scenario, cell: &Cell, seed: u64, run: u64, step
 
 /// [`simulate`] recording every step (and the belief at `belief`: step, samples), with
 /// what each vehicle's computer heard and decided ([`crate::messages`]); None for a
-/// world whose vehicles' computers a stream cannot run (fixed beacon, whose vehicle has
-/// no controller; a fleet with the channel model, whose captures are not JSON lines).
+/// fleet with the channel model, whose captures are not JSON lines.
 pub fn simulate_messages(
     s: &Scenario,
     cell: &Cell,
@@ -196,8 +195,10 @@ fn simulate_recording(
     match (s, cell) {
         (Scenario::FixedBeacon(s), Cell::FixedBeacon(c)) => {
             let mut world = FixedBeaconWorld::new(s, c, seed, run);
-            let mut tracks = factory::fixed_beacon(s, world.unicycle_state(), seed, run);
-            drive(&mut world, &mut tracks, &[], Vec::new(), recorder, false)
+            let z0 = factory::fixed_beacon_start(s, world.unicycle_state(), seed, run);
+            let on_board = vec![computers::fixed_beacon(s, &z0)];
+            let mut tracks = computers::tracks(&on_board);
+            drive(&mut world, &mut tracks, &on_board, Vec::new(), recorder, messages)
         }
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let asv0 = factory::initial_asv_position(s, c);
@@ -248,13 +249,7 @@ fn drive(
 ) -> (RunOutput, Option<Vec<Computer>>) {
     let mut scoring = Scoring::new(tracks.iter().map(|t| t.vehicle).collect(), world.steps());
     let mut helms = computers::helms(computers);
-    let mut m = messages.then(|| {
-        let with_helm = computers.iter().filter(|c| c.config.controller.is_some());
-        Messages::new(
-            with_helm.map(crate::messages::computer).collect(),
-            helms.iter().map(|h| h.serves.clone()).collect(),
-        )
-    });
+    let mut m = messages.then(|| Messages::new(computers));
     {
         let mut observers: Vec<&mut dyn Observer> = vec![&mut scoring, &mut recorder];
         // each pushed reborrowed, for as long as the run

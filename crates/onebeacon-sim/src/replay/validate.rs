@@ -75,8 +75,8 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
     if !d.model.is_planar() && !d.sources.is_empty() {
         return Err(Violation {
             key: "model".into(),
-            value: "\"6dof\"".into(),
-            allowed: "\"planar\" for a log with [[source]] tables (their rows are planar odometry); \"6dof\" is for `stream` on body_velocity, attitude and depth lines".into(),
+            value: format!("{:?}", d.model.label()),
+            allowed: "\"planar\" for a log with [[source]] tables (their rows are planar odometry); \"6dof\" and \"unicycle\" are for `stream` (on body_velocity, attitude and depth lines; on speed, inertial and acoustic lines)".into(),
         });
     }
     if let Some(o) = &d.origin

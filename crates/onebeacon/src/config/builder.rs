@@ -1,13 +1,16 @@
 //! From an estimator spec to its navigator on a log or a stream (replay, `stream`, the
-//! Python `Navigator`): a USBL tracker, the iUSBL navigator, sousa's 6-DOF filter or the
-//! planar family. The simulator's passive-USBL and moving-beacon worlds build their
-//! navigators here too; its fixed-beacon and fleet worlds build theirs in its factory.
+//! Python `Navigator`): a USBL tracker, the iUSBL navigator, sousa's 6-DOF filter,
+//! garin2024's unicycle filter or the planar family. Every world of the simulator builds
+//! its vehicles' navigators here too (a fleet's iUSBL receiver on the channel model
+//! aside).
 
 use super::estimator::{EstimatorKind, EstimatorSpec, Host};
 use crate::models::hoff::{DIM, idx};
 use crate::models::kinematic6dof::{Cov as Cov6, State as Eta};
+use crate::models::unicycle::{Cov as UnicycleCov, State as UnicycleState};
 use crate::nav::capability::Capability;
 use crate::nav::restart::Builder;
+use crate::nav::single_beacon::{self, Guards};
 use crate::nav::{GaussianTracker, IusblNavigator, ParticleTracker, SensorNoise, TrackerNoise, range_6dof};
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
@@ -24,6 +27,11 @@ pub enum VehicleModel {
     /// the estimators are those of a moving_beacon world.
     #[serde(rename = "6dof")]
     Kinematic6Dof,
+    /// garin2024's planar unicycle (sec. III: position, heading, speed, yaw rate and
+    /// acceleration) on speed and inertial lines: the estimators are those of a
+    /// fixed_beacon world.
+    #[serde(rename = "unicycle")]
+    Unicycle,
 }
 
 impl VehicleModel {
@@ -32,6 +40,16 @@ impl VehicleModel {
         match self {
             VehicleModel::Planar => Host::Log,
             VehicleModel::Kinematic6Dof => Host::MovingBeacon,
+            VehicleModel::Unicycle => Host::FixedBeacon,
+        }
+    }
+
+    /// Its `model` key's value.
+    pub fn label(self) -> &'static str {
+        match self {
+            VehicleModel::Planar => "planar",
+            VehicleModel::Kinematic6Dof => "6dof",
+            VehicleModel::Unicycle => "unicycle",
         }
     }
 
@@ -44,13 +62,16 @@ impl VehicleModel {
 /// tracker (hoff2024's state order) depth, pitch, speed and the two rate biases (m, rad,
 /// m/s, rad/s) and the standard deviations of depth, pitch, speed and biases; for the
 /// 6-DOF filter depth, pitch and `roll_rad` with the depth's and pitch's standard
-/// deviations (the roll's is the pitch's); and the seed of the vehicle's particle
-/// filters.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// deviations (the roll's is the pitch's); for the unicycle the speed (the tracker's),
+/// `yaw_rate_accel` (rad/s, m/s^2) and the standard deviations of the three; and the
+/// seed of the vehicle's particle filters.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct TrackerStart {
     pub state: [f64; 5],
     pub sigma: [f64; 4],
     pub roll_rad: f64,
+    pub yaw_rate_accel: [f64; 2],
+    pub yaw_rate_accel_sigma: [f64; 2],
     pub seed: Option<i64>,
 }
 
@@ -69,13 +90,15 @@ impl EstimatorSpec {
     /// session (or the simulator's track) at its start and again from its last sound
     /// pose: a USBL tracker (pf, bearing: hoff2024's eight states), the iUSBL navigator
     /// (which starts from its first fix), or the planar family; with `model` 6dof, sousa's
-    /// filter. The one place navigators are built from specs, for logs, streams and the
-    /// simulator's passive-USBL, moving-beacon and fleet worlds; the noise a spec does not
+    /// filter, with `model` unicycle garin2024's. The one place navigators are built from
+    /// specs, for logs, streams and every world of the simulator; the noise a spec does not
     /// give is [`TrackerNoise::default`] and [`SensorNoise::default`] (a world writes its
     /// own into the specs).
     pub fn builder(&self, start: TrackerStart, model: VehicleModel) -> Builder {
-        if model == VehicleModel::Kinematic6Dof {
-            return self.range_6dof_builder(start);
+        match model {
+            VehicleModel::Kinematic6Dof => return self.range_6dof_builder(start),
+            VehicleModel::Unicycle => return self.unicycle_builder(start),
+            VehicleModel::Planar => {}
         }
         // the seed's 64 bits (TOML integers are signed)
         let seed = self.seed.or(start.seed).unwrap_or(0) as u64;
@@ -108,6 +131,26 @@ impl EstimatorSpec {
             let sigma = Eta::from([s_position, s_position, s_depth, s_attitude, s_attitude, s_heading]);
             let p0 = Cov6::from_diagonal(&sigma.component_mul(&sigma));
             range_6dof::boxed(noise, aiding, filter, t0, (eta, p0), calibration, gate)
+        })
+    }
+
+    /// garin2024's single-beacon filter (its kind's acoustic measurements, eq. 25's
+    /// tuning where a key is absent, the calibration states asked for, its guards),
+    /// starting from `start` (speed, yaw rate, acceleration and their sigmas), its pose
+    /// and their sigmas the builder's arguments.
+    fn unicycle_builder(&self, start: TrackerStart) -> Builder {
+        let (aiding, tuning, filter) = (self.aiding(Host::FixedBeacon), self.ekf_tuning(), self.filter_kind());
+        let (gate, robust) = self.gate();
+        let guards =
+            Guards { min_speed_m_s: self.min_speed_m_s, mirror: self.mirror_recovery.unwrap_or(true), gate, robust };
+        let calibration = self.range_calibration();
+        let ([_, _, speed, ..], [_, _, s_speed, _]) = (start.state, start.sigma);
+        let ([yaw_rate, accel], [s_yaw_rate, s_accel]) = (start.yaw_rate_accel, start.yaw_rate_accel_sigma);
+        Box::new(move |t0, (north, east, heading), s_position, s_heading| {
+            let z = UnicycleState::from([north, east, heading, speed, yaw_rate, accel]);
+            let sigma = UnicycleState::from([s_position, s_position, s_heading, s_speed, s_yaw_rate, s_accel]);
+            let p0 = UnicycleCov::from_diagonal(&sigma.component_mul(&sigma));
+            single_beacon::boxed(aiding, tuning, filter, t0, (z, p0), calibration, guards)
         })
     }
 

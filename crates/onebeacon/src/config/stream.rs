@@ -115,6 +115,16 @@ pub struct Initial {
     pub speed_sigma_m_s: f64,
     #[serde(default = "default_rate_bias_sigma_deg_s")]
     pub rate_bias_sigma_deg_s: f64,
+    /// The unicycle's (`model = "unicycle"`) yaw rate and acceleration, with speed
+    /// (`speed_m_s`), and their standard deviations (the speed's is `speed_sigma_m_s`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub yaw_rate_deg_s: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub accel_m_s2: f64,
+    #[serde(default = "default_yaw_rate_sigma_deg_s", skip_serializing_if = "is_default_yaw_rate_sigma")]
+    pub yaw_rate_sigma_deg_s: f64,
+    #[serde(default = "default_accel_sigma_m_s2", skip_serializing_if = "is_default_accel_sigma")]
+    pub accel_sigma_m_s2: f64,
 }
 
 /// Left out, `[initial]` starts from the first ground-truth pose and its heading column.
@@ -142,12 +152,17 @@ impl Default for Initial {
             pitch_sigma_deg: default_pitch_sigma_deg(),
             speed_sigma_m_s: default_speed_sigma_m_s(),
             rate_bias_sigma_deg_s: default_rate_bias_sigma_deg_s(),
+            yaw_rate_deg_s: 0.0,
+            accel_m_s2: 0.0,
+            yaw_rate_sigma_deg_s: default_yaw_rate_sigma_deg_s(),
+            accel_sigma_m_s2: default_accel_sigma_m_s2(),
         }
     }
 }
 
 impl Initial {
-    /// What a USBL tracker or the 6-DOF filter starts from besides the pose.
+    /// What a USBL tracker, the 6-DOF filter or the unicycle filter starts from besides
+    /// the pose.
     pub fn tracker_start(&self) -> TrackerStart {
         TrackerStart {
             state: [
@@ -164,6 +179,8 @@ impl Initial {
                 self.rate_bias_sigma_deg_s.to_radians(),
             ],
             roll_rad: self.roll_deg.to_radians(),
+            yaw_rate_accel: [self.yaw_rate_deg_s.to_radians(), self.accel_m_s2],
+            yaw_rate_accel_sigma: [self.yaw_rate_sigma_deg_s.to_radians(), self.accel_sigma_m_s2],
             seed: self.seed,
         }
     }
@@ -206,6 +223,10 @@ impl Initial {
             ("pitch_sigma_deg", self.pitch_sigma_deg, Rule::Positive),
             ("speed_sigma_m_s", self.speed_sigma_m_s, Rule::Positive),
             ("rate_bias_sigma_deg_s", self.rate_bias_sigma_deg_s, Rule::Positive),
+            ("yaw_rate_deg_s", self.yaw_rate_deg_s, Rule::Finite),
+            ("accel_m_s2", self.accel_m_s2, Rule::Finite),
+            ("yaw_rate_sigma_deg_s", self.yaw_rate_sigma_deg_s, Rule::Positive),
+            ("accel_sigma_m_s2", self.accel_sigma_m_s2, Rule::Positive),
         ] {
             check(&format!("{section}.{key}"), v, rule)?;
         }
@@ -242,6 +263,20 @@ fn default_speed_sigma_m_s() -> f64 {
 fn default_rate_bias_sigma_deg_s() -> f64 {
     0.05
 }
+// the unicycle's, as the fixed_beacon world's defaults (0.01 rad/s, 0.01 m/s^2; no
+// source beyond that world's own choice)
+fn default_yaw_rate_sigma_deg_s() -> f64 {
+    0.01f64.to_degrees()
+}
+fn default_accel_sigma_m_s2() -> f64 {
+    0.01
+}
+fn is_default_yaw_rate_sigma(v: &f64) -> bool {
+    *v == default_yaw_rate_sigma_deg_s()
+}
+fn is_default_accel_sigma(v: &f64) -> bool {
+    *v == default_accel_sigma_m_s2()
+}
 
 /// One fixed beacon (`[[beacon]]`), in the file's frame, m.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -263,8 +298,9 @@ pub struct StreamConfig {
     pub description: String,
     #[serde(default)]
     pub frame: FrameKey,
-    /// The estimators' vehicle model: `"planar"` (default) or sousa's `"6dof"`, whose
-    /// estimators take a moving_beacon world's keys.
+    /// The estimators' vehicle model: `"planar"` (default), sousa's `"6dof"`, whose
+    /// estimators take a moving_beacon world's keys, or garin2024's `"unicycle"`, whose
+    /// estimators take a fixed_beacon world's.
     #[serde(default, skip_serializing_if = "VehicleModel::is_planar")]
     pub model: VehicleModel,
     /// Fixed beacons (`[[beacon]]`), in the file's frame.
