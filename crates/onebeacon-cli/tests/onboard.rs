@@ -71,6 +71,22 @@ fn stream_lines(run: &Path, name: &str) -> (Vec<Value>, String) {
     (json_lines(&String::from_utf8(o.stdout).unwrap()), String::from_utf8(o.stderr).unwrap())
 }
 
+/// A run's trajectory.csv: the index of a column by its name, and each row by its time
+/// (to the file's 2 decimals, in hundredths of a second).
+fn trajectory(run: &Path) -> (impl Fn(&str) -> usize, std::collections::BTreeMap<i64, Vec<f64>>) {
+    let csv = std::fs::read_to_string(run.join("trajectory.csv")).unwrap();
+    let header: Vec<String> = csv.lines().next().unwrap().split(',').map(String::from).collect();
+    let rows = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect();
+            ((c[0] * 100.0).round() as i64, c)
+        })
+        .collect();
+    (move |name: &str| header.iter().position(|h| h == name).unwrap(), rows)
+}
+
 fn simulator_decisions(run: &Path, name: &str) -> Vec<Value> {
     json_lines(&std::fs::read_to_string(run.join(format!("{name}.decisions.jsonl"))).unwrap())
 }
@@ -144,21 +160,12 @@ fn the_stream_gives_the_simulated_auvs_modes_and_commands() {
     let run = run_messages(&scenario, &dir);
     let (lines, _) = stream_lines(&run, "quokka");
     let input = json_lines(&std::fs::read_to_string(run.join("quokka.input.jsonl")).unwrap());
-    let csv = std::fs::read_to_string(run.join("trajectory.csv")).unwrap();
-    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let (t, n, e) = (column("t_s"), column("quokka/dead-reckoning_north_m"), column("quokka/dead-reckoning_east_m"));
-    let rows: std::collections::BTreeMap<i64, (f64, f64)> = csv
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect();
-            ((c[t] * 100.0).round() as i64, (c[n], c[e]))
-        })
-        .collect();
+    let (column, rows) = trajectory(&run);
+    let (n, e) = (column("quokka/dead-reckoning_north_m"), column("quokka/dead-reckoning_east_m"));
     let mut compared = 0;
     for l in lines.iter().filter(|l| input[l["line"].as_u64().unwrap() as usize - 1]["kind"] == "depth") {
-        let Some((north, east)) = rows.get(&((l["t_s"].as_f64().unwrap() * 100.0).round() as i64)) else { continue };
+        let Some(row) = rows.get(&((l["t_s"].as_f64().unwrap() * 100.0).round() as i64)) else { continue };
+        let (north, east) = (row[n], row[e]);
         let dr = l["estimates"].as_array().unwrap().iter().find(|x| x["name"] == "dead-reckoning").unwrap();
         let off = (dr["x_m"].as_f64().unwrap() - north).abs().max((dr["y_m"].as_f64().unwrap() - east).abs());
         // half the last decimal, and a rounding of the value itself
@@ -195,18 +202,7 @@ fn the_stream_gives_the_simulated_auvs_estimates() {
     assert!(config.contains("model = \"unicycle\"") && !config.contains("[controller]"), "{config}");
     let (lines, stderr) = stream_lines(&run, "auv");
     assert!(stderr.is_empty(), "{stderr}");
-    let csv = std::fs::read_to_string(run.join("trajectory.csv")).unwrap();
-    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    // each step's time (to the file's 2 decimals) to its row
-    let rows: std::collections::BTreeMap<i64, Vec<f64>> = csv
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect();
-            ((c[0] * 100.0).round() as i64, c)
-        })
-        .collect();
+    let (column, rows) = trajectory(&run);
     // the last line at each time
     let mut last = std::collections::BTreeMap::new();
     for l in &lines {
