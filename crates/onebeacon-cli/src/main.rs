@@ -99,12 +99,12 @@ enum Command {
         /// Output directory (default: out/<scenario>-run).
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
-        /// Also write each vehicle computer's side of the run (passive_usbl: the surface
-        /// vehicle; moving_beacon: the beacon vehicle; fleet with the abstract signal
-        /// model: each AUV): NAME.stream.toml (its
-        /// `stream` configuration), NAME.input.jsonl (what it heard) and
-        /// NAME.decisions.jsonl (the simulator's commands), for `onebeacon stream
-        /// NAME.stream.toml < NAME.input.jsonl`.
+        /// Also write each vehicle computer's side of the run (fixed_beacon: the AUV;
+        /// passive_usbl: the surface vehicle; moving_beacon: the beacon vehicle and the
+        /// vehicles it does not serve; fleet with the abstract signal model: each AUV):
+        /// NAME.stream.toml (its `stream` configuration), NAME.input.jsonl (what it
+        /// heard) and NAME.decisions.jsonl (the simulator's commands; none without a
+        /// controller), for `onebeacon stream NAME.stream.toml < NAME.input.jsonl`.
         #[arg(long)]
         messages: bool,
     },
