@@ -46,9 +46,7 @@ pub(crate) struct Start {
 
 /// One vehicle's computer in a run.
 pub(crate) struct OnBoard {
-    /// The vehicle (`asv`, or the AUV's name).
-    pub name: String,
-    /// Its stream configuration: `[initial]` (or `[[tracked]]`, one per start) from
+    /// Its stream configuration (named for the vehicle: `auv`, `asv`, or the AUV's name): `[initial]` (or `[[tracked]]`, one per start) from
     /// `starts`.
     pub config: StreamConfig,
     /// One per vehicle it estimates, in the order of its sessions.
@@ -77,10 +75,14 @@ impl OnBoard {
     }
 }
 
-/// The tracks of every computer of a run, built by their specs, in computer order (a
-/// fleet's with the channel model: [`crate::factory::fleet_builder`]).
-pub(crate) fn tracks(computers: &[OnBoard]) -> Vec<Track> {
-    computers.iter().flat_map(|c| c.tracks(&EstimatorSpec::builder)).collect()
+/// The tracks of every computer of a run, in computer order, each estimator built by
+/// `build` (its spec's [`EstimatorSpec::builder`], or a fleet's with the channel model:
+/// [`crate::factory::fleet_builder`]).
+pub(crate) fn tracks(
+    computers: &[OnBoard],
+    build: &impl Fn(&EstimatorSpec, TrackerStart, VehicleModel) -> Builder,
+) -> Vec<Track> {
+    computers.iter().flat_map(|c| c.tracks(build)).collect()
 }
 
 /// The helms of every computer of a run that has a controller, in computer order.
@@ -155,7 +157,7 @@ pub(crate) fn fixed_beacon(s: &FixedBeacon, z0: &UnicycleState) -> OnBoard {
         model: VehicleModel::Unicycle,
         ..config(description, s.estimators.clone(), None)
     };
-    OnBoard { name: "auv".into(), config, starts: vec![start] }
+    OnBoard { config, starts: vec![start] }
 }
 
 /// Each estimator of a passive-USBL scenario as the surface vehicle's stream
@@ -261,7 +263,7 @@ pub(crate) fn passive_usbl(
         format!("The surface vehicle's computer of a simulated {} run (onebeacon run --messages)", s.name);
     let controller = bearing_controller(s, cell, home);
     let config = StreamConfig { tracked, ..config(description, passive_usbl_estimators(s), Some(controller)) };
-    OnBoard { name: "asv".into(), config, starts }
+    OnBoard { config, starts }
 }
 
 /// Each estimator of a moving-beacon scenario as a stream configuration describes it:
@@ -353,12 +355,12 @@ pub(crate) fn moving_beacon(
                 (format!("vehicle{v}"), d, None)
             };
             let config = StreamConfig {
-                name: name.clone(),
+                name,
                 initial,
                 model: VehicleModel::Kinematic6Dof,
                 ..config(description, estimators.clone(), controller)
             };
-            OnBoard { name, config, starts: vec![start] }
+            OnBoard { config, starts: vec![start] }
         })
         .collect()
 }
@@ -465,7 +467,7 @@ pub(crate) fn fleet(s: &Fleet, seeds: &[Vec<u64>]) -> Vec<OnBoard> {
                 initial: Initial { heading_deg: Some(a.start_heading_deg), ..given(start.pose, start.sigmas) },
                 ..config(description, estimators, Some(controller))
             };
-            OnBoard { name: a.name.clone(), config, starts: vec![start] }
+            OnBoard { config, starts: vec![start] }
         })
         .collect()
 }

@@ -105,7 +105,7 @@ impl Observer for Messages {
 /// What computer `c` heard and decided, yet to be run: its name and configuration.
 fn computer(c: &OnBoard) -> Computer {
     Computer {
-        name: c.name.clone(),
+        name: c.config.name.clone(),
         config: toml::to_string(&c.config).expect("a stream configuration is TOML"),
         input: Vec::new(),
         decisions: Vec::new(),

@@ -10,7 +10,7 @@ use crate::information::{Information, bearing_information, range_information};
 use crate::messages::{Computer, Messages};
 use crate::metrics::RunMetrics;
 use crate::scenario::fleet::SignalModel;
-use crate::scenario::{Cell, Scenario};
+use crate::scenario::{Cell, EstimatorSpec, Scenario};
 use crate::world::{FixedBeaconWorld, FleetWorld, MovingBeaconWorld, PassiveUsblWorld};
 use nalgebra::{DMatrix, Vector2, Vector3};
 use onebeacon::nav::diagnosis::PerBeacon;
@@ -197,7 +197,7 @@ fn simulate_recording(
             let mut world = FixedBeaconWorld::new(s, c, seed, run);
             let z0 = factory::fixed_beacon_start(s, world.unicycle_state(), seed, run);
             let on_board = vec![computers::fixed_beacon(s, &z0)];
-            let mut tracks = computers::tracks(&on_board);
+            let mut tracks = computers::tracks(&on_board, &EstimatorSpec::builder);
             drive(&mut world, &mut tracks, &on_board, Vec::new(), recorder, messages)
         }
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
@@ -205,7 +205,7 @@ fn simulate_recording(
             let mut world = MovingBeaconWorld::new(s, c, asv0, seed, run);
             let starts = factory::moving_beacon_starts(s, &world.states(), seed, run);
             let on_board = computers::moving_beacon(s, c, asv0, &starts);
-            let mut tracks = computers::tracks(&on_board);
+            let mut tracks = computers::tracks(&on_board, &EstimatorSpec::builder);
             let mut info = Information::new(range_information(s.sensor_noise()));
             let extra: Vec<&mut dyn Observer> = vec![&mut info];
             let (mut out, m) = drive(&mut world, &mut tracks, &on_board, extra, recorder, messages);
@@ -216,7 +216,7 @@ fn simulate_recording(
             let mut world = PassiveUsblWorld::new(s, seed, run);
             let starts = factory::tracker_starts(s, &world.initial_states(), seed, run);
             let on_board = vec![computers::passive_usbl(s, c, world.asv_start(), &starts)];
-            let mut tracks = computers::tracks(&on_board);
+            let mut tracks = computers::tracks(&on_board, &EstimatorSpec::builder);
             let mut info = Information::new(bearing_information(s.tracker_noise()));
             let extra: Vec<&mut dyn Observer> = vec![&mut info];
             let (mut out, m) = drive(&mut world, &mut tracks, &on_board, extra, recorder, messages);
@@ -226,8 +226,7 @@ fn simulate_recording(
         (Scenario::Fleet(s), Cell::Fleet) => {
             let mut world = FleetWorld::new(s, seed, run);
             let on_board = computers::fleet(s, &factory::fleet_seeds(s, seed, run));
-            let build = factory::fleet_builder(s);
-            let mut tracks: Vec<Track> = on_board.iter().flat_map(|c| c.tracks(&build)).collect();
+            let mut tracks = computers::tracks(&on_board, &factory::fleet_builder(s));
             // the channel model's captures are not JSON lines
             let messages = messages && s.signal.model != SignalModel::Channel;
             drive(&mut world, &mut tracks, &on_board, Vec::new(), recorder, messages)
