@@ -17,13 +17,28 @@ repo = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file
 CRATES = ["onebeacon", "onebeacon-sim", "onebeacon-cli", "onebeacon-py"]
 
 
+def module_of(rel):
+    """The module path of a source file relative to its crate's src/."""
+    parts = rel.removesuffix(".rs").split("/")
+    return tuple(parts[:-1] if parts[-1] in ("mod", "lib", "main") else parts)
+
+
 def sources(crate):
+    """(path relative to src/, text) of each file of `crate` but the test-only ones: a
+    file its parent declares only under `#[cfg(test)]`, and the files under it."""
     root = os.path.join(repo, "crates", crate, "src")
+    found = []
     for dp, _, fs in os.walk(root):
         for f in sorted(fs):
             if f.endswith(".rs"):
                 p = os.path.join(dp, f)
-                yield os.path.relpath(p, root), open(p).read()
+                found.append((os.path.relpath(p, root), open(p).read()))
+    declared = {}
+    for rel, text in sorted(found, key=lambda f: len(module_of(f[0]))):
+        m = module_of(rel)
+        if not m or m[-1] in declared.get(m[:-1], ()):
+            declared[m] = set(re.findall(r"\bmod (\w+)\s*;", code(text)))
+    return [(rel, text) for rel, text in found if module_of(rel) in declared]
 
 
 LITERAL = re.compile(r'//[^\n]*|/\*.*?\*/|r(#*)".*?"\1|"(?:\\.|[^"\\])*"|\'(?:\\.|[^\\\'])\'', re.S)

@@ -10,7 +10,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use onebeacon::io::jsonl::item_json;
 use onebeacon::io::stream::Lines;
-use onebeacon_sim::replay::{Log, LogError, replay, stream_setup};
+use onebeacon::log::{Log, LogError, stream_setup};
+use onebeacon_sim::replay::replay;
 use std::hint::black_box;
 use std::path::PathBuf;
 

@@ -6,7 +6,7 @@
 //! then with the default calibration (range and turn scale) and Huber kernel.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use onebeacon_sim::replay::Log;
+use onebeacon::log::Log;
 use onebeacon_sim::smooth::{Calibrate, SmoothConfig, smooth};
 use std::hint::black_box;
 use std::path::PathBuf;

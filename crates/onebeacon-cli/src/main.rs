@@ -514,7 +514,7 @@ fn main() -> ExitCode {
             let msg = format!("{e:#}").replace('\n', " ");
             eprintln!("error: {msg}");
             let input = e.downcast_ref::<onebeacon_sim::ScenarioError>().is_some()
-                || e.downcast_ref::<onebeacon_sim::replay::LogError>().is_some()
+                || e.downcast_ref::<onebeacon::log::LogError>().is_some()
                 || e.downcast_ref::<BadInput>().is_some();
             ExitCode::from(if input { 2 } else { 1 })
         }

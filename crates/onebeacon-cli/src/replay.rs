@@ -6,8 +6,9 @@ use crate::output::Staging;
 use crate::{plot, report};
 use anyhow::{Context, Result};
 use onebeacon::io::jsonl;
+use onebeacon::log::{Log, stream_setup};
 use onebeacon::nav::session::Session;
-use onebeacon_sim::replay::{Log, Replay, replay as run_replay, stream_setup};
+use onebeacon_sim::replay::{Replay, replay as run_replay};
 use onebeacon_sim::run::StepRecord;
 use std::collections::BTreeSet;
 use std::io::Write;
@@ -275,7 +276,7 @@ fn print_holdout(names: &[String], table: &HoldoutTable) -> Result<()> {
 
 /// The replay's table: its start, rows dropped, one line per estimator of `summary`
 /// (and the per-beacon range offsets).
-pub(crate) fn print_table(summary: &serde_json::Value, dropped: &[onebeacon_sim::replay::Dropped]) -> Result<()> {
+pub(crate) fn print_table(summary: &serde_json::Value, dropped: &[onebeacon::log::Dropped]) -> Result<()> {
     let st = &summary["start"];
     let f = |k: &str| st[k].as_f64().unwrap_or(f64::NAN);
     outln!(

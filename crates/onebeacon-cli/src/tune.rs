@@ -5,8 +5,8 @@
 use crate::BadInput;
 use crate::output::Staging;
 use anyhow::Result;
+use onebeacon::log::Log;
 use onebeacon::nav::evaluation::ErrorStats;
-use onebeacon_sim::replay::Log;
 use onebeacon_sim::replay::tune::{BOUND_FACTOR, DEFAULT_KEYS, TUNABLE, Tuned, at_bound, tune as fit};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};

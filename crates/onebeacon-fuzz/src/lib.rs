@@ -6,9 +6,10 @@
 use nalgebra::Vector3;
 use onebeacon::geo::Frame;
 use onebeacon::io::stream;
+use onebeacon::log::{Log, LogDescription, LogError};
 use onebeacon_sim::acoustics::channel::simulate_ping;
 use onebeacon_sim::acoustics::wav::Recording;
-use onebeacon_sim::replay::{Log, LogDescription, LogError, replay};
+use onebeacon_sim::replay::replay;
 use onebeacon_sim::scenario::ping::PingConfig;
 use onebeacon_sim::seed::{Stream, rng};
 use std::collections::BTreeMap;

@@ -3,8 +3,9 @@
 
 use crate::{input_error, interruptible, to_py, trajectory_dict, user_warning};
 use numpy::PyArray1;
+use onebeacon::log::{Log, LogError};
 use onebeacon_sim::budget::Budget;
-use onebeacon_sim::replay::{Log, beacon_filter, replay as run_replay};
+use onebeacon_sim::replay::{beacon_filter, replay as run_replay};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::path::PathBuf;
@@ -33,10 +34,10 @@ pub(crate) fn replay<'py>(
     let started = std::time::Instant::now();
     let (records, r) = interruptible(py, |stop| {
         let mut records = Vec::new();
-        let r = run_replay::<onebeacon_sim::replay::LogError>(&l, filter, |rec| {
+        let r = run_replay::<LogError>(&l, filter, |rec| {
             if stop.stopped() {
                 // what is raised is the KeyboardInterrupt
-                return Err(onebeacon_sim::replay::LogError::File { file: String::new(), message: "stopped".into() });
+                return Err(LogError::File { file: String::new(), message: "stopped".into() });
             }
             records.push(rec);
             Ok(())

@@ -4,10 +4,10 @@
 use crate::{from_py, input_error, to_py, user_warning};
 use numpy::{PyArray1, PyArray2};
 use onebeacon::io::stream::{Lines, Note};
+use onebeacon::log::stream_setup;
 use onebeacon::nav::session::Session;
 use onebeacon::vehicle::unit::Unit;
 use onebeacon_sim::budget::Budget;
-use onebeacon_sim::replay::stream_setup;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::PathBuf;

@@ -13,11 +13,11 @@
 //! 5e7 particles peaked at 7.83 GB resident (`/usr/bin/time -v`), estimated 8.47 GB;
 //! 5e6 particles on one thread, 0.79 GB against 0.91 GB.
 
-use crate::replay::Log;
 use crate::run::{Estimate, StepRecord, TruthRecord, recorded_bytes};
 use crate::scenario::{EstimatorSpec, Host, Scenario};
 use onebeacon::config::stream::StreamConfig;
 use onebeacon::config::working_set::particle_filter_bytes;
+use onebeacon::log::Log;
 use onebeacon::nav::planar::{EXTENDED_STATES, STATES, STATES_WITH_OFFSETS};
 
 /// The environment variable that sets the budget, GiB.
@@ -147,7 +147,7 @@ impl Budget {
     /// plaza1 252 MB (0.4 GB estimated), 600 000 odometry and truth rows 1016 MB (1.6 GB);
     /// cfb7f93's estimate was 6-12 times the need.
     pub fn check_smooth(&self, log: &Log) -> Result<(), BudgetError> {
-        use crate::replay::schema::SourceKind::*;
+        use onebeacon::log::schema::SourceKind::*;
         let estimators = &log.description.estimators;
         let kept: Vec<usize> = estimators
             .iter()
@@ -215,11 +215,11 @@ const SMOOTHER_FACTOR_BYTES: f64 = 512.0;
 /// The data rows of `log`'s sources whose kind `which` picks, counted (the lines of
 /// each file but its header); a file that cannot be read counts nothing (the replay
 /// names it).
-fn source_rows(log: &Log, which: impl Fn(crate::replay::schema::SourceKind) -> bool) -> f64 {
+fn source_rows(log: &Log, which: impl Fn(onebeacon::log::schema::SourceKind) -> bool) -> f64 {
     use std::io::Read;
     let mut rows = 0u64;
     for s in log.description.sources.iter().filter(|s| which(s.kind)) {
-        let Ok(mut f) = crate::input_file::open_bounded(&log.base.join(&s.file)) else { continue };
+        let Ok(mut f) = onebeacon::io::file::open_bounded(&log.base().join(&s.file)) else { continue };
         let mut buf = vec![0u8; 1 << 16];
         let mut lines = 0u64;
         while let Ok(n) = f.read(&mut buf) {

@@ -5,10 +5,11 @@
 
 use crate::Scenario;
 use crate::montecarlo::McResult;
-use crate::replay::{Log, Replay};
+use crate::replay::Replay;
 use crate::run::RunOutput;
 use crate::scenario::{Cell, SweepValue};
 use onebeacon::config::stream::InitialFrom;
+use onebeacon::log::Log;
 use onebeacon::nav::evaluation::ErrorStats;
 use serde_json::{Value, json};
 

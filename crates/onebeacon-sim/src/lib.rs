@@ -18,7 +18,6 @@
 //! - [`montecarlo`]: many runs over a sweep, in parallel, independent of thread count;
 //! - [`partial`]: one share of a sharded sweep as a file, and the merge of the shares;
 //! - [`json`]: the JSON forms of results, for the CLI and the Python package;
-//! - [`input_file`]: the one bounded reader of the files a user names;
 //! - [`replay`]: real logs (CSV files described by a TOML file) through the estimators.
 
 pub mod acoustics;
@@ -29,7 +28,6 @@ mod engine;
 mod factory;
 pub mod fleet;
 mod information;
-pub mod input_file;
 pub mod json;
 pub mod messages;
 pub mod metrics;

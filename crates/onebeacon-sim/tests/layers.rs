@@ -63,7 +63,24 @@ fn sources(dir: &Path) -> Vec<Source> {
             }
         }
     }
-    out
+    test_modules_left_out(out)
+}
+
+/// `files` without the test-only ones: a file whose parent declares it only under
+/// `#[cfg(test)]` (`#[cfg(test)] mod burst_tests;`), and the files under it.
+fn test_modules_left_out(mut files: Vec<Source>) -> Vec<Source> {
+    files.sort_by_key(|f| f.module.len());
+    let mut kept: Vec<Source> = Vec::new();
+    for f in files {
+        let declared = match f.module.split_last() {
+            None => true,
+            Some((name, parent)) => kept.iter().any(|p| p.module == parent && p.children.contains(name)),
+        };
+        if declared {
+            kept.push(f);
+        }
+    }
+    kept
 }
 
 /// The text without comments, string and character literals' contents (their quotes
@@ -603,4 +620,15 @@ fn the_former_blind_spots_are_seen() {
     assert_eq!(folder("pub struct Alpha; use super::b::Beta;", "pub struct Beta;"), Vec::<String>::new());
     assert_eq!(folder("pub struct Alpha; use super::b::Beta;", "use super::a::Alpha;"), ["chart: a -> b -> a"]);
     assert_eq!(folder("pub struct Alpha; use super::b::Beta;", "fn f(_: super::Alpha) {}"), ["chart: a -> b -> a"]);
+    // a file declared under `#[cfg(test)]` is test code, and so is what it declares; a
+    // file its parent declares, or no file declares, is not left out
+    let kept = test_modules_left_out(vec![
+        plant(&[], "mod chart;"),
+        plant(&["chart"], "mod a;\n#[cfg(test)]\nmod t;"),
+        plant(&["chart", "a"], ""),
+        plant(&["chart", "t"], "mod u;"),
+        plant(&["chart", "t", "u"], ""),
+    ]);
+    let modules: Vec<String> = kept.iter().map(|f| f.module.join("::")).collect();
+    assert_eq!(modules, ["", "chart", "chart::a"]);
 }

@@ -1,7 +1,8 @@
 //! The real plaza logs (data/plaza) through the replay engine (the table of
 //! docs/reproductions/plaza.md: `scripts/reproduce --only plaza`).
 
-use onebeacon_sim::replay::{Log, LogError, replay};
+use onebeacon::log::{Log, LogError};
+use onebeacon_sim::replay::replay;
 use std::path::PathBuf;
 
 fn log(n: u8) -> Log {

@@ -18,7 +18,11 @@
 //!   beliefs into commands (hoff's planner, sousa's FIM guidance, rypkema's behaviours);
 //! - [`config`]: what a vehicle's computer is configured with: estimators, controller,
 //!   stream (feature `serde`);
-//! - [`io`]: the JSON Lines codec of the session (feature `stream`, adds serde_json).
+//! - [`io`]: the files a user names, read one way ([`io::file`]), and the JSON Lines
+//!   codec of the session (feature `stream`, adds serde_json);
+//! - [`log`]: a log description (TOML) and its CSV files read into the session's items,
+//!   and the computer `onebeacon stream` sets up from one (feature `log`, adds toml,
+//!   csv, chrono for clock times, map_3d for latitudes and longitudes).
 //!
 //! Conventions: NED frame (x north, y east, z down), SI units, radians, heading from
 //! north toward east. Equation numbers in comments refer to the source papers.
@@ -30,6 +34,8 @@ pub mod filter;
 pub mod geo;
 pub mod guidance;
 pub mod io;
+#[cfg(feature = "log")]
+pub mod log;
 pub mod measure;
 pub mod models;
 pub mod nav;

@@ -23,7 +23,7 @@ pub struct Recording<R: Read> {
 impl Recording<std::io::BufReader<std::io::Take<std::fs::File>>> {
     /// Opens the WAV at `path` ([`Recording::new`]): a regular file, read to its length.
     pub fn open(path: &Path, channels: usize, fs_hz: f64) -> Result<Self, WavError> {
-        let file = crate::input_file::open_bounded(path).map_err(WavError)?;
+        let file = onebeacon::io::file::open_bounded(path).map_err(WavError)?;
         Self::new(std::io::BufReader::new(file), channels, fs_hz)
     }
 }

@@ -2,7 +2,9 @@
 //! ranges to one beacon were about 200 m short captured the calibrated filters): with
 //! their default keys, no estimator of the planar family follows it.
 
-use super::{Log, TestLog, replay, write_log};
+use super::replay;
+use onebeacon::log::Log;
+use onebeacon::log::testing::{TestLog, write_log};
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
@@ -271,7 +273,7 @@ fn a_reference_with_its_own_error_is_scored_as_one() {
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
     let base = lbl_log("reference", First::True, "");
-    let truth = std::fs::read_to_string(base.base.join("truth.csv")).unwrap();
+    let truth = std::fs::read_to_string(base.base().join("truth.csv")).unwrap();
     let noise = Normal::new(0.0, 3.0).unwrap();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(53);
     let mut noisy = String::from("t,x,y\n");
@@ -280,13 +282,13 @@ fn a_reference_with_its_own_error_is_scored_as_one() {
         let (dx, dy): (f64, f64) = (noise.sample(&mut rng), noise.sample(&mut rng));
         writeln!(noisy, "{},{},{}", v[0], v[1] + dx, v[2] + dy).unwrap();
     }
-    std::fs::write(base.base.join("truth.csv"), noisy).unwrap();
-    let toml = std::fs::read_to_string(base.base.join("log.toml")).unwrap();
+    std::fs::write(base.base().join("truth.csv"), noisy).unwrap();
+    let toml = std::fs::read_to_string(base.base().join("log.toml")).unwrap();
     let told = toml.replace("file = \"truth.csv\"\n", "file = \"truth.csv\"\nsigma_m = 3.0\n");
     assert_ne!(told, toml);
-    std::fs::write(base.base.join("told.toml"), told).unwrap();
+    std::fs::write(base.base().join("told.toml"), told).unwrap();
     let score = |file: &str| {
-        let log = Log::load(&base.base.join(file)).unwrap();
+        let log = Log::load(&base.base().join(file)).unwrap();
         let r = replay(&log, None, |_| Ok::<_, super::LogError>(())).unwrap();
         let s = r.session;
         let ekf = s.names.iter().position(|n| n == "ekf").unwrap();

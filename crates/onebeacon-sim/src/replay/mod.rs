@@ -1,32 +1,21 @@
 //! Replaying real logs: a log description maps CSV files and columns to measurement
-//! kinds ([`log`]); the onboard [`Session`] runs every configured estimator over the merged,
+//! kinds ([`onebeacon::log`]); the onboard [`Session`] runs every configured estimator over the merged,
 //! time-ordered stream, as `onebeacon stream` does live; [`replay`] does a whole log
 //! and keeps what the outputs need.
 
-mod csv;
-mod error;
-pub(crate) mod geodesy;
-pub mod log;
-mod merge;
-mod rows;
 pub mod rts;
-pub(crate) mod schema;
 pub mod tune;
-pub(crate) mod validate;
 
 #[cfg(test)]
 mod burst_tests;
+#[cfg(test)]
+mod log_tests;
 
-pub use error::LogError;
-pub use log::{InitialStart, Log, LogDescription};
-pub use rows::Dropped;
-
-use log::IncrementFrame;
-use onebeacon::config::stream::{Beacon, StreamConfig};
+use onebeacon::log::schema::IncrementFrame;
+use onebeacon::log::{Dropped, InitialStart, Log, LogError};
 use onebeacon::nav::Kind;
 use onebeacon::nav::diagnosis::BeaconStats;
 use onebeacon::nav::session::{Input, Session, Start, Step};
-use onebeacon::vehicle::unit::Unit;
 
 use crate::run::{Estimate, StepRecord, TruthRecord};
 use nalgebra::{Vector2, Vector3};
@@ -99,60 +88,6 @@ impl Replay {
     }
 }
 
-/// A log description `toml` and its `files` written to a directory of their own
-/// (`onebeacon-<prefix>-<pid>-<name>` in the temporary directory), loaded: the tests' logs.
-/// The directory goes with the log, or is kept (its path printed) when a test fails.
-#[cfg(test)]
-pub(crate) fn write_log(prefix: &str, name: &str, toml: &str, files: &[(&str, &str)]) -> Result<TestLog, LogError> {
-    let dir = std::env::temp_dir().join(format!("onebeacon-{prefix}-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    for (file, text) in files {
-        std::fs::write(dir.join(file), text).unwrap();
-    }
-    std::fs::write(dir.join("log.toml"), toml).unwrap();
-    match Log::load(&dir.join("log.toml")) {
-        Ok(log) => Ok(TestLog { log, dir }),
-        Err(e) => {
-            let _ = std::fs::remove_dir_all(&dir);
-            Err(e)
-        }
-    }
-}
-
-/// A test's log with the directory that holds its files: [`write_log`].
-#[cfg(test)]
-#[derive(Debug)]
-pub(crate) struct TestLog {
-    log: Log,
-    dir: std::path::PathBuf,
-}
-
-#[cfg(test)]
-impl std::ops::Deref for TestLog {
-    type Target = Log;
-    fn deref(&self) -> &Log {
-        &self.log
-    }
-}
-
-#[cfg(test)]
-impl std::ops::DerefMut for TestLog {
-    fn deref_mut(&mut self) -> &mut Log {
-        &mut self.log
-    }
-}
-
-#[cfg(test)]
-impl Drop for TestLog {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            eprintln!("the failed test's log is kept in {}", self.dir.display());
-        } else {
-            let _ = std::fs::remove_dir_all(&self.dir);
-        }
-    }
-}
-
 /// The session a log describes, started at its initial pose.
 pub fn session_for(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Session, LogError> {
     session_and_start(log, beacons).map(|(session, _)| session)
@@ -182,24 +117,6 @@ pub fn beacon_filter(ids: Option<Vec<u32>>, known: &BTreeSet<u32>) -> Result<Opt
         return Err(format!("{id}: not a beacon of the log (beacons: {})", list.join(", ")));
     }
     Ok(Some(ids.into_iter().collect()))
-}
-
-/// The vehicle's computer `onebeacon stream CONFIG` (and the Python `Navigator`) runs,
-/// from a log description: its stream configuration with the fixed beacons of its files
-/// ([`onebeacon::config::stream::StreamConfig::unit`]), refused where `fits` refuses it
-/// (where its filters would not fit in the memory budget: [`crate::budget::Budget::check_stream`]).
-pub fn stream_setup<E: std::fmt::Display>(
-    config: &std::path::Path,
-    fits: impl FnOnce(&StreamConfig) -> Result<(), E>,
-) -> Result<Unit, LogError> {
-    let d = LogDescription::load(config)?;
-    let base = config.parent().unwrap_or(std::path::Path::new("."));
-    let beacons =
-        d.fixed_beacons(base)?.into_iter().map(|(id, p)| Beacon { id, x_m: p.x, y_m: p.y, z_m: p.z }).collect();
-    let file = config.display().to_string();
-    let stream = d.stream_config(beacons);
-    fits(&stream).map_err(|e| LogError::File { file: file.clone(), message: e.to_string() })?;
-    stream.unit().map_err(|v| LogError::File { file, message: v.to_string() })
 }
 
 /// Each estimator's prediction of beacon `id`'s ranges by a run that never hears them,

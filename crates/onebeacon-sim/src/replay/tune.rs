@@ -345,7 +345,11 @@ mod tests {
     /// Gaussian noise of 0.8 m, every `outlier_every`-th range 40 m long (none for 0),
     /// with the estimator `estimator` (TOML keys after name and kind): the log, the
     /// standard deviation of the Gaussian noise drawn and every range's error.
-    fn circle_log(name: &str, outlier_every: usize, estimator: &str) -> (crate::replay::TestLog, f64, Vec<f64>) {
+    fn circle_log(
+        name: &str,
+        outlier_every: usize,
+        estimator: &str,
+    ) -> (onebeacon::log::testing::TestLog, f64, Vec<f64>) {
         let beacons = [(0, 60.0, 0.0), (1, -30.0, 50.0), (2, -30.0, -50.0)];
         let noise = Normal::new(0.0, 0.8).unwrap();
         let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
@@ -385,7 +389,8 @@ mod tests {
             heading_change_sigma_frac = 0.001\nheading_walk_deg_per_sqrt_m = 0.001\n{estimator}"
         );
         let files = [("odo.csv", &odo), ("ranges.csv", &ranges), ("truth.csv", &truth), ("b.csv", &beacon_rows)];
-        let log = crate::replay::write_log("tune", name, &toml, &files.map(|(f, t)| (f, t.as_str()))).unwrap();
+        let log =
+            onebeacon::log::testing::write_log("tune", name, &toml, &files.map(|(f, t)| (f, t.as_str()))).unwrap();
         (log, (drawn_sq / drawn_n as f64).sqrt(), errors)
     }
 

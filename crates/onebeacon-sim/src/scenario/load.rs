@@ -2,6 +2,7 @@
 //! the source, the key and what is allowed.
 
 use super::{FixedBeacon, Fleet, MovingBeacon, PassiveUsbl, Scenario, builtin, validate};
+use onebeacon::config::toml_file::{self, ConfigError};
 use std::path::Path;
 
 /// Why a scenario could not be loaded. Each message is one line naming the source (file
@@ -10,14 +11,8 @@ use std::path::Path;
 pub enum ScenarioError {
     #[error("unknown scenario `{name}`: built-in scenarios are {available}; or give the path of a .toml file")]
     UnknownBuiltin { name: String, available: String },
-    #[error("{source_name}: {message}")]
-    Io { source_name: String, message: String },
-    #[error("{source_name}: line {line}: {message}")]
-    Syntax { source_name: String, line: usize, message: String },
-    #[error("{source_name}: line {line}: key `{key}`: {message}")]
-    Key { source_name: String, line: usize, key: String, message: String },
-    #[error("{source_name}: key `{key}` = {value}: {allowed}")]
-    Invalid { source_name: String, key: String, value: String, allowed: String },
+    #[error(transparent)]
+    File(#[from] ConfigError),
 }
 
 /// Loads `name_or_path`: a built-in scenario name, or the path of a TOML file.
@@ -45,40 +40,17 @@ pub fn load_builtin(name: &str) -> Result<Scenario, ScenarioError> {
 
 /// Loads the scenario of the TOML file at `path`.
 pub fn load_file(path: &Path) -> Result<Scenario, ScenarioError> {
-    let name = path.display().to_string();
-    let text = crate::input_file::read_text(path)
-        .map_err(|message| ScenarioError::Io { source_name: name.clone(), message })?;
-    parse(&text, &name)
+    parse(&toml_file::read(path)?, &path.display().to_string())
 }
 
 /// Deserializes TOML into `T` with errors naming the source, line and key.
 pub(crate) fn deserialize<T: serde::de::DeserializeOwned>(text: &str, source_name: &str) -> Result<T, ScenarioError> {
-    let line_of = |span: Option<std::ops::Range<usize>>| {
-        span.map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1).unwrap_or(0)
-    };
-    let one_line = |m: &str| m.trim().replace('\n', "; ");
-    let syntax = |e: toml::de::Error| ScenarioError::Syntax {
-        source_name: source_name.to_string(),
-        line: line_of(e.span()),
-        message: one_line(e.message()),
-    };
-    let keyed = |e: serde_path_to_error::Error<toml::de::Error>| {
-        let key = e.path().to_string();
-        let inner = e.into_inner();
-        let (line, message) = (line_of(inner.span()), one_line(inner.message()));
-        if key == "." {
-            ScenarioError::Syntax { source_name: source_name.to_string(), line, message }
-        } else {
-            ScenarioError::Key { source_name: source_name.to_string(), line, key, message }
-        }
-    };
-    let de = toml::Deserializer::parse(text).map_err(syntax)?;
-    serde_path_to_error::deserialize(de).map_err(keyed)
+    Ok(toml_file::deserialize(text, source_name)?)
 }
 
 /// Turns a validation failure into the error naming the source.
 pub(crate) fn invalid(source_name: &str, v: validate::Violation) -> ScenarioError {
-    ScenarioError::Invalid { source_name: source_name.to_string(), key: v.key, value: v.value, allowed: v.allowed }
+    toml_file::invalid(source_name, v).into()
 }
 
 /// Parses and validates scenario TOML; `source_name` names it in errors.

@@ -193,9 +193,7 @@ impl PingConfig {
     /// Reads `path`, or the defaults.
     pub fn load(path: Option<&str>) -> Result<Self, ScenarioError> {
         let Some(path) = path else { return Ok(Self::default()) };
-        let text = crate::input_file::read_text(std::path::Path::new(path))
-            .map_err(|message| ScenarioError::Io { source_name: path.to_string(), message })?;
-        Self::parse(&text, path)
+        Self::parse(&onebeacon::config::toml_file::read(std::path::Path::new(path))?, path)
     }
 
     pub fn parse(text: &str, source_name: &str) -> Result<Self, ScenarioError> {

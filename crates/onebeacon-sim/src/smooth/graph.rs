@@ -11,10 +11,10 @@
 
 use super::factor::{At, CalVars, Factor, Node};
 use super::{Calibrate, Offsets, SmoothConfig, SmoothError};
-use crate::replay::Log;
 use nalgebra::Vector3;
 use onebeacon::filter::FilterKind;
 use onebeacon::geo::wrap_angle;
+use onebeacon::log::Log;
 use onebeacon::nav::Kind;
 use onebeacon::nav::session::Input;
 use onebeacon::nav::tracking::INITIAL_VELOCITY_SIGMA_M_S;

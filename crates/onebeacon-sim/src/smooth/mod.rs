@@ -16,10 +16,10 @@ mod tests;
 pub use options::{CALIBRATION_NAMES, KERNEL_NAMES, config};
 pub use solve::SolveError;
 
-use crate::replay::{Log, LogError};
 use factor::Node;
 use nalgebra::{Matrix2, Vector2};
 use onebeacon::filter::consistency::nees;
+use onebeacon::log::{Log, LogError};
 use onebeacon::nav::evaluation::ErrorStats;
 use onebeacon::nav::{PlanarConfig, PlanarNoise, Robust};
 use std::collections::{BTreeMap, BTreeSet};

@@ -3,7 +3,7 @@
 //! variables and a kernel by name.
 
 use super::{Calibrate, Offsets, SmoothConfig};
-use crate::replay::Log;
+use onebeacon::log::Log;
 use onebeacon::nav::Robust;
 
 /// The calibration variables' names.

@@ -34,7 +34,13 @@ const TRACK_BEACONS: [(u32, f64, f64); 3] = [(1, 40.0, -30.0), (2, -20.0, 60.0),
 /// noise, the ground truth, written to a directory of its own and loaded. Truth's steps
 /// are the odometry's plus noise of the smoother's default model (`noisy`), so the
 /// data follow the model exactly.
-fn synthetic(name: &str, steps: usize, scale: f64, offsets: [f64; 2], noisy: Option<u64>) -> crate::replay::TestLog {
+fn synthetic(
+    name: &str,
+    steps: usize,
+    scale: f64,
+    offsets: [f64; 2],
+    noisy: Option<u64>,
+) -> onebeacon::log::testing::TestLog {
     let n = PlanarNoise::default();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(noisy.unwrap_or(0));
     let mut draw = |sigma: f64| if noisy.is_some() { Normal::new(0.0, sigma).unwrap().sample(&mut rng) } else { 0.0 };
@@ -92,7 +98,7 @@ kind = "dead-reckoning"
     );
     let beacons = format!("id,x,y\n{beacons}");
     let files = [("odo.csv", &odo), ("ranges.csv", &ranges), ("truth.csv", &truth), ("beacons.csv", &beacons)];
-    crate::replay::write_log("smooth", name, &toml, &files.map(|(f, t)| (f, t.as_str()))).unwrap()
+    onebeacon::log::testing::write_log("smooth", name, &toml, &files.map(|(f, t)| (f, t.as_str()))).unwrap()
 }
 
 /// Exact odometry and ranges read 5 % long with an offset per beacon: the smoother,
@@ -267,7 +273,7 @@ fn a_track_without_measurements_spreads_as_the_kalman_prediction() {
 /// acceleration of the smoother's q), ranged to three beacons every 2 s (two would
 /// leave a mirror track about their baseline, which the filter too follows): a log of
 /// ranges and ground truth only.
-fn tracked(name: &str, seed: u64) -> crate::replay::TestLog {
+fn tracked(name: &str, seed: u64) -> onebeacon::log::testing::TestLog {
     const ACCEL: f64 = 0.1;
     let n = PlanarNoise::default();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
@@ -313,7 +319,7 @@ nis_gate = inf
     );
     let beacons = format!("id,x,y\n{beacons}");
     let files = [("ranges.csv", &ranges), ("truth.csv", &truth), ("beacons.csv", &beacons)];
-    crate::replay::write_log("smooth", name, &toml, &files.map(|(f, t)| (f, t.as_str()))).unwrap()
+    onebeacon::log::testing::write_log("smooth", name, &toml, &files.map(|(f, t)| (f, t.as_str()))).unwrap()
 }
 
 /// The constant-velocity smoother on data drawn from its own model: its NEES at the

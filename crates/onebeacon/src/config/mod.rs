@@ -16,6 +16,8 @@ mod estimator_check;
 mod estimator_defaults;
 pub mod iusbl;
 pub mod stream;
+#[cfg(feature = "log")]
+pub mod toml_file;
 pub mod working_set;
 
 pub use estimator_check::check_estimators;

@@ -1,5 +1,6 @@
 //! Input and output formats of the onboard crate.
 
+pub mod file;
 #[cfg(feature = "stream")]
 pub mod jsonl;
 #[cfg(feature = "stream")]

@@ -47,7 +47,7 @@ impl Table {
         let path = base.join(file);
         let name = path.display().to_string();
         let f =
-            crate::input_file::open_bounded(&path).map_err(|message| LogError::File { file: name.clone(), message })?;
+            crate::io::file::open_bounded(&path).map_err(|message| LogError::File { file: name.clone(), message })?;
         let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(LineLimited { inner: f, line: 0 });
         let header = reader
             .headers()

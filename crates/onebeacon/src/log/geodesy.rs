@@ -1,8 +1,8 @@
 //! Latitudes and longitudes in a log: their units, the origin, the WGS-84 tangent plane
 //! they become local north and east on (`map_3d`), and where a point may lie.
 
+use crate::geo::Frame;
 use nalgebra::Vector3;
-use onebeacon::geo::Frame;
 use serde::Deserialize;
 
 /// How latitudes and longitudes are written (`latlon_unit`).

@@ -5,10 +5,10 @@ use super::csv::Table;
 use super::error::LogError;
 use super::geodesy::Geodetic;
 use super::schema::{COLUMN_KEYS, IncrementFrame, Source, SourceKind, TimeOrder};
+use crate::geo::Frame;
+use crate::nav::Kind;
+use crate::nav::session::{Input, Item, TruthPose, resolve_beacon};
 use nalgebra::Vector3;
-use onebeacon::geo::Frame;
-use onebeacon::nav::Kind;
-use onebeacon::nav::session::{Input, Item, TruthPose, resolve_beacon};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 

@@ -2,11 +2,11 @@
 //! units, clocks, beacons, start and limits), deserialised and documented.
 
 pub use super::geodesy::{LatLonUnit, Origin};
-use onebeacon::config::builder::VehicleModel;
-use onebeacon::config::controller::ControllerSpec;
-use onebeacon::config::estimator::EstimatorSpec;
-pub use onebeacon::config::stream::{FrameKey, HeadingFrom, Initial, InitialFrom};
-use onebeacon::nav::limits::Limits;
+use crate::config::builder::VehicleModel;
+use crate::config::controller::ControllerSpec;
+use crate::config::estimator::EstimatorSpec;
+pub use crate::config::stream::{FrameKey, HeadingFrom, Initial, InitialFrom};
+use crate::nav::limits::Limits;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -297,7 +297,7 @@ pub struct BeaconEntry {
 }
 
 /// The log description file: the keys of a stream configuration
-/// ([`onebeacon::config::stream::StreamConfig`], which documents them) and where the
+/// ([`crate::config::stream::StreamConfig`], which documents them) and where the
 /// log's data are (its sources, its beacons' file or positions in latitude and
 /// longitude, the origin); [`LogDescription::stream_config`] gives the former.
 #[derive(Debug, Clone, Deserialize)]
@@ -327,7 +327,7 @@ pub struct LogDescription {
     pub estimators: Vec<EstimatorSpec>,
     /// Noise keys every estimator takes unless it gives its own (`[noise]`): one place
     /// for what the sensors are, the estimators differing in what they estimate. Its
-    /// keys are [`onebeacon::config::estimator::NOISE_KEYS`].
+    /// keys are [`crate::config::estimator::NOISE_KEYS`].
     #[serde(default)]
     pub noise: BTreeMap<String, f64>,
     /// What an item must respect before any estimator sees it.

@@ -4,7 +4,7 @@
 use super::error::LogError;
 use super::rows::{Dropped, SourceRows};
 use super::schema::TimeOrder;
-use onebeacon::nav::session::Item;
+use crate::nav::session::Item;
 
 /// The rows of one source still to come.
 pub(super) enum Rows<'a> {

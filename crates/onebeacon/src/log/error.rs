@@ -1,10 +1,10 @@
-//! Why a log could not be loaded, for every file of the replay that reads one.
+//! Why a log could not be loaded, for every file of the log layer that reads one.
 
 /// Why a log could not be loaded: one line each.
 #[derive(Debug, thiserror::Error)]
 pub enum LogError {
     #[error(transparent)]
-    Description(#[from] crate::ScenarioError),
+    Description(#[from] crate::config::toml_file::ConfigError),
     #[error("{file}: {message}")]
     File { file: String, message: String },
     #[error("{file} line {line}, column `{column}`: {message}")]

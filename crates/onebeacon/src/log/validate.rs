@@ -1,10 +1,10 @@
 //! Range checks on a parsed log description's own keys: each source's column keys, its
 //! time keys, the beacons and the origin (the keys it shares with a stream configuration
-//! are checked by [`onebeacon::config::stream::StreamConfig::check`]). The first
+//! are checked by [`crate::config::stream::StreamConfig::check`]). The first
 //! violation is reported with its key.
 
 use super::schema::{COLUMN_KEYS, IncrementFrame, LogDescription, Source, SourceKind, TimeOrder, TimeUnit};
-use crate::scenario::validate::{Rule, Violation, check};
+use crate::config::check::{Rule, Violation, check};
 
 /// A position given as exactly one pair: `x`/`y` or `lat`/`lon` (the keys named by
 /// `keys`, at `at`).
@@ -80,7 +80,7 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
         });
     }
     if let Some(o) = &d.origin
-        && !crate::replay::geodesy::on_earth(o.lat_deg, o.lon_deg)
+        && !super::geodesy::on_earth(o.lat_deg, o.lon_deg)
     {
         return Err(Violation {
             key: "origin".into(),

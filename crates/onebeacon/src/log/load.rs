@@ -8,14 +8,14 @@ use super::geodesy::{Geodetic, check_latlon};
 use super::merge::{Items, Rows};
 use super::rows::{Site, SourceRows};
 pub use super::schema::*;
-use crate::scenario::load::deserialize;
-use crate::scenario::{EstimatorKind, EstimatorSpec};
+use crate::config::builder::VehicleModel;
+use crate::config::estimator::{EstimatorKind, EstimatorSpec, Host};
+use crate::config::stream::{Beacon, StreamConfig};
+use crate::config::toml_file::{deserialize, invalid as invalid_in};
+use crate::geo::Frame;
+use crate::nav::session::Input;
+use crate::nav::{Kind, Measurement, Navigator};
 use nalgebra::{Vector2, Vector3};
-use onebeacon::config::builder::VehicleModel;
-use onebeacon::config::stream::{Beacon, StreamConfig};
-use onebeacon::geo::Frame;
-use onebeacon::nav::session::Input;
-use onebeacon::nav::{Kind, Measurement, Navigator};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -42,12 +42,17 @@ pub struct Log {
     pub(super) tracked: BTreeSet<u32>,
     /// Latitude and longitude to local positions, when the log has them.
     pub(super) geodetic: Option<Geodetic>,
-    pub(crate) base: PathBuf,
+    base: PathBuf,
     /// The description's own path.
     path: PathBuf,
 }
 
 impl Log {
+    /// The directory the description's file names are relative to.
+    pub fn base(&self) -> &Path {
+        &self.base
+    }
+
     /// Every file the log reads: its description, its CSV files and its beacons file.
     pub fn files(&self) -> Vec<PathBuf> {
         let mut files = vec![self.path.clone()];
@@ -73,14 +78,14 @@ impl LogDescription {
     pub fn load(path: &Path) -> Result<Self, LogError> {
         let name = path.display().to_string();
         let text =
-            crate::input_file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
+            crate::io::file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
         Self::parse(&text, &name)
     }
 
     /// Parses and checks the text of a log description; `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, LogError> {
         let mut d: LogDescription = deserialize(text, name)?;
-        let invalid = |v| LogError::Description(crate::scenario::load::invalid(name, v));
+        let invalid = |v| LogError::Description(invalid_in(name, v));
         // the onboard keys as a stream checks them, with `[noise]` handed out
         d.estimators = d.stream_config(Vec::new()).checked().map_err(invalid)?.estimators;
         super::validate::validate_log(&d).map_err(invalid)?;
@@ -93,15 +98,15 @@ impl LogDescription {
     pub fn use_estimators(&mut self, path: &Path) -> Result<(), LogError> {
         self.estimators = load_estimators(path)?;
         let file = path.display().to_string();
-        let invalid = |v| LogError::Description(crate::scenario::load::invalid(&file, v));
+        let invalid = |v| LogError::Description(invalid_in(&file, v));
         self.estimators = self.stream_config(Vec::new()).checked().map_err(invalid)?.estimators;
         Ok(())
     }
 
     /// The noise of an estimator that sets no noise key of its own: the defaults with
     /// `[noise]`'s keys (what `smooth` weighs with, without `--like`).
-    pub fn default_noise(&self) -> onebeacon::nav::PlanarNoise {
-        let mut spec = EstimatorSpec::new(onebeacon::config::estimator::EstimatorKind::RangeEkf);
+    pub fn default_noise(&self) -> crate::nav::PlanarNoise {
+        let mut spec = EstimatorSpec::new(crate::config::estimator::EstimatorKind::RangeEkf);
         for (key, v) in &self.noise {
             if let Some(slot) = spec.key_mut(key) {
                 *slot = Some(*v);
@@ -234,13 +239,13 @@ struct EstimatorFile {
 /// own (`replay --estimators`).
 fn load_estimators(path: &Path) -> Result<Vec<EstimatorSpec>, LogError> {
     let name = path.display().to_string();
-    let text = crate::input_file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
+    let text = crate::io::file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
     let f: EstimatorFile = deserialize(&text, &name)?;
     if f.estimators.is_empty() {
         return Err(LogError::File { file: name, message: "no [[estimators]] table".into() });
     }
-    crate::scenario::validate::check_estimators(&f.estimators, crate::scenario::Host::Log)
-        .map_err(|v| LogError::Description(crate::scenario::load::invalid(&name, v)))?;
+    crate::config::check_estimators(&f.estimators, Host::Log)
+        .map_err(|v| LogError::Description(invalid_in(&name, v)))?;
     Ok(f.estimators)
 }
 
@@ -406,7 +411,7 @@ impl Log {
         let used = beacons.map_or(String::new(), |b| {
             format!(" of beacons {}", b.iter().map(u32::to_string).collect::<Vec<_>>().join(", "))
         });
-        let fix = onebeacon::nav::fix::multilaterate(&shifted, depth).ok_or_else(|| {
+        let fix = crate::nav::fix::multilaterate(&shifted, depth).ok_or_else(|| {
             fail(format!(
                 "initial.from = \"ranges\": the {} ranges{used} in the first {} s (initial.ranges_window_s) do not fix a position (three beacons not in a line are needed; with fewer, start from = \"given\" or \"ground_truth\")",
                 ranges.len(),
@@ -428,7 +433,7 @@ impl Log {
                 .iter()
                 .filter_map(|b| {
                     let others: Vec<_> = shifted.iter().filter(|r| r.0 != *b).copied().collect();
-                    onebeacon::nav::fix::multilaterate(&others, depth).map(|f| f.position)
+                    crate::nav::fix::multilaterate(&others, depth).map(|f| f.position)
                 })
                 .collect()
         } else {
@@ -512,19 +517,19 @@ fn dead_reckoning(t0_s: f64) -> Box<dyn Navigator> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nav::BeaconFix;
+    use crate::nav::session::Item;
     use approx::assert_abs_diff_eq;
-    use onebeacon::nav::BeaconFix;
-    use onebeacon::nav::session::Item;
     use std::f64::consts::{FRAC_PI_2, PI};
 
     /// A log description (`body`, then a dead-reckoning estimator) and its CSV files in
     /// a directory of their own, loaded.
-    fn load(name: &str, body: &str, files: &[(&str, &str)]) -> Result<crate::replay::TestLog, LogError> {
+    fn load(name: &str, body: &str, files: &[(&str, &str)]) -> Result<super::super::testing::TestLog, LogError> {
         let toml = format!(
             "name = \"{name}\"\n{body}\n[initial]\nfrom = \"given\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n\
              [[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n"
         );
-        crate::replay::write_log("log", name, &toml, files)
+        super::super::testing::write_log("log", name, &toml, files)
     }
 
     fn items(log: &Log) -> Vec<Item> {
@@ -721,60 +726,6 @@ y = "y"
         assert_abs_diff_eq!(heading_change_rad, -PI / 6.0, epsilon = 1e-12);
     }
 
-    /// `increment_frame = "start"`: factor-graph edges (a translation in the start pose's
-    /// frame, then the turn) with turns of 80-150 deg. Dead reckoning lands on the
-    /// closed-form SE(2) composition p += R(psi) (d, l), psi += dpsi at every step (1e-9
-    /// m), in a NED and an ENU log, from body_odometry and from odometry; the same rows
-    /// read at the mid-step heading (the default) end metres off.
-    #[test]
-    fn start_frame_increments_compose_as_factor_graph_edges() {
-        for frame in ["ned", "enu"] {
-            for (kind, columns) in
-                [("body_odometry", "forward = \"d\"\nlateral = \"l\""), ("odometry", "distance = \"d\"")]
-            {
-                let (mut odometry, mut truth) = ("t,d,l,dh\n".to_string(), "t,x,y\n".to_string());
-                let (mut x, mut y, mut psi) = (0.0f64, 0.0f64, 0.0f64);
-                for k in 0..40 {
-                    let d = 1.0 + (k % 5) as f64;
-                    let l = if kind == "odometry" { 0.0 } else { 0.4 * ((k % 3) as f64 - 1.0) };
-                    let turn =
-                        (80.0 + 70.0 * ((k * 7) % 11) as f64 / 10.0).to_radians() * if k % 2 == 0 { 1.0 } else { -1.0 };
-                    x += d * psi.cos() - l * psi.sin();
-                    y += d * psi.sin() + l * psi.cos();
-                    psi += turn;
-                    odometry += &format!("{k}.0,{d},{l},{turn}\n");
-                    truth += &format!("{k}.5,{x},{y}\n");
-                }
-                let run = |increment: &str| {
-                    let body = format!(
-                        "frame = \"{frame}\"\n[[source]]\nkind = \"{kind}\"\nfile = \"o.csv\"\ntime = \"t\"\n{columns}\n\
-                         heading_change = \"dh\"\n{increment}\n[[source]]\nkind = \"ground_truth\"\nfile = \"g.csv\"\n\
-                         time = \"t\"\nx = \"x\"\ny = \"y\"\n"
-                    );
-                    let log = load(&format!("start-{frame}-{kind}"), &body, &[("o.csv", &odometry), ("g.csv", &truth)])
-                        .unwrap();
-                    let mut worst: f64 = 0.0;
-                    let r = crate::replay::replay(&log, None, |row| {
-                        worst = worst.max(row.estimates[0].error_m);
-                        Ok::<_, LogError>(())
-                    })
-                    .unwrap();
-                    assert_eq!(r.session.stats[0].count, 40);
-                    (worst, r.warnings(true))
-                };
-                let ((start, quiet), (mid, warned)) = (run("increment_frame = \"start\""), run(""));
-                assert!(start < 1e-9, "{frame} {kind}: {start} m off the composition");
-                assert!(mid > 1.0, "{frame} {kind}: the mid-step reading is {mid} m off");
-                // every turn is wider than the warning's 23 deg: read at mid-step, it is said
-                assert!(quiet.is_empty(), "{quiet:?}");
-                assert!(
-                    warned.iter().any(|w| w.starts_with("40 of 40 odometry rows") && w.contains("increment_frame")),
-                    "{warned:?}"
-                );
-            }
-        }
-    }
-
     /// A CSV file without a header row (its first line is data) is refused by that
     /// name, even when a key names a column by a number the first line holds.
     #[test]
@@ -795,7 +746,7 @@ y = "y"
         let d = LogDescription::parse(toml, "no-initial.toml").unwrap();
         assert_eq!((d.initial.from, d.initial.heading_from), (InitialFrom::GroundTruth, HeadingFrom::Column));
         assert_eq!((d.initial.position_sigma_m, d.initial.heading_sigma_deg, d.initial.track_m), (1.0, 5.0, 2.0));
-        let log = crate::replay::write_log(
+        let log = super::super::testing::write_log(
             "log",
             "no-initial",
             toml,
@@ -1049,49 +1000,6 @@ heading_clockwise = true
         assert_abs_diff_eq!(b.heading_walk_rad_per_sqrt_m, 0.2f64.to_radians(), epsilon = 1e-15);
         let e = LogDescription::parse(&toml.replace("0.7", "-1.0"), "n.toml").unwrap_err().to_string();
         assert!(e.contains("noise.range_sigma_m"), "{e}");
-    }
-
-    /// `initial.from = "ranges"`: a vehicle resting at (3, 4) ranged from three beacons
-    /// (exact ranges, and one 150 m off): the start is the fix, at the end of the window,
-    /// with the heading given; with two beacons it is refused, naming the key.
-    #[test]
-    fn a_start_from_the_first_ranges() {
-        let body = "[[source]]\nkind = \"range\"\nfile = \"r.csv\"\ntime = \"t\"\nbeacon = \"id\"\nrange = \"r\"\n\
-                    [[beacon]]\nid = 0\nx_m = 40.0\ny_m = 0.0\n[[beacon]]\nid = 1\nx_m = -20.0\ny_m = 30.0\n\
-                    [[beacon]]\nid = 2\nx_m = -20.0\ny_m = -30.0\n";
-        let p = (3.0f64, 4.0f64);
-        let d = |bx: f64, by: f64| (p.0 - bx).hypot(p.1 - by);
-        let mut csv = String::from("t,id,r\n");
-        for k in 0..12 {
-            let (id, (bx, by)) = [(0, (40.0, 0.0)), (1, (-20.0, 30.0)), (2, (-20.0, -30.0))][k % 3];
-            let outlier = if k == 4 { 150.0 } else { 0.0 };
-            csv += &format!("{},{id},{}\n", 1.0 + k as f64, d(bx, by) + outlier);
-        }
-        let log = load("ranges-start", body, &[("r.csv", &csv)]).unwrap();
-        let mut log = log;
-        log.description.initial.from = InitialFrom::Ranges;
-        log.description.initial.ranges_window_s = 10.0;
-        log.description.initial.heading_deg = Some(90.0);
-        let InitialStart { t0_s: t0, pose: (n, e, psi), position_sigma_m: sigma } = log.initial_start(None).unwrap();
-        assert_eq!(t0, 11.0);
-        // the 150 m outlier keeps a Huber weight of about 1e-4: 1 mm of pull
-        assert_abs_diff_eq!(n, p.0, epsilon = 0.01);
-        assert_abs_diff_eq!(e, p.1, epsilon = 0.01);
-        assert_abs_diff_eq!(psi, FRAC_PI_2, epsilon = 1e-12);
-        assert_eq!(sigma, 1.0); // the fix is exact: position_sigma_m's default
-        // the replay starts there and says so in its summary (in the log's frame)
-        let r = crate::replay::replay(&log, None, |_| Ok::<_, LogError>(())).unwrap();
-        assert_eq!(r.start, log.initial_start(None).unwrap());
-        let v = crate::json::replay_summary(&log, &[0, 1, 2], &r, 0.0);
-        let at = |k: &str| v["start"][k].as_f64().unwrap();
-        assert_eq!((v["start"]["from"].as_str(), at("t_s"), at("position_sigma_m")), (Some("ranges"), 11.0, 1.0));
-        assert_eq!((at("x_m"), at("y_m"), at("heading_rad")), (n, e, psi));
-        let two = csv.lines().filter(|l| !l.contains(",2,")).collect::<Vec<_>>().join("\n");
-        let mut log = load("ranges-two", body, &[("r.csv", &two)]).unwrap();
-        log.description.initial.from = InitialFrom::Ranges;
-        log.description.initial.heading_deg = Some(0.0);
-        let e = log.initial_start(None).unwrap_err().to_string();
-        assert!(e.contains("initial.ranges_window_s") && e.contains("three beacons"), "{e}");
     }
 
     /// A DVL: forward and lateral speeds and a yaw rate in the source's units, read to
