@@ -4,19 +4,9 @@
 use super::replay;
 use approx::assert_abs_diff_eq;
 use onebeacon::log::schema::InitialFrom;
-use onebeacon::log::testing::{TestLog, write_log};
+use onebeacon::log::testing::dead_reckoning_log as load;
 use onebeacon::log::{InitialStart, LogError};
 use std::f64::consts::FRAC_PI_2;
-
-/// A log description (`body`, then a dead-reckoning estimator) and its CSV files in
-/// a directory of their own, loaded.
-fn load(name: &str, body: &str, files: &[(&str, &str)]) -> Result<TestLog, LogError> {
-    let toml = format!(
-        "name = \"{name}\"\n{body}\n[initial]\nfrom = \"given\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n\
-         [[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n"
-    );
-    write_log("log", name, &toml, files)
-}
 
 /// `increment_frame = "start"`: factor-graph edges (a translation in the start pose's
 /// frame, then the turn) with turns of 80-150 deg. Dead reckoning lands on the

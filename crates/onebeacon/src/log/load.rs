@@ -11,7 +11,7 @@ pub use super::schema::*;
 use crate::config::builder::VehicleModel;
 use crate::config::estimator::{EstimatorKind, EstimatorSpec, Host};
 use crate::config::stream::{Beacon, StreamConfig};
-use crate::config::toml_file::{deserialize, invalid as invalid_in};
+use crate::config::toml_file::{deserialize, invalid as invalid_in, read};
 use crate::geo::Frame;
 use crate::nav::session::Input;
 use crate::nav::{Kind, Measurement, Navigator};
@@ -76,10 +76,7 @@ impl Log {
 impl LogDescription {
     /// Reads and checks a log description (the CSV files are not read).
     pub fn load(path: &Path) -> Result<Self, LogError> {
-        let name = path.display().to_string();
-        let text =
-            crate::io::file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
-        Self::parse(&text, &name)
+        Self::parse(&read(path)?, &path.display().to_string())
     }
 
     /// Parses and checks the text of a log description; `name` names it in errors.
@@ -239,8 +236,7 @@ struct EstimatorFile {
 /// own (`replay --estimators`).
 fn load_estimators(path: &Path) -> Result<Vec<EstimatorSpec>, LogError> {
     let name = path.display().to_string();
-    let text = crate::io::file::read_text(path).map_err(|message| LogError::File { file: name.clone(), message })?;
-    let f: EstimatorFile = deserialize(&text, &name)?;
+    let f: EstimatorFile = deserialize(&read(path)?, &name)?;
     if f.estimators.is_empty() {
         return Err(LogError::File { file: name, message: "no [[estimators]] table".into() });
     }
@@ -516,21 +512,12 @@ fn dead_reckoning(t0_s: f64) -> Box<dyn Navigator> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::testing::dead_reckoning_log as load;
     use super::*;
     use crate::nav::BeaconFix;
     use crate::nav::session::Item;
     use approx::assert_abs_diff_eq;
     use std::f64::consts::{FRAC_PI_2, PI};
-
-    /// A log description (`body`, then a dead-reckoning estimator) and its CSV files in
-    /// a directory of their own, loaded.
-    fn load(name: &str, body: &str, files: &[(&str, &str)]) -> Result<super::super::testing::TestLog, LogError> {
-        let toml = format!(
-            "name = \"{name}\"\n{body}\n[initial]\nfrom = \"given\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n\
-             [[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n"
-        );
-        super::super::testing::write_log("log", name, &toml, files)
-    }
 
     fn items(log: &Log) -> Vec<Item> {
         log.items().unwrap().map(Result::unwrap).collect()

@@ -51,3 +51,13 @@ impl Drop for TestLog {
         }
     }
 }
+
+/// A log description (`body`, then a dead-reckoning estimator started at the origin
+/// heading north) and its CSV files in a directory of their own, loaded.
+pub fn dead_reckoning_log(name: &str, body: &str, files: &[(&str, &str)]) -> Result<TestLog, LogError> {
+    let toml = format!(
+        "name = \"{name}\"\n{body}\n[initial]\nfrom = \"given\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n\
+         [[estimators]]\nname = \"dr\"\nkind = \"dead-reckoning\"\n"
+    );
+    write_log("log", name, &toml, files)
+}
