@@ -1,14 +1,14 @@
 //! Each vehicle's computer in a world, described once: the stream configuration a
 //! vehicle reads (`onebeacon stream CONFIG`: estimators, controller, where each vehicle
-//! it estimates starts), with the run's exact starts. The engine's tracks and helms are
-//! built from it ([`OnBoard::tracks`], [`OnBoard::helm`]) and `run --messages` writes
-//! it ([`crate::messages`]): a fixed-beacon world's AUV (garin2024's filters, no
+//! it estimates starts), with the run's exact starts. The engine runs the
+//! [`Unit`](onebeacon::vehicle::unit::Unit) it builds ([`OnBoard::aboard`]), the very
+//! computer `stream` runs, and `run --messages` writes it ([`crate::messages`]): a fixed-beacon world's AUV (garin2024's filters, no
 //! controller), a passive-USBL world's surface vehicle (tracking every AUV,
 //! its bearing planner), a moving-beacon world's beacon vehicle (the estimators of the
 //! vehicle it serves, its FIM guidance) and the vehicles it does not serve, each fleet
 //! AUV (its iUSBL navigators and dead reckoning, its behaviours).
 
-use crate::engine::{Helm, Track};
+use crate::engine::Aboard;
 use crate::scenario::estimator::IusblKeys;
 use crate::scenario::fleet::{Fleet, Navigation};
 use crate::scenario::moving_beacon::GuidanceKind as FimKind;
@@ -22,8 +22,7 @@ use onebeacon::config::builder::{TrackerStart, VehicleModel};
 use onebeacon::config::controller::{
     BearingModeName, BearingSpec, BehavioursSpec, ControllerSpec, FimMetricName, FimModeName, FimSpec, MetricName,
 };
-use onebeacon::config::stream::{FrameKey, Initial, InitialFrom, StreamConfig};
-use onebeacon::geo::Frame;
+use onebeacon::config::stream::{FrameKey, Initial, InitialFrom, StreamConfig, VehicleStart};
 use onebeacon::models::hoff::idx;
 use onebeacon::models::kinematic6dof::State as Eta;
 use onebeacon::models::unicycle::State as UnicycleState;
@@ -54,40 +53,33 @@ pub(crate) struct OnBoard {
 }
 
 impl OnBoard {
-    /// Every estimator of the configuration on every vehicle it estimates, vehicle by
-    /// vehicle, each built by `build` (the spec's own [`EstimatorSpec::builder`] but
-    /// where a world's signal needs another).
-    pub(crate) fn tracks(&self, build: &impl Fn(&EstimatorSpec, TrackerStart, VehicleModel) -> Builder) -> Vec<Track> {
-        let mut tracks = Vec::new();
-        for s in &self.starts {
-            for e in &self.config.estimators {
-                tracks.push(Track::new(s.vehicle, build(e, s.tracker, self.config.model), s.pose, s.sigmas));
-            }
-        }
-        tracks
-    }
-
-    /// Its controller, serving the vehicles it estimates (None without one).
-    pub(crate) fn helm(&self) -> Option<Helm> {
-        let spec = self.config.controller.as_ref()?;
-        let serves = self.starts.iter().map(|s| s.vehicle).collect();
-        Some(Helm { controller: spec.build(Frame::from(self.config.frame)).controller, serves })
+    /// The computer the engine runs: the [`Unit`](onebeacon::vehicle::unit::Unit) its
+    /// configuration builds ([`StreamConfig::unit_of`]), one session per vehicle it
+    /// estimates started at time 0 at its exact start, each estimator built by `build`
+    /// (the spec's own [`EstimatorSpec::builder`] but where a world's signal needs
+    /// another).
+    pub(crate) fn aboard(&self, build: &dyn Fn(&EstimatorSpec, TrackerStart, VehicleModel) -> Builder) -> Aboard {
+        let starts: Vec<VehicleStart> = self
+            .starts
+            .iter()
+            .map(|s| VehicleStart {
+                start: onebeacon::nav::session::Start::At { t0_s: Some(0.0), pose: s.pose },
+                tracker: s.tracker,
+                sigmas: s.sigmas,
+            })
+            .collect();
+        Aboard { unit: self.config.unit_of(&starts, build), vehicles: self.starts.iter().map(|s| s.vehicle).collect() }
     }
 }
 
-/// The tracks of every computer of a run, in computer order, each estimator built by
-/// `build` (its spec's [`EstimatorSpec::builder`], or a fleet's with the channel model:
+/// The computers of a run, in order, each estimator built by `build` (its spec's
+/// [`EstimatorSpec::builder`], or a fleet's with the channel model:
 /// [`crate::factory::fleet_builder`]).
-pub(crate) fn tracks(
+pub(crate) fn aboard(
     computers: &[OnBoard],
-    build: &impl Fn(&EstimatorSpec, TrackerStart, VehicleModel) -> Builder,
-) -> Vec<Track> {
-    computers.iter().flat_map(|c| c.tracks(build)).collect()
-}
-
-/// The helms of every computer of a run that has a controller, in computer order.
-pub(crate) fn helms(computers: &[OnBoard]) -> Vec<Helm> {
-    computers.iter().filter_map(OnBoard::helm).collect()
+    build: &dyn Fn(&EstimatorSpec, TrackerStart, VehicleModel) -> Builder,
+) -> Vec<Aboard> {
+    computers.iter().map(|c| c.aboard(build)).collect()
 }
 
 /// A stream configuration of `estimators` and `controller`, NED, planar, its vehicles

@@ -1,19 +1,22 @@
 //! The simulation engine: one loop for every world.
 //!
-//! Each step: every [`Helm`] (a vehicle's controller from the onboard crate) decides on
-//! what its vehicle knows of itself and on the beliefs of the vehicles it serves; the
-//! [`World`] moves the truth of its vehicles and beacons one step under those commands
-//! and says which measurements each underwater vehicle received during it; the engine
-//! feeds them, in order, to every estimator ([`Track`]) of that vehicle through the
-//! [`Navigator`] interface alone. Then it shows the step to the [`Observer`]s: error
-//! statistics, recording, guidance snapshots, information for the bound. A world holds
-//! no estimator, controller or scoring code, an observer no world code, so a new
-//! estimator runs in every world and a new world scores every estimator.
+//! Each step: the controller of every vehicle's computer ([`Aboard`]: the onboard
+//! crate's [`Unit`], the one `onebeacon stream` runs on a vehicle) decides on what its
+//! vehicle knows of itself and on its navigators' beliefs; the [`World`] moves the
+//! truth of its vehicles and beacons one step under those commands and says which
+//! measurements each underwater vehicle received during it; the engine pushes them, in
+//! order, into the session of every computer that estimates that vehicle, as `stream`
+//! takes a line, and predicts every session to the step's time. Then it shows the step
+//! to the [`Observer`]s: error statistics, recording, guidance snapshots, information
+//! for the bound. A world holds no estimator, controller or scoring code, an observer
+//! no world code, so a new estimator runs in every world and a new world scores every
+//! estimator.
 
 use nalgebra::{Vector3, Vector6};
-use onebeacon::nav::restart::{Builder, Restart};
+use onebeacon::nav::session::{Input, Item};
 use onebeacon::nav::{Estimate, Measurement, Navigator, Outcome};
-use onebeacon::vehicle::{Command, Controller, Decided, Situation};
+use onebeacon::vehicle::unit::Unit;
+use onebeacon::vehicle::{Command, Decided, Situation};
 
 /// The truth of one underwater vehicle at one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,7 +81,8 @@ pub(crate) trait World {
     fn pilots(&self, _out: &mut Vec<PilotRecord>) {}
     /// What the vehicle of helm `h` knows of itself at the start of the move from step
     /// `k - 1` to `k` when its controller decides now (its clock, a surface vehicle's
-    /// GPS and compass); None: it keeps its last command. A world of no helm has none.
+    /// GPS and compass); None: it keeps its last command. Helm `h` is the `h`-th
+    /// computer with a controller; a world of no helm has none.
     fn situation(&mut self, _k: usize, _h: usize) -> Option<Situation> {
         None
     }
@@ -88,27 +92,19 @@ pub(crate) trait World {
     fn advance(&mut self, k: usize, commands: &[Option<Command>], heard: &mut [Vec<Measurement>]);
 }
 
-/// A vehicle's controller, and the vehicles whose first estimator it reads (its own,
-/// or those a surface vehicle serves).
-pub(crate) struct Helm {
-    pub controller: Box<dyn Controller>,
-    pub serves: Vec<usize>,
+/// A vehicle's computer in a world: the [`Unit`] it runs (what `onebeacon stream` runs
+/// on the vehicle: its sessions of estimators, its controller) and, for each of its
+/// sessions, the world's vehicle it estimates.
+pub(crate) struct Aboard {
+    pub unit: Unit,
+    pub vehicles: Vec<usize>,
 }
 
-/// One estimator on one vehicle, with the restart policy of an unsound estimator (the
-/// session's: [`Restart`]).
-pub(crate) struct Track {
-    pub vehicle: usize,
-    pub navigator: Box<dyn Navigator>,
-    restart: Restart,
-}
-
-impl Track {
-    /// The estimator `builder` gives at time 0 from `pose` (north, east, heading) with
-    /// initial sigmas `sigmas` (position m, heading rad), on vehicle `vehicle`.
-    pub(crate) fn new(vehicle: usize, builder: Builder, pose: (f64, f64, f64), sigmas: (f64, f64)) -> Self {
-        let restart = Restart::new(builder, pose, sigmas);
-        Self { vehicle, navigator: restart.build(0.0, pose), restart }
+impl Aboard {
+    /// The first navigator that estimates vehicle `v` on this computer.
+    pub(crate) fn navigator_of(&self, v: usize) -> Option<&dyn Navigator> {
+        let i = self.vehicles.iter().position(|&w| w == v)?;
+        self.unit.session(i).navigator(0)
     }
 }
 
@@ -129,39 +125,47 @@ pub(crate) struct Step<'a> {
 /// Something that watches a run.
 pub(crate) trait Observer {
     fn step(&mut self, step: &Step<'_>);
-    /// Helm `helm`'s decision on what its vehicle knew of itself.
+    /// Helm `helm`'s decision (the controller of the `helm`-th computer that has one) on
+    /// what its vehicle knew of itself.
     fn decided(&mut self, _helm: usize, _situation: &Situation, _decided: &Decided) {}
-    /// Track `track`'s estimator stopped being sound and started again ([`Restart`]).
+    /// Track `track`'s estimator stopped being sound and started again (the session's
+    /// restart policy, [`onebeacon::nav::restart::Restart`]).
     fn restarted(&mut self, _track: usize) {}
+    /// A computer estimating vehicle `vehicle` screened measurement `m` out (out of its
+    /// limits or of time order, `reason`): none of its estimators saw it.
+    fn screened(&mut self, _vehicle: usize, _m: &Measurement, _reason: &str) {}
     /// The outcome of track `track`'s processing of measurement `m`.
     fn outcome(&mut self, _track: usize, _m: &Measurement, _outcome: &Outcome) {}
-    /// Every track's navigator as it stands at step `k` (before [`Observer::step`]),
-    /// for an observer that records more than estimates (a particle cloud).
-    fn inspect(&mut self, _k: usize, _tracks: &[Track]) {}
+    /// Every computer as it stands at step `k` (before [`Observer::step`]), for an
+    /// observer that records more of a navigator than its estimate (a particle cloud).
+    fn inspect(&mut self, _k: usize, _computers: &[Aboard]) {}
 }
 
-/// Runs `world` from its start to its last step with `tracks` and `helms`, shown to
-/// `observers`.
-pub(crate) fn run(
-    world: &mut dyn World,
-    tracks: &mut [Track],
-    helms: &mut [Helm],
-    observers: &mut [&mut dyn Observer],
-) {
+/// Runs `world` from its start to its last step with its vehicles' `computers`, shown
+/// to `observers`. A track is one estimator of one session of one computer, in that
+/// order. Every measurement goes to the computers as `stream` takes a line, screened
+/// alike ([`Unit::take`]): one out of the computer's limits or of time order reaches no
+/// estimator, as on the vehicle. Estimates are asked for, and the restart policy
+/// applied, at each step's time ([`Unit::predict_to`]).
+pub(crate) fn run(world: &mut dyn World, computers: &mut [Aboard], observers: &mut [&mut dyn Observer]) {
     let vehicles = world.vehicles();
-    let vehicle_of: Vec<usize> = tracks.iter().map(|t| t.vehicle).collect();
-    // the track each vehicle reports from: its first
-    let reporter: Vec<usize> = (0..vehicles)
-        .map(|v| vehicle_of.iter().position(|&w| w == v).expect("every vehicle has an estimator"))
-        .collect();
+    let mut vehicle_of = Vec::new();
+    for c in computers.iter_mut() {
+        assert!(c.unit.start_by(0.0), "a world's computers start at time 0");
+        for (i, &v) in c.vehicles.iter().enumerate() {
+            vehicle_of.extend(std::iter::repeat_n(v, c.unit.session(i).names.len()));
+        }
+    }
+    let helm_of: Vec<usize> = (0..computers.len()).filter(|&c| computers[c].unit.has_controller()).collect();
     let mut heard = vec![Vec::new(); vehicles];
     let mut truth: Vec<VehicleTruth> = (0..vehicles).map(|v| world.truth(v)).collect();
-    let mut estimates: Vec<Estimate> = tracks.iter().map(|t| t.navigator.estimate()).collect();
+    let mut estimates: Vec<Estimate> =
+        computers.iter().flat_map(|c| c.unit.sessions()).flat_map(|s| s.final_estimates()).collect();
     let mut pilots = Vec::new();
-    let mut commands = vec![None; helms.len()];
+    let mut commands = vec![None; helm_of.len()];
     let mut k = 0;
     loop {
-        observers.iter_mut().for_each(|o| o.inspect(k, tracks));
+        observers.iter_mut().for_each(|o| o.inspect(k, computers));
         pilots.clear();
         world.pilots(&mut pilots);
         let step = Step {
@@ -180,24 +184,53 @@ pub(crate) fn run(
         }
         k += 1;
         heard.iter_mut().for_each(Vec::clear);
-        for (h, helm) in helms.iter_mut().enumerate() {
+        for (h, &c) in helm_of.iter().enumerate() {
             let Some(situation) = world.situation(k, h) else { continue };
-            let beliefs: Vec<&dyn Navigator> = helm.serves.iter().map(|&v| &*tracks[reporter[v]].navigator).collect();
-            let decided = helm.controller.decide(&situation, &beliefs).expect("a world gives its helms what they read");
+            let unit = &mut computers[c].unit;
+            if let Some(fix) = situation.fix {
+                unit.set_fix(fix);
+            }
+            let decided = unit
+                .decide(situation.t_s)
+                .expect("a computer with a controller decides")
+                .expect("a world gives its helms what they read");
             commands[h] = Some(decided.command);
             observers.iter_mut().for_each(|o| o.decided(h, &situation, &decided));
         }
         world.advance(k, &commands, &mut heard);
-        for (i, t) in tracks.iter_mut().enumerate() {
-            for m in &heard[t.vehicle] {
-                let outcome = t.navigator.process(m);
-                observers.iter_mut().for_each(|o| o.outcome(i, m, &outcome));
+        let t_s = world.t_s(k);
+        let mut first = 0;
+        for c in computers.iter_mut() {
+            // the computer's first track
+            let own = first;
+            for (i, &v) in c.vehicles.iter().enumerate() {
+                for m in &heard[v] {
+                    let item = Item { t_s: m.t_s, input: Input::Measurement(m.kind.clone()) };
+                    let done = match c.unit.take(i, &item) {
+                        Ok(Some(done)) => done,
+                        Ok(None) => continue,
+                        Err(screened) => {
+                            observers.iter_mut().for_each(|o| o.screened(v, m, &screened.reason));
+                            continue;
+                        }
+                    };
+                    for (j, out) in done.outcomes.iter().enumerate() {
+                        if let Some(out) = out {
+                            observers.iter_mut().for_each(|o| o.outcome(first + j, m, out));
+                        }
+                    }
+                }
+                first += c.unit.session(i).names.len();
             }
             // scored at the step's time, also when no message reached it
-            t.navigator.predict_to(world.t_s(k));
-            estimates[i] = t.navigator.estimate();
-            if t.restart.apply(&mut t.navigator, &mut estimates[i], world.t_s(k)) {
-                observers.iter_mut().for_each(|o| o.restarted(i));
+            let mut track = own;
+            for done in c.unit.predict_to(t_s).into_iter().map(|d| d.expect("started at time 0")) {
+                let n = done.estimates.len();
+                estimates[track..track + n].copy_from_slice(&done.estimates);
+                for j in done.reinitialised {
+                    observers.iter_mut().for_each(|o| o.restarted(track + j));
+                }
+                track += n;
             }
         }
         for (v, tr) in truth.iter_mut().enumerate() {
@@ -209,7 +242,10 @@ pub(crate) fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use onebeacon::geo::Frame;
     use onebeacon::nav::Kind;
+    use onebeacon::nav::restart::Builder;
+    use onebeacon::nav::session::{Session, Start};
     use std::sync::Arc;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -233,8 +269,8 @@ mod tests {
         }
     }
 
-    /// One vehicle that hears one speed a step for three steps.
-    struct Still;
+    /// One vehicle that hears one speed (m/s) a step for three steps.
+    struct Still(f64);
 
     impl World for Still {
         fn vehicles(&self) -> usize {
@@ -253,22 +289,37 @@ mod tests {
             Vector3::zeros()
         }
         fn advance(&mut self, k: usize, _: &[Option<Command>], heard: &mut [Vec<Measurement>]) {
-            heard[0].push(Measurement::new(k as f64, Kind::Speed { speed_m_s: 1.0 }));
+            heard[0].push(Measurement::new(k as f64, Kind::Speed { speed_m_s: self.0 }));
         }
     }
 
-    struct Restarts(Vec<usize>);
+    /// The restarts and the screened measurements a run shows.
+    #[derive(Default)]
+    struct Told {
+        restarts: Vec<usize>,
+        screened: Vec<(usize, String)>,
+    }
 
-    impl Observer for Restarts {
+    impl Observer for Told {
         fn step(&mut self, _: &Step<'_>) {}
         fn restarted(&mut self, track: usize) {
-            self.0.push(track);
+            self.restarts.push(track);
         }
+        fn screened(&mut self, vehicle: usize, _: &Measurement, reason: &str) {
+            self.screened.push((vehicle, reason.to_string()));
+        }
+    }
+
+    /// A computer of one session of `builder`, on vehicle 0, started at (5, -3, 0.2).
+    fn computer(builder: Builder) -> Aboard {
+        let start = Start::At { t0_s: Some(0.0), pose: (5.0, -3.0, 0.2) };
+        let session = Session::new(Frame::Ned, vec![("only".into(), builder)], start, (1.0, 0.1), None);
+        Aboard { unit: Unit::new(vec![session], Default::default(), Frame::Ned, None), vehicles: vec![0] }
     }
 
     /// The engine applies the session's policy: an estimator whose state stops being
     /// sound is built again from its last sound pose at the step's time, and observers
-    /// are told; every step breaks it again here, so three steps, three restarts.
+    /// are told; every speed breaks it again here, so three steps, three restarts.
     #[test]
     fn an_unsound_estimator_starts_again_as_in_the_session() {
         let builds = Arc::new(AtomicUsize::new(0));
@@ -278,12 +329,32 @@ mod tests {
             counted.fetch_add(1, Ordering::SeqCst);
             Box::new(Fragile { inner: planar(t0, at, sp, sh), broken: false })
         });
-        let mut tracks = vec![Track::new(0, builder, (5.0, -3.0, 0.2), (1.0, 0.1))];
-        let mut restarts = Restarts(Vec::new());
-        run(&mut Still, &mut tracks, &mut [], &mut [&mut restarts]);
-        assert_eq!(restarts.0, [0, 0, 0]);
+        let mut computers = vec![computer(builder)];
+        let mut told = Told::default();
+        run(&mut Still(1.0), &mut computers, &mut [&mut told]);
+        assert_eq!(told.restarts, [0, 0, 0]);
+        assert!(told.screened.is_empty());
         assert_eq!(builds.load(Ordering::SeqCst), 4);
-        let e = tracks[0].navigator.estimate();
+        let e = computers[0].unit.session(0).navigator(0).unwrap().estimate();
         assert_eq!((e.north_m(), e.east_m(), e.heading_rad(), e.t_s), (5.0, -3.0, 0.2, 3.0));
+    }
+
+    /// A measurement out of the computer's limits (a speed of 25 m/s against
+    /// `limits.max_speed_m_s` = 20) reaches no estimator, as on the vehicle, and the
+    /// observers are told why: the dead reckoning stays where it started.
+    #[test]
+    fn a_measurement_out_of_the_limits_reaches_no_estimator() {
+        let planar = onebeacon::nav::planar::builder(Default::default(), onebeacon::filter::FilterKind::Ekf);
+        let mut computers = vec![computer(planar)];
+        let mut told = Told::default();
+        run(&mut Still(25.0), &mut computers, &mut [&mut told]);
+        assert_eq!(told.screened.len(), 3, "{:?}", told.screened);
+        assert!(
+            told.screened.iter().all(|(v, r)| *v == 0 && r.contains("limits.max_speed_m_s")),
+            "{:?}",
+            told.screened
+        );
+        let e = computers[0].unit.session(0).navigator(0).unwrap().estimate();
+        assert_eq!((e.north_m(), e.east_m()), (5.0, -3.0));
     }
 }

@@ -97,7 +97,7 @@ pub(crate) fn fleet_seeds(s: &Fleet, seed: u64, run: u64) -> Vec<Vec<u64>> {
         .collect()
 }
 
-/// How a fleet AUV's computer builds each estimator ([`crate::computers::OnBoard::tracks`]):
+/// How a fleet AUV's computer builds each estimator ([`crate::computers::OnBoard::aboard`]):
 /// by its spec; with the channel model the iUSBL navigators take the captures through
 /// their receiver, which no stream configuration describes.
 pub(crate) fn fleet_builder(s: &Fleet) -> impl Fn(&EstimatorSpec, TrackerStart, VehicleModel) -> Builder {

@@ -4,7 +4,7 @@
 //! cell, seed, run index).
 
 use crate::computers::{self, OnBoard};
-use crate::engine::{self, Observer, Step, Track, VehicleTruth, World};
+use crate::engine::{self, Aboard, Observer, Step, VehicleTruth, World};
 use crate::factory;
 use crate::information::{Information, bearing_information, range_information};
 use crate::messages::{Computer, Messages};
@@ -13,8 +13,10 @@ use crate::scenario::fleet::SignalModel;
 use crate::scenario::{Cell, EstimatorSpec, Scenario};
 use crate::world::{FixedBeaconWorld, FleetWorld, MovingBeaconWorld, PassiveUsblWorld};
 use nalgebra::{DMatrix, Vector2, Vector3};
+use onebeacon::config::builder::{TrackerStart, VehicleModel};
 use onebeacon::nav::diagnosis::PerBeacon;
 use onebeacon::nav::evaluation::{ErrorStats, horizontal_error};
+use onebeacon::nav::restart::Builder;
 use onebeacon::nav::{Measurement, Outcome};
 
 /// One estimator's estimate at one step.
@@ -111,6 +113,9 @@ pub struct RunOutput {
     /// [`RunOutput::findings`] reads.
     pub stats: Vec<ErrorStats>,
     pub per_beacon: Vec<PerBeacon>,
+    /// Measurements the vehicles' computers screened out (out of their limits or of time
+    /// order), and the first one's reason: none in a sound world.
+    pub screened: (usize, Option<String>),
     /// For bounds: the Fisher information H' R^-1 H of each acoustic measurement at
     /// the truth (the world's state size), with the vehicle and the step it was received
     /// in (moving-beacon and passive-USBL runs; empty otherwise).
@@ -154,7 +159,11 @@ impl RunOutput {
     /// named `labels` ([`onebeacon::nav::diagnosis::findings`]: overconfident filters,
     /// beacons gated out or reading apart).
     pub fn findings(&self, labels: &[String]) -> Vec<String> {
-        onebeacon::nav::diagnosis::findings(labels, &self.stats, &self.per_beacon)
+        let mut findings = onebeacon::nav::diagnosis::findings(labels, &self.stats, &self.per_beacon);
+        if let (n @ 1.., Some(first)) = &self.screened {
+            findings.push(format!("{n} measurement(s) screened out by the vehicles' computers, the first: {first}"));
+        }
+        findings
     }
 }
 
@@ -197,18 +206,16 @@ fn simulate_recording(
             let mut world = FixedBeaconWorld::new(s, c, seed, run);
             let z0 = factory::fixed_beacon_start(s, world.unicycle_state(), seed, run);
             let on_board = vec![computers::fixed_beacon(s, &z0)];
-            let mut tracks = computers::tracks(&on_board, &EstimatorSpec::builder);
-            drive(&mut world, &mut tracks, &on_board, Vec::new(), recorder, messages)
+            drive(&mut world, &on_board, &EstimatorSpec::builder, Vec::new(), recorder, messages)
         }
         (Scenario::MovingBeacon(s), Cell::MovingBeacon(c)) => {
             let asv0 = factory::initial_asv_position(s, c);
             let mut world = MovingBeaconWorld::new(s, c, asv0, seed, run);
             let starts = factory::moving_beacon_starts(s, &world.states(), seed, run);
             let on_board = computers::moving_beacon(s, c, asv0, &starts);
-            let mut tracks = computers::tracks(&on_board, &EstimatorSpec::builder);
             let mut info = Information::new(range_information(s.sensor_noise()));
             let extra: Vec<&mut dyn Observer> = vec![&mut info];
-            let (mut out, m) = drive(&mut world, &mut tracks, &on_board, extra, recorder, messages);
+            let (mut out, m) = drive(&mut world, &on_board, &EstimatorSpec::builder, extra, recorder, messages);
             out.information = info.into_inner();
             (out, m)
         }
@@ -216,38 +223,40 @@ fn simulate_recording(
             let mut world = PassiveUsblWorld::new(s, seed, run);
             let starts = factory::tracker_starts(s, &world.initial_states(), seed, run);
             let on_board = vec![computers::passive_usbl(s, c, world.asv_start(), &starts)];
-            let mut tracks = computers::tracks(&on_board, &EstimatorSpec::builder);
             let mut info = Information::new(bearing_information(s.tracker_noise()));
             let extra: Vec<&mut dyn Observer> = vec![&mut info];
-            let (mut out, m) = drive(&mut world, &mut tracks, &on_board, extra, recorder, messages);
+            let (mut out, m) = drive(&mut world, &on_board, &EstimatorSpec::builder, extra, recorder, messages);
             out.information = info.into_inner();
             (out, m)
         }
         (Scenario::Fleet(s), Cell::Fleet) => {
             let mut world = FleetWorld::new(s, seed, run);
             let on_board = computers::fleet(s, &factory::fleet_seeds(s, seed, run));
-            let mut tracks = computers::tracks(&on_board, &factory::fleet_builder(s));
             // the channel model's captures are not JSON lines
             let messages = messages && s.signal.model != SignalModel::Channel;
-            drive(&mut world, &mut tracks, &on_board, Vec::new(), recorder, messages)
+            drive(&mut world, &on_board, &factory::fleet_builder(s), Vec::new(), recorder, messages)
         }
         _ => panic!("sweep cell {cell:?} does not belong to scenario {}", s.name()),
     }
 }
 
-/// Runs the engine on `tracks` and the helms of the vehicles' `computers`, with the
-/// scoring and recording observers (and `extra`); with what each computer with a
+/// Runs the engine on the vehicles' `computers` (each estimator built by `build`), with
+/// the scoring and recording observers (and `extra`); with what each computer with a
 /// controller heard and decided when `messages`.
 fn drive(
     world: &mut dyn World,
-    tracks: &mut [Track],
     computers: &[OnBoard],
+    build: &dyn Fn(&EstimatorSpec, TrackerStart, VehicleModel) -> Builder,
     extra: Vec<&mut dyn Observer>,
     mut recorder: Recorder,
     messages: bool,
 ) -> (RunOutput, Option<Vec<Computer>>) {
-    let mut scoring = Scoring::new(tracks.iter().map(|t| t.vehicle).collect(), world.steps());
-    let mut helms = computers::helms(computers);
+    let mut aboard = computers::aboard(computers, build);
+    let vehicle_of = computers
+        .iter()
+        .flat_map(|c| c.starts.iter().flat_map(|s| c.config.estimators.iter().map(|_| s.vehicle)))
+        .collect();
+    let mut scoring = Scoring::new(vehicle_of, world.steps());
     let mut m = messages.then(|| Messages::new(computers));
     {
         let mut observers: Vec<&mut dyn Observer> = vec![&mut scoring, &mut recorder];
@@ -258,7 +267,7 @@ fn drive(
         if let Some(m) = m.as_mut() {
             observers.push(m);
         }
-        engine::run(world, tracks, &mut helms, &mut observers);
+        engine::run(world, &mut aboard, &mut observers);
     }
     let out = RunOutput {
         metrics: scoring
@@ -272,6 +281,7 @@ fn drive(
         frames_decoded: scoring.heard,
         stats: scoring.acc,
         per_beacon: scoring.per_beacon,
+        screened: scoring.screened,
         information: Vec::new(),
         guidance: recorder.guidance,
         belief: recorder.belief,
@@ -292,6 +302,8 @@ struct Scoring {
     vehicle_of: Vec<usize>,
     distance_m: Vec<f64>,
     heard: u64,
+    /// Measurements screened out, and the first one's reason.
+    screened: (usize, Option<String>),
 }
 
 impl Scoring {
@@ -299,7 +311,7 @@ impl Scoring {
         // steps + 1 errors scored, the first half of them apart
         let acc = vec![ErrorStats::with_half(steps.div_ceil(2)); vehicle_of.len()];
         let per_beacon = vec![PerBeacon::default(); vehicle_of.len()];
-        Self { acc, per_beacon, vehicle_of, distance_m: Vec::new(), heard: 0 }
+        Self { acc, per_beacon, vehicle_of, distance_m: Vec::new(), heard: 0, screened: (0, None) }
     }
 }
 
@@ -322,6 +334,13 @@ impl Observer for Scoring {
     fn restarted(&mut self, track: usize) {
         self.acc[track].reinitialised += 1;
     }
+
+    fn screened(&mut self, vehicle: usize, m: &Measurement, reason: &str) {
+        self.screened.0 += 1;
+        self.screened
+            .1
+            .get_or_insert_with(|| format!("vehicle {vehicle}'s {} at {} s: {reason}", m.kind.name(), m.t_s));
+    }
 }
 
 /// Every step and every guidance decision, when asked for, and the belief at one step.
@@ -341,18 +360,18 @@ impl Recorder {
 }
 
 impl Observer for Recorder {
-    fn inspect(&mut self, k: usize, tracks: &[Track]) {
+    fn inspect(&mut self, k: usize, computers: &[Aboard]) {
         let Some((_, samples)) = self.belief_at.filter(|(at, _)| *at == k) else { return };
-        let Some(first) = tracks.iter().find(|t| t.vehicle == 0) else { return };
-        if let Some(positions) = first.navigator.position_sample(samples) {
-            let e = first.navigator.estimate();
+        let Some(first) = computers.iter().find_map(|c| c.navigator_of(0)) else { return };
+        if let Some(positions) = first.position_sample(samples) {
+            let e = first.estimate();
             self.belief = Some(BeliefSnapshot {
                 t_s: e.t_s,
                 positions,
                 estimate: e.position_ned_m,
                 truth: Vector3::from_element(f64::NAN),
                 bearing: None,
-                sets: first.navigator.factored_sets(),
+                sets: first.factored_sets(),
                 beacon: Vector3::from_element(f64::NAN),
             });
         }

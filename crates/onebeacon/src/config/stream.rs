@@ -13,6 +13,7 @@ use super::estimator_check::check_estimators;
 use crate::geo::Frame;
 use crate::nav::capability::Capability;
 use crate::nav::limits::Limits;
+use crate::nav::restart::Builder;
 use crate::nav::session::{Session, Start};
 use crate::vehicle::unit::Unit;
 use nalgebra::Vector3;
@@ -185,6 +186,11 @@ impl Initial {
         }
     }
 
+    /// The initial position and heading standard deviations (m, rad).
+    pub fn sigmas(&self) -> (f64, f64) {
+        (self.position_sigma_m, self.heading_sigma_deg.to_radians())
+    }
+
     /// The given pose in NED (N, E, psi) when `from = "given"`.
     pub fn given_pose(&self, frame: Frame) -> Option<(f64, f64, f64)> {
         if self.from != InitialFrom::Given {
@@ -276,6 +282,16 @@ fn is_default_yaw_rate_sigma(v: &f64) -> bool {
 }
 fn is_default_accel_sigma(v: &f64) -> bool {
     *v == default_accel_sigma_m_s2()
+}
+
+/// Where one vehicle's estimators start: when and from which pose (the session's
+/// [`Start`]), the rest of a tracker's start, and the initial position and heading
+/// standard deviations (m, rad).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VehicleStart {
+    pub start: Start,
+    pub tracker: TrackerStart,
+    pub sigmas: (f64, f64),
 }
 
 /// One fixed beacon (`[[beacon]]`), in the file's frame, m.
@@ -411,8 +427,19 @@ impl StreamConfig {
     /// at `start`, restricted to `beacons` when given (replay and stream).
     pub fn session(&self, initial: &Initial, start: Start, beacons: Option<BTreeSet<u32>>) -> Session {
         let from = initial.tracker_start();
-        let estimators = self.estimators.iter().map(|e| (e.name(), e.builder(from, self.model))).collect();
-        let sigmas = (initial.position_sigma_m, initial.heading_sigma_deg.to_radians());
+        let builders = self.estimators.iter().map(|e| e.builder(from, self.model)).collect();
+        self.session_of(builders, start, initial.sigmas(), beacons)
+    }
+
+    /// A session of the estimators, each built by its builder in `builders`.
+    fn session_of(
+        &self,
+        builders: Vec<Builder>,
+        start: Start,
+        sigmas: (f64, f64),
+        beacons: Option<BTreeSet<u32>>,
+    ) -> Session {
+        let estimators = self.estimators.iter().map(EstimatorSpec::name).zip(builders).collect();
         let mut session = Session::new(self.frame.into(), estimators, start, sigmas, beacons).with_limits(self.limits);
         for (stats, e) in session.stats.iter_mut().zip(&self.estimators) {
             let (gate, kernel) = if self.model.is_planar() { e.log_gate() } else { e.gate() };
@@ -421,20 +448,19 @@ impl StreamConfig {
         session
     }
 
-    /// The vehicle's computer: one session per vehicle it estimates (its own from
-    /// `[initial]`, or each of `[[tracked]]`), each started at its given pose or at the
-    /// first ground-truth line, and the `[controller]` when there is one; no rejection
-    /// log (a stream reports each line as it comes). A heading from the track starts
-    /// where the track is `track_m` long (a stream cannot look ahead); a start from
-    /// ranges, which needs a window of the log, is refused by its key.
-    pub fn unit(&self) -> Result<Unit, Violation> {
+    /// Where each vehicle the computer estimates starts (its own from `[initial]`, or
+    /// each of `[[tracked]]`): at its given pose, or at the first ground-truth line. A
+    /// heading from the track starts where the track is `track_m` long (a stream cannot
+    /// look ahead); a start from ranges, which needs a window of the log, is refused by
+    /// its key.
+    pub fn starts(&self) -> Result<Vec<VehicleStart>, Violation> {
         let frame = Frame::from(self.frame);
         let vehicles: Vec<(String, &Initial)> = if self.tracked.is_empty() {
             vec![("initial".into(), &self.initial)]
         } else {
             self.tracked.iter().enumerate().map(|(v, i)| (format!("tracked[{v}]"), i)).collect()
         };
-        let mut sessions = Vec::new();
+        let mut starts = Vec::new();
         for (section, init) in vehicles {
             let start = match init.given_pose(frame) {
                 Some(pose) => Start::At { t0_s: init.t0_s, pose },
@@ -449,12 +475,39 @@ impl StreamConfig {
                 None if init.heading_from == HeadingFrom::Track => Start::Track { track_m: init.track_m, from: None },
                 None => Start::FirstTruth,
             };
-            let session = self.session(init, start, None);
-            let limits = Limits { max_rejections: 0, ..*session.limits() };
-            sessions.push(session.with_limits(limits));
+            starts.push(VehicleStart { start, tracker: init.tracker_start(), sigmas: init.sigmas() });
         }
+        Ok(starts)
+    }
+
+    /// The vehicle's computer: one session per vehicle it estimates, each started as
+    /// [`StreamConfig::starts`] says, and the `[controller]` when there is one; no
+    /// rejection log (a stream reports each line as it comes).
+    pub fn unit(&self) -> Result<Unit, Violation> {
+        Ok(self.unit_of(&self.starts()?, &EstimatorSpec::builder))
+    }
+
+    /// The vehicle's computer with its vehicles starting at `starts` (one session each)
+    /// and each estimator built by `build` (its spec's [`EstimatorSpec::builder`], or
+    /// the simulator's where a world's signal needs another): [`StreamConfig::unit`]'s,
+    /// and the simulator's, which knows its starts to the last bit.
+    pub fn unit_of(
+        &self,
+        starts: &[VehicleStart],
+        build: &dyn Fn(&EstimatorSpec, TrackerStart, VehicleModel) -> Builder,
+    ) -> Unit {
+        let sessions = starts
+            .iter()
+            .map(|v| {
+                let builders = self.estimators.iter().map(|e| build(e, v.tracker, self.model)).collect();
+                let session = self.session_of(builders, v.start, v.sigmas, None);
+                let limits = Limits { max_rejections: 0, ..*session.limits() };
+                session.with_limits(limits)
+            })
+            .collect();
+        let frame = Frame::from(self.frame);
         let fixed = self.beacons.iter().map(|b| (b.id, Vector3::new(b.x_m, b.y_m, b.z_m))).collect();
         let helm = self.controller.as_ref().map(|c| c.build(frame));
-        Ok(Unit::new(sessions, fixed, frame, helm))
+        Unit::new(sessions, fixed, frame, helm)
     }
 }

@@ -76,6 +76,17 @@ pub struct Step {
     pub reinitialised: Vec<usize>,
 }
 
+/// What taking one item did ([`Session::take`]): each estimator's outcome (none for
+/// beacon positions and truth), and the ground-truth pose when it is one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Taken {
+    pub t_s: f64,
+    pub outcomes: Vec<Option<Outcome>>,
+    pub truth: Option<TruthPose>,
+    /// The measurement the estimators were given (its beacon's position resolved).
+    pub measurement: Option<Kind>,
+}
+
 /// The value of a measurement that rejection logs show (range, else radial speed).
 fn measured_value(m: &Kind) -> f64 {
     match *m {
@@ -286,6 +297,39 @@ impl Session {
         }
     }
 
+    /// Predicts every estimator to `t_s` (a clock tick: the time of a simulator's step)
+    /// and applies the restart policy as after an item (no outcomes: no item was taken);
+    /// `None` before the start. The items' time order stays the items' own: an item
+    /// older than `t_s` is still taken.
+    pub fn predict_to(&mut self, t_s: f64) -> Option<Step> {
+        if !self.started() {
+            return None;
+        }
+        let mut estimates = Vec::with_capacity(self.navs.len());
+        for nav in &mut self.navs {
+            nav.predict_to(t_s);
+            estimates.push(nav.estimate());
+        }
+        let reinitialised = self.restart_unsound(&mut estimates, t_s);
+        Some(Step { t_s, outcomes: Vec::new(), estimates, truth: None, errors: None, reinitialised })
+    }
+
+    /// A filter whose state stops being sound starts again from its last sound estimate
+    /// (`estimates` then hold the new one's) at `t_s`: reported, never silently kept.
+    fn restart_unsound(&mut self, estimates: &mut [Estimate], t_s: f64) -> Vec<usize> {
+        let mut reinitialised = Vec::new();
+        for (i, e) in estimates.iter_mut().enumerate() {
+            if self.restarts[i].apply(&mut self.navs[i], e, t_s) {
+                if self.keep_history {
+                    self.navs[i].keep_history();
+                }
+                self.stats[i].reinitialised += 1;
+                reinitialised.push(i);
+            }
+        }
+        reinitialised
+    }
+
     /// Records a rejection while the log has room.
     fn log_rejection(&mut self, r: Rejection) {
         if self.rejected.len() < self.limits.max_rejections {
@@ -307,9 +351,40 @@ impl Session {
         Screened { reason: r.reason }
     }
 
-    /// Processes one item (in the session's frame): `Ok(None)` before the estimators
-    /// start, `Err` for an item screened out (no estimator saw it; the session goes on).
+    /// Processes one item (in the session's frame) and scores it: `Ok(None)` before the
+    /// estimators start, `Err` for an item screened out (no estimator saw it; the
+    /// session goes on). [`Session::take`], then every estimate, the restart policy and,
+    /// for a ground-truth item, each estimator's error.
     pub fn push(&mut self, item: &Item) -> Result<Option<Step>, Screened> {
+        let Some(Taken { t_s: t, outcomes, truth, measurement }) = self.take(item)? else { return Ok(None) };
+        if let Some(kind) = &measurement {
+            self.count_outcomes(t, kind, &outcomes);
+        }
+        let mut estimates: Vec<Estimate> = self.navs.iter().map(|n| n.estimate()).collect();
+        let reinitialised = self.restart_unsound(&mut estimates, t);
+        if let Some(p) = truth {
+            self.reference_rows += 1;
+            self.reference_var_sum_m2 += p.sigma_m * p.sigma_m;
+        }
+        let errors = truth.map(|p| {
+            estimates
+                .iter()
+                .zip(self.stats.iter_mut())
+                .map(|(e, s)| {
+                    let (err, nees) = horizontal_error(e, p.north_m, p.east_m, p.sigma_m);
+                    s.push(err, nees);
+                    (err, nees.unwrap_or(f64::NAN))
+                })
+                .collect()
+        });
+        Ok(Some(Step { t_s: t, outcomes, estimates, truth, errors, reinitialised }))
+    }
+
+    /// Takes one item (in the session's frame) into every estimator, as
+    /// [`Session::push`] does, without asking for their estimates: no restart check, no
+    /// counting of outcomes, no scoring (the simulator's engine, which counts and scores
+    /// for itself, at its steps: [`Session::predict_to`]). `Ok(None)` before the start.
+    pub fn take(&mut self, item: &Item) -> Result<Option<Taken>, Screened> {
         let t = item.t_s;
         let dt = self.last_t.map(|last| t - last);
         if !t.is_finite() {
@@ -367,7 +442,13 @@ impl Session {
         if self.at_last_t.len() < REPEATS_KEPT {
             self.at_last_t.push(item.input.clone());
         }
-        let item = &Item { t_s: t, input: item.input.clone().to_ned(self.frame) };
+        let in_ned;
+        let item = if self.frame == Frame::Ned {
+            item
+        } else {
+            in_ned = Item { t_s: t, input: item.input.clone().to_ned(self.frame) };
+            &in_ned
+        };
         if let Input::BeaconPosition { beacon_id, position } = item.input {
             if !self.tracked.contains_key(&beacon_id) && self.tracked.len() >= self.limits.max_beacons {
                 let most = self.limits.max_beacons;
@@ -409,70 +490,48 @@ impl Session {
             }
         }
         let mut outcomes = vec![None; self.navs.len()];
-        let mut truth = None;
-        let mut reinitialised = Vec::new();
-        match item.input.clone() {
+        let (mut truth, mut measurement) = (None, None);
+        match &item.input {
             Input::Measurement(m) => {
-                if let Some(kind) = self.resolve(m).map_err(|reason| self.screen(item, reason))? {
-                    let m = Measurement::new(t, kind.clone());
-                    let held = self.held_out.is_some() && kind.beacon().map(|b| b.id) == self.held_out;
+                if let Some(kind) = self.resolve(m.clone()).map_err(|reason| self.screen(item, reason))? {
+                    let m = Measurement::new(t, kind);
+                    let held = self.held_out.is_some() && m.kind.beacon().map(|b| b.id) == self.held_out;
                     for (i, nav) in self.navs.iter_mut().enumerate().filter(|_| held) {
                         if let Some(innovation) = nav.weigh(&m) {
-                            self.held_out_stats[i].push_innovation(&kind, innovation, false);
+                            self.held_out_stats[i].push_innovation(&m.kind, innovation, false);
                         }
                     }
-                    for (i, nav) in self.navs.iter_mut().enumerate().filter(|_| !held) {
-                        let out = nav.process(&m);
-                        self.stats[i].push_outcome(&out, true);
-                        self.beacon_stats[i].push(&kind, &out, self.limits.max_beacons);
-                        outcomes[i] = Some(out);
+                    for (nav, out) in self.navs.iter_mut().zip(&mut outcomes).filter(|_| !held) {
+                        *out = Some(nav.process(&m));
                     }
-                    for (i, out) in outcomes.iter().enumerate() {
-                        if let Some(Outcome::Rejected(super::Innovation { nis, .. })) = *out {
-                            self.log_rejection(Rejection {
-                                estimator: Some(i),
-                                t_s: t,
-                                kind: kind.name(),
-                                beacon_id: kind.beacon().map_or(0, |b| b.id),
-                                value: measured_value(&kind),
-                                nis,
-                                reason: "NIS gate".into(),
-                            });
-                        }
-                    }
+                    measurement = Some(m.kind);
                 }
             }
-            Input::Truth(p) => truth = Some(p),
+            Input::Truth(p) => truth = Some(*p),
             Input::BeaconPosition { .. } => {}
         }
-        let mut estimates: Vec<Estimate> = self.navs.iter().map(|n| n.estimate()).collect();
-        // a filter whose state stops being sound starts again from its last sound
-        // estimate: reported, never silently kept
-        for (i, e) in estimates.iter_mut().enumerate() {
-            if self.restarts[i].apply(&mut self.navs[i], e, t) {
-                if self.keep_history {
-                    self.navs[i].keep_history();
-                }
-                self.stats[i].reinitialised += 1;
-                reinitialised.push(i);
+        Ok(Some(Taken { t_s: t, outcomes, truth, measurement }))
+    }
+
+    /// Counts what each estimator made of measurement `kind` (`outcomes`, at `t_s`): its
+    /// error statistics, its corrections beacon by beacon, the gate's rejections.
+    fn count_outcomes(&mut self, t_s: f64, kind: &Kind, outcomes: &[Option<Outcome>]) {
+        for (i, out) in outcomes.iter().enumerate() {
+            let Some(out) = out else { continue };
+            self.stats[i].push_outcome(out, true);
+            self.beacon_stats[i].push(kind, out, self.limits.max_beacons);
+            if let Outcome::Rejected(super::Innovation { nis, .. }) = *out {
+                self.log_rejection(Rejection {
+                    estimator: Some(i),
+                    t_s,
+                    kind: kind.name(),
+                    beacon_id: kind.beacon().map_or(0, |b| b.id),
+                    value: measured_value(kind),
+                    nis,
+                    reason: "NIS gate".into(),
+                });
             }
         }
-        if let Some(p) = truth {
-            self.reference_rows += 1;
-            self.reference_var_sum_m2 += p.sigma_m * p.sigma_m;
-        }
-        let errors = truth.map(|p| {
-            estimates
-                .iter()
-                .zip(self.stats.iter_mut())
-                .map(|(e, s)| {
-                    let (err, nees) = horizontal_error(e, p.north_m, p.east_m, p.sigma_m);
-                    s.push(err, nees);
-                    (err, nees.unwrap_or(f64::NAN))
-                })
-                .collect()
-        });
-        Ok(Some(Step { t_s: t, outcomes, estimates, truth, errors, reinitialised }))
     }
 
     /// A beacon measurement with its beacon's position (tracked beacons: the latest).

@@ -1,12 +1,13 @@
 //! One vehicle's computer: the sessions of navigators it runs (one per vehicle whose
 //! position it estimates: its own, or the AUVs a surface vehicle tracks) and an optional
 //! [`Controller`] that turns their beliefs into a command. What `onebeacon stream` and
-//! the Python `Navigator` run; the simulator's engine runs the same controllers.
+//! the Python `Navigator` run, and what the simulator's engine runs for every vehicle
+//! with a computer ([`crate::config::stream::StreamConfig::unit_of`]).
 
 use super::{Command, Controller, DecideError, Decided, GuidanceSnapshot, OwnFix, Situation};
 use crate::geo::Frame;
 use crate::nav::Navigator;
-use crate::nav::session::{Item, Screened, Session, Step};
+use crate::nav::session::{Item, Screened, Session, Step, Taken};
 use nalgebra::{Vector2, Vector3};
 use std::collections::BTreeMap;
 
@@ -103,6 +104,26 @@ impl Unit {
         }
     }
 
+    /// Starts every session whose start is a given pose due by `t_s`; whether all run.
+    pub fn start_by(&mut self, t_s: f64) -> bool {
+        // every session tried, not only up to the first that waits
+        let started: Vec<bool> = self.sessions.iter_mut().map(|s| s.start_by(t_s)).collect();
+        started.iter().all(|&s| s)
+    }
+
+    /// Predicts every session's estimators to `t_s` ([`Session::predict_to`]), session
+    /// by session.
+    pub fn predict_to(&mut self, t_s: f64) -> Vec<Option<Step>> {
+        self.sessions.iter_mut().map(|s| s.predict_to(t_s)).collect()
+    }
+
+    /// Takes a measurement or truth item about vehicle `vehicle` into its session
+    /// without scoring it ([`Session::take`]; the simulator, which scores at its steps
+    /// through [`Unit::predict_to`]).
+    pub fn take(&mut self, vehicle: usize, item: &Item) -> Result<Option<Taken>, Screened> {
+        self.sessions[vehicle].take(item)
+    }
+
     /// The vehicle's own fix (NED), as its GPS and compass give it.
     pub fn set_fix(&mut self, fix: OwnFix) {
         self.fix = Some(fix);
@@ -111,10 +132,9 @@ impl Unit {
     /// The controller's decision at `t_s` on the first navigator of every session (None
     /// without a controller); the command is kept.
     pub fn decide(&mut self, t_s: f64) -> Option<Result<Decided, DecideError>> {
+        self.helm.as_ref()?;
+        self.start_by(t_s);
         let helm = self.helm.as_mut()?;
-        for s in &mut self.sessions {
-            s.start_by(t_s);
-        }
         let beliefs: Option<Vec<&dyn Navigator>> = self.sessions.iter().map(|s| s.navigator(0)).collect();
         let Some(beliefs) = beliefs else { return Some(Err(DecideError::NotStarted)) };
         let decided = helm.controller.decide(&Situation { t_s, fix: self.fix }, &beliefs);
