@@ -2,11 +2,12 @@
 //! vehicle reads (`onebeacon stream CONFIG`: estimators, controller, where each vehicle
 //! it estimates starts), with the run's exact starts. The engine runs the
 //! [`Unit`](onebeacon::vehicle::unit::Unit) it builds ([`OnBoard::aboard`]), the very
-//! computer `stream` runs, and `run --messages` writes it ([`crate::messages`]): a fixed-beacon world's AUV (garin2024's filters, no
-//! controller), a passive-USBL world's surface vehicle (tracking every AUV,
-//! its bearing planner), a moving-beacon world's beacon vehicle (the estimators of the
-//! vehicle it serves, its FIM guidance) and the vehicles it does not serve, each fleet
-//! AUV (its iUSBL navigators and dead reckoning, its behaviours).
+//! computer `stream` runs, and `run --messages` writes it ([`crate::messages`]): a
+//! fixed-beacon world's AUV (garin2024's filters, no controller), a passive-USBL world's
+//! surface vehicle (tracking every AUV, its bearing planner), a moving-beacon world's
+//! beacon vehicle (the estimators of the vehicle it serves, its FIM guidance) and the
+//! vehicles it does not serve, each fleet AUV (its iUSBL navigators and dead reckoning,
+//! its behaviours).
 
 use crate::engine::Aboard;
 use crate::scenario::estimator::IusblKeys;
