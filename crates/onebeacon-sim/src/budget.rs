@@ -152,8 +152,8 @@ impl Budget {
         let kept: Vec<usize> = estimators
             .iter()
             .filter(|e| e.kind.aiding(Host::Log).any() && !e.kind.tracks_bearings() && !e.kind.iusbl())
-            .filter(|e| e.track_accel_sigma_m_s2.is_none())
-            .map(|e| match (e.estimate_beacon_offsets == Some(true), e.planar_config().extended()) {
+            .filter(|e| e.planar.track_accel_sigma_m_s2.is_none())
+            .map(|e| match (e.calibration.estimate_beacon_offsets == Some(true), e.planar_config().extended()) {
                 (true, _) => STATES_WITH_OFFSETS,
                 (false, true) => EXTENDED_STATES,
                 (false, false) => STATES,

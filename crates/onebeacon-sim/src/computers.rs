@@ -161,11 +161,11 @@ fn passive_usbl_estimators(s: &PassiveUsbl) -> Vec<EstimatorSpec> {
         .iter()
         .map(|e| {
             let mut e = e.clone();
-            e.usbl_sigma_deg_per_m = e.usbl_sigma_deg_per_m.or(Some(s.usbl.noise_deg_per_m));
-            e.compass_sigma_deg = e.compass_sigma_deg.or(Some(s.asv.compass_noise_deg));
-            e.heading_sigma_deg = e.heading_sigma_deg.or(Some(s.reports.heading_noise_deg));
-            e.speed_sigma_m_s = e.speed_sigma_m_s.or(Some(s.reports.speed_noise_m_s));
-            e.depth_sigma_m = e.depth_sigma_m.or(Some(s.reports.depth_noise_m));
+            e.usbl.usbl_sigma_deg_per_m = e.usbl.usbl_sigma_deg_per_m.or(Some(s.usbl.noise_deg_per_m));
+            e.usbl.compass_sigma_deg = e.usbl.compass_sigma_deg.or(Some(s.asv.compass_noise_deg));
+            e.noise.heading_sigma_deg = e.noise.heading_sigma_deg.or(Some(s.reports.heading_noise_deg));
+            e.noise.speed_sigma_m_s = e.noise.speed_sigma_m_s.or(Some(s.reports.speed_noise_m_s));
+            e.noise.depth_sigma_m = e.noise.depth_sigma_m.or(Some(s.reports.depth_noise_m));
             e.name = Some(e.name());
             e
         })
@@ -191,7 +191,7 @@ fn bearing_controller(s: &PassiveUsbl, cell: &PassiveUsblCell, home: Vector2<f64
         r2_m: g.r2_m,
         radii: g.radii,
         angles: g.angles,
-        usbl_sigma_deg_per_m: s.estimators[0].usbl_sigma_deg_per_m.unwrap_or(s.usbl.noise_deg_per_m),
+        usbl_sigma_deg_per_m: s.estimators[0].usbl.usbl_sigma_deg_per_m.unwrap_or(s.usbl.noise_deg_per_m),
         nominal_speed_m_s: s.asv.nominal_speed_m_s,
         period_s: s.mission.message_period_s,
         planner_particles: g.planner_particles,
@@ -267,11 +267,11 @@ fn moving_beacon_estimators(s: &MovingBeacon) -> Vec<EstimatorSpec> {
         .iter()
         .map(|e| {
             let mut e = e.clone();
-            e.range_sigma_m = e.range_sigma_m.or(Some(a.range_noise_m));
-            e.depth_sigma_m = e.depth_sigma_m.or(Some(n.depth_noise_m));
-            e.velocity_sigma_m_s = e.velocity_sigma_m_s.or(Some(n.velocity_noise_m_s));
-            e.rate_sigma_rad_s = e.rate_sigma_rad_s.or(Some(n.rate_noise_rad_s));
-            e.attitude_sigma_deg = e.attitude_sigma_deg.or(Some(n.attitude_noise_deg));
+            e.noise.range_sigma_m = e.noise.range_sigma_m.or(Some(a.range_noise_m));
+            e.noise.depth_sigma_m = e.noise.depth_sigma_m.or(Some(n.depth_noise_m));
+            e.six_dof.velocity_sigma_m_s = e.six_dof.velocity_sigma_m_s.or(Some(n.velocity_noise_m_s));
+            e.six_dof.rate_sigma_rad_s = e.six_dof.rate_sigma_rad_s.or(Some(n.rate_noise_rad_s));
+            e.six_dof.attitude_sigma_deg = e.six_dof.attitude_sigma_deg.or(Some(n.attitude_noise_deg));
             e.name = Some(e.name());
             e
         })
@@ -394,23 +394,24 @@ fn iusbl_keys(s: &Fleet) -> IusblKeys {
 fn fleet_dead_reckoning(p: &SandSharkParams, n: &Navigation) -> EstimatorSpec {
     let mut e = EstimatorSpec::new(EstimatorKind::DeadReckoning);
     if p.speed_scale_sigma > 0.0 {
-        (e.estimate_distance_scale, e.distance_scale_sigma) = (Some(true), Some(p.speed_scale_sigma));
+        (e.calibration.estimate_distance_scale, e.calibration.distance_scale_sigma) =
+            (Some(true), Some(p.speed_scale_sigma));
     }
-    e.speed_coast_time_s = Some(p.coast_time_constant_s);
+    e.planar.speed_coast_time_s = Some(p.coast_time_constant_s);
     if n.current_sigma_m_s > 0.0 {
-        e.estimate_current = Some(true);
-        (e.current_sigma_m_s, e.current_walk_m_s_per_sqrt_s) =
+        e.calibration.estimate_current = Some(true);
+        (e.calibration.current_sigma_m_s, e.calibration.current_walk_m_s_per_sqrt_s) =
             (Some(n.current_sigma_m_s), Some(n.current_walk_m_s_per_sqrt_s));
     }
     if p.heading_error_deg > 0.0 {
-        e.estimate_heading_offset = Some(true);
-        (e.heading_offset_sigma_deg, e.heading_offset_time_s) =
+        e.calibration.estimate_heading_offset = Some(true);
+        (e.calibration.heading_offset_sigma_deg, e.calibration.heading_offset_time_s) =
             (Some(p.heading_error_deg), Some(p.heading_error_time_s));
     }
-    e.speed_sigma_m_s = Some(p.speed_white_m_s);
-    e.heading_sigma_deg = Some(p.heading_white_deg.max(1e-4f64.to_degrees()));
-    e.heading_walk_deg_per_sqrt_m = Some(p.max_turn_rate_deg_s);
-    e.nis_gate = Some(f64::INFINITY);
+    e.noise.speed_sigma_m_s = Some(p.speed_white_m_s);
+    e.noise.heading_sigma_deg = Some(p.heading_white_deg.max(1e-4f64.to_degrees()));
+    e.planar.heading_walk_deg_per_sqrt_m = Some(p.max_turn_rate_deg_s);
+    e.gating.nis_gate = Some(f64::INFINITY);
     e
 }
 

@@ -108,6 +108,13 @@ impl Aboard {
     }
 }
 
+/// The vehicle each track estimates: a track is one estimator of one session of one
+/// computer, in that order.
+pub(crate) fn vehicle_of(computers: &[Aboard]) -> Vec<usize> {
+    let sessions = computers.iter().flat_map(|c| c.vehicles.iter().enumerate().map(move |(i, &v)| (c, i, v)));
+    sessions.flat_map(|(c, i, v)| std::iter::repeat_n(v, c.unit.session(i).names.len())).collect()
+}
+
 /// What observers see of one step.
 pub(crate) struct Step<'a> {
     pub k: usize,
@@ -149,13 +156,10 @@ pub(crate) trait Observer {
 /// applied, at each step's time ([`Unit::predict_to`]).
 pub(crate) fn run(world: &mut dyn World, computers: &mut [Aboard], observers: &mut [&mut dyn Observer]) {
     let vehicles = world.vehicles();
-    let mut vehicle_of = Vec::new();
     for c in computers.iter_mut() {
         assert!(c.unit.start_by(0.0), "a world's computers start at time 0");
-        for (i, &v) in c.vehicles.iter().enumerate() {
-            vehicle_of.extend(std::iter::repeat_n(v, c.unit.session(i).names.len()));
-        }
     }
+    let vehicle_of = vehicle_of(computers);
     let helm_of: Vec<usize> = (0..computers.len()).filter(|&c| computers[c].unit.has_controller()).collect();
     let mut heard = vec![Vec::new(); vehicles];
     let mut truth: Vec<VehicleTruth> = (0..vehicles).map(|v| world.truth(v)).collect();

@@ -252,11 +252,7 @@ fn drive(
     messages: bool,
 ) -> (RunOutput, Option<Vec<Computer>>) {
     let mut aboard = computers::aboard(computers, build);
-    let vehicle_of = computers
-        .iter()
-        .flat_map(|c| c.starts.iter().flat_map(|s| c.config.estimators.iter().map(|_| s.vehicle)))
-        .collect();
-    let mut scoring = Scoring::new(vehicle_of, world.steps());
+    let mut scoring = Scoring::new(engine::vehicle_of(&aboard), world.steps());
     let mut m = messages.then(|| Messages::new(computers));
     {
         let mut observers: Vec<&mut dyn Observer> = vec![&mut scoring, &mut recorder];
@@ -363,15 +359,15 @@ impl Observer for Recorder {
     fn inspect(&mut self, k: usize, computers: &[Aboard]) {
         let Some((_, samples)) = self.belief_at.filter(|(at, _)| *at == k) else { return };
         let Some(first) = computers.iter().find_map(|c| c.navigator_of(0)) else { return };
-        if let Some(positions) = first.position_sample(samples) {
+        if let Some(particles) = first.particles() {
             let e = first.estimate();
             self.belief = Some(BeliefSnapshot {
                 t_s: e.t_s,
-                positions,
+                positions: particles.position_sample(samples),
                 estimate: e.position_ned_m,
                 truth: Vector3::from_element(f64::NAN),
                 bearing: None,
-                sets: first.factored_sets(),
+                sets: first.factored().map(|f| f.factored_sets().clone()),
                 beacon: Vector3::from_element(f64::NAN),
             });
         }

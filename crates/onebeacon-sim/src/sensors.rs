@@ -126,7 +126,7 @@ impl SensorSuite {
         let lost = self.acoustic.random::<f64>() < self.frame_loss_prob;
         let (n, x) = (&self.noise, state(truth));
         let range_noise = Range2d { beacon, var: n.range_noise_m.powi(2) }.noise(&x, &mut self.acoustic);
-        let doppler = RadialSpeed2d { beacon, known_speed_m_s: None, var: n.doppler_noise_m_s.powi(2) };
+        let doppler = RadialSpeed2d { beacon, known_speed_m_s: None, dz_m: 0.0, var: n.doppler_noise_m_s.powi(2) };
         let doppler_noise = doppler.noise(&x, &mut self.acoustic);
         if lost {
             return None;

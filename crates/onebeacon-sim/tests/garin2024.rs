@@ -68,7 +68,7 @@ fn mirror_recovery_removes_the_reflected_divergences() {
     let Scenario::FixedBeacon(mut s) = garin(&[3.0]) else { unreachable!() };
     let mut published = s.estimators[0].clone();
     published.name = Some("published".into());
-    published.mirror_recovery = Some(false);
+    published.unicycle.mirror_recovery = Some(false);
     s.estimators.push(published);
     let r = monte_carlo(&Scenario::FixedBeacon(s), 100, 7, None, &|| {}).unwrap();
     let (rd, published) = (cell(&r, 0, "range+doppler"), cell(&r, 0, "published"));
@@ -97,7 +97,7 @@ fn the_robust_filter_keeps_every_run() {
         let Scenario::FixedBeacon(mut s) = garin(&[t_com]) else { unreachable!() };
         let mut published = s.estimators[0].clone();
         published.name = Some("published".into());
-        published.mirror_recovery = Some(false);
+        published.unicycle.mirror_recovery = Some(false);
         s.estimators.push(published);
         let s = Scenario::FixedBeacon(s);
         let labels: Vec<String> = s.track_labels();
@@ -189,8 +189,8 @@ fn a_run_names_a_filter_told_too_little_noise() {
     };
     let mut told = s.estimators[0].clone();
     told.name = Some("told-too-little".into());
-    told.range_sigma_m = Some(12f64.sqrt() / 10.0);
-    told.doppler_sigma_m_s = Some(0.2f64.sqrt() / 10.0);
+    told.noise.range_sigma_m = Some(12f64.sqrt() / 10.0);
+    told.noise.doppler_sigma_m_s = Some(0.2f64.sqrt() / 10.0);
     s.estimators.push(told);
     let s = Scenario::FixedBeacon(s);
     let out = onebeacon_sim::run::simulate(&s, &s.base_cell(), s.seed(), 0, false);

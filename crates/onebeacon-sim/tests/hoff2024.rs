@@ -14,7 +14,7 @@ fn small(particles: usize, duration_s: f64, guidance: &[GuidanceKind]) -> Scenar
         unreachable!()
     };
     s.mission.duration_s = duration_s;
-    s.estimators[0].particles = Some(particles);
+    s.estimators[0].particle.particles = Some(particles);
     s.guidance.planner_particles = 1000;
     s.sweep.guidance = Some(guidance.to_vec());
     Scenario::PassiveUsbl(s)

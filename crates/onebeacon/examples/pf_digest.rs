@@ -38,7 +38,7 @@ fn main() {
         pf.process(&Measurement::new(t, bearing));
     }
     let e = pf.estimate();
-    let positions = pf.position_sample(20_000).expect("a particle belief");
+    let positions = pf.particles().expect("a particle belief").position_sample(20_000);
     let weights = vec![1.0 / positions.len() as f64; positions.len()];
     let belief = Belief { positions: &positions, weights: &weights, velocity_m_s: Vector2::new(0.0, 1.5), lead_s: 8.0 };
     let planner = BearingPlanner {

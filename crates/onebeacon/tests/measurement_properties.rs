@@ -71,7 +71,7 @@ proptest! {
     #[test]
     fn radial_speed(x in state(), b in beacon(), known in proptest::option::of(-3.0..3.0f64)) {
         prop_assume!((x.xy() - b.xy()).norm() > 1.0);
-        check(&RadialSpeed2d { beacon: Vector2::new(b.x, b.y), known_speed_m_s: known, var: 0.2 }, &x)?;
+        check(&RadialSpeed2d { beacon: Vector2::new(b.x, b.y), known_speed_m_s: known, dz_m: 0.0, var: 0.2 }, &x)?;
     }
 
     #[test]

@@ -75,7 +75,7 @@ fn calibration_not_estimated_is_absent() {
 #[test]
 fn a_configured_unit_estimates_from_its_lines() {
     let c = config(CONFIG).checked().unwrap();
-    assert_eq!(c.estimators[0].range_sigma_m, Some(0.5), "[noise] is handed to the estimators");
+    assert_eq!(c.estimators[0].noise.range_sigma_m, Some(0.5), "[noise] is handed to the estimators");
     let last = last_line(c);
     let estimate = |i: usize| {
         let e = &last["estimates"][i];

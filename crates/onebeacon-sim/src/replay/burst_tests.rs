@@ -252,7 +252,7 @@ fn a_held_out_beacon_is_predicted_by_the_others() {
 fn one_beacon_alone_with_an_early_false_track_captures_no_range_scale_filter() {
     let worst = |scale_sigma: Option<f64>| {
         let mut log = lbl_log(&format!("alone-{}", scale_sigma.unwrap_or(0.0)), First::False, "");
-        log.description.estimators.iter_mut().for_each(|e| e.range_scale_sigma = scale_sigma);
+        log.description.estimators.iter_mut().for_each(|e| e.calibration.range_scale_sigma = scale_sigma);
         let r = replay(&log, Some([0].into()), |_| Ok::<_, super::LogError>(())).unwrap();
         let s = &r.session;
         s.names.iter().zip(&s.stats).find(|(n, _)| *n == "ekf-cal").map(|(_, st)| st.max_m).unwrap()

@@ -45,9 +45,9 @@ pub fn rts(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<Vec<RtsRun>, Log
         }
         Ok::<_, LogError>(())
     })?;
-    let session = &r.session;
+    let mut session = r.session;
     let runs = (0..session.names.len()).filter_map(|i| {
-        let estimates = session.navigator(i)?.smoothed();
+        let estimates = session.smoothed(i)?;
         (!estimates.is_empty()).then(|| {
             let mut run = RtsRun { name: session.names[i].clone(), estimates, stats: ErrorStats::default() };
             for &(t, north, east, sigma) in &truth {

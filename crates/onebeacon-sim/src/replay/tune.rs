@@ -213,7 +213,7 @@ pub fn tune(
     };
     // a key the estimator's model does not have would change the model, not fit it
     if let Some(k) = keys.iter().find(|k| *k == "track_accel_sigma_m_s2")
-        && spec.track_accel_sigma_m_s2.is_none()
+        && spec.planar.track_accel_sigma_m_s2.is_none()
     {
         return Err(LogError::File {
             file: log.description.name.clone(),
@@ -407,7 +407,7 @@ mod tests {
         let fitted = t.keys[0].2;
         assert!((fitted / drawn - 1.0).abs() < 0.1, "fitted {fitted} m, drawn {drawn} m");
         assert!(t.nll_after < t.nll_before);
-        assert_eq!(t.spec.range_sigma_m, Some(fitted));
+        assert_eq!(t.spec.noise.range_sigma_m, Some(fitted));
     }
 
     /// The fitted range sigma's interval against the closed form: n Gaussian residuals

@@ -330,11 +330,11 @@ mod tests {
         s.initial.accel_sigma_m_s2 = 1e-6;
         // and tell the filters their sensors are (nearly) exact
         for e in &mut s.estimators {
-            e.range_sigma_m = Some(1e-3);
-            e.doppler_sigma_m_s = Some(1e-4);
-            e.heading_sigma_deg = Some(1e-4f64.to_degrees());
-            e.yaw_rate_sigma_rad_s = Some(1e-5);
-            e.accel_sigma_m_s2 = Some(1e-5);
+            e.noise.range_sigma_m = Some(1e-3);
+            e.noise.doppler_sigma_m_s = Some(1e-4);
+            e.noise.heading_sigma_deg = Some(1e-4f64.to_degrees());
+            e.unicycle.yaw_rate_sigma_rad_s = Some(1e-5);
+            e.unicycle.accel_sigma_m_s2 = Some(1e-5);
         }
         // the UKF too
         let mut ukf = s.estimators[0].clone();

@@ -141,8 +141,12 @@ impl EstimatorSpec {
     fn unicycle_builder(&self, start: TrackerStart) -> Builder {
         let (aiding, tuning, filter) = (self.aiding(Host::FixedBeacon), self.ekf_tuning(), self.filter_kind());
         let (gate, robust) = self.gate();
-        let guards =
-            Guards { min_speed_m_s: self.min_speed_m_s, mirror: self.mirror_recovery.unwrap_or(true), gate, robust };
+        let guards = Guards {
+            min_speed_m_s: self.unicycle.min_speed_m_s,
+            mirror: self.unicycle.mirror_recovery.unwrap_or(true),
+            gate,
+            robust,
+        };
         let calibration = self.range_calibration();
         let ([_, _, speed, ..], [_, _, s_speed, _]) = (start.state, start.sigma);
         let ([yaw_rate, accel], [s_yaw_rate, s_accel]) = (start.yaw_rate_accel, start.yaw_rate_accel_sigma);
@@ -169,5 +173,53 @@ impl EstimatorSpec {
                 None => Box::new(GaussianTracker::new(config, filter, t0, &x, &sigma)),
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each kind's navigator hands out the capabilities its type has and no other (the
+    /// table is read from the navigators' docs: particles for the two particle filters,
+    /// factored sets for the factored one only, held-out weighing for the Gaussian range
+    /// family, smoothing for it with beacon aiding, offsets only when asked for), and
+    /// the controller capabilities agree with what [`EstimatorSpec::provides`] says at
+    /// configuration.
+    #[test]
+    fn each_navigator_hands_out_the_capabilities_of_its_kind() {
+        use EstimatorKind::*;
+        let start =
+            TrackerStart { state: [10.0, 0.0, 1.5, 0.0, 0.0], sigma: [1.0, 0.1, 0.2, 0.01], ..Default::default() };
+        // kind, model, offsets, then particles, factored, weighing, smoothing, offsets
+        let table = [
+            (RangeDoppler, VehicleModel::Planar, false, [false, false, true, true, false]),
+            (Rosb, VehicleModel::Planar, true, [false, false, true, true, true]),
+            (DeadReckoning, VehicleModel::Planar, false, [false, false, true, false, false]),
+            (Particle, VehicleModel::Planar, false, [true, false, false, false, false]),
+            (Bearing, VehicleModel::Planar, false, [false, false, false, false, false]),
+            (Iusbl, VehicleModel::Planar, false, [true, true, false, false, false]),
+            (IusblJoint, VehicleModel::Planar, false, [true, false, false, false, false]),
+            (RangeEkf, VehicleModel::Kinematic6Dof, false, [false, false, false, false, false]),
+        ];
+        for (kind, model, offsets, want) in table {
+            let mut spec = EstimatorSpec::new(kind);
+            spec.calibration.estimate_beacon_offsets = Some(offsets);
+            let mut nav = spec.builder(start, model)(0.0, (0.0, 0.0, 0.0), 1.0, 0.1);
+            let got = [
+                nav.particles().is_some(),
+                nav.factored().is_some(),
+                nav.weighing().is_some(),
+                nav.smoothing().is_some(),
+                nav.beacon_offsets().is_some(),
+            ];
+            assert_eq!(got, want, "{} ({model:?})", kind.label());
+            for (capability, has) in [
+                (Capability::BeaconRelative, nav.beacon_relative().is_some()),
+                (Capability::BodyVelocity, nav.body_velocity().is_some()),
+            ] {
+                assert_eq!(spec.provides(capability, model), has, "{} ({model:?}): {capability:?}", kind.label());
+            }
+        }
     }
 }

@@ -7,6 +7,10 @@
 //! unicycle of hoff2024 eq. 4 in `passive_usbl` worlds, planar odometry on logs.
 
 pub use super::estimator_defaults::*;
+pub use super::estimator_keys::{
+    CalibrationKeys, GateKeys, NoiseKeys, ParticleKeys, PlanarKeys, ResamplerName, RobustName, SixDofKeys,
+    UnicycleKeys, UsblKeys,
+};
 pub use super::iusbl::IusblKeys;
 use crate::filter::particle::{ParticleSettings, Resampler};
 use crate::filter::{FilterKind, UkfParams};
@@ -15,7 +19,9 @@ use crate::nav::{
     Aiding, CurrentPrior, EkfTuning, HeadingOffsetPrior, MisalignmentPrior, OffsetPrior, PlanarConfig, PlanarNoise,
     RangeCalibration, Robust, SensorNoise, TrackerConfig, TrackerNoise,
 };
+use serde::de::{DeserializeSeed, Deserializer, Error, MapAccess, Visitor};
 use serde::{Deserialize, Serialize};
+use std::sync::LazyLock;
 
 /// Which filter an estimator runs: the `filter` key of every `[[estimators]]` table.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -49,26 +55,6 @@ impl FilterName {
             FilterName::Ukf => "-ukf",
         }
     }
-}
-
-/// A heavy-tailed update (`robust` key).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RobustName {
-    /// Huber's weight, threshold `huber_k` standard deviations (default 1.345).
-    Huber,
-    /// A Student-t likelihood with `student_t_dof` degrees of freedom (default 4).
-    StudentT,
-}
-
-/// How a particle filter resamples (`resampler` key).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ResamplerName {
-    Multinomial,
-    Systematic,
-    Stratified,
-    Residual,
 }
 
 /// Where an estimator runs.
@@ -179,142 +165,49 @@ pub enum Acoustic {
     Bearing,
 }
 
-/// One `[[estimators]]` table. Every key but `kind` is optional; tuning keys apply to
-/// the hosts named beside them (validation refuses the others).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// One `[[estimators]]` table. Every key but `kind` is optional; tuning keys are
+/// grouped by what they tune ([`super::estimator_keys`]; the table stays flat) and apply
+/// to the hosts named beside them (validation refuses the others).
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EstimatorSpec {
     pub kind: EstimatorKind,
     /// Name in outputs (default: the kind, with "-ukf" for the UKF).
-    #[serde(default)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// The acoustic measurements used (default: the kind's): `["range"]`,
     /// `["range", "doppler"]`, `[]`...
-    #[serde(default)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub measurements: Option<Vec<Acoustic>>,
     /// `"ekf"` (default) or `"ukf"`, with the UKF's sigma-point parameters (1, 2, 0).
-    #[serde(default)]
     pub filter: FilterName,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ukf_alpha: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ukf_beta: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ukf_kappa: Option<f64>,
-    // Measurement noise the filter assumes (standard deviations). Default: garin2024
-    // eq. 25 (fixed_beacon), the sensors' (moving_beacon), PlanarNoise (logs).
-    /// Range, m (fixed_beacon, moving_beacon, log).
-    pub range_sigma_m: Option<f64>,
-    /// Doppler radial speed, m/s (fixed_beacon, log).
-    pub doppler_sigma_m_s: Option<f64>,
-    /// Heading, deg (fixed_beacon, log; passive_usbl: the vehicle's reported heading).
-    pub heading_sigma_deg: Option<f64>,
-    /// USBL bearings: sigma_USBL, deg per metre of range (passive_usbl).
-    pub usbl_sigma_deg_per_m: Option<f64>,
-    /// USBL bearings: the angles' noise floor besides sigma_USBL's range-proportional
-    /// term, deg (passive_usbl; default 0, the paper's).
-    pub usbl_floor_deg: Option<f64>,
-    /// Read hoff2024's eq. 6 as printed: sigma_USBL r (eq. 3) as the angles' variance
-    /// instead of their standard deviation (passive_usbl; default false).
-    pub usbl_as_printed: Option<bool>,
-    /// The USBL head's yaw misalignment as a state of the particle filter: its standard
-    /// deviation about zero at the start, deg (pf; absent: the head is taken as aligned).
-    pub usbl_misalignment_sigma_deg: Option<f64>,
-    /// That misalignment's random walk, deg per sqrt(s) (pf; default
-    /// [`DEFAULT_MISALIGNMENT_WALK_DEG_PER_SQRT_S`]).
-    pub usbl_misalignment_walk_deg_per_sqrt_s: Option<f64>,
-    /// The station's compass error, deg (passive_usbl).
-    pub compass_sigma_deg: Option<f64>,
-    /// The vehicle's reported depth, m (passive_usbl; moving_beacon: its depth sensor).
-    pub depth_sigma_m: Option<f64>,
-    /// The 6-DOF filter's sensors (moving_beacon): body velocity (u, v, w), m/s; body
-    /// rates (p, q, r), rad/s; roll, pitch and heading, deg. Absent: the world's sensors,
-    /// or on a stream [`SensorNoise::default`].
-    pub velocity_sigma_m_s: Option<f64>,
-    pub rate_sigma_rad_s: Option<f64>,
-    pub attitude_sigma_deg: Option<f64>,
-    /// Scales every process noise standard deviation of hoff2024 eq. 4 (passive_usbl).
-    pub process_noise_scale: Option<f64>,
-    /// The process noise standard deviations of eq. 4 per second, state order [x, y, z,
-    /// theta, psi, u, b_theta, b_psi] (m/s, rad/s, m/s^2, rad/s^2; passive_usbl; default:
-    /// hoff2024 sec. 5).
-    pub process_sigma: Option<[f64; 8]>,
-    /// Particles (pf; default 500000, hoff2024 sec. 5).
-    pub particles: Option<usize>,
-    /// `"multinomial"` (hoff2024 eq. 9), `"systematic"` (default), `"stratified"` or
-    /// `"residual"` (pf).
-    pub resampler: Option<ResamplerName>,
-    /// Resample when the effective sample size falls below this fraction (pf; default
-    /// 0.5; 1: every message).
-    pub ess_fraction: Option<f64>,
-    /// Roughening after resampling, K of Gordon et al. (pf; default off).
-    pub roughening_k: Option<f64>,
-    /// The fewest effective particles an update may leave: a sharper measurement is
-    /// tempered (pf; default 20; 0: off).
-    pub min_effective_particles: Option<f64>,
-    /// Yaw rate, rad/s, and forward acceleration, m/s^2 (fixed_beacon).
-    pub yaw_rate_sigma_rad_s: Option<f64>,
-    pub accel_sigma_m_s2: Option<f64>,
-    /// Diagonal of Q per step, state order [x, y, psi, v, Omega, a] (fixed_beacon).
-    pub q_diag: Option<[f64; 6]>,
-    /// Take a state driving backwards for the mirror image of the vehicle through the
-    /// beacon and reflect it back (fixed_beacon; default true, false: garin2024's
-    /// filter as published).
-    pub mirror_recovery: Option<bool>,
-    /// The slowest the vehicle goes ahead, m/s: a speed estimate below it is projected
-    /// onto it with the states correlated with it (fixed_beacon; default none).
-    pub min_speed_m_s: Option<f64>,
-    // Planar odometry model and calibration states (log).
-    pub distance_sigma_frac: Option<f64>,
-    pub heading_change_sigma_frac: Option<f64>,
-    pub heading_walk_deg_per_sqrt_m: Option<f64>,
-    pub speed_sigma_m_s: Option<f64>,
-    pub bias_walk_m_per_sqrt_s: Option<f64>,
-    /// Position random walk, m / sqrt(s): the motion model of a craft without inputs
-    /// (log).
-    pub position_walk_m_per_sqrt_s: Option<f64>,
-    /// Track the craft with a constant-velocity model, white acceleration of this
-    /// standard deviation, m/s^2 per sqrt(s); no motion inputs are used (log).
-    pub track_accel_sigma_m_s2: Option<f64>,
-    pub nis_gate: Option<f64>,
-    /// A heavy-tailed update (log): `"huber"` or `"student_t"`, Gaussian when absent.
-    pub robust: Option<RobustName>,
-    pub huber_k: Option<f64>,
-    pub student_t_dof: Option<f64>,
-    /// A range offset state (log, moving_beacon: a clock offset, a latency), starting at
-    /// `bias_m` with `bias_sigma_m`, walking with `bias_walk_m_per_sqrt_s`.
-    pub estimate_bias: Option<bool>,
-    /// A drift state of the range offset, m/s (moving_beacon: a clock's frequency error,
-    /// 1 ppm at 1500 m/s is 1.5e-3 m/s), prior standard deviation `bias_drift_sigma_m_s`;
-    /// implies `estimate_bias`.
-    pub estimate_bias_drift: Option<bool>,
-    pub bias_drift_sigma_m_s: Option<f64>,
-    /// An offset per beacon instead of one shared (log).
-    pub estimate_beacon_offsets: Option<bool>,
-    pub bias_m: Option<f64>,
-    pub bias_sigma_m: Option<f64>,
-    pub estimate_range_scale: Option<bool>,
-    pub range_scale_sigma: Option<f64>,
-    pub estimate_distance_scale: Option<bool>,
-    pub distance_scale_sigma: Option<f64>,
-    pub estimate_turn_scale: Option<bool>,
-    pub turn_scale_sigma: Option<f64>,
-    /// The water's current as two states (north, east; fixed_beacon, moving_beacon, log):
-    /// zero at the start with `current_sigma_m_s` on each axis, walking with
-    /// `current_walk_m_s_per_sqrt_s`.
-    pub estimate_current: Option<bool>,
-    pub current_sigma_m_s: Option<f64>,
-    pub current_walk_m_s_per_sqrt_s: Option<f64>,
-    /// The heading sensor's offset as a state (log): heading fixes read the heading plus
-    /// it; zero at the start with `heading_offset_sigma_deg`, a first-order Gauss-Markov
-    /// process of correlation time `heading_offset_time_s` (none: a constant).
-    /// A speed input of zero is a stopped propeller: the vehicle coasts on with this time
-    /// constant, s (log; none: it stops at once).
-    pub speed_coast_time_s: Option<f64>,
-    pub estimate_heading_offset: Option<bool>,
-    pub heading_offset_sigma_deg: Option<f64>,
-    pub heading_offset_time_s: Option<f64>,
+    #[serde(flatten)]
+    pub noise: NoiseKeys,
+    #[serde(flatten)]
+    pub gating: GateKeys,
+    #[serde(flatten)]
+    pub calibration: CalibrationKeys,
+    #[serde(flatten)]
+    pub unicycle: UnicycleKeys,
+    #[serde(flatten)]
+    pub six_dof: SixDofKeys,
+    #[serde(flatten)]
+    pub usbl: UsblKeys,
+    #[serde(flatten)]
+    pub particle: ParticleKeys,
+    #[serde(flatten)]
+    pub planar: PlanarKeys,
     /// The seed of the estimator's random draws, any 64-bit integer (a particle
     /// filter's; log; default: the vehicle's `[initial]` seed, else 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub seed: Option<i64>,
     /// The iUSBL navigator's settings (kinds iusbl and iusbl-joint on a log).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub iusbl: Option<IusblKeys>,
 }
 
@@ -329,61 +222,14 @@ impl EstimatorSpec {
             ukf_alpha: None,
             ukf_beta: None,
             ukf_kappa: None,
-            range_sigma_m: None,
-            doppler_sigma_m_s: None,
-            heading_sigma_deg: None,
-            usbl_sigma_deg_per_m: None,
-            usbl_floor_deg: None,
-            usbl_as_printed: None,
-            usbl_misalignment_sigma_deg: None,
-            usbl_misalignment_walk_deg_per_sqrt_s: None,
-            compass_sigma_deg: None,
-            depth_sigma_m: None,
-            velocity_sigma_m_s: None,
-            rate_sigma_rad_s: None,
-            attitude_sigma_deg: None,
-            process_noise_scale: None,
-            process_sigma: None,
-            particles: None,
-            resampler: None,
-            ess_fraction: None,
-            roughening_k: None,
-            min_effective_particles: None,
-            yaw_rate_sigma_rad_s: None,
-            accel_sigma_m_s2: None,
-            q_diag: None,
-            mirror_recovery: None,
-            min_speed_m_s: None,
-            distance_sigma_frac: None,
-            heading_change_sigma_frac: None,
-            heading_walk_deg_per_sqrt_m: None,
-            speed_sigma_m_s: None,
-            bias_walk_m_per_sqrt_s: None,
-            position_walk_m_per_sqrt_s: None,
-            track_accel_sigma_m_s2: None,
-            nis_gate: None,
-            robust: None,
-            huber_k: None,
-            student_t_dof: None,
-            estimate_bias: None,
-            estimate_bias_drift: None,
-            bias_drift_sigma_m_s: None,
-            estimate_beacon_offsets: None,
-            bias_m: None,
-            bias_sigma_m: None,
-            estimate_range_scale: None,
-            range_scale_sigma: None,
-            estimate_distance_scale: None,
-            distance_scale_sigma: None,
-            estimate_turn_scale: None,
-            turn_scale_sigma: None,
-            estimate_current: None,
-            current_sigma_m_s: None,
-            current_walk_m_s_per_sqrt_s: None,
-            speed_coast_time_s: None,
-            estimate_heading_offset: None,
-            heading_offset_sigma_deg: None,
-            heading_offset_time_s: None,
+            noise: NoiseKeys::default(),
+            gating: GateKeys::default(),
+            calibration: CalibrationKeys::default(),
+            unicycle: UnicycleKeys::default(),
+            six_dof: SixDofKeys::default(),
+            usbl: UsblKeys::default(),
+            particle: ParticleKeys::default(),
+            planar: PlanarKeys::default(),
             seed: None,
             iusbl: None,
         }
@@ -393,16 +239,16 @@ impl EstimatorSpec {
     /// to read or set; None for another key.
     pub fn key_mut(&mut self, key: &str) -> Option<&mut Option<f64>> {
         Some(match key {
-            "range_sigma_m" => &mut self.range_sigma_m,
-            "doppler_sigma_m_s" => &mut self.doppler_sigma_m_s,
-            "heading_sigma_deg" => &mut self.heading_sigma_deg,
-            "distance_sigma_frac" => &mut self.distance_sigma_frac,
-            "heading_change_sigma_frac" => &mut self.heading_change_sigma_frac,
-            "heading_walk_deg_per_sqrt_m" => &mut self.heading_walk_deg_per_sqrt_m,
-            "speed_sigma_m_s" => &mut self.speed_sigma_m_s,
-            "bias_walk_m_per_sqrt_s" => &mut self.bias_walk_m_per_sqrt_s,
-            "position_walk_m_per_sqrt_s" => &mut self.position_walk_m_per_sqrt_s,
-            "track_accel_sigma_m_s2" => &mut self.track_accel_sigma_m_s2,
+            "range_sigma_m" => &mut self.noise.range_sigma_m,
+            "doppler_sigma_m_s" => &mut self.noise.doppler_sigma_m_s,
+            "heading_sigma_deg" => &mut self.noise.heading_sigma_deg,
+            "distance_sigma_frac" => &mut self.planar.distance_sigma_frac,
+            "heading_change_sigma_frac" => &mut self.planar.heading_change_sigma_frac,
+            "heading_walk_deg_per_sqrt_m" => &mut self.planar.heading_walk_deg_per_sqrt_m,
+            "speed_sigma_m_s" => &mut self.noise.speed_sigma_m_s,
+            "bias_walk_m_per_sqrt_s" => &mut self.calibration.bias_walk_m_per_sqrt_s,
+            "position_walk_m_per_sqrt_s" => &mut self.planar.position_walk_m_per_sqrt_s,
+            "track_accel_sigma_m_s2" => &mut self.planar.track_accel_sigma_m_s2,
             _ => return None,
         })
     }
@@ -433,12 +279,12 @@ impl EstimatorSpec {
         let d = EkfTuning::default();
         let var = |sigma: Option<f64>, default: f64| sigma.map_or(default, |s| s * s);
         EkfTuning {
-            q_diag: self.q_diag.unwrap_or(d.q_diag),
-            r_range_m2: var(self.range_sigma_m, d.r_range_m2),
-            r_doppler_m2_s2: var(self.doppler_sigma_m_s, d.r_doppler_m2_s2),
-            r_heading_rad2: var(self.heading_sigma_deg.map(f64::to_radians), d.r_heading_rad2),
-            r_yaw_rate_rad2_s2: var(self.yaw_rate_sigma_rad_s, d.r_yaw_rate_rad2_s2),
-            r_accel_m2_s4: var(self.accel_sigma_m_s2, d.r_accel_m2_s4),
+            q_diag: self.unicycle.q_diag.unwrap_or(d.q_diag),
+            r_range_m2: var(self.noise.range_sigma_m, d.r_range_m2),
+            r_doppler_m2_s2: var(self.noise.doppler_sigma_m_s, d.r_doppler_m2_s2),
+            r_heading_rad2: var(self.noise.heading_sigma_deg.map(f64::to_radians), d.r_heading_rad2),
+            r_yaw_rate_rad2_s2: var(self.unicycle.yaw_rate_sigma_rad_s, d.r_yaw_rate_rad2_s2),
+            r_accel_m2_s4: var(self.unicycle.accel_sigma_m_s2, d.r_accel_m2_s4),
         }
     }
 
@@ -447,11 +293,11 @@ impl EstimatorSpec {
     /// `rate_sigma_rad_s`, `attitude_sigma_deg`).
     pub fn sensor_noise(&self, sensors: SensorNoise) -> SensorNoise {
         SensorNoise {
-            velocity_m_s: self.velocity_sigma_m_s.unwrap_or(sensors.velocity_m_s),
-            rate_rad_s: self.rate_sigma_rad_s.unwrap_or(sensors.rate_rad_s),
-            depth_m: self.depth_sigma_m.unwrap_or(sensors.depth_m),
-            attitude_rad: self.attitude_sigma_deg.map_or(sensors.attitude_rad, f64::to_radians),
-            range_m: self.range_sigma_m.unwrap_or(sensors.range_m),
+            velocity_m_s: self.six_dof.velocity_sigma_m_s.unwrap_or(sensors.velocity_m_s),
+            rate_rad_s: self.six_dof.rate_sigma_rad_s.unwrap_or(sensors.rate_rad_s),
+            depth_m: self.noise.depth_sigma_m.unwrap_or(sensors.depth_m),
+            attitude_rad: self.six_dof.attitude_sigma_deg.map_or(sensors.attitude_rad, f64::to_radians),
+            range_m: self.noise.range_sigma_m.unwrap_or(sensors.range_m),
         }
     }
 
@@ -461,18 +307,22 @@ impl EstimatorSpec {
     /// priors and walk where a key is absent.
     pub fn range_calibration(&self) -> RangeCalibration {
         let c = PlanarConfig::default();
-        let drift = self.estimate_bias_drift == Some(true);
-        let offset = (self.estimate_bias == Some(true) || drift).then(|| OffsetPrior {
-            initial_m: self.bias_m.unwrap_or(c.bias_m),
-            sigma_m: self.bias_sigma_m.unwrap_or(c.bias_sigma_m),
-            walk_m_per_sqrt_s: self.bias_walk_m_per_sqrt_s.unwrap_or(c.noise.bias_walk_m_per_sqrt_s),
-            drift_sigma_m_s: drift.then(|| self.bias_drift_sigma_m_s.unwrap_or(DEFAULT_BIAS_DRIFT_SIGMA_M_S)),
+        let drift = self.calibration.estimate_bias_drift == Some(true);
+        let offset = (self.calibration.estimate_bias == Some(true) || drift).then(|| OffsetPrior {
+            initial_m: self.calibration.bias_m.unwrap_or(c.bias_m),
+            sigma_m: self.calibration.bias_sigma_m.unwrap_or(c.bias_sigma_m),
+            walk_m_per_sqrt_s: self.calibration.bias_walk_m_per_sqrt_s.unwrap_or(c.noise.bias_walk_m_per_sqrt_s),
+            drift_sigma_m_s: drift
+                .then(|| self.calibration.bias_drift_sigma_m_s.unwrap_or(DEFAULT_BIAS_DRIFT_SIGMA_M_S)),
         });
-        let scale_sigma =
-            (self.estimate_range_scale == Some(true)).then(|| self.range_scale_sigma.unwrap_or(c.range_scale_sigma));
-        let current = (self.estimate_current == Some(true)).then(|| CurrentPrior {
-            sigma_m_s: self.current_sigma_m_s.unwrap_or(DEFAULT_CURRENT_SIGMA_M_S),
-            walk_m_s_per_sqrt_s: self.current_walk_m_s_per_sqrt_s.unwrap_or(DEFAULT_CURRENT_WALK_M_S_PER_SQRT_S),
+        let scale_sigma = (self.calibration.estimate_range_scale == Some(true))
+            .then(|| self.calibration.range_scale_sigma.unwrap_or(c.range_scale_sigma));
+        let current = (self.calibration.estimate_current == Some(true)).then(|| CurrentPrior {
+            sigma_m_s: self.calibration.current_sigma_m_s.unwrap_or(DEFAULT_CURRENT_SIGMA_M_S),
+            walk_m_s_per_sqrt_s: self
+                .calibration
+                .current_walk_m_s_per_sqrt_s
+                .unwrap_or(DEFAULT_CURRENT_WALK_M_S_PER_SQRT_S),
         });
         RangeCalibration { offset, scale_sigma, current }
     }
@@ -483,45 +333,49 @@ impl EstimatorSpec {
     pub fn log_gate(&self) -> (f64, Option<Robust>) {
         let (gate, robust) = self.gate();
         let planar = !self.kind.tracks_bearings() && !self.kind.iusbl();
-        (if planar && self.nis_gate.is_none() { LOG_NIS_GATE } else { gate }, robust)
+        (if planar && self.gating.nis_gate.is_none() { LOG_NIS_GATE } else { gate }, robust)
     }
 
     /// The gate (a NIS; infinity: none) and heavy-tailed update asked for (`nis_gate`,
     /// `robust`), of ranges, Doppler speeds, heading fixes and bearings alike.
     pub fn gate(&self) -> (f64, Option<Robust>) {
-        let robust = self.robust.map(|r| match r {
-            RobustName::Huber => Robust::Huber { k: self.huber_k.unwrap_or(1.345) },
-            RobustName::StudentT => Robust::StudentT { dof: self.student_t_dof.unwrap_or(4.0) },
+        let robust = self.gating.robust.map(|r| match r {
+            RobustName::Huber => Robust::Huber { k: self.gating.huber_k.unwrap_or(1.345) },
+            RobustName::StudentT => Robust::StudentT { dof: self.gating.student_t_dof.unwrap_or(4.0) },
         });
-        (self.nis_gate.unwrap_or(f64::INFINITY), robust)
+        (self.gating.nis_gate.unwrap_or(f64::INFINITY), robust)
     }
 
     /// The trackers' configuration (passive_usbl): the world's noise `n` (a matched
     /// filter) and [`HoffProcess::default`] where a key is absent.
     pub fn tracker_config(&self, n: TrackerNoise) -> TrackerConfig {
         let d = TrackerConfig::default();
-        let scale = self.process_noise_scale.unwrap_or(1.0);
+        let scale = self.usbl.process_noise_scale.unwrap_or(1.0);
         let (nis_gate, robust) = self.gate();
         TrackerConfig {
             process: HoffProcess {
-                sigma: self.process_sigma.unwrap_or(d.process.sigma).map(|s| s * scale),
+                sigma: self.usbl.process_sigma.unwrap_or(d.process.sigma).map(|s| s * scale),
                 ..d.process
             },
             noise: TrackerNoise {
-                usbl_sigma_rad_per_m: self.usbl_sigma_deg_per_m.map_or(n.usbl_sigma_rad_per_m, f64::to_radians),
-                usbl_floor_rad: self.usbl_floor_deg.map_or(n.usbl_floor_rad, f64::to_radians),
-                station_heading_sigma_rad: self.compass_sigma_deg.map_or(n.station_heading_sigma_rad, f64::to_radians),
-                heading_sigma_rad: self.heading_sigma_deg.map_or(n.heading_sigma_rad, f64::to_radians),
-                speed_sigma_m_s: self.speed_sigma_m_s.unwrap_or(n.speed_sigma_m_s),
-                depth_sigma_m: self.depth_sigma_m.unwrap_or(n.depth_sigma_m),
-                usbl_as_printed: self.usbl_as_printed.unwrap_or(n.usbl_as_printed),
+                usbl_sigma_rad_per_m: self.usbl.usbl_sigma_deg_per_m.map_or(n.usbl_sigma_rad_per_m, f64::to_radians),
+                usbl_floor_rad: self.usbl.usbl_floor_deg.map_or(n.usbl_floor_rad, f64::to_radians),
+                station_heading_sigma_rad: self
+                    .usbl
+                    .compass_sigma_deg
+                    .map_or(n.station_heading_sigma_rad, f64::to_radians),
+                heading_sigma_rad: self.noise.heading_sigma_deg.map_or(n.heading_sigma_rad, f64::to_radians),
+                speed_sigma_m_s: self.noise.speed_sigma_m_s.unwrap_or(n.speed_sigma_m_s),
+                depth_sigma_m: self.noise.depth_sigma_m.unwrap_or(n.depth_sigma_m),
+                usbl_as_printed: self.usbl.usbl_as_printed.unwrap_or(n.usbl_as_printed),
             },
             aiding: self.aiding(Host::PassiveUsbl),
             nis_gate,
             robust,
-            misalignment: self.usbl_misalignment_sigma_deg.map(|sigma| MisalignmentPrior {
+            misalignment: self.usbl.usbl_misalignment_sigma_deg.map(|sigma| MisalignmentPrior {
                 sigma_rad: sigma.to_radians(),
                 walk_rad_per_sqrt_s: self
+                    .usbl
                     .usbl_misalignment_walk_deg_per_sqrt_s
                     .unwrap_or(DEFAULT_MISALIGNMENT_WALK_DEG_PER_SQRT_S)
                     .to_radians(),
@@ -532,7 +386,7 @@ impl EstimatorSpec {
     /// The particle filter's size and settings (pf).
     pub fn particle_settings(&self) -> (usize, ParticleSettings) {
         let d = ParticleSettings::default();
-        let resampler = match self.resampler {
+        let resampler = match self.particle.resampler {
             None => d.resampler,
             Some(ResamplerName::Multinomial) => Resampler::Multinomial,
             Some(ResamplerName::Systematic) => Resampler::Systematic,
@@ -541,11 +395,11 @@ impl EstimatorSpec {
         };
         let settings = ParticleSettings {
             resampler,
-            ess_fraction: self.ess_fraction.unwrap_or(d.ess_fraction),
-            roughening_k: self.roughening_k.or(d.roughening_k),
-            min_effective: self.min_effective_particles.unwrap_or(DEFAULT_MIN_EFFECTIVE),
+            ess_fraction: self.particle.ess_fraction.unwrap_or(d.ess_fraction),
+            roughening_k: self.particle.roughening_k.or(d.roughening_k),
+            min_effective: self.particle.min_effective_particles.unwrap_or(DEFAULT_MIN_EFFECTIVE),
         };
-        (self.particles.unwrap_or(DEFAULT_PARTICLES), settings)
+        (self.particle.particles.unwrap_or(DEFAULT_PARTICLES), settings)
     }
 
     /// The planar navigator's configuration (logs): [`PlanarConfig::default`] where a
@@ -554,40 +408,228 @@ impl EstimatorSpec {
         let c = PlanarConfig::default();
         let d = c.noise;
         let noise = PlanarNoise {
-            distance_sigma_frac: self.distance_sigma_frac.unwrap_or(d.distance_sigma_frac),
-            heading_change_sigma_frac: self.heading_change_sigma_frac.unwrap_or(d.heading_change_sigma_frac),
+            distance_sigma_frac: self.planar.distance_sigma_frac.unwrap_or(d.distance_sigma_frac),
+            heading_change_sigma_frac: self.planar.heading_change_sigma_frac.unwrap_or(d.heading_change_sigma_frac),
             heading_walk_rad_per_sqrt_m: self
+                .planar
                 .heading_walk_deg_per_sqrt_m
                 .map_or(d.heading_walk_rad_per_sqrt_m, f64::to_radians),
-            speed_sigma_m_s: self.speed_sigma_m_s.unwrap_or(d.speed_sigma_m_s),
-            range_sigma_m: self.range_sigma_m.unwrap_or(d.range_sigma_m),
-            heading_sigma_rad: self.heading_sigma_deg.map_or(d.heading_sigma_rad, f64::to_radians),
-            doppler_sigma_m_s: self.doppler_sigma_m_s.unwrap_or(d.doppler_sigma_m_s),
-            bias_walk_m_per_sqrt_s: self.bias_walk_m_per_sqrt_s.unwrap_or(d.bias_walk_m_per_sqrt_s),
-            position_walk_m_per_sqrt_s: self.position_walk_m_per_sqrt_s.unwrap_or(d.position_walk_m_per_sqrt_s),
+            speed_sigma_m_s: self.noise.speed_sigma_m_s.unwrap_or(d.speed_sigma_m_s),
+            range_sigma_m: self.noise.range_sigma_m.unwrap_or(d.range_sigma_m),
+            heading_sigma_rad: self.noise.heading_sigma_deg.map_or(d.heading_sigma_rad, f64::to_radians),
+            doppler_sigma_m_s: self.noise.doppler_sigma_m_s.unwrap_or(d.doppler_sigma_m_s),
+            bias_walk_m_per_sqrt_s: self.calibration.bias_walk_m_per_sqrt_s.unwrap_or(d.bias_walk_m_per_sqrt_s),
+            position_walk_m_per_sqrt_s: self.planar.position_walk_m_per_sqrt_s.unwrap_or(d.position_walk_m_per_sqrt_s),
         };
         PlanarConfig {
             aiding: self.aiding(Host::Log),
-            estimate_bias: self.estimate_bias.unwrap_or(c.estimate_bias),
-            estimate_beacon_offsets: self.estimate_beacon_offsets.unwrap_or(c.estimate_beacon_offsets),
-            bias_m: self.bias_m.unwrap_or(c.bias_m),
-            bias_sigma_m: self.bias_sigma_m.unwrap_or(c.bias_sigma_m),
-            estimate_range_scale: self.estimate_range_scale.unwrap_or(c.estimate_range_scale),
-            range_scale_sigma: self.range_scale_sigma.unwrap_or(c.range_scale_sigma),
-            estimate_distance_scale: self.estimate_distance_scale.unwrap_or(c.estimate_distance_scale),
-            distance_scale_sigma: self.distance_scale_sigma.unwrap_or(c.distance_scale_sigma),
-            estimate_turn_scale: self.estimate_turn_scale.unwrap_or(c.estimate_turn_scale),
-            turn_scale_sigma: self.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
+            estimate_bias: self.calibration.estimate_bias.unwrap_or(c.estimate_bias),
+            estimate_beacon_offsets: self.calibration.estimate_beacon_offsets.unwrap_or(c.estimate_beacon_offsets),
+            bias_m: self.calibration.bias_m.unwrap_or(c.bias_m),
+            bias_sigma_m: self.calibration.bias_sigma_m.unwrap_or(c.bias_sigma_m),
+            estimate_range_scale: self.calibration.estimate_range_scale.unwrap_or(c.estimate_range_scale),
+            range_scale_sigma: self.calibration.range_scale_sigma.unwrap_or(c.range_scale_sigma),
+            estimate_distance_scale: self.calibration.estimate_distance_scale.unwrap_or(c.estimate_distance_scale),
+            distance_scale_sigma: self.calibration.distance_scale_sigma.unwrap_or(c.distance_scale_sigma),
+            estimate_turn_scale: self.calibration.estimate_turn_scale.unwrap_or(c.estimate_turn_scale),
+            turn_scale_sigma: self.calibration.turn_scale_sigma.unwrap_or(c.turn_scale_sigma),
             nis_gate: Some(self.log_gate().0),
             robust: self.gate().1,
             noise,
-            speed_coast_time_s: self.speed_coast_time_s,
-            heading_offset: (self.estimate_heading_offset == Some(true)).then(|| HeadingOffsetPrior {
-                sigma_rad: self.heading_offset_sigma_deg.unwrap_or(DEFAULT_HEADING_OFFSET_SIGMA_DEG).to_radians(),
-                time_s: self.heading_offset_time_s.unwrap_or(f64::INFINITY),
+            speed_coast_time_s: self.planar.speed_coast_time_s,
+            heading_offset: (self.calibration.estimate_heading_offset == Some(true)).then(|| HeadingOffsetPrior {
+                sigma_rad: self
+                    .calibration
+                    .heading_offset_sigma_deg
+                    .unwrap_or(DEFAULT_HEADING_OFFSET_SIGMA_DEG)
+                    .to_radians(),
+                time_s: self.calibration.heading_offset_time_s.unwrap_or(f64::INFINITY),
             }),
             current: self.range_calibration().current,
-            track_accel_sigma_m_s2: self.track_accel_sigma_m_s2,
+            track_accel_sigma_m_s2: self.planar.track_accel_sigma_m_s2,
         }
+    }
+}
+
+// The reader of one flat `[[estimators]]` table into the spec and its groups. A key no
+// group knows is refused with its line and the keys allowed, as `deny_unknown_fields`
+// refuses it (serde's `flatten` would lose both: it buffers the table and accepts any
+// key).
+
+/// The keys of the table itself, besides the groups'.
+const OWN_KEYS: &[&str] =
+    &["kind", "name", "measurements", "filter", "ukf_alpha", "ukf_beta", "ukf_kappa", "seed", "iusbl"];
+
+/// Every key an `[[estimators]]` table may hold.
+static ALL_KEYS: LazyLock<Vec<&'static str>> = LazyLock::new(|| {
+    let groups = [
+        NoiseKeys::KEYS,
+        GateKeys::KEYS,
+        CalibrationKeys::KEYS,
+        UnicycleKeys::KEYS,
+        SixDofKeys::KEYS,
+        UsblKeys::KEYS,
+        ParticleKeys::KEYS,
+        PlanarKeys::KEYS,
+    ];
+    OWN_KEYS.iter().chain(groups.into_iter().flatten()).copied().collect()
+});
+
+impl<'de> Deserialize<'de> for EstimatorSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_map(TableVisitor)
+    }
+}
+
+struct TableVisitor;
+
+/// A key of [`ALL_KEYS`], refused otherwise.
+struct KnownKey;
+
+impl<'de> DeserializeSeed<'de> for KnownKey {
+    type Value = &'static str;
+
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<&'static str, D::Error> {
+        d.deserialize_identifier(self)
+    }
+}
+
+impl Visitor<'_> for KnownKey {
+    type Value = &'static str;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a key of an [[estimators]] table")
+    }
+
+    fn visit_str<E: Error>(self, v: &str) -> Result<&'static str, E> {
+        ALL_KEYS.iter().find(|k| **k == v).copied().ok_or_else(|| E::unknown_field(v, &ALL_KEYS))
+    }
+}
+
+impl<'de> Visitor<'de> for TableVisitor {
+    type Value = EstimatorSpec;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("an [[estimators]] table")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<EstimatorSpec, A::Error> {
+        let mut kind: Option<EstimatorKind> = None;
+        let mut e = EstimatorSpec::new(EstimatorKind::DeadReckoning);
+        // an unknown key is refused as it is read, so that the error has its line
+        while let Some(key) = map.next_key_seed(KnownKey)? {
+            let taken = match key {
+                "kind" => {
+                    kind = Some(map.next_value()?);
+                    true
+                }
+                "name" => {
+                    e.name = Some(map.next_value()?);
+                    true
+                }
+                "measurements" => {
+                    e.measurements = Some(map.next_value::<Vec<Acoustic>>()?);
+                    true
+                }
+                "filter" => {
+                    e.filter = map.next_value::<FilterName>()?;
+                    true
+                }
+                "ukf_alpha" => {
+                    e.ukf_alpha = Some(map.next_value()?);
+                    true
+                }
+                "ukf_beta" => {
+                    e.ukf_beta = Some(map.next_value()?);
+                    true
+                }
+                "ukf_kappa" => {
+                    e.ukf_kappa = Some(map.next_value()?);
+                    true
+                }
+                "seed" => {
+                    e.seed = Some(map.next_value()?);
+                    true
+                }
+                "iusbl" => {
+                    e.iusbl = Some(map.next_value()?);
+                    true
+                }
+                k => {
+                    e.noise.take(k, &mut map)?
+                        || e.gating.take(k, &mut map)?
+                        || e.calibration.take(k, &mut map)?
+                        || e.unicycle.take(k, &mut map)?
+                        || e.six_dof.take(k, &mut map)?
+                        || e.usbl.take(k, &mut map)?
+                        || e.particle.take(k, &mut map)?
+                        || e.planar.take(k, &mut map)?
+                }
+            };
+            if !taken {
+                return Err(A::Error::unknown_field(key, &ALL_KEYS));
+            }
+        }
+        e.kind = kind.ok_or_else(|| A::Error::missing_field("kind"))?;
+        Ok(e)
+    }
+}
+
+#[cfg(all(test, feature = "log"))]
+mod tests {
+    use super::*;
+    use crate::config::toml_file::deserialize;
+    use serde::Serialize;
+
+    #[derive(Debug, serde::Deserialize, Serialize)]
+    struct File {
+        estimators: Vec<EstimatorSpec>,
+    }
+
+    fn error(text: &str) -> String {
+        deserialize::<File>(text, "f.toml").unwrap_err().to_string()
+    }
+
+    /// A key of every group read from one flat table into its group, written back flat
+    /// and read again to the same spec; every key is in exactly one group.
+    #[test]
+    fn a_flat_table_fills_the_groups_and_round_trips() {
+        let text = "[[estimators]]\nkind = \"pf\"\nname = \"a\"\nrange_sigma_m = 2\nnis_gate = 9.0\n\
+                    estimate_bias = true\nq_diag = [1, 1, 1, 1, 1, 1]\nvelocity_sigma_m_s = 0.1\n\
+                    usbl_floor_deg = 0.5\nparticles = 1000\nresampler = \"residual\"\n\
+                    speed_coast_time_s = 4\nseed = -3\n[estimators.iusbl]\nparticles = 7\n";
+        let f: File = deserialize(text, "f.toml").unwrap();
+        let e = &f.estimators[0];
+        assert_eq!(e.kind, EstimatorKind::Particle);
+        assert_eq!(e.noise.range_sigma_m, Some(2.0));
+        assert_eq!(e.gating.nis_gate, Some(9.0));
+        assert_eq!(e.calibration.estimate_bias, Some(true));
+        assert_eq!(e.unicycle.q_diag, Some([1.0; 6]));
+        assert_eq!(e.six_dof.velocity_sigma_m_s, Some(0.1));
+        assert_eq!(e.usbl.usbl_floor_deg, Some(0.5));
+        assert_eq!((e.particle.particles, e.particle.resampler), (Some(1000), Some(ResamplerName::Residual)));
+        assert_eq!(e.planar.speed_coast_time_s, Some(4.0));
+        assert_eq!((e.seed, e.iusbl.as_ref().map(|k| k.particles)), (Some(-3), Some(7)));
+        let written = toml::to_string(&f).unwrap();
+        let again: File = deserialize(&written, "written").unwrap();
+        assert_eq!(again.estimators, f.estimators, "{written}");
+        let mut keys = ALL_KEYS.clone();
+        keys.sort();
+        keys.dedup();
+        assert_eq!(keys.len(), ALL_KEYS.len(), "a key in two groups");
+    }
+
+    /// What `deny_unknown_fields` gave: the key, its line and the keys allowed; a wrong
+    /// type names the key and its line; `kind` is required.
+    #[test]
+    fn a_bad_key_is_named_with_its_line() {
+        let e = error("[[estimators]]\nkind = \"rosb\"\n\nrange_sigma_mm = 2\n");
+        assert!(e.starts_with("f.toml: line 4: key `estimators[0]"), "{e}");
+        assert!(e.contains("unknown field `range_sigma_mm`, expected one of `kind`"), "{e}");
+        assert!(e.contains("`range_sigma_m`") && e.contains("`speed_coast_time_s`"), "{e}");
+        let e = error("[[estimators]]\nkind = \"rosb\"\nnis_gate = \"high\"\n");
+        assert!(e.starts_with("f.toml: line 3: key `estimators[0].nis_gate`"), "{e}");
+        let e = error("[[estimators]]\nname = \"x\"\n");
+        assert!(e.contains("missing field `kind`"), "{e}");
     }
 }

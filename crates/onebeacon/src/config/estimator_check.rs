@@ -19,63 +19,68 @@ impl EstimatorSpec {
         const GATED: &[Host] = &[FixedBeacon, MovingBeacon, PassiveUsbl, Log];
         let flag = |b: Option<bool>| b.map(|b| f64::from(u8::from(b)));
         let mut keys = vec![
-            ("range_sigma_m", self.range_sigma_m, Positive, RANGING),
-            ("doppler_sigma_m_s", self.doppler_sigma_m_s, Positive, FIXED_LOG),
-            ("heading_sigma_deg", self.heading_sigma_deg, Positive, &[FixedBeacon, PassiveUsbl, Log]),
-            ("usbl_sigma_deg_per_m", self.usbl_sigma_deg_per_m, Positive, USBL),
-            ("usbl_floor_deg", self.usbl_floor_deg, NonNegative, USBL),
-            ("usbl_as_printed", flag(self.usbl_as_printed), Finite, USBL),
-            ("usbl_misalignment_sigma_deg", self.usbl_misalignment_sigma_deg, Positive, USBL),
-            ("usbl_misalignment_walk_deg_per_sqrt_s", self.usbl_misalignment_walk_deg_per_sqrt_s, NonNegative, USBL),
-            ("compass_sigma_deg", self.compass_sigma_deg, NonNegative, USBL),
-            ("depth_sigma_m", self.depth_sigma_m, Positive, &[MovingBeacon, PassiveUsbl, Log]),
-            ("velocity_sigma_m_s", self.velocity_sigma_m_s, Positive, &[MovingBeacon]),
-            ("rate_sigma_rad_s", self.rate_sigma_rad_s, Positive, &[MovingBeacon]),
-            ("attitude_sigma_deg", self.attitude_sigma_deg, Positive, &[MovingBeacon]),
+            ("range_sigma_m", self.noise.range_sigma_m, Positive, RANGING),
+            ("doppler_sigma_m_s", self.noise.doppler_sigma_m_s, Positive, FIXED_LOG),
+            ("heading_sigma_deg", self.noise.heading_sigma_deg, Positive, &[FixedBeacon, PassiveUsbl, Log]),
+            ("usbl_sigma_deg_per_m", self.usbl.usbl_sigma_deg_per_m, Positive, USBL),
+            ("usbl_floor_deg", self.usbl.usbl_floor_deg, NonNegative, USBL),
+            ("usbl_as_printed", flag(self.usbl.usbl_as_printed), Finite, USBL),
+            ("usbl_misalignment_sigma_deg", self.usbl.usbl_misalignment_sigma_deg, Positive, USBL),
+            (
+                "usbl_misalignment_walk_deg_per_sqrt_s",
+                self.usbl.usbl_misalignment_walk_deg_per_sqrt_s,
+                NonNegative,
+                USBL,
+            ),
+            ("compass_sigma_deg", self.usbl.compass_sigma_deg, NonNegative, USBL),
+            ("depth_sigma_m", self.noise.depth_sigma_m, Positive, &[MovingBeacon, PassiveUsbl, Log]),
+            ("velocity_sigma_m_s", self.six_dof.velocity_sigma_m_s, Positive, &[MovingBeacon]),
+            ("rate_sigma_rad_s", self.six_dof.rate_sigma_rad_s, Positive, &[MovingBeacon]),
+            ("attitude_sigma_deg", self.six_dof.attitude_sigma_deg, Positive, &[MovingBeacon]),
             ("seed", self.seed.map(|s| s as f64), Finite, &[Log]),
-            ("process_noise_scale", self.process_noise_scale, Positive, USBL),
-            ("particles", self.particles.map(|n| n as f64), Positive, USBL),
-            ("ess_fraction", self.ess_fraction, Positive, USBL),
-            ("roughening_k", self.roughening_k, Positive, USBL),
-            ("min_effective_particles", self.min_effective_particles, NonNegative, USBL),
-            ("yaw_rate_sigma_rad_s", self.yaw_rate_sigma_rad_s, Positive, &[FixedBeacon]),
-            ("accel_sigma_m_s2", self.accel_sigma_m_s2, Positive, &[FixedBeacon]),
-            ("distance_sigma_frac", self.distance_sigma_frac, NonNegative, &[Log]),
-            ("heading_change_sigma_frac", self.heading_change_sigma_frac, NonNegative, &[Log]),
-            ("heading_walk_deg_per_sqrt_m", self.heading_walk_deg_per_sqrt_m, NonNegative, &[Log]),
-            ("speed_sigma_m_s", self.speed_sigma_m_s, NonNegative, &[PassiveUsbl, Log]),
-            ("bias_walk_m_per_sqrt_s", self.bias_walk_m_per_sqrt_s, NonNegative, CALIBRATING),
-            ("position_walk_m_per_sqrt_s", self.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
-            ("track_accel_sigma_m_s2", self.track_accel_sigma_m_s2, Positive, &[Log]),
-            ("nis_gate", self.nis_gate, Threshold, GATED),
-            ("huber_k", self.huber_k, Positive, GATED),
-            ("student_t_dof", self.student_t_dof, Positive, GATED),
-            ("mirror_recovery", flag(self.mirror_recovery), Finite, &[FixedBeacon]),
-            ("min_speed_m_s", self.min_speed_m_s, Positive, &[FixedBeacon]),
-            ("estimate_bias", flag(self.estimate_bias), Finite, CALIBRATING),
-            ("estimate_bias_drift", flag(self.estimate_bias_drift), Finite, CLOCKED),
-            ("bias_drift_sigma_m_s", self.bias_drift_sigma_m_s, Positive, CLOCKED),
-            ("estimate_beacon_offsets", flag(self.estimate_beacon_offsets), Finite, &[Log]),
-            ("bias_m", self.bias_m, Finite, CALIBRATING),
-            ("bias_sigma_m", self.bias_sigma_m, Positive, CALIBRATING),
-            ("estimate_range_scale", flag(self.estimate_range_scale), Finite, CALIBRATING),
-            ("range_scale_sigma", self.range_scale_sigma, Positive, CALIBRATING),
-            ("estimate_distance_scale", flag(self.estimate_distance_scale), Finite, &[Log]),
-            ("distance_scale_sigma", self.distance_scale_sigma, Positive, &[Log]),
-            ("estimate_turn_scale", flag(self.estimate_turn_scale), Finite, &[Log]),
-            ("turn_scale_sigma", self.turn_scale_sigma, Positive, &[Log]),
-            ("estimate_current", flag(self.estimate_current), Finite, CARRIED),
-            ("current_sigma_m_s", self.current_sigma_m_s, Positive, CARRIED),
-            ("current_walk_m_s_per_sqrt_s", self.current_walk_m_s_per_sqrt_s, NonNegative, CARRIED),
-            ("speed_coast_time_s", self.speed_coast_time_s, Positive, &[Log]),
-            ("estimate_heading_offset", flag(self.estimate_heading_offset), Finite, &[Log]),
-            ("heading_offset_sigma_deg", self.heading_offset_sigma_deg, Positive, &[Log]),
-            ("heading_offset_time_s", self.heading_offset_time_s, Positive, &[Log]),
+            ("process_noise_scale", self.usbl.process_noise_scale, Positive, USBL),
+            ("particles", self.particle.particles.map(|n| n as f64), Positive, USBL),
+            ("ess_fraction", self.particle.ess_fraction, Positive, USBL),
+            ("roughening_k", self.particle.roughening_k, Positive, USBL),
+            ("min_effective_particles", self.particle.min_effective_particles, NonNegative, USBL),
+            ("yaw_rate_sigma_rad_s", self.unicycle.yaw_rate_sigma_rad_s, Positive, &[FixedBeacon]),
+            ("accel_sigma_m_s2", self.unicycle.accel_sigma_m_s2, Positive, &[FixedBeacon]),
+            ("distance_sigma_frac", self.planar.distance_sigma_frac, NonNegative, &[Log]),
+            ("heading_change_sigma_frac", self.planar.heading_change_sigma_frac, NonNegative, &[Log]),
+            ("heading_walk_deg_per_sqrt_m", self.planar.heading_walk_deg_per_sqrt_m, NonNegative, &[Log]),
+            ("speed_sigma_m_s", self.noise.speed_sigma_m_s, NonNegative, &[PassiveUsbl, Log]),
+            ("bias_walk_m_per_sqrt_s", self.calibration.bias_walk_m_per_sqrt_s, NonNegative, CALIBRATING),
+            ("position_walk_m_per_sqrt_s", self.planar.position_walk_m_per_sqrt_s, NonNegative, &[Log]),
+            ("track_accel_sigma_m_s2", self.planar.track_accel_sigma_m_s2, Positive, &[Log]),
+            ("nis_gate", self.gating.nis_gate, Threshold, GATED),
+            ("huber_k", self.gating.huber_k, Positive, GATED),
+            ("student_t_dof", self.gating.student_t_dof, Positive, GATED),
+            ("mirror_recovery", flag(self.unicycle.mirror_recovery), Finite, &[FixedBeacon]),
+            ("min_speed_m_s", self.unicycle.min_speed_m_s, Positive, &[FixedBeacon]),
+            ("estimate_bias", flag(self.calibration.estimate_bias), Finite, CALIBRATING),
+            ("estimate_bias_drift", flag(self.calibration.estimate_bias_drift), Finite, CLOCKED),
+            ("bias_drift_sigma_m_s", self.calibration.bias_drift_sigma_m_s, Positive, CLOCKED),
+            ("estimate_beacon_offsets", flag(self.calibration.estimate_beacon_offsets), Finite, &[Log]),
+            ("bias_m", self.calibration.bias_m, Finite, CALIBRATING),
+            ("bias_sigma_m", self.calibration.bias_sigma_m, Positive, CALIBRATING),
+            ("estimate_range_scale", flag(self.calibration.estimate_range_scale), Finite, CALIBRATING),
+            ("range_scale_sigma", self.calibration.range_scale_sigma, Positive, CALIBRATING),
+            ("estimate_distance_scale", flag(self.calibration.estimate_distance_scale), Finite, &[Log]),
+            ("distance_scale_sigma", self.calibration.distance_scale_sigma, Positive, &[Log]),
+            ("estimate_turn_scale", flag(self.calibration.estimate_turn_scale), Finite, &[Log]),
+            ("turn_scale_sigma", self.calibration.turn_scale_sigma, Positive, &[Log]),
+            ("estimate_current", flag(self.calibration.estimate_current), Finite, CARRIED),
+            ("current_sigma_m_s", self.calibration.current_sigma_m_s, Positive, CARRIED),
+            ("current_walk_m_s_per_sqrt_s", self.calibration.current_walk_m_s_per_sqrt_s, NonNegative, CARRIED),
+            ("speed_coast_time_s", self.planar.speed_coast_time_s, Positive, &[Log]),
+            ("estimate_heading_offset", flag(self.calibration.estimate_heading_offset), Finite, &[Log]),
+            ("heading_offset_sigma_deg", self.calibration.heading_offset_sigma_deg, Positive, &[Log]),
+            ("heading_offset_time_s", self.calibration.heading_offset_time_s, Positive, &[Log]),
         ];
-        for q in self.q_diag.iter().flatten() {
+        for q in self.unicycle.q_diag.iter().flatten() {
             keys.push(("q_diag", Some(*q), NonNegative, &[FixedBeacon]));
         }
-        for q in self.process_sigma.iter().flatten() {
+        for q in self.usbl.process_sigma.iter().flatten() {
             keys.push(("process_sigma", Some(*q), NonNegative, USBL));
         }
         keys.into_iter().filter_map(|(k, v, s, h)| v.map(|v| (k, v, s, h))).collect()
@@ -109,8 +114,8 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
             }
             check(&key(name), v, rule)?;
         }
-        if e.estimate_beacon_offsets == Some(true)
-            && (e.estimate_bias == Some(true) || e.track_accel_sigma_m_s2.is_some())
+        if e.calibration.estimate_beacon_offsets == Some(true)
+            && (e.calibration.estimate_bias == Some(true) || e.planar.track_accel_sigma_m_s2.is_some())
         {
             return Err(Violation {
                 key: key("estimate_beacon_offsets"),
@@ -120,12 +125,12 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
         }
         // a log's motion states are the planar navigator's
         let motion = [
-            ("estimate_heading_offset", e.estimate_heading_offset == Some(true)),
-            ("speed_coast_time_s", e.speed_coast_time_s.is_some()),
-            ("estimate_current", host == Host::Log && e.estimate_current == Some(true)),
+            ("estimate_heading_offset", e.calibration.estimate_heading_offset == Some(true)),
+            ("speed_coast_time_s", e.planar.speed_coast_time_s.is_some()),
+            ("estimate_current", host == Host::Log && e.calibration.estimate_current == Some(true)),
         ];
         if let Some((name, _)) = motion.iter().find(|(_, on)| *on)
-            && (e.kind.tracks_bearings() || e.kind.iusbl() || e.track_accel_sigma_m_s2.is_some())
+            && (e.kind.tracks_bearings() || e.kind.iusbl() || e.planar.track_accel_sigma_m_s2.is_some())
         {
             return Err(Violation {
                 key: key(name),
@@ -164,13 +169,13 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
             return Err(Violation { key: key("kind"), value: format!("{:?}", e.kind.label()), allowed });
         }
         let pf_only = [
-            ("particles", e.particles.is_some()),
-            ("resampler", e.resampler.is_some()),
-            ("ess_fraction", e.ess_fraction.is_some()),
-            ("roughening_k", e.roughening_k.is_some()),
-            ("min_effective_particles", e.min_effective_particles.is_some()),
-            ("usbl_misalignment_sigma_deg", e.usbl_misalignment_sigma_deg.is_some()),
-            ("usbl_misalignment_walk_deg_per_sqrt_s", e.usbl_misalignment_walk_deg_per_sqrt_s.is_some()),
+            ("particles", e.particle.particles.is_some()),
+            ("resampler", e.particle.resampler.is_some()),
+            ("ess_fraction", e.particle.ess_fraction.is_some()),
+            ("roughening_k", e.particle.roughening_k.is_some()),
+            ("min_effective_particles", e.particle.min_effective_particles.is_some()),
+            ("usbl_misalignment_sigma_deg", e.usbl.usbl_misalignment_sigma_deg.is_some()),
+            ("usbl_misalignment_walk_deg_per_sqrt_s", e.usbl.usbl_misalignment_walk_deg_per_sqrt_s.is_some()),
         ];
         if let Some((name, _)) = pf_only.iter().find(|(_, set)| *set).filter(|_| !particle) {
             return Err(Violation {
@@ -179,7 +184,7 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
                 allowed: format!("applies to a particle filter (kind = \"pf\") only, not to kind {:?}", e.kind.label()),
             });
         }
-        if e.usbl_misalignment_walk_deg_per_sqrt_s.is_some() && e.usbl_misalignment_sigma_deg.is_none() {
+        if e.usbl.usbl_misalignment_walk_deg_per_sqrt_s.is_some() && e.usbl.usbl_misalignment_sigma_deg.is_none() {
             return Err(Violation {
                 key: key("usbl_misalignment_walk_deg_per_sqrt_s"),
                 value: "(set)".into(),
@@ -187,8 +192,8 @@ pub fn check_estimators(specs: &[EstimatorSpec], host: Host) -> Result<(), Viola
             });
         }
         if particle {
-            check_count(&key("particles"), e.particles.unwrap_or(1), 1, 50_000_000)?;
-            if let Some(f) = e.ess_fraction {
+            check_count(&key("particles"), e.particle.particles.unwrap_or(1), 1, 50_000_000)?;
+            if let Some(f) = e.particle.ess_fraction {
                 check(&key("ess_fraction"), f, Rule::Probability)?;
             }
         }

@@ -4,9 +4,11 @@
 //! Sign: positive when the vehicle closes on the beacon. The vehicle moves along its
 //! heading at its forward speed (no sideslip): v_r = v cos(omega_b - psi) with
 //! omega_b = atan2(y - y_ref, x - x_ref) + pi the bearing from the vehicle to the beacon
-//! ([`RadialSpeed2d`], the paper's horizontal geometry). [`LineOfSightSpeed`] is the same
-//! speed along the slant line of sight, for a state that holds the velocity itself (the
-//! smoother's tracks and the interval velocities of its poses).
+//! ([`RadialSpeed2d`], the paper's horizontal geometry, or along the slant line of sight
+//! of a vehicle below the beacon). [`LineOfSightSpeed`] is the same slant speed for a
+//! state that holds the velocity itself (the smoother's tracks and the interval
+//! velocities of its poses): on a log, the filters and the smoother read a Doppler speed
+//! alike.
 
 use super::ScalarModel;
 use crate::models::unicycle::idx;
@@ -14,12 +16,14 @@ use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
 /// Radial speed of the vehicle toward `beacon` (NED, m), read from the unicycle state
 /// layout (position, heading, forward speed), or with the forward speed a known input
-/// (`known_speed_m_s`: odometry, DVL), when only position and heading are states. Noise
-/// variance `var` ((m/s)^2).
+/// (`known_speed_m_s`: odometry, DVL), when only position and heading are states; along
+/// the slant line of sight of a vehicle `dz_m` below the beacon (0: the paper's
+/// horizontal geometry, exactly). Noise variance `var` ((m/s)^2).
 #[derive(Debug, Clone, Copy)]
 pub struct RadialSpeed2d {
     pub beacon: Vector2<f64>,
     pub known_speed_m_s: Option<f64>,
+    pub dz_m: f64,
     pub var: f64,
 }
 
@@ -27,7 +31,8 @@ impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
     fn predict(&self, x: &SVector<f64, N>) -> f64 {
         let (dx, dy) = (x[idx::X] - self.beacon.x, x[idx::Y] - self.beacon.y);
         let c = dy.atan2(dx) - x[idx::PSI]; // C of eq. 23
-        -self.speed(x) * c.cos() // eq. 20, second row; equals eq. 13 with eq. 14
+        let horizontal = -self.speed(x) * c.cos(); // eq. 20, second row; equals eq. 13 with eq. 14
+        if self.dz_m == 0.0 { horizontal } else { horizontal * self.slant(dx, dy).0 }
     }
 
     fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
@@ -45,6 +50,14 @@ impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
         if self.known_speed_m_s.is_none() {
             h[idx::V] = -c.cos();
         }
+        if self.dz_m != 0.0 {
+            // the horizontal speed w times the slant factor f: f dw + w df
+            let (f, df) = self.slant(dx, dy);
+            let w = -v * c.cos();
+            h *= f;
+            h[idx::X] += w * df.x;
+            h[idx::Y] += w * df.y;
+        }
         h
     }
 
@@ -56,6 +69,21 @@ impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
 impl RadialSpeed2d {
     fn speed<const N: usize>(&self, x: &SVector<f64, N>) -> f64 {
         self.known_speed_m_s.unwrap_or_else(|| x[idx::V])
+    }
+
+    /// The share of a horizontal speed along the slant line of sight, f = h / sqrt(h^2 +
+    /// dz^2) with h the horizontal distance (dx, dy), and its gradient in (dx, dy):
+    /// dz^2 (dx, dy) / (h R^3). One at the beacon's depth; zero straight below it.
+    pub(crate) fn slant(&self, dx: f64, dy: f64) -> (f64, Vector2<f64>) {
+        if self.dz_m == 0.0 {
+            return (1.0, Vector2::zeros());
+        }
+        let h = dx.hypot(dy);
+        let r = h.hypot(self.dz_m);
+        if h < 1e-9 {
+            return (0.0, Vector2::zeros());
+        }
+        (h / r, Vector2::new(dx, dy) * (self.dz_m * self.dz_m / (h * r * r * r)))
     }
 }
 
@@ -115,7 +143,7 @@ mod tests {
 
     #[test]
     fn sign_is_positive_when_closing() {
-        let m = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, var: 0.1 };
+        let m = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, dz_m: 0.0, var: 0.1 };
         // vehicle 10 m north of the beacon heading south at 1.5 m/s: closing at 1.5
         assert_abs_diff_eq!(ScalarModel::<6>::predict(&m, &state(10.0, 0.0, PI, 1.5)), 1.5, epsilon = 1e-12);
         // heading north: opening
@@ -138,7 +166,7 @@ mod tests {
             assert_abs_diff_eq!(h, fd, epsilon = 1e-7);
         }
         let level = LineOfSightSpeed { beacon: Vector3::new(0.0, 0.0, 0.0), depth_m: 0.0, var: 0.1 };
-        let flat = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, var: 0.1 };
+        let flat = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, dz_m: 0.0, var: 0.1 };
         for (n, e, psi, v) in [(10.0, 10.0, -FRAC_PI_2, 2.0), (-30.0, 4.0, 0.3, 1.1)] {
             let x = SVector::<f64, 4>::from([n, e, v * f64::cos(psi), v * f64::sin(psi)]);
             let horizontal = ScalarModel::<6>::predict(&flat, &state(n, e, psi, v));
@@ -148,11 +176,25 @@ mod tests {
         let above = LineOfSightSpeed { beacon: Vector3::new(0.0, 0.0, 0.0), depth_m: 30.0, var: 0.1 };
         let x = SVector::<f64, 4>::from([40.0, 0.0, -1.0, 0.0]);
         assert_abs_diff_eq!(ScalarModel::<4>::predict(&above, &x), 0.8, epsilon = 1e-12);
+        // the heading-and-speed layout below the beacon reads the same slant speed, and its
+        // Jacobian (the slant factor's gradient included) the central differences
+        let below = RadialSpeed2d { dz_m: 37.0, ..flat };
+        let deep = LineOfSightSpeed { depth_m: 37.0, ..level };
+        for (n, e, psi, v) in [(10.0, 10.0, -FRAC_PI_2, 2.0), (-30.0, 4.0, 0.3, 1.1), (60.0, -80.0, 2.9, 1.6)] {
+            let x = SVector::<f64, 4>::from([n, e, v * f64::cos(psi), v * f64::sin(psi)]);
+            let slant = ScalarModel::<6>::predict(&below, &state(n, e, psi, v));
+            assert_abs_diff_eq!(ScalarModel::<4>::predict(&deep, &x), slant, epsilon = 1e-12);
+            let (h, fd) = (
+                ScalarModel::<6>::jacobian(&below, &state(n, e, psi, v)),
+                finite_difference::<6>(&below, &state(n, e, psi, v)),
+            );
+            assert_abs_diff_eq!(h, fd, epsilon = 1e-7);
+        }
     }
 
     #[test]
     fn jacobian_matches_finite_differences() {
-        let m = RadialSpeed2d { beacon: Vector2::new(50.0, 100.0), known_speed_m_s: None, var: 0.1 };
+        let m = RadialSpeed2d { beacon: Vector2::new(50.0, 100.0), known_speed_m_s: None, dz_m: 0.0, var: 0.1 };
         let known = RadialSpeed2d { known_speed_m_s: Some(1.3), ..m };
         for x in [state(10.0, 20.0, 0.4, 1.1), state(80.0, 230.0, -2.5, 0.9), state(49.0, 101.0, 3.0, -1.2)] {
             for m in [m, known] {

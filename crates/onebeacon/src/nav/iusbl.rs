@@ -12,7 +12,7 @@
 //! frame when unknown).
 
 use super::Calibration;
-use super::capability::BeaconRelative;
+use super::capability::{BeaconRelative, FactoredBelief, ParticleBelief};
 use super::{Estimate, Kind, Measurement, Navigator, Outcome};
 use crate::dsp::beamform::direction;
 use crate::dsp::modes::ModeConfirmation;
@@ -428,28 +428,38 @@ impl Navigator for IusblNavigator {
         }
     }
 
-    fn position_sample(&self, m: usize) -> Option<Vec<Vector3<f64>>> {
-        let origin = self.origin();
-        let step = (self.filter.particles().len() / m.max(1)).max(1);
-        Some(
-            self.filter
-                .particles()
-                .iter()
-                .step_by(step)
-                .map(|p| {
-                    let d = self.displacement_m;
-                    Vector3::new(origin.x + d.x - p.x, origin.y + d.y - p.y, self.depth_m.unwrap_or(0.0))
-                })
-                .collect(),
-        )
+    fn particles(&self) -> Option<&dyn ParticleBelief> {
+        Some(self)
     }
 
     fn beacon_relative(&self) -> Option<&dyn BeaconRelative> {
         Some(self)
     }
 
-    fn factored_sets(&self) -> Option<FactoredSets> {
-        self.config.factored.then(|| self.filter.sets().clone())
+    /// The sets of the factored filter (rypkema sec. 4.2); none for the joint one.
+    fn factored(&self) -> Option<&dyn FactoredBelief> {
+        self.config.factored.then_some(self as &dyn FactoredBelief)
+    }
+}
+
+impl ParticleBelief for IusblNavigator {
+    /// Every k-th particle (equally weighted after each resampling), k = n / m.
+    fn position_sample(&self, m: usize) -> Vec<Vector3<f64>> {
+        let origin = self.origin();
+        let step = (self.filter.particles().len() / m.max(1)).max(1);
+        let d = self.displacement_m;
+        self.filter
+            .particles()
+            .iter()
+            .step_by(step)
+            .map(|p| Vector3::new(origin.x + d.x - p.x, origin.y + d.y - p.y, self.depth_m.unwrap_or(0.0)))
+            .collect()
+    }
+}
+
+impl FactoredBelief for IusblNavigator {
+    fn factored_sets(&self) -> &FactoredSets {
+        self.filter.sets()
     }
 }
 

@@ -270,10 +270,8 @@ pub trait Navigator: Send {
     /// a navigator that moves only on messages (the trackers). Navigators kept current by
     /// their dead-reckoning inputs do nothing.
     fn predict_to(&mut self, _t_s: f64) {}
-    /// Up to `m` equally weighted samples of the position belief (NED), for a planner
-    /// that scores a belief by its spread: a particle filter's particles, drawn in
-    /// proportion to their weights; None for a Gaussian belief.
-    fn position_sample(&self, _m: usize) -> Option<Vec<Vector3<f64>>> {
+    /// Samples of a particle belief; None for a Gaussian one.
+    fn particles(&self) -> Option<&dyn capability::ParticleBelief> {
         None
     }
     /// Its position relative to the beacon it navigates on and the confirmed command
@@ -285,31 +283,20 @@ pub trait Navigator: Send {
     fn body_velocity(&self) -> Option<&dyn capability::BodyVelocity> {
         None
     }
-    /// The innovation a range `m` would have, without taking it (the navigator moved to
-    /// its time first, as any measurement moves it): how a beacon held out of the run is
-    /// predicted. None for a navigator that cannot say, or for another kind.
-    fn weigh(&mut self, _m: &Measurement) -> Option<Innovation> {
+    /// The prediction of a held-out range; None for a navigator that cannot say.
+    fn weighing(&mut self) -> Option<&mut dyn capability::Weighing> {
         None
     }
-    /// Each beacon's estimated range offset and its standard deviation (beacon, m, m),
-    /// for a navigator that estimates one per beacon.
-    fn beacon_offsets(&self) -> Vec<(u32, f64, f64)> {
-        Vec::new()
+    /// Per-beacon range offsets; None for a navigator that estimates none.
+    fn beacon_offsets(&self) -> Option<&dyn capability::BeaconOffsets> {
+        None
     }
-    /// Keeps, from now on, what a Rauch-Tung-Striebel pass over this navigator's run
-    /// needs (memory grows with the run: for a log, not a stream); whether it can (the
-    /// Gaussian planar family can).
-    fn keep_history(&mut self) -> bool {
-        false
+    /// A Rauch-Tung-Striebel pass over its run; None for a navigator that has none.
+    fn smoothing(&mut self) -> Option<&mut dyn capability::Smoothing> {
+        None
     }
-    /// The Rauch-Tung-Striebel smoothed estimates of the run kept since
-    /// [`Navigator::keep_history`]: one per interval between predictions, each holding
-    /// from its time `t_s` on, in time order; empty without a history.
-    fn smoothed(&self) -> Vec<Estimate> {
-        Vec::new()
-    }
-    /// The range and angle sets of a factored particle filter's last update.
-    fn factored_sets(&self) -> Option<crate::filter::factored::FactoredSets> {
+    /// A factored particle filter's range and angle sets.
+    fn factored(&self) -> Option<&dyn capability::FactoredBelief> {
         None
     }
 }

@@ -18,6 +18,7 @@
 //! the sound-speed error; modelling that is left for when a log needs it).
 
 use super::Calibration;
+use super::capability::{BeaconOffsets, Smoothing, Weighing};
 pub use super::planar_config::{HeadingOffsetPrior, PlanarConfig, PlanarNoise};
 use super::planar_models::{Drift, OdometryStep, OffsetHeading};
 use super::range_calibration::CarriedDoppler;
@@ -342,32 +343,64 @@ impl<const N: usize> PlanarNavigator<N> {
         SlantRange { beacon, depth_m: self.depth_m, bias: Some(bias), scale: Some(idx::RANGE_SCALE), var }
     }
 
-    /// The radial speed toward `beacon` over ground: the held speed along the heading,
+    /// The radial speed toward `beacon` over ground along the slant line of sight (the
+    /// smoother's [`crate::measure::LineOfSightSpeed`]): the held speed along the heading,
     /// plus the current's share when it is a state.
     fn doppler_model(&self, beacon: Vector3<f64>) -> CarriedDoppler {
         let var = self.config.noise.doppler_sigma_m_s * self.config.noise.doppler_sigma_m_s;
-        let doppler = RadialSpeed2d { beacon: beacon.xy(), known_speed_m_s: Some(self.speed_m_s), var };
+        let (known_speed_m_s, dz_m) = (Some(self.speed_m_s), self.depth_m - beacon.z);
+        let doppler = RadialSpeed2d { beacon: beacon.xy(), known_speed_m_s, dz_m, var };
         CarriedDoppler { doppler, current: self.config.current.map(|_| idx::CURRENT_N) }
     }
 }
 
-impl<const N: usize> Navigator for PlanarNavigator<N> {
-    /// Each beacon heard with its estimated offset and the offset's standard deviation
-    /// (none without [`PlanarConfig::estimate_beacon_offsets`]).
-    fn beacon_offsets(&self) -> Vec<(u32, f64, f64)> {
+impl<const N: usize> BeaconOffsets for PlanarNavigator<N> {
+    fn offsets(&self) -> Vec<(u32, f64, f64)> {
         let (x, p) = (self.filter.mean(), self.filter.covariance());
         let slot = |i: usize| EXTENDED_STATES + i;
         self.offset_beacons.iter().enumerate().map(|(i, &b)| (b, x[slot(i)], p[(slot(i), slot(i))].sqrt())).collect()
     }
+}
 
-    /// Whatever the aiding (dead reckoning's prediction is the baseline of a held-out
-    /// beacon), with the beacon's own offset state where it would have one.
+/// Whatever the aiding (dead reckoning's prediction is the baseline of a held-out
+/// beacon), with the beacon's own offset state where it would have one.
+impl<const N: usize> Weighing for PlanarNavigator<N> {
     fn weigh(&mut self, m: &Measurement) -> Option<Innovation> {
         let Kind::Range { beacon, range_m } = m.kind else { return None };
         self.advance_to(m.t_s);
         let model = self.range_model(&beacon);
         super::gated_update(&mut self.filter, &[&model as &dyn ScalarModel<N>], Vector1::new(range_m), -1.0, None)
             .innovation()
+    }
+}
+
+impl<const N: usize> Smoothing for PlanarNavigator<N> {
+    fn keep_history(&mut self) {
+        self.history = Some((History::new(self.t_s), vec![self.depth_m]));
+    }
+
+    fn smoothed(&self) -> Vec<Estimate> {
+        let Some((history, depths)) = &self.history else { return Vec::new() };
+        let last = (*self.filter.mean(), *self.filter.covariance());
+        let smoothed = history.smooth(last, |k| k == idx::PSI || (N > STATES && k == idx::HEADING_OFFSET));
+        smoothed.iter().zip(depths).map(|((t, (x, p)), d)| Self::estimate_of(&self.config, *t, x, p, *d)).collect()
+    }
+}
+
+impl<const N: usize> Navigator for PlanarNavigator<N> {
+    /// Each beacon heard with its estimated offset and the offset's standard deviation
+    /// (with [`PlanarConfig::estimate_beacon_offsets`]).
+    fn beacon_offsets(&self) -> Option<&dyn BeaconOffsets> {
+        (self.config.estimate_beacon_offsets && N > EXTENDED_STATES).then_some(self as &dyn BeaconOffsets)
+    }
+
+    fn weighing(&mut self) -> Option<&mut dyn Weighing> {
+        Some(self)
+    }
+
+    /// Dead reckoning (no beacon aiding) has no correction to carry back: it keeps none.
+    fn smoothing(&mut self) -> Option<&mut dyn Smoothing> {
+        self.config.aiding.any().then_some(self as &mut dyn Smoothing)
     }
 
     /// Processes one measurement (measurements in time order; an earlier time is taken
@@ -443,21 +476,6 @@ impl<const N: usize> Navigator for PlanarNavigator<N> {
 
     fn estimate(&self) -> Estimate {
         Self::estimate_of(&self.config, self.t_s, self.filter.mean(), self.filter.covariance(), self.depth_m)
-    }
-
-    /// Dead reckoning (no beacon aiding) has no correction to carry back: it keeps none.
-    fn keep_history(&mut self) -> bool {
-        if self.config.aiding.any() {
-            self.history = Some((History::new(self.t_s), vec![self.depth_m]));
-        }
-        self.history.is_some()
-    }
-
-    fn smoothed(&self) -> Vec<Estimate> {
-        let Some((history, depths)) = &self.history else { return Vec::new() };
-        let last = (*self.filter.mean(), *self.filter.covariance());
-        let smoothed = history.smooth(last, |k| k == idx::PSI || (N > STATES && k == idx::HEADING_OFFSET));
-        smoothed.iter().zip(depths).map(|((t, (x, p)), d)| Self::estimate_of(&self.config, *t, x, p, *d)).collect()
     }
 }
 
@@ -769,7 +787,7 @@ mod tests {
             (0.5, 0.02),
         );
         let worst = run(&mut nav);
-        let offsets = nav.beacon_offsets();
+        let offsets = nav.offsets();
         assert_eq!(offsets.len(), 3);
         assert_eq!(offsets.iter().map(|o| o.0).collect::<Vec<_>>(), [1, 2, 0]); // the order heard
         for (id, offset, sigma) in offsets {
@@ -794,7 +812,7 @@ mod tests {
             let b = Vector3::new(100.0 * f64::from(id + 1), 0.0, 0.0);
             full.process(&Measurement::new(1.0, Kind::Range { beacon: BeaconFix::fixed(id, b), range_m: b.norm() }));
         }
-        assert_eq!(full.beacon_offsets().len(), BEACON_OFFSETS);
+        assert_eq!(full.offsets().len(), BEACON_OFFSETS);
         assert_eq!(full.filter.covariance()[(idx::BIAS, idx::BIAS)], 0.0);
     }
 
@@ -849,5 +867,26 @@ mod tests {
             Kind::Doppler { beacon: BeaconFix::fixed(0, beacon), radial_speed_m_s: -1.5 },
         ));
         assert!(matches!(out, Outcome::Accepted(i) if i.nis < 1.0), "{out:?}");
+    }
+
+    /// A Doppler speed heard 30 m below a surface beacon 40 m off reads along the slant
+    /// line of sight: closing at 1.5 m/s horizontally is 1.2 m/s (4/5, a closed form),
+    /// as the smoother's line-of-sight speed reads it.
+    #[test]
+    fn a_doppler_speed_from_below_the_beacon_is_read_along_the_slant_line() {
+        let innovation = |depth_m: f64, radial_speed_m_s: f64| {
+            let mut nav = start(PlanarConfig { aiding: Aiding::RANGE_DOPPLER, ..PlanarConfig::default() });
+            nav.process(&Measurement::new(0.0, Kind::Depth { depth_m }));
+            nav.process(&Measurement::new(0.0, Kind::Speed { speed_m_s: 1.5 }));
+            // heading north from 40 m south of the beacon: closing
+            let beacon = BeaconFix::fixed(0, Vector3::new(40.0, 0.0, 0.0));
+            match nav.process(&Measurement::new(0.0, Kind::Doppler { beacon, radial_speed_m_s })) {
+                Outcome::Accepted(i) | Outcome::Rejected(i) => i.residual,
+                other => panic!("{other:?}"),
+            }
+        };
+        assert_abs_diff_eq!(innovation(30.0, 1.2), 0.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(innovation(0.0, 1.5), 0.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(innovation(30.0, 1.5), 0.3, epsilon = 1e-12);
     }
 }

@@ -293,16 +293,19 @@ impl CarriedDoppler {
 impl<const N: usize> ScalarModel<N> for CarriedDoppler {
     fn predict(&self, x: &SVector<f64, N>) -> f64 {
         let water = ScalarModel::<N>::predict(&self.doppler, x);
-        self.geometry(x).map_or(water, |(u, _, c)| water - u.dot(&c))
+        self.geometry(x).map_or(water, |(u, r, c)| water - self.doppler.slant(u.x * r, u.y * r).0 * u.dot(&c))
     }
 
     fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
         let mut h = ScalarModel::<N>::jacobian(&self.doppler, x);
         if let (Some((u, r, c)), Some(i)) = (self.geometry(x), self.current) {
-            // d(-u.c)/dp = -(c - u (u.c)) / r; d(-u.c)/dc = -u
-            let dp = -(c - u * u.dot(&c)) / r;
+            // the current's share -f u.c along the slant line of sight (f = 1 level with
+            // the beacon): d(-u.c)/dp = -(c - u (u.c)) / r, d(-u.c)/dc = -u, and the
+            // slant factor's gradient df
+            let (f, df) = self.doppler.slant(u.x * r, u.y * r);
+            let dp = -(c - u * u.dot(&c)) / r * f - df * u.dot(&c);
             (h[0], h[1]) = (h[0] + dp.x, h[1] + dp.y);
-            (h[i], h[i + 1]) = (-u.x, -u.y);
+            (h[i], h[i + 1]) = (-f * u.x, -f * u.y);
         }
         h
     }
@@ -427,7 +430,7 @@ mod tests {
     /// the water's.
     #[test]
     fn the_doppler_over_ground_has_the_currents_share() {
-        let doppler = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, var: 0.1 };
+        let doppler = RadialSpeed2d { beacon: Vector2::new(0.0, 0.0), known_speed_m_s: None, dz_m: 0.0, var: 0.1 };
         let m = CarriedDoppler { doppler, current: Some(6) };
         let at = |c: [f64; 2]| SVector::<f64, 8>::from([10.0, 0.0, 0.0, 0.0, 0.0, 0.0, c[0], c[1]]);
         assert_abs_diff_eq!(ScalarModel::<8>::predict(&m, &at([-0.5, 0.0])), 0.5, epsilon = 1e-12);
@@ -442,5 +445,16 @@ mod tests {
         }
         let still = CarriedDoppler { doppler, current: None };
         assert_eq!(ScalarModel::<8>::predict(&still, &x), ScalarModel::<8>::predict(&doppler, &x));
+        // 30 m below the beacon, 40 m off: the current's share is 4/5 of the level one
+        let below = CarriedDoppler { doppler: RadialSpeed2d { dz_m: 30.0, ..doppler }, current: Some(6) };
+        let at = SVector::<f64, 8>::from([40.0, 0.0, 0.0, 0.0, 0.0, 0.0, -0.5, 0.0]);
+        assert_abs_diff_eq!(ScalarModel::<8>::predict(&below, &at), 0.4, epsilon = 1e-12);
+        let h = ScalarModel::<8>::jacobian(&below, &x);
+        for j in 0..8 {
+            let mut xp = x;
+            xp[j] += 1e-6;
+            let fd = (ScalarModel::<8>::predict(&below, &xp) - ScalarModel::<8>::predict(&below, &x)) / 1e-6;
+            assert_abs_diff_eq!(h[j], fd, epsilon = 1e-6);
+        }
     }
 }

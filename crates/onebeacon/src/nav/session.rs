@@ -201,8 +201,9 @@ impl Session {
         self
     }
 
-    /// The session with every estimator keeping its history for a Rauch-Tung-Striebel
-    /// pass ([`Navigator::keep_history`]; from a restart on, for one restarted).
+    /// The session with every estimator that can keeping its history for a
+    /// Rauch-Tung-Striebel pass ([`super::capability::Smoothing::keep_history`]; from a
+    /// restart on, for one restarted).
     pub fn with_history(mut self) -> Self {
         self.keep_history = true;
         self
@@ -262,12 +263,18 @@ impl Session {
     /// Each estimator's per-beacon range offsets (beacon, offset m, its sigma m); empty
     /// for one without them.
     pub fn beacon_offsets(&self) -> Vec<Vec<(u32, f64, f64)>> {
-        self.navs.iter().map(|n| n.beacon_offsets()).collect()
+        self.navs.iter().map(|n| n.beacon_offsets().map(|o| o.offsets()).unwrap_or_default()).collect()
     }
 
     /// Estimator `i`'s navigator (None before the start).
     pub fn navigator(&self, i: usize) -> Option<&dyn Navigator> {
         self.navs.get(i).map(|n| &**n)
+    }
+
+    /// Estimator `i`'s Rauch-Tung-Striebel smoothed run kept since the start
+    /// ([`Session::with_history`]); None for one that keeps none, or before the start.
+    pub fn smoothed(&mut self, i: usize) -> Option<Vec<Estimate>> {
+        Some(self.navs.get_mut(i)?.smoothing()?.smoothed())
     }
 
     pub fn started(&self) -> bool {
@@ -293,7 +300,7 @@ impl Session {
         self.restarts = std::mem::take(&mut self.builders).into_iter().map(|b| Restart::new(b, pose, sigmas)).collect();
         self.navs = self.restarts.iter().map(|r| r.build(t0, pose)).collect();
         if self.keep_history {
-            self.navs.iter_mut().for_each(|n| _ = n.keep_history());
+            self.navs.iter_mut().filter_map(|n| n.smoothing()).for_each(|s| s.keep_history());
         }
     }
 
@@ -320,8 +327,10 @@ impl Session {
         let mut reinitialised = Vec::new();
         for (i, e) in estimates.iter_mut().enumerate() {
             if self.restarts[i].apply(&mut self.navs[i], e, t_s) {
-                if self.keep_history {
-                    self.navs[i].keep_history();
+                if self.keep_history
+                    && let Some(s) = self.navs[i].smoothing()
+                {
+                    s.keep_history();
                 }
                 self.stats[i].reinitialised += 1;
                 reinitialised.push(i);
@@ -497,7 +506,7 @@ impl Session {
                     let m = Measurement::new(t, kind);
                     let held = self.held_out.is_some() && m.kind.beacon().map(|b| b.id) == self.held_out;
                     for (i, nav) in self.navs.iter_mut().enumerate().filter(|_| held) {
-                        if let Some(innovation) = nav.weigh(&m) {
+                        if let Some(innovation) = nav.weighing().and_then(|w| w.weigh(&m)) {
                             self.held_out_stats[i].push_innovation(&m.kind, innovation, false);
                         }
                     }
@@ -538,13 +547,10 @@ impl Session {
     /// A beacon left out by the beacon filter is counted in `left_out` and goes to no
     /// estimator (`None`); a beacon whose position is not known is an error.
     fn resolve(&mut self, mut m: Kind) -> Result<Option<Kind>, String> {
-        let Some(beacon) = m.beacon_mut() else { return Ok(Some(m)) };
+        let Some(beacon) = m.beacon() else { return Ok(Some(m)) };
         let id = beacon.id;
-        let position = if beacon.position_ned_m.iter().all(|v| v.is_finite()) {
-            Some(beacon.position_ned_m)
-        } else {
-            self.tracked.get(&id).copied()
-        };
+        let given = beacon.position_ned_m.iter().all(|v| v.is_finite());
+        let position = if given { Some(beacon.position_ned_m) } else { self.tracked.get(&id).copied() };
         let Some(position) = position else {
             return Err(format!("beacon {id}'s position is not known yet (no beacon_position item for it)"));
         };
@@ -552,7 +558,10 @@ impl Session {
             self.left_out += 1;
             return Ok(None);
         }
-        beacon.position_ned_m = position;
+        // written only when filled in: a capture shared with its item is copied then only
+        if !given && let Some(beacon) = m.beacon_mut() {
+            beacon.position_ned_m = position;
+        }
         self.last_beacon = Some(position);
         Ok(Some(m))
     }

@@ -332,7 +332,7 @@ impl<const N: usize, P: ProcessModel<N>> SingleBeaconNavigator<N, P> {
             }
         }
         let range = range_model(r_range);
-        let doppler = RadialSpeed2d { beacon: fr.beacon, known_speed_m_s: None, var: t.r_doppler_m2_s2 };
+        let doppler = RadialSpeed2d { beacon: fr.beacon, known_speed_m_s: None, dz_m: 0.0, var: t.r_doppler_m2_s2 };
         let doppler = CarriedDoppler { doppler, current: layout.current };
         match (range_m, fr.radial_speed_m_s) {
             (None, None) => update(f, &self.inertial, [heading, yaw_rate, accel]),
@@ -459,7 +459,8 @@ mod tests {
                 let frame = (k % 12 == 0).then(|| Kind::RangeDoppler {
                     beacon: fix,
                     range_m: ScalarModel::<DIM>::predict(&Range2d { beacon, var: 0.0 }, &truth),
-                    radial_speed_m_s: RadialSpeed2d { beacon, known_speed_m_s: None, var: 0.0 }.predict(&truth),
+                    radial_speed_m_s: RadialSpeed2d { beacon, known_speed_m_s: None, dz_m: 0.0, var: 0.0 }
+                        .predict(&truth),
                 });
                 let inertial = Kind::Inertial { heading_rad: FRAC_PI_2, yaw_rate_rad_s: 0.0, accel_m_s2: 0.0 };
                 for (f, e) in filters.iter_mut().zip(speed_err.iter_mut()) {
@@ -512,7 +513,8 @@ mod tests {
                         let frame = Kind::RangeDoppler {
                             beacon: fix,
                             range_m: ScalarModel::<DIM>::predict(&Range2d { beacon, var: 0.0 }, &truth),
-                            radial_speed_m_s: RadialSpeed2d { beacon, known_speed_m_s: None, var: 0.0 }.predict(&truth),
+                            radial_speed_m_s: RadialSpeed2d { beacon, known_speed_m_s: None, dz_m: 0.0, var: 0.0 }
+                                .predict(&truth),
                         };
                         nav.process(&Measurement::new(t, frame));
                     }

@@ -7,6 +7,7 @@
 //! range offset b (m) and scale error k_r (ranges read (1 + k_r) r + b).
 
 use super::Calibration;
+use super::capability::Weighing;
 use super::{Estimate, Innovation, Kind, Measurement, Navigator, Outcome, PlanarConfig};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
 use crate::measure::{ScalarModel, SlantRange};
@@ -140,14 +141,20 @@ impl TrackingNavigator {
     }
 }
 
-impl Navigator for TrackingNavigator {
-    /// Ranges correct the track and depths enter slant ranges; a craft tracked from
-    /// outside gives no other measurement this model uses.
+impl Weighing for TrackingNavigator {
     fn weigh(&mut self, m: &Measurement) -> Option<Innovation> {
         let Kind::Range { beacon, range_m } = m.kind else { return None };
         self.advance_to(m.t_s);
         let model: [&dyn ScalarModel<STATES>; 1] = [&self.range(beacon.position_ned_m)];
         super::gated_update(&mut self.filter, &model, Vector1::new(range_m), -1.0, None).innovation()
+    }
+}
+
+/// Ranges correct the track and depths enter slant ranges; a craft tracked from
+/// outside gives no other measurement this model uses.
+impl Navigator for TrackingNavigator {
+    fn weighing(&mut self) -> Option<&mut dyn Weighing> {
+        Some(self)
     }
 
     fn process(&mut self, m: &Measurement) -> Outcome {

@@ -6,6 +6,7 @@
 //! same measurements.
 
 use super::Calibration;
+use super::capability::ParticleBelief;
 use super::{Aiding, Estimate, Gate, Kind, Measurement, Navigator, Outcome, Robust, gated_update};
 use crate::filter::particle::{ParticleFilter, ParticleSettings};
 use crate::filter::{AnyFilter, FilterKind, GaussianFilter, ProcessModel};
@@ -244,9 +245,15 @@ impl Navigator for ParticleTracker {
         })
     }
 
-    fn position_sample(&self, m: usize) -> Option<Vec<Vector3<f64>>> {
+    fn particles(&self) -> Option<&dyn ParticleBelief> {
+        Some(self)
+    }
+}
+
+impl ParticleBelief for ParticleTracker {
+    fn position_sample(&self, m: usize) -> Vec<Vector3<f64>> {
         let picked = with_pf!(&self.cloud, pf => pf.subsample(m.min(pf.len()), [idx::X, idx::Y, idx::Z]));
-        Some(picked.into_iter().map(Vector3::from).collect())
+        picked.into_iter().map(Vector3::from).collect()
     }
 }
 
@@ -380,8 +387,8 @@ mod tests {
         }
         let (a, b) = (pf.estimate().position_ned_m, ekf.estimate().position_ned_m);
         assert!((a - b).norm() < 1.0, "{a:?} against {b:?}");
-        assert_eq!(pf.position_sample(100).map(|v| v.len()), Some(100));
-        assert!(ekf.position_sample(100).is_none());
+        assert_eq!(pf.particles().map(|p| p.position_sample(100).len()), Some(100));
+        assert!(ekf.particles().is_none());
     }
 
     /// A head turned by 3 deg reads every azimuth 3 deg less: heard from stations on a

@@ -80,8 +80,8 @@ impl BearingGuidance {
             .unwrap_or(0);
         let e = &estimates[worst];
         let positions = beliefs[worst]
-            .position_sample(c.planner_particles)
-            .unwrap_or_else(|| gaussian_sample(e, c.planner_particles));
+            .particles()
+            .map_or_else(|| gaussian_sample(e, c.planner_particles), |p| p.position_sample(c.planner_particles));
         let weights = vec![1.0 / positions.len() as f64; positions.len()];
         // the velocity over ground of the estimated heading, pitch and speed
         let velocity = e.body_to_ned() * Vector3::new(e.speed_m_s.unwrap_or(0.0), 0.0, 0.0);
