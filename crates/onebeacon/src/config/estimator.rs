@@ -518,56 +518,29 @@ impl<'de> Visitor<'de> for TableVisitor {
         let mut e = EstimatorSpec::new(EstimatorKind::DeadReckoning);
         // an unknown key is refused as it is read, so that the error has its line
         while let Some(key) = map.next_key_seed(KnownKey)? {
-            let taken = match key {
-                "kind" => {
-                    kind = Some(map.next_value()?);
-                    true
-                }
-                "name" => {
-                    e.name = Some(map.next_value()?);
-                    true
-                }
-                "measurements" => {
-                    e.measurements = Some(map.next_value::<Vec<Acoustic>>()?);
-                    true
-                }
-                "filter" => {
-                    e.filter = map.next_value::<FilterName>()?;
-                    true
-                }
-                "ukf_alpha" => {
-                    e.ukf_alpha = Some(map.next_value()?);
-                    true
-                }
-                "ukf_beta" => {
-                    e.ukf_beta = Some(map.next_value()?);
-                    true
-                }
-                "ukf_kappa" => {
-                    e.ukf_kappa = Some(map.next_value()?);
-                    true
-                }
-                "seed" => {
-                    e.seed = Some(map.next_value()?);
-                    true
-                }
-                "iusbl" => {
-                    e.iusbl = Some(map.next_value()?);
-                    true
-                }
+            match key {
+                "kind" => kind = Some(map.next_value()?),
+                "name" => e.name = Some(map.next_value()?),
+                "measurements" => e.measurements = Some(map.next_value()?),
+                "filter" => e.filter = map.next_value()?,
+                "ukf_alpha" => e.ukf_alpha = Some(map.next_value()?),
+                "ukf_beta" => e.ukf_beta = Some(map.next_value()?),
+                "ukf_kappa" => e.ukf_kappa = Some(map.next_value()?),
+                "seed" => e.seed = Some(map.next_value()?),
+                "iusbl" => e.iusbl = Some(map.next_value()?),
                 k => {
-                    e.noise.take(k, &mut map)?
+                    let taken = e.noise.take(k, &mut map)?
                         || e.gating.take(k, &mut map)?
                         || e.calibration.take(k, &mut map)?
                         || e.unicycle.take(k, &mut map)?
                         || e.six_dof.take(k, &mut map)?
                         || e.usbl.take(k, &mut map)?
                         || e.particle.take(k, &mut map)?
-                        || e.planar.take(k, &mut map)?
+                        || e.planar.take(k, &mut map)?;
+                    if !taken {
+                        return Err(A::Error::unknown_field(k, &ALL_KEYS));
+                    }
                 }
-            };
-            if !taken {
-                return Err(A::Error::unknown_field(key, &ALL_KEYS));
             }
         }
         e.kind = kind.ok_or_else(|| A::Error::missing_field("kind"))?;

@@ -436,25 +436,23 @@ mod tests {
         assert_abs_diff_eq!(ScalarModel::<8>::predict(&m, &at([-0.5, 0.0])), 0.5, epsilon = 1e-12);
         assert_abs_diff_eq!(ScalarModel::<8>::predict(&m, &at([0.0, 0.5])), 0.0, epsilon = 1e-12);
         let x = SVector::<f64, 8>::from([30.0, -40.0, 0.7, 1.2, 0.0, 0.0, 0.25, -0.15]);
-        let h = ScalarModel::<8>::jacobian(&m, &x);
-        for j in 0..8 {
-            let mut xp = x;
-            xp[j] += 1e-6;
-            let fd = (ScalarModel::<8>::predict(&m, &xp) - ScalarModel::<8>::predict(&m, &x)) / 1e-6;
-            assert_abs_diff_eq!(h[j], fd, epsilon = 1e-6);
-        }
+        // the Jacobian against forward differences
+        let differences = |m: &CarriedDoppler| {
+            let h = ScalarModel::<8>::jacobian(m, &x);
+            for j in 0..8 {
+                let mut xp = x;
+                xp[j] += 1e-6;
+                let fd = (ScalarModel::<8>::predict(m, &xp) - ScalarModel::<8>::predict(m, &x)) / 1e-6;
+                assert_abs_diff_eq!(h[j], fd, epsilon = 1e-6);
+            }
+        };
+        differences(&m);
         let still = CarriedDoppler { doppler, current: None };
         assert_eq!(ScalarModel::<8>::predict(&still, &x), ScalarModel::<8>::predict(&doppler, &x));
         // 30 m below the beacon, 40 m off: the current's share is 4/5 of the level one
         let below = CarriedDoppler { doppler: RadialSpeed2d { dz_m: 30.0, ..doppler }, current: Some(6) };
         let at = SVector::<f64, 8>::from([40.0, 0.0, 0.0, 0.0, 0.0, 0.0, -0.5, 0.0]);
         assert_abs_diff_eq!(ScalarModel::<8>::predict(&below, &at), 0.4, epsilon = 1e-12);
-        let h = ScalarModel::<8>::jacobian(&below, &x);
-        for j in 0..8 {
-            let mut xp = x;
-            xp[j] += 1e-6;
-            let fd = (ScalarModel::<8>::predict(&below, &xp) - ScalarModel::<8>::predict(&below, &x)) / 1e-6;
-            assert_abs_diff_eq!(h[j], fd, epsilon = 1e-6);
-        }
+        differences(&below);
     }
 }
