@@ -227,14 +227,9 @@ pub(crate) fn run(world: &mut dyn World, computers: &mut [Aboard], observers: &m
                 first += c.unit.session(i).names.len();
             }
             // scored at the step's time, also when no message reached it
-            let mut track = own;
-            for done in c.unit.predict_to(t_s).into_iter().map(|d| d.expect("started at time 0")) {
-                let n = done.estimates.len();
-                estimates[track..track + n].copy_from_slice(&done.estimates);
-                for j in done.reinitialised {
-                    observers.iter_mut().for_each(|o| o.restarted(track + j));
-                }
-                track += n;
+            let again = c.unit.predict_to(t_s, &mut estimates[own..first]).expect("started at time 0");
+            for j in again {
+                observers.iter_mut().for_each(|o| o.restarted(own + j));
             }
         }
         for (v, tr) in truth.iter_mut().enumerate() {

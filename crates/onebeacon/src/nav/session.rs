@@ -77,11 +77,12 @@ pub struct Step {
 }
 
 /// What taking one item did ([`Session::take`]): each estimator's outcome (none for
-/// beacon positions and truth), and the ground-truth pose when it is one.
+/// beacon positions and truth; held by the session until its next item, so that taking
+/// an item allocates nothing), and the ground-truth pose when it is one.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Taken {
+pub struct Taken<'a> {
     pub t_s: f64,
-    pub outcomes: Vec<Option<Outcome>>,
+    pub outcomes: &'a [Option<Outcome>],
     pub truth: Option<TruthPose>,
     /// The measurement the estimators were given (its beacon's position resolved).
     pub measurement: Option<Kind>,
@@ -144,6 +145,8 @@ pub struct Session {
     /// The items taken at the time of the last one (at most [`REPEATS_KEPT`]), against
     /// which a repeated message is screened.
     at_last_t: Vec<Input>,
+    /// What the estimators made of the last item taken ([`Taken::outcomes`]).
+    outcomes: Vec<Option<Outcome>>,
     /// Whether the estimators keep their history ([`Session::with_history`]).
     keep_history: bool,
 }
@@ -190,6 +193,7 @@ impl Session {
             last_t: None,
             jump: None,
             at_last_t: Vec::new(),
+            outcomes: Vec::new(),
             restarts: Vec::new(),
             keep_history: false,
         }
@@ -304,21 +308,20 @@ impl Session {
         }
     }
 
-    /// Predicts every estimator to `t_s` (a clock tick: the time of a simulator's step)
-    /// and applies the restart policy as after an item (no outcomes: no item was taken);
-    /// `None` before the start. The items' time order stays the items' own: an item
-    /// older than `t_s` is still taken.
-    pub fn predict_to(&mut self, t_s: f64) -> Option<Step> {
+    /// Predicts every estimator to `t_s` (a clock tick: the time of a simulator's step),
+    /// writes their estimates into `estimates` (one per estimator) and applies the
+    /// restart policy as after an item: the estimators started again (empty, allocating
+    /// nothing, when none was), or `None` before the start. The items' time order stays
+    /// the items' own: an item older than `t_s` is still taken.
+    pub fn predict_to(&mut self, t_s: f64, estimates: &mut [Estimate]) -> Option<Vec<usize>> {
         if !self.started() {
             return None;
         }
-        let mut estimates = Vec::with_capacity(self.navs.len());
-        for nav in &mut self.navs {
+        for (nav, e) in self.navs.iter_mut().zip(estimates.iter_mut()) {
             nav.predict_to(t_s);
-            estimates.push(nav.estimate());
+            *e = nav.estimate();
         }
-        let reinitialised = self.restart_unsound(&mut estimates, t_s);
-        Some(Step { t_s, outcomes: Vec::new(), estimates, truth: None, errors: None, reinitialised })
+        Some(self.restart_unsound(estimates, t_s))
     }
 
     /// A filter whose state stops being sound starts again from its last sound estimate
@@ -366,6 +369,7 @@ impl Session {
     /// for a ground-truth item, each estimator's error.
     pub fn push(&mut self, item: &Item) -> Result<Option<Step>, Screened> {
         let Some(Taken { t_s: t, outcomes, truth, measurement }) = self.take(item)? else { return Ok(None) };
+        let outcomes = outcomes.to_vec();
         if let Some(kind) = &measurement {
             self.count_outcomes(t, kind, &outcomes);
         }
@@ -393,7 +397,7 @@ impl Session {
     /// [`Session::push`] does, without asking for their estimates: no restart check, no
     /// counting of outcomes, no scoring (the simulator's engine, which counts and scores
     /// for itself, at its steps: [`Session::predict_to`]). `Ok(None)` before the start.
-    pub fn take(&mut self, item: &Item) -> Result<Option<Taken>, Screened> {
+    pub fn take(&mut self, item: &Item) -> Result<Option<Taken<'_>>, Screened> {
         let t = item.t_s;
         let dt = self.last_t.map(|last| t - last);
         if !t.is_finite() {
@@ -498,7 +502,8 @@ impl Session {
                 }
             }
         }
-        let mut outcomes = vec![None; self.navs.len()];
+        self.outcomes.clear();
+        self.outcomes.resize(self.navs.len(), None);
         let (mut truth, mut measurement) = (None, None);
         match &item.input {
             Input::Measurement(m) => {
@@ -510,7 +515,7 @@ impl Session {
                             self.held_out_stats[i].push_innovation(&m.kind, innovation, false);
                         }
                     }
-                    for (nav, out) in self.navs.iter_mut().zip(&mut outcomes).filter(|_| !held) {
+                    for (nav, out) in self.navs.iter_mut().zip(&mut self.outcomes).filter(|_| !held) {
                         *out = Some(nav.process(&m));
                     }
                     measurement = Some(m.kind);
@@ -519,7 +524,7 @@ impl Session {
             Input::Truth(p) => truth = Some(*p),
             Input::BeaconPosition { .. } => {}
         }
-        Ok(Some(Taken { t_s: t, outcomes, truth, measurement }))
+        Ok(Some(Taken { t_s: t, outcomes: &self.outcomes, truth, measurement }))
     }
 
     /// Counts what each estimator made of measurement `kind` (`outcomes`, at `t_s`): its

@@ -6,6 +6,7 @@
 
 use super::{Command, Controller, DecideError, Decided, GuidanceSnapshot, OwnFix, Situation};
 use crate::geo::Frame;
+use crate::nav::Estimate;
 use crate::nav::Navigator;
 use crate::nav::session::{Item, Screened, Session, Step, Taken};
 use nalgebra::{Vector2, Vector3};
@@ -112,15 +113,25 @@ impl Unit {
     }
 
     /// Predicts every session's estimators to `t_s` ([`Session::predict_to`]), session
-    /// by session.
-    pub fn predict_to(&mut self, t_s: f64) -> Vec<Option<Step>> {
-        self.sessions.iter_mut().map(|s| s.predict_to(t_s)).collect()
+    /// by session, their estimates written into `estimates` in that order (one per
+    /// estimator of every session): the estimators started again, counted across the
+    /// sessions in the same order, or `None` when a session has not started.
+    pub fn predict_to(&mut self, t_s: f64, estimates: &mut [Estimate]) -> Option<Vec<usize>> {
+        let mut restarted = Vec::new();
+        let mut first = 0;
+        for s in &mut self.sessions {
+            let n = s.names.len();
+            let again = s.predict_to(t_s, &mut estimates[first..first + n])?;
+            restarted.extend(again.into_iter().map(|j| first + j));
+            first += n;
+        }
+        Some(restarted)
     }
 
     /// Takes a measurement or truth item about vehicle `vehicle` into its session
     /// without scoring it ([`Session::take`]; the simulator, which scores at its steps
     /// through [`Unit::predict_to`]).
-    pub fn take(&mut self, vehicle: usize, item: &Item) -> Result<Option<Taken>, Screened> {
+    pub fn take(&mut self, vehicle: usize, item: &Item) -> Result<Option<Taken<'_>>, Screened> {
         self.sessions[vehicle].take(item)
     }
 
