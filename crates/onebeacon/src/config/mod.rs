@@ -15,6 +15,7 @@ pub mod estimator;
 mod estimator_check;
 mod estimator_defaults;
 mod estimator_keys;
+mod estimator_read;
 pub mod iusbl;
 pub mod stream;
 #[cfg(feature = "log")]
