@@ -32,7 +32,7 @@ impl<const N: usize> ScalarModel<N> for RadialSpeed2d {
         let (dx, dy) = (x[idx::X] - self.beacon.x, x[idx::Y] - self.beacon.y);
         let c = dy.atan2(dx) - x[idx::PSI]; // C of eq. 23
         let horizontal = -self.speed(x) * c.cos(); // eq. 20, second row; equals eq. 13 with eq. 14
-        if self.dz_m == 0.0 { horizontal } else { horizontal * self.slant(dx, dy).0 }
+        horizontal * self.slant(dx, dy).0 // exactly 1 level with the beacon
     }
 
     fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {

@@ -280,29 +280,37 @@ pub(crate) struct CarriedDoppler {
 }
 
 impl CarriedDoppler {
-    /// The unit vector u, the distance, and the current, when there is one and the
-    /// vehicle is off the beacon.
-    fn geometry<const N: usize>(&self, x: &SVector<f64, N>) -> Option<(Vector2<f64>, f64, Vector2<f64>)> {
+    /// The horizontal offset d from the beacon, the unit vector u along it, the distance,
+    /// and the current, when there is one and the vehicle is off the beacon.
+    fn geometry<const N: usize>(&self, x: &SVector<f64, N>) -> Option<Geometry> {
         let i = self.current?;
         let d = Vector2::new(x[0], x[1]) - self.doppler.beacon;
         let r = d.norm();
-        (r > 1e-9).then(|| (d / r, r, Vector2::new(x[i], x[i + 1])))
+        (r > 1e-9).then(|| Geometry { d, u: d / r, r, current: Vector2::new(x[i], x[i + 1]) })
     }
+}
+
+/// [`CarriedDoppler::geometry`]'s parts.
+struct Geometry {
+    d: Vector2<f64>,
+    u: Vector2<f64>,
+    r: f64,
+    current: Vector2<f64>,
 }
 
 impl<const N: usize> ScalarModel<N> for CarriedDoppler {
     fn predict(&self, x: &SVector<f64, N>) -> f64 {
         let water = ScalarModel::<N>::predict(&self.doppler, x);
-        self.geometry(x).map_or(water, |(u, r, c)| water - self.doppler.slant(u.x * r, u.y * r).0 * u.dot(&c))
+        self.geometry(x).map_or(water, |g| water - self.doppler.slant(g.d.x, g.d.y).0 * g.u.dot(&g.current))
     }
 
     fn jacobian(&self, x: &SVector<f64, N>) -> SMatrix<f64, 1, N> {
         let mut h = ScalarModel::<N>::jacobian(&self.doppler, x);
-        if let (Some((u, r, c)), Some(i)) = (self.geometry(x), self.current) {
+        if let (Some(Geometry { d, u, r, current: c }), Some(i)) = (self.geometry(x), self.current) {
             // the current's share -f u.c along the slant line of sight (f = 1 level with
             // the beacon): d(-u.c)/dp = -(c - u (u.c)) / r, d(-u.c)/dc = -u, and the
             // slant factor's gradient df
-            let (f, df) = self.doppler.slant(u.x * r, u.y * r);
+            let (f, df) = self.doppler.slant(d.x, d.y);
             let dp = -(c - u * u.dot(&c)) / r * f - df * u.dot(&c);
             (h[0], h[1]) = (h[0] + dp.x, h[1] + dp.y);
             (h[i], h[i + 1]) = (-f * u.x, -f * u.y);

@@ -317,6 +317,7 @@ impl Session {
         if !self.started() {
             return None;
         }
+        debug_assert_eq!(estimates.len(), self.navs.len(), "one estimate per estimator");
         for (nav, e) in self.navs.iter_mut().zip(estimates.iter_mut()) {
             nav.predict_to(t_s);
             *e = nav.estimate();

@@ -108,8 +108,11 @@ impl Unit {
     /// Starts every session whose start is a given pose due by `t_s`; whether all run.
     pub fn start_by(&mut self, t_s: f64) -> bool {
         // every session tried, not only up to the first that waits
-        let started: Vec<bool> = self.sessions.iter_mut().map(|s| s.start_by(t_s)).collect();
-        started.iter().all(|&s| s)
+        let mut all = true;
+        for s in &mut self.sessions {
+            all &= s.start_by(t_s);
+        }
+        all
     }
 
     /// Predicts every session's estimators to `t_s` ([`Session::predict_to`]), session
