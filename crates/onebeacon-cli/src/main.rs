@@ -24,6 +24,7 @@ mod plot;
 mod progress;
 mod replay;
 mod report;
+mod sea_fit;
 mod smooth;
 mod tune;
 
@@ -291,6 +292,29 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Fit the sea of a log: per beacon its range noise, bias, scale, drift, multipath
+    /// and false detections, the lost messages, the heading bias, the speed scale and
+    /// the current, against its ground truth (or the smoother's trajectory), each with
+    /// a 95 % interval. Writes sea.toml (a `[sea]` table for a scenario, each value's
+    /// source beside it) and sea-fit.json; prints the table (docs/logs.md, "The sea of
+    /// a log").
+    SeaFit {
+        /// The log description (TOML).
+        log: PathBuf,
+        /// Use only these beacons (ids, comma-separated).
+        #[arg(long, value_delimiter = ',', value_name = "IDS")]
+        beacons: Option<Vec<u32>>,
+        /// The windows over which the speed scale, the current and the odometry's scales
+        /// are fitted, s.
+        #[arg(long, value_name = "S", default_value_t = 60.0)]
+        window_s: f64,
+        /// Output directory (default: out/<log>-sea).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Print one JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Run the estimators of CONFIG on JSON Lines measurements from stdin, writing one
     /// JSON line of estimates per input line to stdout, flushed after each.
     Stream {
@@ -500,6 +524,9 @@ fn main() -> ExitCode {
         }
         Command::Tune { log, estimators, keys, beacons, each_beacon, out, json } => {
             tune::tune(&log, tune::TuneArgs { estimators, keys, beacons, each_beacon, out, json })
+        }
+        Command::SeaFit { log, beacons, window_s, out, json } => {
+            sea_fit::sea_fit(&log, sea_fit::SeaFitArgs { beacons, window_s, out, json })
         }
         Command::Stream { config } => replay::stream(&config),
         Command::Guidance { command: GuidanceCommand::Standoff { speed_m_s, depths_m, period_s, json } } => {

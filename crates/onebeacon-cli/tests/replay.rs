@@ -11,6 +11,36 @@ fn plaza(n: u8) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../data/plaza/plaza{n}.toml")).display().to_string()
 }
 
+/// `sea-fit` on plaza2 gives what data/plaza/README.md measured on the files by other
+/// means (a least-squares line per beacon, a fit of the whole track's turns): ranges
+/// 1.068-1.071 times the distance, a robust residual sigma of 0.51-0.62 m, turns 0.954
+/// times the reported; each within what separates the two methods (the scale to 0.005,
+/// sigma to 0.05 m, the turn scale to 0.006). And it writes sea.toml and sea-fit.json.
+#[test]
+fn sea_fit_on_plaza2_finds_what_was_measured_on_its_files() {
+    let dir = scratch("sea-fit");
+    let out = dir.join("sea");
+    let o = run(&["sea-fit", &plaza(2), "--json", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let j: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["reference"], "ground truth");
+    let ranges = j["ranges"].as_array().unwrap();
+    assert_eq!(ranges.len(), 4);
+    for r in ranges {
+        let k = r["scale"]["value"].as_f64().unwrap();
+        assert!((0.063..=0.076).contains(&k), "{r}");
+        let s = r["sigma_m"]["value"].as_f64().unwrap();
+        assert!((0.46..=0.67).contains(&s), "{r}");
+    }
+    let turn = j["odometry"]["turn_scale"]["value"].as_f64().unwrap();
+    assert!((turn - (0.954 - 1.0)).abs() < 0.006, "{turn}");
+    let toml = std::fs::read_to_string(out.join("sea.toml")).unwrap();
+    let table: toml::Table = toml::from_str(&toml).unwrap();
+    assert!(table["sea"]["link"]["loss_prob"].as_float().is_some(), "{toml}");
+    assert!(toml.contains("# fit (") && toml.contains("95 % ["), "{toml}");
+    assert!(out.join("sea-fit.json").is_file());
+}
+
 /// `onebeacon stream CONFIG` fed `input` on stdin (from a thread, so a large input
 /// cannot block on a full stdout pipe).
 fn stream(config: &str, input: Vec<u8>) -> Output {

@@ -37,6 +37,7 @@ pub mod pcrb;
 pub mod replay;
 pub mod run;
 pub mod scenario;
+pub mod seafit;
 pub mod seed;
 pub mod sensor_errors;
 pub mod sensors;
