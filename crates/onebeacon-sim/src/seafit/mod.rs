@@ -174,20 +174,28 @@ pub fn fit(log: &Log, opts: &SeaFitOptions, progress: impl Fn(&str)) -> Result<S
     Ok(out)
 }
 
-/// The clocks' drift sigma from the beacons' range drifts c_i (m/s): each is the rate
-/// of two clocks apart times the sound speed, of variance 2 sigma^2, so sigma^2 = sum
-/// c_i^2 / (2 B c^2); its interval from chi-square with B degrees of freedom (the
-/// drifts' own fit errors and their sharing of the vehicle's clock neglected).
+/// The clocks' drift sigma from the beacons' range drifts c_i (m/s, each fitted with a
+/// standard deviation s_i): each is the rate of two clocks apart times the sound speed,
+/// of variance 2 sigma^2, and its fit adds s_i^2, so sigma^2 = sum (c_i^2 - s_i^2) /
+/// (2 B) in ppm^2 (0 where the drifts are no larger than their fit errors); its interval
+/// from chi-square with B degrees of freedom on sum c_i^2 less the fit errors (the
+/// beacons' sharing of the vehicle's clock neglected).
 fn drift_sigma(fits: &[RangeFit]) -> Option<Value> {
     use statrs::distribution::{ChiSquared, ContinuousCDF};
     let b = fits.len();
     let chi = ChiSquared::new(b as f64).ok()?;
-    let ss: f64 =
-        fits.iter().map(|f| (f.drift_m_per_s.value / NOMINAL_SOUND_SPEED_M_S * 1e6).powi(2)).sum::<f64>() / 2.0;
-    let sigma = (ss / b as f64).sqrt();
+    let ppm = |v: f64| v / NOMINAL_SOUND_SPEED_M_S * 1e6;
+    let ss: f64 = fits.iter().map(|f| ppm(f.drift_m_per_s.value).powi(2)).sum::<f64>() / 2.0;
+    let fit_error: f64 = fits
+        .iter()
+        .map(|f| f.drift_m_per_s.interval.map_or(0.0, |[lo, hi]| ppm((hi - lo) / (2.0 * 1.96)).powi(2)))
+        .sum::<f64>()
+        / 2.0;
+    let sigma = |ss: f64| ((ss - fit_error) / b as f64).max(0.0).sqrt();
+    let n = b as f64;
     Some(Value {
-        value: sigma,
-        interval: Some([(ss / chi.inverse_cdf(0.975)).sqrt(), (ss / chi.inverse_cdf(0.025)).sqrt()]),
+        value: sigma(ss),
+        interval: Some([sigma(ss * n / chi.inverse_cdf(0.975)), sigma(ss * n / chi.inverse_cdf(0.025))]),
     })
 }
 
