@@ -19,7 +19,8 @@ pub use motion::{HeadingFit, OdometryFit, SpeedFit};
 pub use ranges::{RangeFit, Value};
 
 use crate::smooth::{SmoothConfig, SmoothError, smooth};
-use motion::{OdometryWindow, VelocityWindow, wrap};
+use motion::{OdometryWindow, VelocityWindow};
+use onebeacon::geo::wrap_angle as wrap;
 use onebeacon::log::{Log, LogError};
 use onebeacon::nav::Kind;
 use onebeacon::nav::session::Input;
@@ -91,7 +92,7 @@ pub fn fit(log: &Log, opts: &SeaFitOptions, progress: impl Fn(&str)) -> Result<S
         }
     }
     let (track, reference) = if reads.truth.len() >= 2 {
-        (Track::new(reads.truth.clone()), "ground truth")
+        (Track::new(std::mem::take(&mut reads.truth)), "ground truth")
     } else {
         progress("smoothing (the log has no ground truth)");
         notes.push("no ground truth: every value is read against the smoother's trajectory, which the same ranges made: their errors are understated".into());

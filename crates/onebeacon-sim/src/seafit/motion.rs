@@ -11,7 +11,6 @@
 
 use super::mle::{minimise, profile_interval};
 use super::ranges::Value;
-use std::f64::consts::PI;
 
 /// The heading bias fitted.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,10 +40,6 @@ pub struct OdometryFit {
     pub windows: usize,
     pub distance_scale: Value,
     pub turn_scale: Option<Value>,
-}
-
-pub(crate) fn wrap(a: f64) -> f64 {
-    (a + PI).rem_euclid(2.0 * PI) - PI
 }
 
 /// The heading errors `(t, e)` (rad, in time order), at most 20 000 of them (evenly

@@ -69,7 +69,7 @@ fn simulated_log(seed: u64, with_truth: bool) -> (TestLog, Drawn) {
                 speed_k = speed / sensors.speed(t, speed) - 1.0;
             }
             let h = sensors.heading(t, heading) + gauss(&mut noise, 0.5f64.to_radians());
-            let _ = writeln!(nav, "{t},{measured},{}", motion::wrap(h));
+            let _ = writeln!(nav, "{t},{measured},{}", onebeacon::geo::wrap_angle(h));
         }
         if step % 4 == 0 {
             let i = (step / 4) % BEACONS.len();
@@ -83,7 +83,7 @@ fn simulated_log(seed: u64, with_truth: bool) -> (TestLog, Drawn) {
         }
         let v = [speed * heading.cos() + CURRENT[0], speed * heading.sin() + CURRENT[1]];
         p = [p[0] + v[0] * dt, p[1] + v[1] * dt];
-        heading = motion::wrap(heading + speed / radius * dt);
+        heading = onebeacon::geo::wrap_angle(heading + speed / radius * dt);
     }
     let offsets = clocks
         .iter_mut()

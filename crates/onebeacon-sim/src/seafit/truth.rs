@@ -1,7 +1,7 @@
 //! A reference track read between its rows: position linear in time, heading along the
 //! shorter turn; nothing outside its first and last row.
 
-use super::motion::wrap;
+use onebeacon::geo::wrap_angle as wrap;
 
 pub(crate) struct Track {
     rows: Vec<(f64, [f64; 2], Option<f64>)>,
