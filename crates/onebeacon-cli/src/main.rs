@@ -27,6 +27,7 @@ mod report;
 mod sea_fit;
 mod smooth;
 mod tune;
+mod twin;
 
 use clap::{Parser, Subcommand};
 
@@ -315,6 +316,35 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Simulate a log's mission again with a fitted sea (the log's truth, beacons and
+    /// measurement times; each value drawn anew), run its estimators on every run, and
+    /// compare their RMSE, final error and NEES with the log's own replay, per beacon
+    /// set; writes twin.csv, twin.json, twin.png (docs/logs.md, "The twin of a log").
+    Twin {
+        /// The log description (TOML).
+        log: PathBuf,
+        /// The sea: a file with a [sea] table (`onebeacon sea-fit` writes sea.toml).
+        #[arg(long, value_name = "SEA.toml")]
+        sea: PathBuf,
+        /// Simulated runs.
+        #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        runs: u32,
+        /// Base seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Worker threads (default: one per core). Results do not depend on it.
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+        threads: Option<u16>,
+        /// One beacon set (ids, comma-separated; default: all the beacons, then each alone).
+        #[arg(long, value_delimiter = ',', value_name = "IDS")]
+        beacons: Option<Vec<u32>>,
+        /// Output directory (default: out/<log>-twin).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Print one JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Run the estimators of CONFIG on JSON Lines measurements from stdin, writing one
     /// JSON line of estimates per input line to stdout, flushed after each.
     Stream {
@@ -528,6 +558,10 @@ fn main() -> ExitCode {
         Command::SeaFit { log, beacons, window_s, out, json } => {
             sea_fit::sea_fit(&log, sea_fit::SeaFitArgs { beacons, window_s, out, json })
         }
+        Command::Twin { log, sea, runs, seed, threads, beacons, out, json } => twin::run(
+            &log,
+            twin::TwinArgs { sea, runs: runs as usize, seed, threads: threads.map(usize::from), beacons, out, json },
+        ),
         Command::Stream { config } => replay::stream(&config),
         Command::Guidance { command: GuidanceCommand::Standoff { speed_m_s, depths_m, period_s, json } } => {
             commands::standoff(speed_m_s, &depths_m, period_s, json)

@@ -343,6 +343,10 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
     let sweep = write("sweep.toml", "name = \"s\"\n[sweep]\nt_com_s = [3.0, -6.0]\n");
     let not_a_dir = write("file.txt", "x");
     let escape = write("escape.toml", "name = \"../../x\"\n");
+    let usbl_sea = write("usbl-sea.toml", "[sea.usbl]\nwave_roll_deg = 3.0\n");
+    let no_sea = write("no-sea.toml", "name = \"x\"\n");
+    let good_sea = write("good-sea.toml", "[sea.odometry]\nturn_scale = 0.01\n");
+    let two_seas = write("two.toml", "[[sea.ranges]]\nbeacon = 1\n[[sea.ranges]]\nbeacon = 1\n");
     let huge = write("huge.toml", "name = \"huge\"\n[mission]\nduration_s = 25000000\n");
     let estimator = write("est.toml", "name = \"e\"\n[[estimators]]\nkind = \"rosb\"\ndistance_sigma_frac = 0.1\n");
     let builtin = |name: &str| text(&run(&["scenarios", "--show", name]).stdout);
@@ -412,6 +416,14 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["sea-fit", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
         (vec!["sea-fit", plaza1, "--window-s", "0", "--out", out], &["--window-s 0", "> 0"]),
         (vec!["sea-fit", plaza1, "--beacons", "9", "--out", out], &["--beacons", "9"]),
+        (vec!["twin", "/dev/zero", "--sea", &no_sea, "--out", out], &["/dev/zero", "not a regular file"]),
+        (vec!["twin", plaza1, "--sea", "/dev/zero", "--out", out], &["--sea /dev/zero", "not a regular file"]),
+        (vec!["twin", plaza1, "--sea", &no_sea, "--out", out], &["no-sea.toml", "no [sea] table", "sea-fit"]),
+        (vec!["twin", plaza1, "--sea", &usbl_sea, "--out", out], &["usbl-sea.toml", "sea.usbl", "leave it out"]),
+        (vec!["twin", plaza1, "--sea", &two_seas, "--out", out], &["two.toml", "two entries for beacon 1"]),
+        (vec!["twin", plaza1, "--sea", &malformed, "--out", out], &["--sea", "malformed.toml", "line 2"]),
+        (vec!["twin", plaza1, "--sea", &no_sea, "--runs", "0", "--out", out], &["--runs", "0"]),
+        (vec!["twin", plaza1, "--sea", &good_sea, "--beacons", "9", "--out", out], &["--beacons", "9"]),
         (vec!["stream", "/dev/zero"], &["/dev/zero", "not a regular file"]),
         (vec!["replay", plaza1, "--estimators", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
         (vec!["dsp", "simulate", "--config", "/dev/zero", "--out", &wav], &["/dev/zero", "not a regular file"]),

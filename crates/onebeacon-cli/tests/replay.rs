@@ -41,6 +41,38 @@ fn sea_fit_on_plaza2_finds_what_was_measured_on_its_files() {
     assert!(out.join("sea-fit.json").is_file());
 }
 
+/// `twin` of plaza2 with the sea `sea-fit` finds on plaza1: every (beacon set,
+/// estimator) cell (dead reckoning once: 9 + 4 x 8), each with its band, the agreement
+/// counted, twin.csv and twin.png written; and the same JSON on one thread as on two.
+#[test]
+fn twin_of_plaza2_with_plaza1s_sea() {
+    let dir = scratch("twin");
+    let sea = dir.join("sea");
+    assert!(run(&["sea-fit", &plaza(1), "--json", "--out", sea.to_str().unwrap()]).status.success());
+    let sea_toml = sea.join("sea.toml");
+    let twin = |threads: &str, out: &str| {
+        let out = dir.join(out);
+        let args = ["twin", &plaza(2), "--sea", sea_toml.to_str().unwrap(), "--runs", "4", "--json"];
+        let o = run(&[&args[..], &["--threads", threads, "--out", out.to_str().unwrap()]].concat());
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        (serde_json::from_slice::<Value>(&o.stdout).unwrap(), out)
+    };
+    let (j, out) = twin("1", "one");
+    let cells = j["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 9 + 4 * 8, "{j}");
+    assert_eq!(cells.iter().filter(|c| c["estimator"] == "dead-reckoning").count(), 1);
+    for c in cells {
+        let b = &c["twin"]["rmse_m"];
+        assert!(b["p5"].as_f64().unwrap() <= b["median"].as_f64().unwrap(), "{c}");
+        assert!(b["median"].as_f64().unwrap() <= b["p95"].as_f64().unwrap(), "{c}");
+    }
+    assert_eq!(j["agreement"]["cells"], 41);
+    assert!(out.join("twin.csv").is_file() && out.join("twin.png").is_file());
+    let (mut two, _) = twin("2", "two");
+    two["wall_s"] = j["wall_s"].clone();
+    assert_eq!(two, j);
+}
+
 /// `onebeacon stream CONFIG` fed `input` on stdin (from a thread, so a large input
 /// cannot block on a full stdout pipe).
 fn stream(config: &str, input: Vec<u8>) -> Output {

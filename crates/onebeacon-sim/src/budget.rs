@@ -137,6 +137,25 @@ impl Budget {
 }
 
 impl Budget {
+    /// Refuses a twin of `log` (`onebeacon twin`) with `concurrent` runs under way where
+    /// it would not fit: the replay's share ([`Budget::check_replay`]), every row of the
+    /// log held once with its plan (counted as two items) and once more per run under
+    /// way (its drawn stream), each run's estimators.
+    pub fn check_twin(&self, log: &Log, concurrent: usize) -> Result<(), BudgetError> {
+        self.check_replay(log, false)?;
+        let rows = source_rows(log, |_| true);
+        let item = std::mem::size_of::<onebeacon::nav::item::Item>() as f64;
+        let n = concurrent as f64;
+        let need = BASE_BYTES + n * filters_bytes(&log.description.estimators) + rows * item * (2.0 + n);
+        let detail = format!("{rows:.0} rows of {item:.0} bytes held {:.0} times", 2.0 + n);
+        self.check(
+            &format!("a twin of {}", log.description.name),
+            need,
+            &detail,
+            "--threads, the log's length (cut it)",
+        )
+    }
+
     /// Refuses smoothing `log` (`onebeacon smooth`) where it would not fit: the replay's
     /// share ([`Budget::check_replay`]), the smoother's graph ([`SMOOTHER_NODE_BYTES`] a
     /// motion row, [`SMOOTHER_FACTOR_BYTES`] any other row) and the history each

@@ -42,6 +42,7 @@ pub mod seed;
 pub mod sensor_errors;
 pub mod sensors;
 pub mod smooth;
+pub mod twin;
 pub mod vehicles;
 pub mod water;
 mod world;

@@ -1,7 +1,8 @@
 //! A vehicle's navigation sensors as they drift (`[sea.sensors]`): a heading bias that
 //! wanders as a first-order Gauss-Markov process, a speed scale factor (a DVL's or a
 //! speed log's calibration, drawn once a run) and dropouts of the speed sensor (bottom
-//! lock lost), during which the vehicle keeps the last velocity it measured.
+//! lock lost), during which the vehicle keeps the last velocity it measured; and a
+//! wheel or pose-graph odometry's scales and noise (`[sea.odometry]`, a log's twin only).
 
 use crate::seed::gauss;
 use rand::RngExt;
@@ -108,6 +109,42 @@ impl DriftingSensors {
         let read = v.map(|c| self.speed_scale * c);
         self.held = Some(read);
         read
+    }
+}
+
+/// `[sea.odometry]`: a row of odometry reads (1 + scale) times the true distance and
+/// turn, plus white noise whose variance grows with the distance (distance) and the time
+/// (turn) the row spans: a heading random walk.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OdometryErrors {
+    pub distance_scale: f64,
+    pub turn_scale: f64,
+    pub distance_sigma_m_per_sqrt_m: f64,
+    pub turn_sigma_deg_per_sqrt_s: f64,
+}
+
+impl OdometryErrors {
+    /// A row's distance and turn from the true ones over `dt_s`.
+    pub(crate) fn read(&self, distance_m: f64, turn_rad: f64, dt_s: f64, rng: &mut Pcg64Mcg) -> (f64, f64) {
+        let d =
+            (1.0 + self.distance_scale) * distance_m + gauss(rng, self.distance_sigma_m_per_sqrt_m * distance_m.sqrt());
+        let sigma_turn = self.turn_sigma_deg_per_sqrt_s.to_radians() * dt_s.max(0.0).sqrt();
+        (d.max(0.0), (1.0 + self.turn_scale) * turn_rad + gauss(rng, sigma_turn))
+    }
+
+    pub(crate) fn check(&self) -> Result<(), String> {
+        for (key, v, lo, hi) in [
+            ("distance_scale", self.distance_scale, -0.5, 0.5),
+            ("turn_scale", self.turn_scale, -0.5, 0.5),
+            ("distance_sigma_m_per_sqrt_m", self.distance_sigma_m_per_sqrt_m, 0.0, 10.0),
+            ("turn_sigma_deg_per_sqrt_s", self.turn_sigma_deg_per_sqrt_s, 0.0, 90.0),
+        ] {
+            if !(lo..=hi).contains(&v) {
+                return Err(format!("sea.odometry.{key} = {v:?}: allowed from {lo} to {hi}"));
+            }
+        }
+        Ok(())
     }
 }
 

@@ -289,8 +289,10 @@ mod beliefs;
 mod dsp;
 mod fleet;
 mod runs;
+mod twin;
 
 pub use beliefs::{bearing_map, belief_density, factored_snapshot, guidance_map};
 pub use dsp::{beam_map, range_distribution};
 pub use fleet::{fleet_modes, fleet_tracks};
 pub use runs::{autopilots, error_vs_time, mc_errors, top_view};
+pub use twin::twin_bands;

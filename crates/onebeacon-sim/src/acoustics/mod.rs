@@ -3,6 +3,7 @@
 //! multichannel WAV recordings read a capture at a time. The truth of sound, configured by no scenario type
 //! (the receiver chain that processes recordings is [`crate::chain`]).
 
+pub mod beacon_ranges;
 pub mod channel;
 pub mod clock;
 pub mod link;

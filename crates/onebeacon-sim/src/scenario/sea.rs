@@ -6,12 +6,13 @@
 //! vehicles' drifting sensors and the water's current.
 
 use super::validate::{Rule, Violation, check};
+use crate::acoustics::beacon_ranges::BeaconRanges;
 use crate::acoustics::clock::ClockErrors;
 use crate::acoustics::link::LinkErrors;
 use crate::acoustics::profile::Profile;
 use crate::acoustics::usbl_head::UsblErrors;
 use crate::scenario::World;
-use crate::sensor_errors::SensorErrors;
+use crate::sensor_errors::{OdometryErrors, SensorErrors};
 use crate::water::Current;
 use onebeacon::dsp::sound_speed::mackenzie;
 use serde::{Deserialize, Serialize};
@@ -38,6 +39,10 @@ pub struct Sea {
     pub sensors: SensorErrors,
     /// `[sea.current]`: the water's current, which carries the vehicles over ground.
     pub current: Current,
+    /// `[[sea.ranges]]`: each beacon's ranges as a log heard them (a log's twin only).
+    pub ranges: Vec<BeaconRanges>,
+    /// `[sea.odometry]`: a log's odometry (a log's twin only).
+    pub odometry: OdometryErrors,
 }
 
 /// `[sea.sound_speed]`: a cast, as speeds or as temperatures (Mackenzie 1981) at
@@ -278,6 +283,13 @@ impl Sea {
                 &[FixedBeacon, Fleet][..],
                 "worlds whose vehicles measure their speed through the water (fixed_beacon, fleet); a passive_usbl world's current is its own [current] table, and a moving_beacon world's DVL locks on the bottom",
             ),
+            (
+                "sea.ranges",
+                !self.ranges.is_empty(),
+                &[][..],
+                "a log's twin (`onebeacon twin`; a world's receiver noise is its own signal.range_sigma_m)",
+            ),
+            ("sea.odometry", self.odometry != OdometryErrors::default(), &[][..], "a log's twin (`onebeacon twin`)"),
         ];
         if let Some((key, _, _, hosts)) = set.iter().find(|(_, on, kinds, _)| *on && !kinds.contains(&kind)) {
             return Err(Violation {
@@ -325,6 +337,38 @@ impl Sea {
         within("sea.clocks.drift_sigma_ppm", c.drift_sigma_ppm, 0.0, 1000.0, "ppm")?;
         within("sea.clocks.walk_s_per_sqrt_s", c.walk_s_per_sqrt_s, 0.0, 0.01, "s/sqrt(s)")?;
         Ok(())
+    }
+}
+
+impl Sea {
+    /// The checks of a log's twin: the tables it draws from checked as a world's are,
+    /// the ranges' entries one per beacon at most; a USBL's or a sound-speed profile's
+    /// tables refused (a twin keeps the log's angles, its ranges are straight).
+    pub fn check_twin(&self) -> Result<(), String> {
+        let said = |v: Violation| format!("{} = {}: {}", v.key, v.value, v.allowed);
+        for (key, set) in
+            [("sea.usbl", self.usbl != UsblErrors::default()), ("sea.sound_speed", self.sound_speed.is_some())]
+        {
+            if set {
+                return Err(format!(
+                    "{key}: not drawn by a twin (it keeps the log's angles; its ranges travel straight): leave it out"
+                ));
+            }
+        }
+        check_link(&self.link).map_err(said)?;
+        check_sensors(&self.sensors).map_err(said)?;
+        check_current("sea.current", &self.current).map_err(said)?;
+        let c = &self.clocks;
+        within("sea.clocks.drift_sigma_ppm", c.drift_sigma_ppm, 0.0, 1000.0, "ppm").map_err(said)?;
+        let mut seen = std::collections::BTreeSet::new();
+        for r in &self.ranges {
+            r.check()?;
+            if !seen.insert(r.beacon) {
+                let which = r.beacon.map_or("without `beacon`".to_string(), |b| format!("for beacon {b}"));
+                return Err(format!("sea.ranges: two entries {which}: one each"));
+            }
+        }
+        self.odometry.check()
     }
 }
 

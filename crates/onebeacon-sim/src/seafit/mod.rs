@@ -9,7 +9,7 @@ mod mle;
 mod motion;
 mod ranges;
 mod toml_out;
-mod truth;
+pub(crate) mod truth;
 
 #[cfg(test)]
 mod tests;
@@ -167,6 +167,13 @@ pub fn fit(log: &Log, opts: &SeaFitOptions, progress: impl Fn(&str)) -> Result<S
     }
     out.speed = motion::fit_speed(&reads.velocity_windows(&track, opts.window_s));
     out.odometry = motion::fit_odometry(&reads.odometry_windows(&track, opts.window_s));
+    // a heading no gyro or wheel could match: the reference's heading is the odometry's
+    if let Some(t) = out.odometry.and_then(|o| o.turn_sigma).filter(|t| t.value < 1e-6) {
+        out.notes.push(format!(
+            "the {reference}'s heading follows the odometry's turns to {:.1e} rad per sqrt s: it is the odometry's own heading, so the odometry's turn errors are not seen (turn_scale and turn_sigma read 0)",
+            t.value
+        ));
+    }
     if out.ranges.is_empty() && out.heading.is_none() && out.speed.is_none() && out.odometry.is_none() {
         return Err(SeaFitError::Nothing(format!(
             "no beacon with 20 ranges, heading, speed or odometry within the {reference}"
@@ -315,7 +322,7 @@ impl Reads {
             last = Some((p, h));
             match open {
                 Some((t_start, w)) if t - t_start >= window_s => {
-                    out.push(w);
+                    out.push(OdometryWindow { span_s: t - t_start, ..w });
                     open = None;
                 }
                 _ => {}
@@ -326,6 +333,7 @@ impl Reads {
                     turn_rad: 0.0,
                     true_distance_m: 0.0,
                     true_turn_rad: h.map(|_| 0.0),
+                    span_s: 0.0,
                 };
                 open = Some((t, w));
             }

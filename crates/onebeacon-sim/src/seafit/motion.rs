@@ -34,12 +34,16 @@ pub struct SpeedFit {
     pub current_east_m_s: Value,
 }
 
-/// Odometry scales: true = (1 + k) x measured.
+/// Odometry scales, true = (1 + k) x measured, and the white noise about them: the
+/// distance's variance growing with the path (m per sqrt m), the turn's with the time
+/// (rad per sqrt s, a heading random walk).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OdometryFit {
     pub windows: usize,
     pub distance_scale: Value,
     pub turn_scale: Option<Value>,
+    pub distance_sigma: Value,
+    pub turn_sigma: Option<Value>,
 }
 
 /// The heading errors `(t, e)` (rad, in time order), at most 20 000 of them (evenly
@@ -167,6 +171,22 @@ pub(crate) struct OdometryWindow {
     pub turn_rad: f64,
     pub true_distance_m: f64,
     pub true_turn_rad: Option<f64>,
+    pub span_s: f64,
+}
+
+/// The white noise of residuals `(e, x)` whose variance is q x (x > 0): its sigma,
+/// sqrt(q), q = mean(e^2 / x) by maximum likelihood, with the chi-square interval of n
+/// windows.
+fn noise_per_sqrt(residuals: &[(f64, f64)]) -> Option<Value> {
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    let r: Vec<f64> = residuals.iter().filter(|(_, x)| *x > 0.0).map(|(e, x)| e * e / x).collect();
+    let n = r.len() as f64;
+    let chi = ChiSquared::new(n).ok()?;
+    let sum: f64 = r.iter().sum();
+    Some(Value {
+        value: (sum / n).sqrt(),
+        interval: Some([(sum / chi.inverse_cdf(0.975)).sqrt(), (sum / chi.inverse_cdf(0.025)).sqrt()]),
+    })
 }
 
 pub(crate) fn fit_odometry(windows: &[OdometryWindow]) -> Option<OdometryFit> {
@@ -181,7 +201,25 @@ pub(crate) fn fit_odometry(windows: &[OdometryWindow]) -> Option<OdometryFit> {
         .filter(|w| w.turn_rad.abs() > 5f64.to_radians())
         .filter_map(|w| w.true_turn_rad.map(|t| (vec![w.turn_rad], t)))
         .collect();
-    let turn_scale =
-        (turns.len() >= 4).then(|| least_squares(&turns, 1)).flatten().map(|(b, c)| value(&b, &c, 0, -1.0));
-    Some(OdometryFit { windows: windows.len(), distance_scale: value(&beta, &cov, 0, -1.0), turn_scale })
+    let turn_fit = (turns.len() >= 4).then(|| least_squares(&turns, 1)).flatten();
+    let turn_scale = turn_fit.as_ref().map(|(b, c)| value(b, c, 0, -1.0));
+    // the noise about the scales: every window's residual (the turn's where the truth
+    // has a heading), read as the measured row's error
+    let distance_sigma = noise_per_sqrt(
+        &windows.iter().map(|w| (w.true_distance_m / beta[0] - w.distance_m, w.true_distance_m)).collect::<Vec<_>>(),
+    )?;
+    let k_turn = turn_fit.map_or(1.0, |(b, _)| b[0]);
+    let turn_sigma = noise_per_sqrt(
+        &windows
+            .iter()
+            .filter_map(|w| w.true_turn_rad.map(|t| (t / k_turn - w.turn_rad, w.span_s)))
+            .collect::<Vec<_>>(),
+    );
+    Some(OdometryFit {
+        windows: windows.len(),
+        distance_scale: value(&beta, &cov, 0, -1.0),
+        turn_scale,
+        distance_sigma,
+        turn_sigma,
+    })
 }

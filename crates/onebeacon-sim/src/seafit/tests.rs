@@ -6,6 +6,7 @@ use crate::acoustics::clock::{Clock, ClockErrors};
 use crate::acoustics::link::{Link, LinkErrors};
 use crate::seed::gauss;
 use crate::sensor_errors::{DriftingSensors, SensorErrors};
+use motion::OdometryFit;
 use onebeacon::log::testing::{TestLog, write_log};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -170,7 +171,7 @@ fn a_simulated_sea_is_fitted_back_within_its_intervals() {
 }
 
 /// What sea-fit writes is a `[sea]` table the scenario format reads (its keys known,
-/// its values of the right types).
+/// its values of the right types) and a twin takes.
 #[test]
 fn the_written_table_is_a_scenarios_sea() {
     let (log, _) = simulated_log(5, true);
@@ -183,6 +184,10 @@ fn the_written_table_is_a_scenarios_sea() {
     assert!((s.sea.link.loss_prob - LINK.loss_prob).abs() < 0.05, "{text}");
     assert!(s.sea.sensors.heading_bias_sigma_deg > 0.0 && s.sea.current.speed_m_s > 0.0, "{text}");
     assert!(s.sea.link.false_max_range_m > 0.0 && s.sea.clocks.drift_sigma_ppm > 0.0, "{text}");
+    // a twin reads it whole: each beacon's ranges, and one entry for every other beacon
+    s.sea.check_twin().unwrap_or_else(|e| panic!("{e}\n{text}"));
+    let ids: Vec<Option<u32>> = s.sea.ranges.iter().map(|r| r.beacon).collect();
+    assert_eq!(ids, [Some(1), Some(2), None], "{text}");
 }
 
 /// Per value: name, seeds whose interval covered the truth, seeds, median fitted.
@@ -226,5 +231,35 @@ fn without_ground_truth_the_smoother_is_the_reference() {
     assert!(f.to_toml("onebeacon sea-fit log.toml").contains("read against the smoother's trajectory"));
     for r in &f.ranges {
         assert!(r.sigma_m.value > SIGMA_M / 2.0 && r.sigma_m.value < SIGMA_M * 2.0, "{r:?}");
+    }
+}
+
+/// A land robot's odometry (the twin's drawn logs: `OdometryErrors::read`, every error
+/// on) fitted back over 40 seeds in windows of 30 s: each of the two scales and two
+/// noises covered by its 95 % interval in at least 33 of 40 (as above). The fit reads
+/// true = (1 + k) measured, the simulator measured = (1 + scale) true: k = 1 / (1 +
+/// scale) - 1.
+#[test]
+fn a_drawn_odometry_is_fitted_back_within_its_intervals() {
+    let o = crate::twin::tests::sea().odometry;
+    let k = |scale: f64| 1.0 / (1.0 + scale) - 1.0;
+    let fits: Vec<OdometryFit> = (0..40u64)
+        .into_par_iter()
+        .map(|seed| {
+            let log = crate::twin::tests::drawn_log(seed);
+            fit(&log, &SeaFitOptions { window_s: 30.0, ..SeaFitOptions::default() }, |_| {}).unwrap().odometry.unwrap()
+        })
+        .collect();
+    type Of = fn(&OdometryFit) -> Option<Value>;
+    let cases: [(&str, f64, Of); 4] = [
+        ("distance_scale", k(o.distance_scale), |f| Some(f.distance_scale)),
+        ("turn_scale", k(o.turn_scale), |f| f.turn_scale),
+        ("distance_sigma", o.distance_sigma_m_per_sqrt_m, |f| Some(f.distance_sigma)),
+        ("turn_sigma", o.turn_sigma_deg_per_sqrt_s.to_radians(), |f| f.turn_sigma),
+    ];
+    for (name, truth, of) in cases {
+        let hit = fits.iter().filter(|f| of(f).is_some_and(|v| covers(&v, truth))).count();
+        let values: Vec<f64> = fits.iter().filter_map(|f| of(f).map(|v| v.value)).collect();
+        assert!(hit >= 33, "{name}: {hit} of 40 covered {truth}; fitted {values:?}");
     }
 }

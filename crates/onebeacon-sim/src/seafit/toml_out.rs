@@ -1,6 +1,6 @@
 //! A fitted sea written out: the `[sea]` table of the scenario format, every value with
-//! its source beside it (the log, the fit, its 95 % interval), what no key of the
-//! format holds (each beacon's range errors) as comments below; and the same as JSON.
+//! its source beside it (the log, the fit, its 95 % interval), each beacon's ranges
+//! and the odometry in the tables a log's twin reads; and the same as JSON.
 
 use super::{NOMINAL_SOUND_SPEED_M_S, SeaFit, Value};
 use serde_json::{Value as Json, json};
@@ -45,10 +45,22 @@ fn interval(v: &Value) -> String {
 
 fn key(out: &mut String, name: &str, v: f64, source: &str) {
     let line = format!("{name} = {}", num(v));
-    let _ = writeln!(out, "{line:<36}# {source}");
+    let _ = writeln!(out, "{line:<35} # {source}");
 }
 
 impl SeaFit {
+    /// The multipath excess of the beacons that show multipath, pooled.
+    fn multipath_excess(&self) -> Option<Value> {
+        pool(
+            &self
+                .ranges
+                .iter()
+                .filter(|r| r.multipath_prob.value > 0.0)
+                .map(|r| r.multipath_excess_m)
+                .collect::<Vec<_>>(),
+        )
+    }
+
     /// The `[sea]` table: `command` is what made it (cited in every source).
     pub fn to_toml(&self, command: &str) -> String {
         let mut out = String::new();
@@ -58,7 +70,12 @@ impl SeaFit {
         };
         let _ = writeln!(out, "# The sea of a log, fitted by `{command}`, read against {against}:");
         let _ = writeln!(out, "# each value with its 95 % interval (maximum likelihood: the curvature at the optimum,");
-        let _ = writeln!(out, "# or the profile for the heading bias; pooled over beacons). Paste into a scenario.");
+        let _ = writeln!(
+            out,
+            "# or the profile for the heading bias; pooled over beacons). `onebeacon twin` reads it whole;
+# a scenario takes its [sea.clocks], [sea.link], [sea.sensors] and [sea.current] (the
+# [[sea.ranges]] and [sea.odometry] are a log's: a world refuses them)."
+        );
         for n in &self.notes {
             let _ = writeln!(out, "# note: {n}");
         }
@@ -110,14 +127,7 @@ impl SeaFit {
             then(&mut out);
         };
         if !self.ranges.is_empty() {
-            let excess = pool(
-                &self
-                    .ranges
-                    .iter()
-                    .filter(|r| r.multipath_prob.value > 0.0)
-                    .map(|r| r.multipath_excess_m)
-                    .collect::<Vec<_>>(),
-            );
+            let excess = self.multipath_excess();
             kind("multipath_prob", |r| r.multipath_prob, &mut |out: &mut String| {
                 if let Some(e) = excess {
                     key(out, "multipath_excess_m", e.value, &src("the multipath arrivals' excess", &e));
@@ -154,54 +164,104 @@ impl SeaFit {
             );
             key(&mut out, "toward_deg", e.atan2(n).to_degrees().rem_euclid(360.0), "fit: the current's direction");
         }
-        let _ = writeln!(out, "\n# What no key of [sea] holds (the receiver's noise is signal.range_sigma_m or");
-        let _ = writeln!(out, "# the world's own key; offsets, scales and drifts are this log's):");
-        let share = |v: &Value, excess: Option<&Value>| match (v.value > 0.0, excess) {
-            (false, _) => "none".to_string(),
-            (true, Some(e)) => {
-                format!("{} ({}), excess {} m ({})", num(v.value), interval(v), num(e.value), interval(e))
-            }
-            (true, None) => format!("{} ({})", num(v.value), interval(v)),
+        // each beacon's ranges, then one entry for a beacon the log did not hear (a
+        // twin of another log): the beacons' values pooled, the outliers' shares weighted
+        // by their ranges, the excess of the beacons that show multipath
+        let n_all = self.ranges.iter().map(|r| r.ranges).sum::<usize>().max(1) as f64;
+        let share = |of: fn(&super::RangeFit) -> Value| Value {
+            value: self.ranges.iter().map(|r| of(r).value * r.ranges as f64).sum::<f64>() / n_all,
+            interval: None,
         };
-        for r in &self.ranges {
-            let _ = writeln!(
-                out,
-                "# beacon {}: {} ranges; sigma {} m ({}); bias {} m ({}); scale k {} ({}); drift {} m/s ({}); multipath {}; false {}",
-                r.beacon,
-                r.ranges,
-                num(r.sigma_m.value),
-                interval(&r.sigma_m),
-                num(r.bias_m.value),
-                interval(&r.bias_m),
-                num(r.scale.value),
-                interval(&r.scale),
-                num(r.drift_m_per_s.value),
-                interval(&r.drift_m_per_s),
-                share(&r.multipath_prob, Some(&r.multipath_excess_m)),
-                share(&r.false_prob, None),
+        let pooled = |name: &str| match name {
+            "multipath_prob" => Some(share(|r| r.multipath_prob)),
+            "false_prob" => Some(share(|r| r.false_prob)),
+            "multipath_excess_m" => self.multipath_excess().or(Some(Value { value: 0.0, interval: None })),
+            _ => None,
+        };
+        let entries = self
+            .ranges
+            .iter()
+            .map(|r| (Some(r), format!("{} ranges", r.ranges)))
+            .chain((!self.ranges.is_empty()).then(|| (None, format!("the {} beacons pooled", self.ranges.len()))));
+        for (r, what) in entries {
+            let _ = writeln!(out, "\n[[sea.ranges]]");
+            match r {
+                Some(r) => {
+                    let line = format!("beacon = {}", r.beacon);
+                    let _ = writeln!(out, "{line:<35} # the log");
+                }
+                None => {
+                    let _ = writeln!(out, "# every other beacon (no `beacon` key); its drift drawn from [sea.clocks]");
+                }
+            }
+            let mut field = |name: &str, of: fn(&super::RangeFit) -> Value| {
+                let v = match r {
+                    Some(r) => Some(of(r)),
+                    None => pooled(name).or_else(|| pool(&self.ranges.iter().map(of).collect::<Vec<_>>())),
+                };
+                match v {
+                    Some(v) if v.value == 0.0 && v.interval.is_none() => {
+                        key(&mut out, name, 0.0, &format!("fit ({what}): none shown (fewer than 3 expected)"))
+                    }
+                    Some(v) if r.is_none() && v.interval.is_none() => {
+                        key(&mut out, name, v.value, &format!("fit ({what}): the beacons' shares by their ranges"))
+                    }
+                    Some(v) => key(&mut out, name, v.value, &src(&what, &v)),
+                    None => {}
+                }
+            };
+            field("sigma_m", |r| r.sigma_m);
+            field("offset_m", |r| r.bias_m);
+            field("scale", |r| r.scale);
+            if r.is_some() {
+                field("drift_m_s", |r| r.drift_m_per_s);
+            }
+            field("multipath_prob", |r| r.multipath_prob);
+            field("multipath_excess_m", |r| r.multipath_excess_m);
+            field("false_prob", |r| r.false_prob);
+            let r_max = r.map_or_else(
+                || self.ranges.iter().map(|r| r.false_max_range_m).fold(0.0, f64::max),
+                |r| r.false_max_range_m,
             );
+            key(&mut out, "false_max_range_m", r_max, "the log: the largest range heard");
+        }
+        if let Some(o) = &self.odometry {
+            // the fit's k reads true = (1 + k) x measured; the simulator's scale, measured =
+            // (1 + scale) x true: 1 / (1 + k) - 1, its interval's ends swapped
+            let flip = |v: &Value| Value {
+                value: 1.0 / (1.0 + v.value) - 1.0,
+                interval: v.interval.map(|[lo, hi]| [1.0 / (1.0 + hi) - 1.0, 1.0 / (1.0 + lo) - 1.0]),
+            };
+            let _ = writeln!(out, "\n[sea.odometry]");
+            let what = format!("{} windows", o.windows);
+            let d = flip(&o.distance_scale);
+            key(&mut out, "distance_scale", d.value, &src(&what, &d));
+            match &o.turn_scale {
+                Some(t) => key(&mut out, "turn_scale", flip(t).value, &src(&what, &flip(t))),
+                None => {
+                    key(&mut out, "turn_scale", 0.0, "none: fewer than 4 windows turned over 5 deg against a heading")
+                }
+            }
+            let ds = &o.distance_sigma;
+            key(&mut out, "distance_sigma_m_per_sqrt_m", ds.value, &src(&what, ds));
+            match &o.turn_sigma {
+                Some(t) => {
+                    let deg =
+                        Value { value: t.value.to_degrees(), interval: t.interval.map(|i| i.map(f64::to_degrees)) };
+                    key(&mut out, "turn_sigma_deg_per_sqrt_s", deg.value, &src(&what, &deg));
+                }
+                None => key(&mut out, "turn_sigma_deg_per_sqrt_s", 0.0, "none: the reference has no heading"),
+            }
         }
         if let Some(h) = &self.heading {
             let _ = writeln!(
                 out,
-                "# heading: the errors' mean {} deg, their sd {} deg; white noise {} deg ({})",
+                "\n# heading: the errors' mean {} deg, their sd {} deg; white noise {} deg ({})",
                 num(h.mean_deg),
                 num(h.sd_deg),
                 num(h.white_deg.value),
                 interval(&h.white_deg)
             );
-        }
-        if let Some(o) = &self.odometry {
-            let _ = writeln!(
-                out,
-                "# odometry ({} windows): distance scale k {} ({})",
-                o.windows,
-                num(o.distance_scale.value),
-                interval(&o.distance_scale)
-            );
-            if let Some(t) = &o.turn_scale {
-                let _ = writeln!(out, "# odometry: turn scale k {} ({})", num(t.value), interval(t));
-            }
         }
         out
     }
@@ -232,6 +292,7 @@ impl SeaFit {
             })),
             "odometry": self.odometry.map(|o| json!({
                 "windows": o.windows, "distance_scale": v(&o.distance_scale), "turn_scale": o.turn_scale.as_ref().map(v),
+                "distance_sigma_m_per_sqrt_m": v(&o.distance_sigma), "turn_sigma_rad_per_sqrt_s": o.turn_sigma.as_ref().map(v),
             })),
             "notes": self.notes,
         })
