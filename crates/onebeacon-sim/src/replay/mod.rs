@@ -102,10 +102,15 @@ fn session_and_start(log: &Log, beacons: Option<BTreeSet<u32>>) -> Result<(Sessi
         });
     }
     let start = log.initial_start(beacons.as_ref())?;
+    Ok((session_from(log, beacons, &start), start))
+}
+
+/// The session a log describes on `beacons`, started at `start` (its
+/// [`Log::initial_start`], read once for many sessions).
+pub(crate) fn session_from(log: &Log, beacons: Option<BTreeSet<u32>>, start: &InitialStart) -> Session {
     let d = &log.description;
     let at = Start::At { t0_s: Some(start.t0_s), pose: start.pose };
-    let session = d.stream_config(Vec::new()).session(&d.initial, at, beacons);
-    Ok((session.with_position_sigma(start.position_sigma_m), start))
+    d.stream_config(Vec::new()).session(&d.initial, at, beacons).with_position_sigma(start.position_sigma_m)
 }
 
 /// Beacon ids asked for (all when `None`) checked against the log's: the set to use, or

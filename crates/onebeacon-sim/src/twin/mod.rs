@@ -12,7 +12,7 @@ mod draw;
 pub(crate) mod tests;
 
 use crate::montecarlo::{Progress, SweepError, in_pool};
-use crate::replay::{replay, session_for};
+use crate::replay::{replay, session_from};
 use crate::scenario::EstimatorKind;
 use crate::scenario::sea::Sea;
 use crate::seafit::truth::Track;
@@ -168,8 +168,10 @@ pub fn twin(log: &Log, sea: &Sea, opts: &TwinOptions, progress: &dyn Progress) -
     let hears: Vec<bool> = log.description.estimators.iter().map(|e| e.kind != EstimatorKind::DeadReckoning).collect();
     let scored = |set: usize, i: usize| set == 0 || hears[i];
     let mut cells = Vec::new();
+    let mut starts = Vec::new();
     for (k, set) in opts.sets.iter().enumerate() {
         let real = replay(log, set.clone(), |_| Ok::<_, LogError>(()))?;
+        starts.push(real.start);
         let beacons: Vec<u32> = set.clone().unwrap_or_else(|| log.beacon_ids()).into_iter().collect();
         for (i, (name, st)) in real.session.names.iter().zip(&real.session.stats).enumerate() {
             if scored(k, i) {
@@ -178,7 +180,7 @@ pub fn twin(log: &Log, sea: &Sea, opts: &TwinOptions, progress: &dyn Progress) -
             }
         }
     }
-    let per_run: Option<Result<Vec<Vec<Score>>, LogError>> = in_pool(opts.threads, || {
+    let per_run: Option<Vec<Vec<Score>>> = in_pool(opts.threads, || {
         (0..opts.runs as u64)
             .into_par_iter()
             .map(|run| {
@@ -187,11 +189,8 @@ pub fn twin(log: &Log, sea: &Sea, opts: &TwinOptions, progress: &dyn Progress) -
                 }
                 let stream = drawer.run(opts.seed, run);
                 let mut scores = Vec::new();
-                for (k, set) in opts.sets.iter().enumerate() {
-                    let mut session = match session_for(log, set.clone()) {
-                        Ok(s) => s,
-                        Err(e) => return Some(Err(e)),
-                    };
+                for (k, (set, start)) in opts.sets.iter().zip(&starts).enumerate() {
+                    let mut session = session_from(log, set.clone(), start);
                     for item in &stream {
                         // a screened item is counted by the session, as in a replay
                         let _ = session.push(item);
@@ -200,11 +199,11 @@ pub fn twin(log: &Log, sea: &Sea, opts: &TwinOptions, progress: &dyn Progress) -
                     scores.extend(stats.map(|(_, st)| Score::of(st)));
                 }
                 progress.tick();
-                Some(Ok(scores))
+                Some(scores)
             })
             .collect()
     })?;
-    for scores in per_run.ok_or(SweepError::Stopped)?? {
+    for scores in per_run.ok_or(SweepError::Stopped)? {
         for (cell, s) in cells.iter_mut().zip(scores) {
             cell.runs.push(s);
         }
