@@ -120,7 +120,11 @@ fn print_table(t: &Twin, title: &str, wall_s: f64) -> Result<()> {
             c.estimator,
             c.real.rmse_m,
             band(r),
-            if r.holds(c.real.rmse_m) { "yes" } else { "no" },
+            match (c.real.rmse_m.is_finite(), r.holds(c.real.rmse_m)) {
+                (false, _) => "-",
+                (true, true) => "yes",
+                (true, false) => "no",
+            },
             c.real.nees,
             band(c.nees()),
             c.nees_ratio()

@@ -122,13 +122,15 @@ pub struct Twin {
 pub const NEES_FACTOR: f64 = 1.5;
 
 impl Twin {
-    /// Cells whose real RMSE lies within the simulated 5-95 % band, and those whose real
-    /// NEES is within [`NEES_FACTOR`] of the simulated median (of the cells with one).
+    /// Cells whose real RMSE lies within the simulated 5-95 % band (of the cells with a
+    /// real RMSE: a log without ground truth has none), and those whose real NEES is
+    /// within [`NEES_FACTOR`] of the simulated median (of the cells with one).
     pub fn agreement(&self) -> ((usize, usize), (usize, usize)) {
-        let rmse = self.cells.iter().filter(|c| c.rmse().holds(c.real.rmse_m)).count();
+        let scored: Vec<&TwinCell> = self.cells.iter().filter(|c| c.real.rmse_m.is_finite()).collect();
+        let rmse = scored.iter().filter(|c| c.rmse().holds(c.real.rmse_m)).count();
         let with_nees: Vec<f64> = self.cells.iter().map(|c| c.nees_ratio()).filter(|r| r.is_finite()).collect();
         let nees = with_nees.iter().filter(|r| (1.0 / NEES_FACTOR..=NEES_FACTOR).contains(*r)).count();
-        ((rmse, self.cells.len()), (nees, with_nees.len()))
+        ((rmse, scored.len()), (nees, with_nees.len()))
     }
 }
 

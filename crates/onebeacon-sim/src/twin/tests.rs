@@ -39,6 +39,11 @@ pub(crate) fn sea() -> Sea {
 /// 5 Hz), ranging each beacon in turn every second, every value drawn by the sea's own
 /// models from streams of the test's.
 pub(crate) fn drawn_log(seed: u64) -> TestLog {
+    log_of(seed, true)
+}
+
+/// [`drawn_log`], with its ground truth or, without, started at the circle's start.
+fn log_of(seed: u64, with_truth: bool) -> TestLog {
     let s = sea();
     let stream = |k: u64| Pcg64Mcg::seed_from_u64(seed * 16 + k + 1000);
     let (mut noise, mut odometry, mut link) = (stream(0), stream(1), Link::new(&s.ranges[0].link_errors(), stream(2)));
@@ -68,10 +73,14 @@ pub(crate) fn drawn_log(seed: u64) -> TestLog {
             let _ = writeln!(ranges, "{t},{id},{r}");
         }
     }
-    let mut toml = String::from(
+    let mut toml = String::from(if with_truth {
         "name = \"twin\"\n[initial]\nfrom = \"ground_truth\"\nheading_from = \"column\"\nposition_sigma_m = 0.5\n\
-         [[source]]\nkind = \"ground_truth\"\nfile = \"truth.csv\"\ntime = \"t_s\"\nx = \"x_m\"\ny = \"y_m\"\nheading = \"heading_rad\"\n\
-         [[source]]\nkind = \"odometry\"\nfile = \"odometry.csv\"\ntime = \"t_s\"\ndistance = \"distance_m\"\nheading_change = \"turn_rad\"\n\
+         [[source]]\nkind = \"ground_truth\"\nfile = \"truth.csv\"\ntime = \"t_s\"\nx = \"x_m\"\ny = \"y_m\"\nheading = \"heading_rad\"\n"
+    } else {
+        "name = \"twin\"\n[initial]\nfrom = \"given\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\nposition_sigma_m = 0.5\n"
+    });
+    toml.push_str(
+        "[[source]]\nkind = \"odometry\"\nfile = \"odometry.csv\"\ntime = \"t_s\"\ndistance = \"distance_m\"\nheading_change = \"turn_rad\"\n\
          [[source]]\nkind = \"range\"\nfile = \"ranges.csv\"\ntime = \"t_s\"\nbeacon = \"beacon_id\"\nrange = \"range_m\"\n",
     );
     for (id, b) in BEACONS {
@@ -135,4 +144,24 @@ fn a_twin_does_not_depend_on_the_threads() {
     assert_eq!(one.cells, two.cells);
     assert_eq!(one.cells.len(), 7);
     assert!(one.cells.iter().all(|c| c.runs.len() == 6));
+}
+
+/// Without ground truth the twin's truth is the smoother's trajectory: the runs are
+/// scored against it, the log against nothing (no cell counts toward the agreement), and
+/// the twin says so; the filter that estimates the sea's range offset keeps its
+/// simulated RMSE about the smoothed circle within ten times the range noise (5 m).
+#[test]
+fn without_ground_truth_the_smoother_is_the_twins_truth() {
+    let log = log_of(2, false);
+    let t = twin(&log, &sea(), &options(4, None), &|| {}).unwrap();
+    assert_eq!(t.reference, "smoother");
+    assert!(t.notes.iter().any(|n| n.contains("no ground truth")), "{:?}", t.notes);
+    assert_eq!(t.agreement(), ((0, 0), (0, 0)));
+    for c in &t.cells {
+        assert!(c.real.rmse_m.is_nan(), "{c:?}");
+        assert!(c.runs.iter().all(|r| r.rmse_m.is_finite()), "{c:?}");
+        if c.estimator == "ekf-bias" {
+            assert!(c.rmse().median < 5.0, "{c:?}");
+        }
+    }
 }
