@@ -246,7 +246,7 @@ fn a_drawn_odometry_is_fitted_back_within_its_intervals() {
     let fits: Vec<OdometryFit> = (0..40u64)
         .into_par_iter()
         .map(|seed| {
-            let log = crate::twin::tests::drawn_log(seed);
+            let log = crate::twin::tests::drawn_log("odometry", seed);
             fit(&log, &SeaFitOptions { window_s: 30.0, ..SeaFitOptions::default() }, |_| {}).unwrap().odometry.unwrap()
         })
         .collect();

@@ -38,12 +38,14 @@ pub(crate) fn sea() -> Sea {
 /// Ten minutes of a land robot on a 40 m circle at 1 m/s (odometry and ground truth at
 /// 5 Hz), ranging each beacon in turn every second, every value drawn by the sea's own
 /// models from streams of the test's.
-pub(crate) fn drawn_log(seed: u64) -> TestLog {
-    log_of(seed, true)
+/// `test` names the log's directory apart from other tests' (the tests of one process
+/// run at once, and each removes its logs when done).
+pub(crate) fn drawn_log(test: &str, seed: u64) -> TestLog {
+    log_of(test, seed, true)
 }
 
 /// [`drawn_log`], with its ground truth or, without, started at the circle's start.
-fn log_of(seed: u64, with_truth: bool) -> TestLog {
+fn log_of(test: &str, seed: u64, with_truth: bool) -> TestLog {
     let s = sea();
     let stream = |k: u64| Pcg64Mcg::seed_from_u64(seed * 16 + k + 1000);
     let (mut noise, mut odometry, mut link) = (stream(0), stream(1), Link::new(&s.ranges[0].link_errors(), stream(2)));
@@ -92,7 +94,7 @@ fn log_of(seed: u64, with_truth: bool) -> TestLog {
          [[estimators]]\nname = \"ekf-bias\"\nkind = \"range-ekf\"\nestimate_bias = true\n",
     );
     let files = [("truth.csv", truth.as_str()), ("odometry.csv", rows.as_str()), ("ranges.csv", ranges.as_str())];
-    write_log("twin", &format!("seed{seed}"), &toml, &files).expect("the drawn log loads")
+    write_log("twin", &format!("{test}-seed{seed}"), &toml, &files).expect("the drawn log loads")
 }
 
 fn options(runs: usize, threads: Option<usize>) -> TwinOptions {
@@ -104,7 +106,7 @@ fn options(runs: usize, threads: Option<usize>) -> TwinOptions {
 fn within(logs: u64, sea: &Sea) -> (usize, usize) {
     let mut inside = (0, 0);
     for seed in 0..logs {
-        let log = drawn_log(seed);
+        let log = drawn_log("band", seed);
         let t = twin(&log, sea, &options(40, None), &|| {}).unwrap();
         assert_eq!(t.kept.keys().collect::<Vec<_>>(), ["odometry (the first row: no span)"]);
         let ((hit, n), _) = t.agreement();
@@ -138,7 +140,7 @@ fn a_log_drawn_from_a_sea_lies_within_its_twins_band() {
 /// A twin is a function of (log, sea, seed): the same cells on one thread or two.
 #[test]
 fn a_twin_does_not_depend_on_the_threads() {
-    let log = drawn_log(1);
+    let log = drawn_log("threads", 1);
     let one = twin(&log, &sea(), &options(6, Some(1)), &|| {}).unwrap();
     let two = twin(&log, &sea(), &options(6, Some(2)), &|| {}).unwrap();
     assert_eq!(one.cells, two.cells);
@@ -152,7 +154,7 @@ fn a_twin_does_not_depend_on_the_threads() {
 /// simulated RMSE about the smoothed circle within ten times the range noise (5 m).
 #[test]
 fn without_ground_truth_the_smoother_is_the_twins_truth() {
-    let log = log_of(2, false);
+    let log = log_of("no-truth", 2, false);
     let t = twin(&log, &sea(), &options(4, None), &|| {}).unwrap();
     assert_eq!(t.reference, "smoother");
     assert!(t.notes.iter().any(|n| n.contains("no ground truth")), "{:?}", t.notes);
