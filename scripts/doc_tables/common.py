@@ -29,6 +29,7 @@ SEA_SOURCES = _script("sea_sources")
 OUTLIERS = _script("plaza_outliers")
 LOG_PAIRED = _script("log_paired")
 ABLATION = _script("sea_ablation")
+PRESETS = _script("sea_presets")
 
 
 def binary():
@@ -69,6 +70,9 @@ RUNS = {
     "garin2024-sea-ablation": (10, 100),
     "sousa-sea-ablation": (2, 10),
     "hoff2024-sea-ablation": (2, 10),
+    # scripts/sea_presets.py ablate's runs per variant
+    "garin2024-sea-unsourced": (4, 100),
+    "sousa-sea-unsourced": (2, 10),
     # scripts/sea_sources.py's runs per cell
     "sea-clock": (2, 10),
     "sea-link": (2, 10),

@@ -4,7 +4,7 @@ scenario (each error source alone) that the papers' pages hold."""
 import tempfile
 from pathlib import Path
 
-from .common import ABLATION, ROOT, RUNS, SEA_SOURCES, binary, header, spread, verdict_counts
+from .common import ABLATION, PRESETS, ROOT, RUNS, SEA_SOURCES, binary, header, spread, verdict_counts
 
 
 def ablation(scenario, quick, columns):
@@ -76,9 +76,39 @@ def sea_sound_speed(quick):
         ("dead reckoning, the cast", "sea", "dead-reckoning")])
 
 
+def sea_presets(quick):
+    """docs/scenarios.md: per -sea preset, its error sources' values, how many carry a
+    source and how many say "unsourced" (`scripts/sea_presets.py count`; no runs)."""
+    rows = header("preset", "values", "sourced", "unsourced")
+    counts = PRESETS.counts()
+    for name, n, s, u in counts:
+        rows.append(f"| {name} | {n} | {s} | {u} |")
+    n, s = sum(c[1] for c in counts), sum(c[2] for c in counts)
+    rows.append(f"| all | {n} | {s} ({100 * s / n:.0f} %) | {n - s} |")
+    return rows
+
+
+def unsourced(preset, estimator, quick):
+    """docs/scenarios.md: `scripts/sea_presets.py ablate PRESET --runs N --estimator E` at
+    RUNS' count: each unsourced value of the preset, the estimator's mean error with the
+    value as set, and each variant's change from it, paired by run (95 %)."""
+    runs = RUNS[f"{preset}-unsourced"][0 if quick else 1]
+    with tempfile.TemporaryDirectory() as tmp:
+        first, found = PRESETS.ablate(preset, runs, binary(), tmp, progress=not quick, estimator=estimator)
+    rows = header("value", f"{first}: mean error as set, m (95 %)", "default or x0.5: change, m (95 %)",
+                  "x2 or +180 deg: change, m (95 %)")
+    for table, key, value, (mean, half, _, _), changes in found:
+        cells = [PRESETS.change(c) for c in changes] + ["-"] * (2 - len(changes))
+        rows.append(f"| [{table}] {key} = {value} | {mean:.2f} (+-{half:.2f}) | " + " | ".join(cells) + " |")
+    return rows
+
+
 # the tables of this module by the name that marks them in docs/
 TABLES = {
     "sea-clock": sea_clock,
     "sea-link": sea_link,
     "sea-sound-speed": sea_sound_speed,
+    "sea-presets": sea_presets,
+    "garin2024-sea-unsourced": lambda quick: unsourced("garin2024-sea", "range+doppler", quick),
+    "sousa-sea-unsourced": lambda quick: unsourced("sousa-sea", "range-ekf", quick),
 }

@@ -1,0 +1,83 @@
+"""scripts/sea_presets.py: every value of the shipped -sea presets says where it comes from;
+a value that says neither is refused by name; the ablation's variants change the one
+value they name and nothing else."""
+import os
+import pathlib
+import sys
+
+import pytest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import sea_presets  # noqa: E402
+
+PRESET = """name = "x-sea"
+[mission]
+duration_s = 60.0
+
+[sea.link]
+loss_prob = 0.6            # unsourced: lost,
+                           # in bursts
+multipath_excess_m = 10.0  # source: a paper, sec. 1
+                           # (its Table 2)
+false_prob = 0.02          # unsourced
+
+[sea.current]
+toward_deg = 300.0         # unsourced
+speed_m_s = 0.1            # source: a datasheet
+
+[sweep]
+t_com_s = [3.0, 6.0]
+"""
+
+
+def write(tmp_path, text):
+    path = tmp_path / "x-sea.toml"
+    path.write_text(text)
+    return path
+
+
+def test_every_shipped_preset_value_is_marked():
+    # the presets as shipped: values() raises on the first unmarked one
+    found = {p.stem: sea_presets.values(p) for p in sea_presets.presets()}
+    assert len(found) == 5 and all(found.values())
+    for name, vs in found.items():
+        assert {v["status"] for v in vs} <= {"sourced", "unsourced"}, name
+
+
+def test_values_read_marks_and_their_continued_comments(tmp_path):
+    vs = sea_presets.values(write(tmp_path, PRESET))
+    assert [(v["table"], v["key"], v["status"]) for v in vs] == [
+        ("sea.link", "loss_prob", "unsourced"), ("sea.link", "multipath_excess_m", "sourced"),
+        ("sea.link", "false_prob", "unsourced"), ("sea.current", "toward_deg", "unsourced"),
+        ("sea.current", "speed_m_s", "sourced")]
+    assert vs[1]["comment"] == "source: a paper, sec. 1 (its Table 2)"
+
+
+@pytest.mark.parametrize("comment", ["# a fifth lost", "", "# Source: capitalised"])
+def test_an_unmarked_value_is_refused_by_name(tmp_path, comment):
+    text = PRESET.replace("false_prob = 0.02          # unsourced", f"false_prob = 0.02 {comment}")
+    with pytest.raises(sea_presets.Unmarked, match=r"\[sea.link\] false_prob = 0.02"):
+        sea_presets.values(write(tmp_path, text))
+
+
+def test_the_variants_change_one_value(tmp_path):
+    vs = {v["key"]: v for v in sea_presets.values(write(tmp_path, PRESET))}
+    as_set = dict(sea_presets.variants(PRESET, vs["loss_prob"]))["as set"]
+    assert "[sweep]" not in as_set and "loss_prob = 0.6\n" in as_set
+
+    def lines(toml):
+        return [line.strip() for line in toml.splitlines() if line.strip()]
+
+    def diff(label, key, removable=True):
+        got = dict(sea_presets.variants(PRESET, vs[key], removable))
+        return sorted(set(lines(got["as set"])) ^ set(lines(got[label])))
+
+    # removed with its comment's second line (every variant, "as set" too, rewrites the
+    # value's line alone); 0.6 is not doubled (1.2 is no probability)
+    assert [label for label, _ in sea_presets.variants(PRESET, vs["loss_prob"])] == ["default", "as set"]
+    assert diff("default", "loss_prob") == ["loss_prob = 0.6"] and "in bursts" not in as_set
+    assert diff("x2", "multipath_excess_m") == ["multipath_excess_m = 10.0", "multipath_excess_m = 20.0"]
+    assert diff("x0.5", "multipath_excess_m", removable=False) == [
+        "multipath_excess_m = 10.0", "multipath_excess_m = 5.0"]
+    assert diff("+180 deg", "toward_deg") == ["toward_deg = 120.0", "toward_deg = 300.0"]
+    assert diff("x2", "false_prob") == ["false_prob = 0.02", "false_prob = 0.04"]
