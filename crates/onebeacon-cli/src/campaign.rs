@@ -27,7 +27,7 @@ pub fn shard(
     let seed = seed.unwrap_or(s.seed());
     check_shard_count(&s, runs, &format!("--shard {shard}"), shard.count)?;
     crate::check_memory(name, &s, onebeacon_sim::budget::concurrent_runs(threads, runs), 0)?;
-    let file = format!("partial-{}-of-{}.json", shard.index, shard.count);
+    let file = onebeacon_sim::partial::file_name(shard);
     let staging = Staging::beside(out, &[&file])?;
     let total = shard.len(s.cells().len() * runs) as u64;
     let bar = crate::progress::Progress::new(total, "runs", format!("mc {} shard {shard}", s.name()));
@@ -35,7 +35,7 @@ pub fn shard(
     let summaries = monte_carlo_shard(&s, runs, seed, shard, threads, &|| bar.inc(1))?;
     bar.finish();
     let partial = Partial::new(&s, runs, seed, shard, start.elapsed().as_secs_f64(), &summaries);
-    staging.write(&partial.file_name(), partial.to_json().as_bytes())?;
+    staging.write(&file, partial.to_json().as_bytes())?;
     for f in staging.move_files_to()? {
         eprintln!("wrote {} ({total} of {} runs)", f.display(), runs * s.cells().len());
     }

@@ -5,7 +5,9 @@ use crate::BadInput;
 use crate::output::Staging;
 use anyhow::{Context, Result};
 use onebeacon::log::Log;
+use onebeacon_sim::montecarlo::Shard;
 use onebeacon_sim::scenario::sea::Sea;
+use onebeacon_sim::twin::partial::{MergedTwin, TwinPartial, merge_twin, read_twin_partials};
 use onebeacon_sim::twin::{NEES_FACTOR, Twin, TwinError, TwinOptions, twin};
 use serde_json::json;
 use std::collections::BTreeSet;
@@ -20,6 +22,10 @@ pub struct TwinArgs {
     pub beacons: Option<Vec<u32>>,
     pub out: Option<PathBuf>,
     pub json: bool,
+    /// Simulate this share of the runs alone and write it as a partial.
+    pub shard: Option<Shard>,
+    /// Merge these shares' partials instead of simulating.
+    pub merge: Option<Vec<PathBuf>>,
 }
 
 /// A `[sea]` table read from `path` (a sea-fit's sea.toml, or any file whose `[sea]`
@@ -40,7 +46,9 @@ fn read_sea(path: &Path) -> Result<Sea> {
 
 /// `onebeacon twin LOG.toml --sea SEA.toml [--runs 50] [--seed 1] [--threads N]
 /// [--beacons IDS] [--out DIR] [--json]`: writes twin.csv, twin.json and twin.png in DIR
-/// (default out/<log>-twin), prints the table (or the JSON).
+/// (default out/<log>-twin), prints the table (or the JSON). With `--shard I/N`, the
+/// share's runs alone, as DIR/partial-I-of-N.json; with `--merge PATHS`, the shares'
+/// runs instead of new ones.
 pub fn run(path: &Path, a: TwinArgs) -> Result<()> {
     let log = Log::load(path)?;
     let sea = read_sea(&a.sea)?;
@@ -56,24 +64,53 @@ pub fn run(path: &Path, a: TwinArgs) -> Result<()> {
         }
         None => vec![None],
     };
-    let name = &log.description.name;
+    let name = log.description.name.clone();
     let dir = a.out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-twin")));
     let mut inputs = log.files();
     inputs.push(a.sea.clone());
-    let staging = Staging::new(&dir, &inputs)?;
+    inputs.extend(a.merge.iter().flatten().cloned());
+    let shard = a.shard.unwrap_or(Shard::WHOLE);
+    if shard.count > a.runs {
+        return Err(BadInput(format!("--shard {shard}: {} runs cut into at most {} shares", a.runs, a.runs)).into());
+    }
+    // the output is staged before the runs: a directory that cannot take it fails first
+    let partial_file = onebeacon_sim::partial::file_name(shard);
+    let staging = match a.shard {
+        Some(_) => Staging::beside(&dir, &[&partial_file])?,
+        None => Staging::new(&dir, &inputs)?,
+    };
     let started = std::time::Instant::now();
-    let bar = crate::progress::Progress::new(a.runs as u64, "runs", format!("twin of {name}"));
-    let opts = TwinOptions { runs: a.runs, seed: a.seed, threads: a.threads, sets };
-    let t = twin(&log, &sea, &opts, &|| bar.inc(1)).map_err(|e| match e {
+    let runs = if a.merge.is_some() { 0 } else { a.runs };
+    let opts = TwinOptions { runs, seed: a.seed, threads: a.threads, sets, shard };
+    // a merge simulates nothing: the replay alone, without a progress line
+    let bar =
+        (runs > 0).then(|| crate::progress::Progress::new(shard.len(runs) as u64, "runs", format!("twin of {name}")));
+    let t = twin(&log, &sea, &opts, &|| bar.iter().for_each(|b| b.inc(1))).map_err(|e| match e {
         TwinError::Sea(m) => anyhow::Error::from(BadInput(format!("--sea {}: {m}", a.sea.display()))),
         e => e.into(),
     })?;
-    bar.finish();
-    let wall_s = started.elapsed().as_secs_f64();
-    let summary = to_json(&t, name, &a.sea, a.runs, a.seed, wall_s);
+    bar.iter().for_each(|b| b.finish());
+    let (t, runs, seed, wall_s) = match &a.merge {
+        Some(paths) => {
+            let bad = |e: onebeacon_sim::partial::MergeError| BadInput(e.to_string());
+            let partials = read_twin_partials(paths, &crate::budget()).map_err(bad)?;
+            let MergedTwin { twin, runs, seed, wall_s } = merge_twin(&name, t, &sea, partials).map_err(bad)?;
+            (twin, runs, seed, wall_s)
+        }
+        None => (t, a.runs, a.seed, started.elapsed().as_secs_f64()),
+    };
+    if a.shard.is_some() {
+        let partial = TwinPartial::new(&name, &sea, &t, runs, seed, shard, wall_s);
+        staging.write(&partial_file, partial.to_json().as_bytes())?;
+        for f in staging.move_files_to()? {
+            eprintln!("wrote {} ({} of {runs} runs)", f.display(), t.run_indices.len());
+        }
+        return Ok(());
+    }
+    let summary = to_json(&t, &name, &a.sea, runs, seed, wall_s);
     staging.write("twin.json", serde_json::to_string_pretty(&summary)?.as_bytes())?;
     staging.write("twin.csv", to_csv(&t)?.as_bytes())?;
-    let title = format!("{name}: twin with {} ({} runs)", a.sea.display(), a.runs);
+    let title = format!("{name}: twin with {} ({runs} runs)", a.sea.display());
     crate::plot::twin_bands(&staging.file("twin.png"), &title, &t).context("cannot draw twin.png")?;
     let files = staging.commit()?;
     if a.json {

@@ -424,6 +424,18 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         (vec!["twin", plaza1, "--sea", &malformed, "--out", out], &["--sea", "malformed.toml", "line 2"]),
         (vec!["twin", plaza1, "--sea", &no_sea, "--runs", "0", "--out", out], &["--runs", "0"]),
         (vec!["twin", plaza1, "--sea", &good_sea, "--beacons", "9", "--out", out], &["--beacons", "9"]),
+        (
+            vec!["twin", plaza1, "--sea", &good_sea, "--runs", "4", "--shard", "0/9", "--out", out],
+            &["--shard 0/9", "4 runs", "at most 4"],
+        ),
+        (
+            vec!["twin", plaza1, "--sea", &good_sea, "--merge", "/dev/zero", "--out", out],
+            &["/dev/zero", "not a regular file"],
+        ),
+        (
+            vec!["twin", plaza1, "--sea", &good_sea, "--merge", partial.to_str().unwrap(), "--out", out],
+            &["not an onebeacon twin partial", "onebeacon-mc-partial/1"],
+        ),
         (vec!["stream", "/dev/zero"], &["/dev/zero", "not a regular file"]),
         (vec!["replay", plaza1, "--estimators", "/dev/zero", "--out", out], &["/dev/zero", "not a regular file"]),
         (vec!["dsp", "simulate", "--config", "/dev/zero", "--out", &wav], &["/dev/zero", "not a regular file"]),

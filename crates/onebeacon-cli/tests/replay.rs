@@ -43,7 +43,9 @@ fn sea_fit_on_plaza2_finds_what_was_measured_on_its_files() {
 
 /// `twin` of plaza2 with the sea `sea-fit` finds on plaza1: every (beacon set,
 /// estimator) cell (dead reckoning once: 9 + 4 x 8), each with its band, the agreement
-/// counted, twin.csv and twin.png written; and the same JSON on one thread as on two.
+/// counted, twin.csv and twin.png written; the same JSON on one thread as on two, and
+/// from three shards (`--shard I/3`, then `--merge`); a merge short of a shard is refused
+/// in one line, exit 2.
 #[test]
 fn twin_of_plaza2_with_plaza1s_sea() {
     let dir = scratch("twin");
@@ -71,6 +73,27 @@ fn twin_of_plaza2_with_plaza1s_sea() {
     let (mut two, _) = twin("2", "two");
     two["wall_s"] = j["wall_s"].clone();
     assert_eq!(two, j);
+    let shards = dir.join("shards");
+    let base = ["twin", &plaza(2), "--sea", sea_toml.to_str().unwrap()];
+    for i in 0..3 {
+        let shard = format!("{i}/3");
+        let o = run(&[&base[..], &["--runs", "4", "--shard", &shard, "--out", shards.to_str().unwrap()]].concat());
+        assert!(o.status.success(), "{}", text(&o.stderr));
+    }
+    let merged = dir.join("merged");
+    let o =
+        run(&[&base[..], &["--merge", shards.to_str().unwrap(), "--json", "--out", merged.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let mut from_shards: Value = serde_json::from_slice(&o.stdout).unwrap();
+    from_shards["wall_s"] = j["wall_s"].clone();
+    assert_eq!(from_shards, j);
+    assert!(merged.join("twin.csv").is_file() && merged.join("twin.png").is_file());
+    let two_of_three: Vec<String> =
+        (0..2).map(|i| shards.join(format!("partial-{i}-of-3.json")).display().to_string()).collect();
+    let o = run(&[&base[..], &["--merge"], &two_of_three.iter().map(String::as_str).collect::<Vec<_>>()[..]].concat());
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert!(err.contains("missing shard(s) 2 of 3") && err.trim().lines().count() == 1, "{err}");
 }
 
 /// `onebeacon stream CONFIG` fed `input` on stdin (from a thread, so a large input

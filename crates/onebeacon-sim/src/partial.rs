@@ -56,19 +56,17 @@ pub enum MergeError {
     Empty,
     #[error("{path}: cannot read: {message}")]
     Io { path: String, message: String },
-    #[error("{path}: no partial-*-of-*.json in this directory (written by `mc --shard I/N --out DIR`)")]
-    NoneInDir { path: String },
-    #[error("{path}: not an onebeacon mc partial: {message}")]
-    NotPartial { path: String, message: String },
+    #[error("{path}: no partial-*-of-*.json in this directory (written by `{by} --shard I/N --out DIR`)")]
+    NoneInDir { path: String, by: &'static str },
+    #[error("{path}: not an onebeacon {by} partial: {message}")]
+    NotPartial { path: String, by: &'static str, message: String },
     #[error("{path}: the partial's scenario does not parse: {source}")]
     Scenario { path: String, source: ScenarioError },
     #[error(
         "{path}: shard {shard} should hold {expected} (cell, run) pairs, it holds {got}: the file is incomplete or edited"
     )]
     Incomplete { path: String, shard: Shard, expected: usize, got: usize },
-    #[error(
-        "{first} and {second} differ in {what}: {a} against {b}; merge only the shares of one `mc --shard` campaign"
-    )]
+    #[error("{first} and {second} differ in {what}: {a} against {b}; merge only the shares of one `--shard` campaign")]
     Mismatch { first: String, second: String, what: &'static str, a: String, b: String },
     #[error("{path} was written by onebeacon {theirs}; this is {ours}: merge with the version that ran the shards")]
     Version { path: String, theirs: String, ours: String },
@@ -128,11 +126,6 @@ impl Partial {
         }
     }
 
-    /// The file name a partial is written under in its directory.
-    pub fn file_name(&self) -> String {
-        format!("partial-{}-of-{}.json", self.shard, self.shards)
-    }
-
     /// The partial as JSON.
     pub fn to_json(&self) -> String {
         serde_json::to_string(self).expect("serialisable")
@@ -140,17 +133,8 @@ impl Partial {
 
     /// Reads a partial from `text` (`path` names it in errors), with its shape checked.
     pub fn from_json(text: &str, path: &str) -> Result<Partial, MergeError> {
-        let not = |message: String| MergeError::NotPartial { path: path.to_string(), message };
-        let head: serde_json::Value = serde_json::from_str(text).map_err(|e| not(e.to_string()))?;
-        match head.get("format").and_then(|f| f.as_str()) {
-            Some(FORMAT) => {}
-            Some(other) => return Err(not(format!("format `{other}`; this version reads `{FORMAT}`"))),
-            None => return Err(not("no `format` field".into())),
-        }
-        let p: Partial = serde_json::from_value(head).map_err(|e| not(e.to_string()))?;
-        if p.shards == 0 || p.shard >= p.shards {
-            return Err(not(format!("shard {}/{} is not I/N with I < N", p.shard, p.shards)));
-        }
+        let p: Partial = parse_partial(text, path, "mc", FORMAT, |p: &Partial| p.shard_of())?;
+        let not = |message: String| MergeError::NotPartial { path: path.to_string(), by: "mc", message };
         for r in &p.results {
             if r.metrics.iter().any(|m| m.len() != RunMetrics::WORDS)
                 || r.information.iter().any(|(_, _, n, e)| n.checked_mul(*n) != Some(e.len()))
@@ -218,43 +202,110 @@ pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
     if shards > pairs {
         return Err(count("shards", shards));
     }
-    let mut by_shard: BTreeMap<usize, String> = BTreeMap::new();
     for (path, p) in &partials {
-        if p.version != VERSION {
-            return Err(MergeError::Version { path: path.clone(), theirs: p.version.clone(), ours: VERSION.into() });
+        if p.scenario_toml != first.scenario_toml {
+            let (a, b) = (format!("`{}`", first.scenario), format!("`{}`", p.scenario));
+            let what = if a == b { "the scenario's keys (same name, edited in between)" } else { "scenario" };
+            let (first, second) = (first_path.clone(), path.clone());
+            return Err(MergeError::Mismatch { first, second, what, a, b });
+        }
+    }
+    let shares: Vec<Share> = partials
+        .iter()
+        .map(|(path, p)| Share {
+            path,
+            version: &p.version,
+            seed: p.seed,
+            runs: p.runs,
+            shard: p.shard_of(),
+            results: p.results.len(),
+        })
+        .collect();
+    check_shares(&shares, pairs)?;
+    let mut summaries = Vec::with_capacity(pairs);
+    let mut wall_s = 0.0;
+    for (_, p) in partials {
+        wall_s += p.wall_s;
+        summaries.extend(p.summaries());
+    }
+    let result = aggregate(&scenario, runs, seed, summaries)?;
+    Ok(Merged { scenario, result, wall_s })
+}
+
+/// The file name of a share's partial: `partial-I-of-N.json`.
+pub fn file_name(shard: Shard) -> String {
+    format!("partial-{}-of-{}.json", shard.index, shard.count)
+}
+
+/// A partial's JSON `text` (`path` names it in errors) read as a `T` whose `format` field
+/// is `format` and whose shard (`shard_of`) is I/N with I < N; `by` names the command that
+/// writes it.
+pub(crate) fn parse_partial<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &str,
+    by: &'static str,
+    format: &str,
+    shard_of: impl Fn(&T) -> Shard,
+) -> Result<T, MergeError> {
+    let not = |message: String| MergeError::NotPartial { path: path.to_string(), by, message };
+    let head: serde_json::Value = serde_json::from_str(text).map_err(|e| not(e.to_string()))?;
+    match head.get("format").and_then(|f| f.as_str()) {
+        Some(f) if f == format => {}
+        Some(other) => return Err(not(format!("format `{other}`; this version reads `{format}`"))),
+        None => return Err(not("no `format` field".into())),
+    }
+    let p: T = serde_json::from_value(head).map_err(|e| not(e.to_string()))?;
+    let shard = shard_of(&p);
+    if shard.count == 0 || shard.index >= shard.count {
+        return Err(not(format!("shard {}/{} is not I/N with I < N", shard.index, shard.count)));
+    }
+    Ok(p)
+}
+
+/// What a share of a campaign says of the campaign (`mc --shard` or `twin --shard`).
+pub(crate) struct Share<'a> {
+    pub path: &'a str,
+    pub version: &'a str,
+    pub seed: u64,
+    pub runs: usize,
+    pub shard: Shard,
+    /// How many results the share holds.
+    pub results: usize,
+}
+
+/// Checks that `shares` are every share of one campaign of `pairs` results, once each:
+/// the version of onebeacon, the seed, the runs and the shard count of the first, each
+/// with the count of results its shard holds.
+pub(crate) fn check_shares(shares: &[Share], pairs: usize) -> Result<(), MergeError> {
+    let Some(first) = shares.first() else { return Err(MergeError::Empty) };
+    let (runs, seed, shards) = (first.runs, first.seed, first.shard.count);
+    let mut by_shard: BTreeMap<usize, String> = BTreeMap::new();
+    for s in shares {
+        if s.version != VERSION {
+            return Err(MergeError::Version { path: s.path.into(), theirs: s.version.into(), ours: VERSION.into() });
         }
         let mismatch = |what, a: String, b: String| MergeError::Mismatch {
-            first: first_path.clone(),
-            second: path.clone(),
+            first: first.path.into(),
+            second: s.path.into(),
             what,
             a,
             b,
         };
-        if p.scenario_toml != first.scenario_toml {
-            let (a, b) = (format!("`{}`", first.scenario), format!("`{}`", p.scenario));
-            let what = if a == b { "the scenario's keys (same name, edited in between)" } else { "scenario" };
-            return Err(mismatch(what, a, b));
+        if s.seed != seed {
+            return Err(mismatch("seed", seed.to_string(), s.seed.to_string()));
         }
-        if p.seed != seed {
-            return Err(mismatch("seed", seed.to_string(), p.seed.to_string()));
+        if s.runs != runs {
+            return Err(mismatch("runs per cell", runs.to_string(), s.runs.to_string()));
         }
-        if p.runs != runs {
-            return Err(mismatch("runs per cell", runs.to_string(), p.runs.to_string()));
+        if s.shard.count != shards {
+            return Err(mismatch("shard count", shards.to_string(), s.shard.count.to_string()));
         }
-        if p.shards != shards {
-            return Err(mismatch("shard count", shards.to_string(), p.shards.to_string()));
+        let expected = s.shard.len(pairs);
+        if s.results != expected {
+            return Err(MergeError::Incomplete { path: s.path.into(), shard: s.shard, expected, got: s.results });
         }
-        let expected = p.shard_of().len(pairs);
-        if p.results.len() != expected {
-            return Err(MergeError::Incomplete {
-                path: path.clone(),
-                shard: p.shard_of(),
-                expected,
-                got: p.results.len(),
-            });
-        }
-        if let Some(earlier) = by_shard.insert(p.shard, path.clone()) {
-            return Err(MergeError::Duplicate { shard: p.shard_of(), first: earlier, second: path.clone() });
+        if let Some(earlier) = by_shard.insert(s.shard.index, s.path.into()) {
+            return Err(MergeError::Duplicate { shard: s.shard, first: earlier, second: s.path.into() });
         }
     }
     if by_shard.len() < shards {
@@ -267,14 +318,7 @@ pub fn merge(partials: Vec<(String, Partial)>) -> Result<Merged, MergeError> {
         let have: Vec<String> = by_shard.keys().take(SHOWN).map(|i| i.to_string()).collect();
         return Err(MergeError::Missing { missing: missing.join(", "), count: shards, have: have.join(", ") });
     }
-    let mut summaries = Vec::with_capacity(pairs);
-    let mut wall_s = 0.0;
-    for (_, p) in partials {
-        wall_s += p.wall_s;
-        summaries.extend(p.summaries());
-    }
-    let result = aggregate(&scenario, runs, seed, summaries)?;
-    Ok(Merged { scenario, result, wall_s })
+    Ok(())
 }
 
 /// Reads the partials of `paths`: each a partial file, or a directory whose
@@ -284,6 +328,21 @@ pub fn read_partials(
     paths: &[std::path::PathBuf],
     budget: &crate::budget::Budget,
 ) -> Result<Vec<(String, Partial)>, MergeError> {
+    read_texts(paths, budget, "mc")?
+        .into_iter()
+        .map(|(name, text)| Partial::from_json(&text, &name).map(|p| (name, p)))
+        .collect()
+}
+
+/// The texts of the partial files of `paths` (each a file, or a directory whose
+/// `partial-*-of-*.json` files are all read, in name order), with their names: only
+/// regular files, and only while their sizes fit in `budget`. `by` names the command that
+/// writes them.
+pub(crate) fn read_texts(
+    paths: &[std::path::PathBuf],
+    budget: &crate::budget::Budget,
+    by: &'static str,
+) -> Result<Vec<(String, String)>, MergeError> {
     let io = |p: &std::path::Path, e: std::io::Error| MergeError::Io {
         path: p.display().to_string(),
         message: e.to_string(),
@@ -300,7 +359,7 @@ pub fn read_partials(
                 })
                 .collect();
             if found.is_empty() {
-                return Err(MergeError::NoneInDir { path: path.display().to_string() });
+                return Err(MergeError::NoneInDir { path: path.display().to_string(), by });
             }
             found.sort();
             files.extend(found);
@@ -317,7 +376,8 @@ pub fn read_partials(
             if !meta.is_file() {
                 return Err(MergeError::NotPartial {
                     path: f.display().to_string(),
-                    message: "not a regular file (a partial is a file written by `mc --shard`)".into(),
+                    by,
+                    message: format!("not a regular file (a partial is a file written by `{by} --shard`)"),
                 });
             }
             Ok(meta.len())
@@ -334,8 +394,7 @@ pub fn read_partials(
             use std::io::Read;
             let mut text = String::new();
             std::fs::File::open(&f).and_then(|file| file.take(len).read_to_string(&mut text)).map_err(|e| io(&f, e))?;
-            let name = f.display().to_string();
-            Partial::from_json(&text, &name).map(|p| (name, p))
+            Ok((f.display().to_string(), text))
         })
         .collect()
 }

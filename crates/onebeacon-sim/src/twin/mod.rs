@@ -7,11 +7,12 @@
 //! (docs/logs.md, "The twin of a log").
 
 mod draw;
+pub mod partial;
 
 #[cfg(test)]
 pub(crate) mod tests;
 
-use crate::montecarlo::{Progress, SweepError, in_pool};
+use crate::montecarlo::{Progress, Shard, SweepError, in_pool};
 use crate::replay::{replay, session_from};
 use crate::scenario::EstimatorKind;
 use crate::scenario::sea::Sea;
@@ -35,6 +36,8 @@ pub struct TwinOptions {
     pub threads: Option<usize>,
     /// The beacon sets, each run by every estimator (None: all the log's beacons).
     pub sets: Vec<Option<BTreeSet<u32>>>,
+    /// The share of the runs to simulate (run j goes to share j mod N).
+    pub shard: Shard,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -113,6 +116,8 @@ impl TwinCell {
 pub struct Twin {
     pub reference: &'static str,
     pub cells: Vec<TwinCell>,
+    /// The index of each simulated run, in the order of every cell's `runs`.
+    pub run_indices: Vec<u64>,
     pub kept: Kept,
     pub notes: Vec<String>,
 }
@@ -182,9 +187,11 @@ pub fn twin(log: &Log, sea: &Sea, opts: &TwinOptions, progress: &dyn Progress) -
             }
         }
     }
+    let run_indices: Vec<u64> = opts.shard.pairs(1, opts.runs).map(|(_, run)| run).collect();
     let per_run: Option<Vec<Vec<Score>>> = in_pool(opts.threads, || {
-        (0..opts.runs as u64)
-            .into_par_iter()
+        run_indices
+            .par_iter()
+            .map(|&run| run)
             .map(|run| {
                 if progress.stopped() {
                     return None;
@@ -210,5 +217,5 @@ pub fn twin(log: &Log, sea: &Sea, opts: &TwinOptions, progress: &dyn Progress) -
             cell.runs.push(s);
         }
     }
-    Ok(Twin { reference, cells, kept: drawer.kept(), notes })
+    Ok(Twin { reference, cells, run_indices, kept: drawer.kept(), notes })
 }

@@ -99,7 +99,7 @@ fn log_of(test: &str, seed: u64, with_truth: bool) -> TestLog {
 
 fn options(runs: usize, threads: Option<usize>) -> TwinOptions {
     let each = BEACONS.iter().map(|(id, _)| Some(BTreeSet::from([*id])));
-    TwinOptions { runs, seed: 7, threads, sets: std::iter::once(None).chain(each).collect() }
+    TwinOptions { runs, seed: 7, threads, sets: std::iter::once(None).chain(each).collect(), shard: Shard::WHOLE }
 }
 
 /// Cells within the band, and cells, over `logs` drawn logs.
@@ -146,6 +146,38 @@ fn a_twin_does_not_depend_on_the_threads() {
     assert_eq!(one.cells, two.cells);
     assert_eq!(one.cells.len(), 7);
     assert!(one.cells.iter().all(|c| c.runs.len() == 6));
+}
+
+/// The shares of a twin's runs (`--shard I/N`), each written and read back as a partial
+/// file, merge into the unsharded twin bit for bit, in any order; a missing share, one
+/// of another sea and one of another log are refused by name.
+#[test]
+fn a_twins_shards_merge_into_the_unsharded_twin() {
+    use partial::{MergedTwin, TwinPartial, merge_twin};
+    let log = drawn_log("shards", 1);
+    let whole = twin(&log, &sea(), &options(7, None), &|| {}).unwrap();
+    let share = |sea: &Sea, log: &Log, index| {
+        let opts = TwinOptions { shard: Shard { index, count: 3 }, ..options(7, None) };
+        let t = twin(log, sea, &opts, &|| {}).unwrap();
+        let p = TwinPartial::new("shards", sea, &t, 7, 7, opts.shard, 1.0);
+        let name = crate::partial::file_name(opts.shard);
+        (name.clone(), TwinPartial::from_json(&p.to_json(), &name).unwrap())
+    };
+    let real = || twin(&log, &sea(), &options(0, None), &|| {}).unwrap();
+    let shares: Vec<_> = [2, 0, 1].into_iter().map(|i| share(&sea(), &log, i)).collect();
+    let MergedTwin { twin: merged, runs, seed, wall_s } = merge_twin("shards", real(), &sea(), shares.clone()).unwrap();
+    assert_eq!((runs, seed, wall_s), (7, 7, 3.0));
+    assert_eq!(merged.cells, whole.cells);
+    assert_eq!(merged.run_indices, (0..7).collect::<Vec<u64>>());
+    let err = |shares| merge_twin("shards", real(), &sea(), shares).unwrap_err().to_string();
+    assert!(err(shares[..2].to_vec()).contains("missing shard(s) 1 of 3"), "{}", err(shares[..2].to_vec()));
+    let mut other_sea = sea();
+    other_sea.ranges[0].sigma_m = 0.6;
+    let foreign = vec![shares[0].clone(), shares[1].clone(), share(&other_sea, &log, 2)];
+    assert!(err(foreign).contains("differ in the sea"));
+    let other_log = drawn_log("shards", 2);
+    let foreign = vec![shares[0].clone(), shares[1].clone(), share(&sea(), &other_log, 2)];
+    assert!(err(foreign).contains("differ in the log or its beacon sets"));
 }
 
 /// Without ground truth the twin's truth is the smoother's trajectory: the runs are
