@@ -323,37 +323,8 @@ enum Command {
     Twin {
         /// The log description (TOML).
         log: PathBuf,
-        /// The sea: a file with a [sea] table (`onebeacon sea-fit` writes sea.toml).
-        #[arg(long, value_name = "SEA.toml")]
-        sea: PathBuf,
-        /// Simulated runs.
-        #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(1..=100_000), conflicts_with = "merge")]
-        runs: u32,
-        /// Base seed.
-        #[arg(long, default_value_t = 1, conflicts_with = "merge")]
-        seed: u64,
-        /// Worker threads (default: one per core). Results do not depend on it.
-        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024), conflicts_with = "merge")]
-        threads: Option<u16>,
-        /// One beacon set (ids, comma-separated; default: all the beacons, then each alone).
-        #[arg(long, value_delimiter = ',', value_name = "IDS")]
-        beacons: Option<Vec<u32>>,
-        /// Output directory (default: out/<log>-twin); with --shard, where the partial
-        /// (partial-I-of-N.json) goes.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Print one JSON object instead of the table.
-        #[arg(long, conflicts_with = "shard")]
-        json: bool,
-        /// Simulate share I of N of the runs (run j goes to share j mod N) and write it as
-        /// DIR/partial-I-of-N.json; `--merge` puts the shares together.
-        #[arg(long, value_name = "I/N", conflicts_with = "merge")]
-        shard: Option<onebeacon_sim::montecarlo::Shard>,
-        /// Put the shares of `--shard` together (their directories or partial files) into
-        /// what the unsharded command prints and writes; the log, --sea and --beacons must
-        /// be the shares' (their runs and seed are taken from them).
-        #[arg(long, num_args = 1.., value_name = "DIR|FILE")]
-        merge: Option<Vec<PathBuf>>,
+        #[command(flatten)]
+        args: twin::TwinArgs,
     },
     /// Run the estimators of CONFIG on JSON Lines measurements from stdin, writing one
     /// JSON line of estimates per input line to stdout, flushed after each.
@@ -568,20 +539,7 @@ fn main() -> ExitCode {
         Command::SeaFit { log, beacons, window_s, out, json } => {
             sea_fit::sea_fit(&log, sea_fit::SeaFitArgs { beacons, window_s, out, json })
         }
-        Command::Twin { log, sea, runs, seed, threads, beacons, out, json, shard, merge } => twin::run(
-            &log,
-            twin::TwinArgs {
-                sea,
-                runs: runs as usize,
-                seed,
-                threads: threads.map(usize::from),
-                beacons,
-                out,
-                json,
-                shard,
-                merge,
-            },
-        ),
+        Command::Twin { log, args } => twin::run(&log, args),
         Command::Stream { config } => replay::stream(&config),
         Command::Guidance { command: GuidanceCommand::Standoff { speed_m_s, depths_m, period_s, json } } => {
             commands::standoff(speed_m_s, &depths_m, period_s, json)

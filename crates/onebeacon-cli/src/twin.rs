@@ -13,18 +13,39 @@ use serde_json::json;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-/// What `twin` is asked besides the log.
+/// What `twin` is asked besides the log (its command-line options).
+#[derive(Debug, clap::Args)]
 pub struct TwinArgs {
+    /// The sea: a file with a [sea] table (`onebeacon sea-fit` writes sea.toml).
+    #[arg(long, value_name = "SEA.toml")]
     pub sea: PathBuf,
-    pub runs: usize,
+    /// Simulated runs.
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(1..=100_000), conflicts_with = "merge")]
+    pub runs: u32,
+    /// Base seed.
+    #[arg(long, default_value_t = 1, conflicts_with = "merge")]
     pub seed: u64,
-    pub threads: Option<usize>,
+    /// Worker threads (default: one per core). Results do not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024), conflicts_with = "merge")]
+    pub threads: Option<u16>,
+    /// One beacon set (ids, comma-separated; default: all the beacons, then each alone).
+    #[arg(long, value_delimiter = ',', value_name = "IDS")]
     pub beacons: Option<Vec<u32>>,
+    /// Output directory (default: out/<log>-twin); with --shard, where the partial
+    /// (partial-I-of-N.json) goes.
+    #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Print one JSON object instead of the table.
+    #[arg(long, conflicts_with = "shard")]
     pub json: bool,
-    /// Simulate this share of the runs alone and write it as a partial.
+    /// Simulate share I of N of the runs (run j goes to share j mod N) and write it as
+    /// DIR/partial-I-of-N.json; `--merge` puts the shares together.
+    #[arg(long, value_name = "I/N", conflicts_with = "merge")]
     pub shard: Option<Shard>,
-    /// Merge these shares' partials instead of simulating.
+    /// Put the shares of `--shard` together (their directories or partial files) into
+    /// what the unsharded command prints and writes; the log, --sea and --beacons must
+    /// be the shares' (their runs and seed are taken from them).
+    #[arg(long, num_args = 1.., value_name = "DIR|FILE")]
     pub merge: Option<Vec<PathBuf>>,
 }
 
@@ -50,10 +71,11 @@ fn read_sea(path: &Path) -> Result<Sea> {
 /// share's runs alone, as DIR/partial-I-of-N.json; with `--merge PATHS`, the shares'
 /// runs instead of new ones.
 pub fn run(path: &Path, a: TwinArgs) -> Result<()> {
+    let (runs_asked, threads) = (a.runs as usize, a.threads.map(usize::from));
     let log = Log::load(path)?;
     let sea = read_sea(&a.sea)?;
     sea.check_twin().map_err(|e| BadInput(format!("--sea {}: {e}", a.sea.display())))?;
-    let concurrent = onebeacon_sim::budget::concurrent_runs(a.threads, a.runs);
+    let concurrent = onebeacon_sim::budget::concurrent_runs(threads, runs_asked);
     crate::budget().check_twin(&log, concurrent).map_err(|e| BadInput(e.to_string()))?;
     let known = log.beacon_ids();
     let sets: Vec<Option<BTreeSet<u32>>> = match crate::replay::beacon_filter(a.beacons, &known)? {
@@ -70,8 +92,8 @@ pub fn run(path: &Path, a: TwinArgs) -> Result<()> {
     inputs.push(a.sea.clone());
     inputs.extend(a.merge.iter().flatten().cloned());
     let shard = a.shard.unwrap_or(Shard::WHOLE);
-    if shard.count > a.runs {
-        return Err(BadInput(format!("--shard {shard}: {} runs cut into at most {} shares", a.runs, a.runs)).into());
+    if shard.count > runs_asked {
+        return Err(BadInput(format!("--shard {shard}: {runs_asked} runs cut into at most {runs_asked} shares")).into());
     }
     // the output is staged before the runs: a directory that cannot take it fails first
     let partial_file = onebeacon_sim::partial::file_name(shard);
@@ -80,8 +102,8 @@ pub fn run(path: &Path, a: TwinArgs) -> Result<()> {
         None => Staging::new(&dir, &inputs)?,
     };
     let started = std::time::Instant::now();
-    let runs = if a.merge.is_some() { 0 } else { a.runs };
-    let opts = TwinOptions { runs, seed: a.seed, threads: a.threads, sets, shard };
+    let runs = if a.merge.is_some() { 0 } else { runs_asked };
+    let opts = TwinOptions { runs, seed: a.seed, threads, sets, shard };
     // a merge simulates nothing: the replay alone, without a progress line
     let bar =
         (runs > 0).then(|| crate::progress::Progress::new(shard.len(runs) as u64, "runs", format!("twin of {name}")));
@@ -97,7 +119,7 @@ pub fn run(path: &Path, a: TwinArgs) -> Result<()> {
             let MergedTwin { twin, runs, seed, wall_s } = merge_twin(&name, t, &sea, partials).map_err(bad)?;
             (twin, runs, seed, wall_s)
         }
-        None => (t, a.runs, a.seed, started.elapsed().as_secs_f64()),
+        None => (t, runs_asked, a.seed, started.elapsed().as_secs_f64()),
     };
     if a.shard.is_some() {
         let partial = TwinPartial::new(&name, &sea, &t, runs, seed, shard, wall_s);
