@@ -15,7 +15,8 @@ section, table or figure; a datasheet; a fit on a shipped log with its command) 
         a list the preset cannot lose alone, as a cast's depths, takes its table with it),
         halved where the preset is refused without it (as `false_max_range_m` while
         `false_prob` is set), kept, and doubled (a direction turned by 180 deg instead; a
-        probability whose double reaches 1 and a list are not doubled): `onebeacon mc
+        probability whose double reaches 1 and a list are not doubled; a variant the
+        key's range refuses is said so): `onebeacon mc
         --json` on the preset's base cell (its sweep dropped) for each, with its runs (or
         --runs), the same seeds in every variant. Prints the estimator's (default: the
         preset's first) mean error, m, as set (95 % interval of the mean), and each
@@ -166,13 +167,17 @@ def ablate(preset, runs=None, binary=str(ROOT / "target/release/onebeacon"), out
         for label, toml in todo:
             got = cells(toml)
             if got is None:
-                sys.exit(f"{preset}: [{v['table']}] {v['key']} {label}: onebeacon refused the variant (see {out})")
+                if label == "as set":
+                    sys.exit(f"{preset}: onebeacon refused the preset itself (see {out})")
+                found[label] = None  # a value outside what the key takes (a salinity of 60 ppt)
+                continue
             first = first or got[0]["estimator"]
             found[label] = next((c for c in got if c["estimator"] == first), None)
             if found[label] is None:
                 sys.exit(f"{preset}: no estimator `{first}` (it has {', '.join(c['estimator'] for c in got)})")
         base = found.pop("as set")
-        changes = [(label, *paired(c["run_mean_errors_m"], base["run_mean_errors_m"])) for label, c in found.items()]
+        changes = [(label, *paired(c["run_mean_errors_m"], base["run_mean_errors_m"])) if c else (label, None, None, 0)
+                   for label, c in found.items()]
         rows.append((v["table"], v["key"], v["value"], sea_ablation.summary(base), changes))
         if progress:
             print(f"{preset} {i + 1}/{len(unsourced)}: [{v['table']}] {v['key']}", file=sys.stderr, flush=True)
@@ -193,9 +198,10 @@ def run(toml, path, runs, binary):
 
 
 def change(entry):
-    """A variant's paired change: "+1.23 (+-0.45) m" (the interval's half-width)."""
+    """A variant's paired change: "+1.23 (+-0.45) m" (the interval's half-width), or
+    "refused" when the value is outside what its key takes."""
     label, mean, half, _ = entry
-    return f"{label} {mean:+.2f} (+-{half:.2f})"
+    return f"{label} refused (outside the key's range)" if mean is None else f"{label} {mean:+.2f} (+-{half:.2f})"
 
 
 def main():

@@ -81,3 +81,23 @@ def test_the_variants_change_one_value(tmp_path):
         "multipath_excess_m = 10.0", "multipath_excess_m = 5.0"]
     assert diff("+180 deg", "toward_deg") == ["toward_deg = 120.0", "toward_deg = 300.0"]
     assert diff("x2", "false_prob") == ["false_prob = 0.02", "false_prob = 0.04"]
+
+
+def test_a_refused_variant_is_said_so_and_the_rest_is_kept(tmp_path, monkeypatch):
+    # a fake `onebeacon mc`: the filter errs 1.0 m a run (+-0.1) with the false detections
+    # as set, 1.5 m without them, and the binary refuses (None) a share of 0.04
+    def fake_run(toml, path, runs, binary):
+        if "false_prob = 0.04" in toml:
+            return None
+        err = 1.0 if "false_prob = 0.02\n" in toml else 1.5
+        return [{"estimator": "ekf", "run_mean_errors_m": [err, err + 0.1, err - 0.1], "nees_mean_all_runs": 2.0}]
+
+    (tmp_path / "scenarios").mkdir()
+    (tmp_path / "scenarios" / "x-sea.toml").write_text(PRESET)
+    monkeypatch.setattr(sea_presets, "ROOT", tmp_path)
+    monkeypatch.setattr(sea_presets, "run", fake_run)
+    first, rows = sea_presets.ablate("x-sea", 3, "onebeacon", tmp_path / "out", progress=False)
+    assert first == "ekf" and [r[1] for r in rows] == ["loss_prob", "false_prob", "toward_deg"]
+    _, _, value, (mean, _, _, runs), changes = rows[1]
+    assert (value, mean, runs) == ("0.02", 1.0, 3)
+    assert [sea_presets.change(c) for c in changes] == ["default +0.50 (+-0.00)", "x2 refused (outside the key's range)"]
