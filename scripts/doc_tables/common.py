@@ -53,13 +53,16 @@ RUNS = {
     "garin2024": (20, 300),
     "garin2024-sea": (20, 300),
     "garin2024-beacon": (20, 300),
+    "garin2024-at-sea": (20, 300),
     "sousa": (2, 10),
     "sousa-sea": (2, 10),
     "sousa-pair": (2, 10),
+    "sousa-spiral": (2, 10),
     "hoff2024-sea": (2, 10),
     "hoff2024-literal": (2, 10),
     "hoff2024-sea-long": (2, 300),
     "hoff2024-sea-floors": (2, 60),
+    "hoff2024-untold-floor": (2, 20),
     # --quick also cuts the missions to 15 min and the particles to 5e4
     "hoff2024": (2, 20),
     "hoff2024-kinematic": (2, 20),
@@ -81,6 +84,7 @@ RUNS = {
     "rypkema": (1, 2),
     "rypkema-reference": (1, 4),
     "rypkema-sea": (1, 4),
+    "rypkema-dead-reckoning": (1, 8),
 }
 
 

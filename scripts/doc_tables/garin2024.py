@@ -1,8 +1,10 @@
 """docs/reproductions/garin2024.md's tables: range + Doppler EKF on one fixed beacon."""
 
 import re
+import statistics
 
-from .common import ABLATION, PAIRED, ROOT, RUNS, cli, header, mc, mc_text, nees_figure, paired_cell
+from .common import (ABLATION, PAIRED, ROOT, RUNS, blocks_kept, cli, header, mc, mc_text, nees_figure,
+    paired_cell)
 from .sea import ablation
 
 
@@ -172,9 +174,67 @@ def garin2024_current(quick):
     return rows
 
 
+# garin2024 Table 8 (at sea): mean positioning error in m of the proposed method against
+# T_com for trajectories #1-#4 (None: "DIV", the filter diverged); Table 6: ROSB's at T_com 3 s
+GARIN_AT_SEA = {
+    3: (4.6225, 2.1537, 5.0740, 4.2069),
+    6: (5.0982, 3.3472, 7.1929, 4.4613),
+    9: (5.6782, 3.3813, 7.4395, 5.0431),
+    12: (6.0585, 3.4354, 8.4071, 5.6932),
+    15: (None, 2.5071, 8.2798, 5.3535),
+    18: (13.71, 4.4618, 9.3593, 7.5195),
+}
+GARIN_AT_SEA_ROSB = (5.4287, 2.9931, 8.6719, 6.2746)
+
+
+def at_sea_world(with_sea):
+    """scenarios/garin2024-sea.toml cut to the trial's 600 s (Table 6: trajectories #1 and #3)
+    over Table 8's T_com, with the paper's filter, ROSB and range+doppler-current; its sea
+    whole (`with_sea`) or its clocks alone (the sea's sourced part: no link, no current)."""
+    def keep(head, text):
+        if head == "estimators":
+            return "name =" not in text or "range+doppler-current" in text
+        return head != "sweep" and (with_sea or head not in ("sea.link", "sea.current"))
+    toml = blocks_kept(ROOT / "scenarios/garin2024-sea.toml", keep)
+    toml = toml.replace("[mission]\n", "[mission]\nduration_s = 600\n", 1)
+    return toml + '\n[[estimators]]\nkind = "rosb"\n\n[sweep]\nt_com_s = [3.0, 6.0, 9.0, 12.0, 15.0, 18.0]\n'
+
+
+def garin2024_at_sea(quick):
+    """docs/reproductions/garin2024.md: Table 8's growth with T_com and Table 6's gain of
+    Doppler over ROSB, at sea, beside garin2024-sea cut to the trial's 600 s (300 runs per
+    T_com): the paper's mean over its four trajectories (their range), ours with the sea's
+    clocks alone (the paper's filter, ROSB, ROSB - the paper's filter paired by run) and in
+    the whole sea (range+doppler-current; the paper's filter); the last row, 18 s / 3 s."""
+    runs = RUNS["garin2024-at-sea"][0 if quick else 1]
+    clocks, whole = ({(c["sweep"]["t_com_s"], c["estimator"]): c for c in mc_text(at_sea_world(w), runs)}
+                     for w in (False, True))
+    mean = lambda c: sum(c["run_mean_errors_m"]) / len(c["run_mean_errors_m"])
+    rows = header("T_com", "paper at sea, Table 8: mean of #1-#4 (range)", "clocks alone: paper's filter",
+                  "ROSB", "ROSB - paper's filter [95 %]", "whole sea: range+doppler-current", "paper's filter")
+    for t, paper in GARIN_AT_SEA.items():
+        known = [x for x in paper if x is not None]
+        cell = f"{statistics.mean(known):.2f} ({min(known):.2f}-{max(known):.2f})"
+        cell += "" if len(known) == 4 else ", #1 diverged"
+        if t == 3:
+            gains = [r - p for r, p in zip(GARIN_AT_SEA_ROSB, paper)]
+            cell += f"; ROSB - it, Table 6: {statistics.mean(gains):.2f} ({min(gains):.2f}-{max(gains):.2f})"
+        rd, rosb = clocks[(float(t), "range+doppler")], clocks[(float(t), "rosb")]
+        cur, paper_sea = whole[(float(t), "range+doppler-current")], whole[(float(t), "range+doppler")]
+        rows.append(f"| {t} s | {cell} | {mean(rd):.2f} | {mean(rosb):.2f} | {paired_cell(rosb, rd)} "
+                    f"| {mean(cur):.2f} | {mean(paper_sea):.1f} |")
+    growth = [a / b for a, b in zip(GARIN_AT_SEA[18], GARIN_AT_SEA[3])]
+    ratio = lambda cells, e: ratio_cell(cells[(18.0, e)], cells[(3.0, e)])
+    rows.append(f"| 18 s / 3 s | {statistics.mean(growth):.2f} ({min(growth):.2f}-{max(growth):.2f}) "
+                f"| {ratio(clocks, 'range+doppler')} | {ratio(clocks, 'rosb')} | | "
+                f"{ratio(whole, 'range+doppler-current')} | {ratio(whole, 'range+doppler')} |")
+    return rows
+
+
 # the tables of this module by the name that marks them in docs/
 TABLES = {
     "garin2024": garin2024,
+    "garin2024-at-sea": garin2024_at_sea,
     "garin2024-over-10m": garin2024_over_10m,
     "garin2024-beacon": garin2024_beacon,
     "garin2024-paired": garin2024_paired,

@@ -24,10 +24,21 @@ def fleet(scenario, campaign, quick, reference=False):
     runs = RUNS[campaign][0 if quick else 1]
     toml = cli("scenarios", "--show", scenario)
     if quick:
-        toml = re.sub(r'(?m)^model = "channel"', 'model = "abstract"', toml)
+        toml = abstract_pings(toml)
     if reference:
         toml += "\n[reference]\nsigma_m = 3.9\n"
-    stats = json.loads(cli_on_toml("fleet", toml, "--runs", str(runs), "--json", out=True))["statistics"]
+    return fleet_statistics(toml, runs)
+
+
+def abstract_pings(toml):
+    """A fleet scenario's text with its pings drawn the abstract way (`signal.model`)."""
+    return re.sub(r'(?m)^model = "channel"', 'model = "abstract"', toml)
+
+
+def fleet_statistics(toml, runs):
+    """The error percentiles by label (`fleet/iusbl`, `platypus/iusbl`, ...) of `onebeacon
+    fleet FILE --runs RUNS --json` on the scenario text `toml`."""
+    stats = json.loads(cli_on_toml("fleet", toml, "--runs", str(runs), "--json"))["statistics"]
     return {p["label"]: p for p in stats["tracks"] + stats["fleet"]}
 
 
@@ -97,9 +108,52 @@ def rypkema_nees(quick):
     return rows
 
 
+# rypkema-dead-reckoning: what moves dead reckoning to the paper's (label, [sea.sensors] keys,
+# [sea.current] speed): the -sea preset as shipped, a compass deviation (all of the paper's
+# 3 deg 1 sigma as one, amplitude 3 sqrt(2), and 3 deg), and the 5 cm/s current of 2026-12-03
+DEAD_RECKONING_VARIANTS = [
+    ("as shipped", "", None),
+    ("+ a compass deviation of 3 deg (`sea.sensors.heading_deviation_deg`)", "heading_deviation_deg = 3.0", None),
+    ("+ a compass deviation of 4.24 deg (the paper's 3 deg 1 sigma, all of it)", "heading_deviation_deg = 4.24",
+     None),
+    ("+ a current of 5 cm/s (for 2.6 mm/s)", "", "0.05"),
+]
+
+
+def fleet_variant(scenario, sensors, current, runs):
+    """`fleet_statistics` of `onebeacon fleet SCENARIO` with its pings drawn the abstract
+    way, `sensors` (TOML keys) as its `[sea.sensors]` and `current` (m/s, text, or None) as
+    its `[sea.current]` speed."""
+    toml = abstract_pings(cli("scenarios", "--show", scenario))
+    if sensors:
+        toml += f"\n[sea.sensors]\n{sensors}\n"
+    if current:
+        head, rest = toml.split("[sea.current]", 1)
+        toml = head + "[sea.current]" + re.sub(r"(?m)^speed_m_s = [0-9.e-]+", f"speed_m_s = {current}", rest, count=1)
+    return fleet_statistics(toml, runs)
+
+
+def rypkema_dead_reckoning(quick):
+    """docs/reproductions/rypkema.md: dead reckoning's error in rypkema-m1-sea and -m6-sea
+    (pings drawn the abstract way, 8 runs) as shipped and with each candidate cause added:
+    the fleet's iusbl and dead reckoning, 68 % / 95 %, m, and dead reckoning's mean NEES."""
+    runs = RUNS["rypkema-dead-reckoning"][0 if quick else 1]
+    missions = ("rypkema-m1-sea", "rypkema-m6-sea")
+    rows = header("", *(f"{m}: {e}" for m in missions for e in ("iusbl", "dead reckoning (NEES)")))
+    for label, sensors, current in DEAD_RECKONING_VARIANTS:
+        cells = []
+        for m in missions:
+            f = fleet_variant(m, sensors, current, runs)
+            dr = f["fleet/dead-reckoning"]
+            cells += [percent_cell(f["fleet/iusbl"], 2), f"{percent_cell(dr, 2)} ({figure(dr['nees_mean'])})"]
+        rows.append(f"| {label} | " + " | ".join(cells) + " |")
+    return rows
+
+
 # the tables of this module by the name that marks them in docs/
 TABLES = {
     "rypkema": rypkema,
     "rypkema-sea": rypkema_sea,
     "rypkema-nees": rypkema_nees,
+    "rypkema-dead-reckoning": rypkema_dead_reckoning,
 }

@@ -1,8 +1,9 @@
 """docs/reproductions/sousa.md's tables: range-only EKF, the beacon on a guided ASV."""
 
 import json
+import re
 
-from .common import header, mc, paired_cell, spread, verdict_counts
+from .common import ROOT, RUNS, header, mc, mc_text, paired_cell, spread, verdict_counts
 from .sea import ablation
 
 
@@ -127,6 +128,32 @@ def sousa_sea_ablation(quick):
                     ("range-ekf", "range-ekf (the thesis's)"), ("dead-reckoning", "dead-reckoning")])
 
 
+# sousa-spiral: the spiral's descent rates tried, m/s (sousa.toml's 0.005 first)
+SPIRAL_DESCENTS = ("0.005", "0.02", "0.05")
+
+
+def sousa_spiral(quick):
+    """docs/reproductions/sousa.md: the conjecture that the thesis's spiral descends faster
+    than ours, measured: scenarios/sousa.toml under approach A, circular and spiral paths
+    from 1 m and 5 m, with each spiral descent rate; the range EKF's mean error and the
+    spiral's minus the circle's, paired by run (10 runs)."""
+    runs = RUNS["sousa-spiral"][0 if quick else 1]
+    depths = (1.0, 5.0)
+    rows = header("spiral descent, m/s (deeper after 2 h)", *(f"spiral from {d:g} m" for d in depths),
+                  *(f"spiral - circle from {d:g} m [95 %]" for d in depths))
+    for descent in SPIRAL_DESCENTS:
+        toml = re.sub(r"(?m)^spiral_descent_m_s = [0-9.]+", f"spiral_descent_m_s = {descent}",
+                      (ROOT / "scenarios/sousa.toml").read_text())
+        toml = toml[:toml.index("[sweep]")] + (
+            '[sweep]\npath = ["circular", "spiral"]\ndepth_m = [1.0, 5.0]\nguidance = ["A"]\n')
+        cells = {(c["sweep"]["path"], c["sweep"]["depth_m"]): c
+                 for c in mc_text(toml, runs) if c["estimator"] == "range-ekf"}
+        rows.append(f"| {descent} ({float(descent) * 7200:.0f} m) | " + " | ".join(
+            f"{cells[('spiral', d)]['mean_error_m']:.3f}" for d in depths) + " | " + " | ".join(
+            paired_cell(cells[("spiral", d)], cells[("circular", d)], 3) for d in depths) + " |")
+    return rows
+
+
 # the tables of this module by the name that marks them in docs/
 TABLES = {
     "sousa": sousa,
@@ -135,4 +162,5 @@ TABLES = {
     "sousa-guidance": sousa_guidance,
     "sousa-pair": sousa_pair,
     "sousa-pair-paired": sousa_pair_paired,
+    "sousa-spiral": sousa_spiral,
 }

@@ -1,5 +1,6 @@
 //! A vehicle's navigation sensors as they drift (`[sea.sensors]`): a heading bias that
-//! wanders as a first-order Gauss-Markov process, a speed scale factor (a DVL's or a
+//! wanders as a first-order Gauss-Markov process, a compass's one-cycle deviation (an
+//! error that depends on the heading, as a hard-iron residual's does), a speed scale factor (a DVL's or a
 //! speed log's calibration, drawn once a run) and dropouts of the speed sensor (bottom
 //! lock lost), during which the vehicle keeps the last velocity it measured; and a
 //! wheel or pose-graph odometry's scales and noise (`[sea.odometry]`, a log's twin only).
@@ -17,6 +18,12 @@ pub struct SensorErrors {
     /// time, s.
     pub heading_bias_sigma_deg: f64,
     pub heading_bias_time_constant_s: f64,
+    /// A compass's one-cycle deviation, deg: the heading reads D sin(psi + phi) off at a
+    /// true heading psi, the phase phi drawn once a run (uniform). Bowditch, The American
+    /// Practical Navigator (NGA Pub. 9), ch. 6: deviation = A + B sin(psi) + C cos(psi) + D
+    /// sin(2 psi) + E cos(2 psi), whose B and C (hard iron) this is. Unlike a bias it does
+    /// not cancel on a closed track: circling at speed v it moves dead reckoning by v D / 2.
+    pub heading_deviation_deg: f64,
     /// The speed scale factor's standard deviation (0.01: 1 %), drawn once a run.
     pub speed_scale_sigma: f64,
     /// The share of time the speed sensor is out, and the mean length of an outage, s.
@@ -29,6 +36,7 @@ impl Default for SensorErrors {
         Self {
             heading_bias_sigma_deg: 0.0,
             heading_bias_time_constant_s: 600.0,
+            heading_deviation_deg: 0.0,
             speed_scale_sigma: 0.0,
             speed_dropout_prob: 0.0,
             speed_dropout_mean_s: 30.0,
@@ -41,6 +49,7 @@ impl Default for SensorErrors {
 pub struct DriftingSensors {
     errors: SensorErrors,
     heading_bias_rad: f64,
+    deviation_phase_rad: f64,
     speed_scale: f64,
     out: bool,
     held: Option<[f64; 3]>,
@@ -50,11 +59,23 @@ pub struct DriftingSensors {
 
 impl DriftingSensors {
     /// The sensors of `errors`, drawing from `rng` (a stream of their own): the bias
-    /// starts from its stationary distribution, the scale is drawn once.
+    /// starts from its stationary distribution, the scale and the deviation's phase are
+    /// drawn once (the phase only with a deviation: without one the draws are as before it).
     pub fn new(errors: &SensorErrors, mut rng: Pcg64Mcg) -> Self {
         let heading_bias_rad = gauss(&mut rng, errors.heading_bias_sigma_deg.to_radians());
         let speed_scale = 1.0 + gauss(&mut rng, errors.speed_scale_sigma);
-        Self { errors: *errors, heading_bias_rad, speed_scale, out: false, held: None, last_t_s: None, rng }
+        let deviation_phase_rad =
+            if errors.heading_deviation_deg > 0.0 { rng.random::<f64>() * std::f64::consts::TAU } else { 0.0 };
+        Self {
+            errors: *errors,
+            heading_bias_rad,
+            deviation_phase_rad,
+            speed_scale,
+            out: false,
+            held: None,
+            last_t_s: None,
+            rng,
+        }
     }
 
     /// Moves the errors on to `t_s`: the bias by its exact discretisation, b <- a b +
@@ -88,7 +109,8 @@ impl DriftingSensors {
     /// noise).
     pub fn heading(&mut self, t_s: f64, heading_rad: f64) -> f64 {
         self.advance(t_s);
-        heading_rad + self.heading_bias_rad
+        let deviation = self.errors.heading_deviation_deg.to_radians() * (heading_rad + self.deviation_phase_rad).sin();
+        heading_rad + self.heading_bias_rad + deviation
     }
 
     /// The speed the sensor reads at `t_s` for a measured `speed_m_s` (the true speed
@@ -165,6 +187,7 @@ mod tests {
             speed_scale_sigma: 0.01,
             speed_dropout_prob: 0.2,
             speed_dropout_mean_s: 30.0,
+            ..SensorErrors::default()
         };
         let mut s = DriftingSensors::new(&errors, Pcg64Mcg::seed_from_u64(9));
         let n = 200_000;
@@ -215,5 +238,37 @@ mod tests {
             last = Some(read);
         }
         assert!(held > 500, "{held} held");
+    }
+
+    /// A one-cycle deviation D sin(psi + phi): dead reckoning on the heading it reads, a
+    /// vehicle circling at v = 1 m/s drifts by v D / 2 per unit time (to first order in D;
+    /// the second-order term, D^2 / 8 of v, is 1e-4 m/s at 3 deg), toward a direction set by
+    /// the phase; a constant bias of the same size drifts by nothing over whole laps. Over
+    /// 10 laps of 100 s each, at 3 deg: within 1 % of v D / 2.
+    #[test]
+    fn a_deviation_drifts_a_circling_dead_reckoning_by_half_its_amplitude() {
+        let drift = |errors: SensorErrors, seed: u64| {
+            let mut s = DriftingSensors::new(&errors, Pcg64Mcg::seed_from_u64(seed));
+            let (dt, lap_s, laps) = (0.01, 100.0, 10);
+            let n = (laps as f64 * lap_s / dt) as usize;
+            let (mut north, mut east) = (0.0, 0.0);
+            for k in 0..n {
+                let t = k as f64 * dt;
+                let psi = std::f64::consts::TAU * (t + 0.5 * dt) / lap_s;
+                let read = s.heading(t, psi);
+                north += (read.cos() - psi.cos()) * dt;
+                east += (read.sin() - psi.sin()) * dt;
+            }
+            f64::hypot(north, east) / (n as f64 * dt)
+        };
+        let d = 3.0f64;
+        for seed in 0..4 {
+            let rate = drift(SensorErrors { heading_deviation_deg: d, ..SensorErrors::default() }, seed);
+            let expected = d.to_radians() / 2.0;
+            assert!((rate / expected - 1.0).abs() < 0.01, "seed {seed}: {rate} m/s against {expected}");
+        }
+        let biased =
+            SensorErrors { heading_bias_sigma_deg: d, heading_bias_time_constant_s: 1e7, ..SensorErrors::default() };
+        assert!(drift(biased, 1) < 1e-3, "a constant bias drifts by {}", drift(biased, 1));
     }
 }

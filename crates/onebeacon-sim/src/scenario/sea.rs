@@ -221,6 +221,7 @@ pub(super) fn check_current(table: &str, c: &Current) -> Result<(), Violation> {
 fn check_sensors(e: &SensorErrors) -> Result<(), Violation> {
     for (key, v, range, allowed) in [
         ("heading_bias_sigma_deg", e.heading_bias_sigma_deg, 0.0..=30.0, "from 0 to 30"),
+        ("heading_deviation_deg", e.heading_deviation_deg, 0.0..=30.0, "an amplitude from 0 to 30"),
         ("speed_scale_sigma", e.speed_scale_sigma, 0.0..=0.5, "from 0 to 0.5"),
         ("speed_dropout_prob", e.speed_dropout_prob, 0.0..=0.99, "a share of time from 0 to 0.99"),
         (
@@ -318,13 +319,14 @@ impl Sea {
                 != (SensorErrors {
                     heading_bias_sigma_deg: self.sensors.heading_bias_sigma_deg,
                     heading_bias_time_constant_s: self.sensors.heading_bias_time_constant_s,
+                    heading_deviation_deg: self.sensors.heading_deviation_deg,
                     ..SensorErrors::default()
                 })
         {
             return Err(Violation {
                 key: "sea.sensors".into(),
                 value: "(set)".into(),
-                allowed: "a fixed_beacon world's AUV has no speed sensor: heading_bias_sigma_deg and heading_bias_time_constant_s only".into(),
+                allowed: "a fixed_beacon world's AUV has no speed sensor: heading_bias_sigma_deg, heading_bias_time_constant_s and heading_deviation_deg only".into(),
             });
         }
         if let Some(s) = &self.sound_speed {
@@ -399,6 +401,13 @@ mod tests {
             (link(LinkErrors { multipath_excess_m: big, ..LinkErrors::default() }), "sea.link.multipath_excess_m"),
             (link(LinkErrors { false_max_range_m: big, ..LinkErrors::default() }), "sea.link.false_max_range_m"),
             (link(LinkErrors { loss_burst_mean: Some(big), ..LinkErrors::default() }), "sea.link.loss_burst_mean"),
+            (
+                Sea {
+                    sensors: SensorErrors { heading_deviation_deg: 31.0, ..SensorErrors::default() },
+                    ..Sea::default()
+                },
+                "sea.sensors.heading_deviation_deg",
+            ),
         ];
         for (sea, key) in cases {
             let why = refused(&sea, World::FixedBeacon).unwrap_or_default();

@@ -30,6 +30,7 @@ const CLOCKS: ClockErrors = ClockErrors { offset_sigma_s: 1e-3, drift_sigma_ppm:
 const SENSORS: SensorErrors = SensorErrors {
     heading_bias_sigma_deg: 3.0,
     heading_bias_time_constant_s: 600.0,
+    heading_deviation_deg: 0.0,
     speed_scale_sigma: 0.03,
     speed_dropout_prob: 0.0,
     speed_dropout_mean_s: 30.0,
