@@ -328,21 +328,19 @@ pub fn read_partials(
     paths: &[std::path::PathBuf],
     budget: &crate::budget::Budget,
 ) -> Result<Vec<(String, Partial)>, MergeError> {
-    read_texts(paths, budget, "mc")?
-        .into_iter()
-        .map(|(name, text)| Partial::from_json(&text, &name).map(|p| (name, p)))
-        .collect()
+    read_parsed(paths, budget, "mc", Partial::from_json)
 }
 
-/// The texts of the partial files of `paths` (each a file, or a directory whose
-/// `partial-*-of-*.json` files are all read, in name order), with their names: only
-/// regular files, and only while their sizes fit in `budget`. `by` names the command that
-/// writes them.
-pub(crate) fn read_texts(
+/// The partial files of `paths` (each a file, or a directory whose `partial-*-of-*.json`
+/// files are all read, in name order), each parsed by `parse(text, name)`, with their
+/// names: only regular files, and only while their sizes fit in `budget`. `by` names the
+/// command that writes them.
+pub(crate) fn read_parsed<T>(
     paths: &[std::path::PathBuf],
     budget: &crate::budget::Budget,
     by: &'static str,
-) -> Result<Vec<(String, String)>, MergeError> {
+    parse: fn(&str, &str) -> Result<T, MergeError>,
+) -> Result<Vec<(String, T)>, MergeError> {
     let io = |p: &std::path::Path, e: std::io::Error| MergeError::Io {
         path: p.display().to_string(),
         message: e.to_string(),
@@ -394,7 +392,8 @@ pub(crate) fn read_texts(
             use std::io::Read;
             let mut text = String::new();
             std::fs::File::open(&f).and_then(|file| file.take(len).read_to_string(&mut text)).map_err(|e| io(&f, e))?;
-            Ok((f.display().to_string(), text))
+            let name = f.display().to_string();
+            parse(&text, &name).map(|p| (name, p))
         })
         .collect()
 }

@@ -6,7 +6,7 @@
 
 use super::{Score, Twin};
 use crate::montecarlo::Shard;
-use crate::partial::{MergeError, Share, VERSION, check_shares, parse_partial, read_texts};
+use crate::partial::{MergeError, Share, VERSION, check_shares, parse_partial, read_parsed};
 use crate::scenario::sea::Sea;
 use serde::{Deserialize, Serialize};
 
@@ -115,10 +115,7 @@ pub fn read_twin_partials(
     paths: &[std::path::PathBuf],
     budget: &crate::budget::Budget,
 ) -> Result<Vec<(String, TwinPartial)>, MergeError> {
-    read_texts(paths, budget, "twin")?
-        .into_iter()
-        .map(|(name, text)| TwinPartial::from_json(&text, &name).map(|p| (name, p)))
-        .collect()
+    read_parsed(paths, budget, "twin", TwinPartial::from_json)
 }
 
 /// What the shares of a twin merge into.
