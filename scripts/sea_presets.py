@@ -9,7 +9,7 @@ section, table or figure; a datasheet; a fit on a shipped log with its command) 
   scripts/sea_presets.py count            per preset: values, sourced, unsourced (exit 1
                                           when a value says neither, naming it)
   scripts/sea_presets.py list [--unsourced]   every value: preset, key, value, status
-  scripts/sea_presets.py ablate PRESET [--runs N] [--estimator NAME] [--bin BIN] [--out DIR]
+  scripts/sea_presets.py ablate PRESET [--runs N] [--estimator NAME] [--abstract-pings] [--bin BIN] [--out DIR]
         each unsourced value of scenarios/PRESET.toml set to its default (the key removed:
         off for every key but `loss_burst_mean`, whose default loses each message alone;
         a list the preset cannot lose alone, as a cast's depths, takes its table with it),
@@ -21,7 +21,11 @@ section, table or figure; a datasheet; a fit on a shipped log with its command) 
         --runs), the same seeds in every variant. Prints the estimator's (default: the
         preset's first) mean error, m, as set (95 % interval of the mean), and each
         variant's change from it, paired by run (95 % interval), and writes them to
-        DIR/ablate.json (default /tmp/sea_presets_PRESET).
+        DIR/ablate.json (default /tmp/sea_presets_PRESET). A fleet preset (rypkema's) runs
+        `onebeacon fleet --runs 1 --seed S --json` once per run (S: the preset's seed plus
+        the run's index) and takes each estimator's fleet-wide mean error as the run's;
+        --abstract-pings draws its pings the abstract way (`signal.model`: seconds a run
+        instead of half a minute).
 """
 import argparse
 import json
@@ -139,16 +143,19 @@ def variants(text, value, removable=True):
 
 
 def ablate(preset, runs=None, binary=str(ROOT / "target/release/onebeacon"), out=None, progress=True,
-           estimator=None):
+           estimator=None, transform=None):
     """Runs every unsourced value's variants of scenarios/PRESET.toml (identical variants
     once). Returns the estimator's name (`estimator`, default the preset's first) and
-    [(table, key, value, as_set, changes)]:
+    [(table, key, value, as_set, changes)]. `transform`, when given, rewrites the preset's text
+    before its variants are made (`abstract_pings`, or a shorter mission):
     as_set its (mean error, 95 % half-width, NEES, runs) with the preset as it is, changes
     [(label, mean change of the run means, 95 % half-width, runs)] paired by run."""
     path = ROOT / "scenarios" / f"{preset}.toml"
     if not path.is_file():
         sys.exit(f"{preset}: no such preset (scenarios/*-sea.toml: {', '.join(p.stem for p in presets())})")
     text = path.read_text()
+    if transform:
+        text = transform(text)
     out = pathlib.Path(out or f"/tmp/sea_presets_{preset}")
     out.mkdir(parents=True, exist_ok=True)
     first, rows, cache = estimator, [], {}
@@ -185,16 +192,41 @@ def ablate(preset, runs=None, binary=str(ROOT / "target/release/onebeacon"), out
     return first, rows
 
 
+def abstract_pings(text):
+    """A fleet preset's text with its pings drawn the abstract way (`signal.model`)."""
+    return re.sub(r'(?m)^model = "channel"', 'model = "abstract"', text)
+
+
 def run(toml, path, runs, binary):
-    """`onebeacon mc PATH --json [--runs N]` on `toml`: its cells, or None when refused."""
+    """`onebeacon mc PATH --json [--runs N]` on `toml`: its cells, or None when refused. A
+    fleet: `onebeacon fleet PATH --runs 1 --seed S --json` for each run, as mc's cells (per
+    estimator its fleet-wide mean error of each run, and the mean of their NEES)."""
     path.write_text(toml)
-    cmd = [binary, "mc", str(path), "--json"] + (["--runs", str(runs)] if runs else [])
-    done = subprocess.run(cmd, capture_output=True, text=True)
+    if not re.search(r'(?m)^kind\s*=\s*"fleet"', toml):
+        done = onebeacon(binary, "mc", str(path), "--json", *(["--runs", str(runs)] if runs else []))
+        return done and json.loads(done)["cells"]
+    setting = lambda key, default: int(m.group(1)) if (m := re.search(rf"(?m)^{key}\s*=\s*(\d+)", toml)) else default
+    by = {}
+    for i in range(runs or setting("runs", 1)):
+        done = onebeacon(binary, "fleet", str(path), "--runs", "1", "--seed", str(setting("seed", 1) + i), "--json",
+                         "--out", str(path.with_suffix("")) + "-fleet")  # its plots and tracks
+        if done is None:
+            return None
+        for p in json.loads(done)["statistics"]["fleet"]:
+            by.setdefault(p["label"].removeprefix("fleet/"), []).append(p)
+    return [{"estimator": e, "run_mean_errors_m": [p["mean_m"] for p in ps],
+             "nees_mean_all_runs": sum(p["nees_mean"] for p in ps) / len(ps)} for e, ps in by.items()]
+
+
+def onebeacon(binary, *args):
+    """The stdout of `onebeacon ARGS`, or None when it refuses its input (exit 2); any
+    other failure ends the script with its stderr."""
+    done = subprocess.run([binary, *args], capture_output=True, text=True)
     if done.returncode == 2:
         return None
     if done.returncode != 0:
-        sys.exit(f"onebeacon {' '.join(cmd[1:])} failed ({done.returncode}): {done.stderr.strip()}")
-    return json.loads(done.stdout)["cells"]
+        sys.exit(f"onebeacon {' '.join(args)} failed ({done.returncode}): {done.stderr.strip()}")
+    return done.stdout
 
 
 def change(entry):
@@ -214,6 +246,7 @@ def main():
     ab.add_argument("preset")
     ab.add_argument("--runs", type=int)
     ab.add_argument("--estimator")
+    ab.add_argument("--abstract-pings", action="store_true")
     ab.add_argument("--bin", default=str(ROOT / "target/release/onebeacon"))
     ab.add_argument("--out")
     a = ap.parse_args()
@@ -231,7 +264,8 @@ def main():
                     if not a.unsourced or v["status"] == "unsourced":
                         print(f"{p.stem}\t[{v['table']}] {v['key']} = {v['value']}\t{v['status']}\t{v['comment']}")
         else:
-            first, rows = ablate(a.preset, a.runs, a.bin, a.out, estimator=a.estimator)
+            first, rows = ablate(a.preset, a.runs, a.bin, a.out, estimator=a.estimator,
+                                 transform=abstract_pings if a.abstract_pings else None)
             print(f"{a.preset}, base cell, {first}: mean error as set, m (95 % interval of the mean); "
                   "each variant's change from it, paired by run, m (95 %)")
             for table, key, value, (mean, half, _, n), changes in rows:

@@ -76,6 +76,9 @@ RUNS = {
     # scripts/sea_presets.py ablate's runs per variant
     "garin2024-sea-unsourced": (4, 100),
     "sousa-sea-unsourced": (2, 10),
+    "hoff2024-sea-unsourced": (2, 10),
+    "rypkema-m1-sea-unsourced": (2, 8),
+    "rypkema-m6-sea-unsourced": (2, 8),
     # scripts/sea_sources.py's runs per cell
     "sea-clock": (2, 10),
     "sea-link": (2, 10),

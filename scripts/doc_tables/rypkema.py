@@ -37,8 +37,9 @@ def abstract_pings(toml):
 
 def fleet_statistics(toml, runs):
     """The error percentiles by label (`fleet/iusbl`, `platypus/iusbl`, ...) of `onebeacon
-    fleet FILE --runs RUNS --json` on the scenario text `toml`."""
-    stats = json.loads(cli_on_toml("fleet", toml, "--runs", str(runs), "--json"))["statistics"]
+    fleet FILE --runs RUNS --json` on the scenario text `toml` (its plots and tracks to a
+    temporary directory: `fleet` writes them even with --json)."""
+    stats = json.loads(cli_on_toml("fleet", toml, "--runs", str(runs), "--json", out=True))["statistics"]
     return {p["label"]: p for p in stats["tracks"] + stats["fleet"]}
 
 

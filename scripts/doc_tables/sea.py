@@ -1,6 +1,7 @@
 """docs/scenarios.md's tables of the sea's error sources, and the ablation of a -sea
 scenario (each error source alone) that the papers' pages hold."""
 
+import re
 import tempfile
 from pathlib import Path
 
@@ -88,13 +89,15 @@ def sea_presets(quick):
     return rows
 
 
-def unsourced(preset, estimator, quick):
+def unsourced(preset, estimator, quick, transform=None):
     """docs/scenarios.md: `scripts/sea_presets.py ablate PRESET --runs N --estimator E` at
-    RUNS' count: each unsourced value of the preset, the estimator's mean error with the
-    value as set, and each variant's change from it, paired by run (95 %)."""
+    RUNS' count (its text rewritten by `transform`, as --abstract-pings does): each unsourced
+    value of the preset, the estimator's mean error with the value as set, and each
+    variant's change from it, paired by run (95 %)."""
     runs = RUNS[f"{preset}-unsourced"][0 if quick else 1]
     with tempfile.TemporaryDirectory() as tmp:
-        first, found = PRESETS.ablate(preset, runs, binary(), tmp, progress=not quick, estimator=estimator)
+        first, found = PRESETS.ablate(preset, runs, binary(), tmp, progress=not quick, estimator=estimator,
+                                      transform=transform)
     rows = header("value", f"{first}: mean error as set, m (95 %)", "default or x0.5: change, m (95 %)",
                   "x2 or +180 deg: change, m (95 %)")
     for table, key, value, (mean, half, _, _), changes in found:
@@ -111,4 +114,10 @@ TABLES = {
     "sea-presets": sea_presets,
     "garin2024-sea-unsourced": lambda quick: unsourced("garin2024-sea", "range+doppler", quick),
     "sousa-sea-unsourced": lambda quick: unsourced("sousa-sea", "range-ekf", quick),
+    # --quick checks the rows alone: hoff2024-sea's missions cut to 5 min there
+    "hoff2024-sea-unsourced": lambda quick: unsourced(
+        "hoff2024-sea", "pf-sea", quick,
+        (lambda text: re.sub(r"(?m)^duration_s = \d+", "duration_s = 300", text)) if quick else None),
+    "rypkema-m1-sea-unsourced": lambda quick: unsourced("rypkema-m1-sea", "iusbl", quick, PRESETS.abstract_pings),
+    "rypkema-m6-sea-unsourced": lambda quick: unsourced("rypkema-m6-sea", "iusbl", quick, PRESETS.abstract_pings),
 }

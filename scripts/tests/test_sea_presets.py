@@ -101,3 +101,33 @@ def test_a_refused_variant_is_said_so_and_the_rest_is_kept(tmp_path, monkeypatch
     _, _, value, (mean, _, _, runs), changes = rows[1]
     assert (value, mean, runs) == ("0.02", 1.0, 3)
     assert [sea_presets.change(c) for c in changes] == ["default +0.50 (+-0.00)", "x2 refused (outside the key's range)"]
+
+
+def test_a_fleet_preset_runs_once_per_seed_and_pairs_the_runs(tmp_path):
+    # a fake `onebeacon`: `fleet FILE --runs 1 --seed S --json` errs S m, plus 2 m with the
+    # losses of the preset as set (absent, the default, they cost nothing); it is called
+    # once per run with the preset's seed plus the run's index, its pings made abstract
+    fake = tmp_path / "onebeacon"
+    fake.write_text("""#!/usr/bin/env python3
+import json, sys
+args = sys.argv[1:]
+assert args[0] == "fleet" and args[2:4] == ["--runs", "1"] and args[6] == "--json" and args[7] == "--out", args
+toml = open(args[1]).read()
+assert 'model = "abstract"' in toml
+seed = int(args[5])
+err = seed + (2.0 if "loss_prob = 0.2" in toml else 0.4 if "loss_prob = 0.4" in toml else 0.0)
+print(json.dumps({"statistics": {"fleet": [{"label": "fleet/iusbl", "mean_m": err, "nees_mean": 1.0}]}}))
+""")
+    fake.chmod(0o755)
+    preset = 'kind = "fleet"\nname = "f-sea"\nseed = 7\nruns = 3\n\n[signal]\nmodel = "channel"\n\n' \
+             '[sea.link]\nloss_prob = 0.2          # unsourced\n'
+    (tmp_path / "scenarios").mkdir()
+    (tmp_path / "scenarios" / "f-sea.toml").write_text(preset)
+    import unittest.mock
+    with unittest.mock.patch.object(sea_presets, "ROOT", tmp_path):
+        first, rows = sea_presets.ablate("f-sea", None, str(fake), tmp_path / "out", progress=False,
+                                         transform=sea_presets.abstract_pings)
+    (table, key, value, (mean, _, nees, runs), changes) = rows[0]
+    # seeds 7, 8, 9: 9, 10, 11 m as set; the default (no losses) 2 m less, doubled 1.6 m less
+    assert (first, table, key, runs, mean, nees) == ("iusbl", "sea.link", "loss_prob", 3, 10.0, 1.0)
+    assert [sea_presets.change(c) for c in changes] == ["default -2.00 (+-0.00)", "x2 -1.60 (+-0.00)"]
