@@ -1,9 +1,10 @@
 //! A vehicle's navigation sensors as they drift (`[sea.sensors]`): a heading bias that
 //! wanders as a first-order Gauss-Markov process, a compass's one-cycle deviation (an
-//! error that depends on the heading, as a hard-iron residual's does), a speed scale factor (a DVL's or a
-//! speed log's calibration, drawn once a run) and dropouts of the speed sensor (bottom
-//! lock lost), during which the vehicle keeps the last velocity it measured; and a
-//! wheel or pose-graph odometry's scales and noise (`[sea.odometry]`, a log's twin only).
+//! error that depends on the heading, as a hard-iron residual's does), a speed scale
+//! factor (a DVL's or a speed log's calibration, drawn once a run) and dropouts of the
+//! speed sensor (bottom lock lost), during which the vehicle keeps the last velocity it
+//! measured; and a wheel or pose-graph odometry's scales and noise (`[sea.odometry]`, a
+//! log's twin only).
 
 use crate::seed::gauss;
 use rand::RngExt;
@@ -18,11 +19,12 @@ pub struct SensorErrors {
     /// time, s.
     pub heading_bias_sigma_deg: f64,
     pub heading_bias_time_constant_s: f64,
-    /// A compass's one-cycle deviation, deg: the heading reads D sin(psi + phi) off at a
-    /// true heading psi, the phase phi drawn once a run (uniform). Bowditch, The American
-    /// Practical Navigator (NGA Pub. 9), ch. 6: deviation = A + B sin(psi) + C cos(psi) + D
-    /// sin(2 psi) + E cos(2 psi), whose B and C (hard iron) this is. Unlike a bias it does
-    /// not cancel on a closed track: circling at speed v it moves dead reckoning by v D / 2.
+    /// A compass's one-cycle deviation, deg: the heading reads a sin(psi + phi) off at a
+    /// true heading psi, amplitude a, the phase phi drawn once a run (uniform). Bowditch,
+    /// The American Practical Navigator (NGA Pub. 9), ch. 6: deviation = A + B sin(psi) + C
+    /// cos(psi) + D sin(2 psi) + E cos(2 psi); this is its hard-iron part, B and C, with a =
+    /// sqrt(B^2 + C^2). Unlike a bias it does not cancel on a closed track: circling at
+    /// speed v it moves dead reckoning by v a / 2.
     pub heading_deviation_deg: f64,
     /// The speed scale factor's standard deviation (0.01: 1 %), drawn once a run.
     pub speed_scale_sigma: f64,
