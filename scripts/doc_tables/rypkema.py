@@ -4,7 +4,7 @@ import functools
 import json
 import re
 
-from .common import RUNS, cli, cli_on_toml, figure, header
+from .common import PRESETS, RUNS, cli, cli_on_toml, figure, header
 
 
 # rypkema Table 3: the 2-norm error's 68 % / 95 %, m, all six missions, real data
@@ -24,15 +24,10 @@ def fleet(scenario, campaign, quick, reference=False):
     runs = RUNS[campaign][0 if quick else 1]
     toml = cli("scenarios", "--show", scenario)
     if quick:
-        toml = abstract_pings(toml)
+        toml = PRESETS.abstract_pings(toml)
     if reference:
         toml += "\n[reference]\nsigma_m = 3.9\n"
     return fleet_statistics(toml, runs)
-
-
-def abstract_pings(toml):
-    """A fleet scenario's text with its pings drawn the abstract way (`signal.model`)."""
-    return re.sub(r'(?m)^model = "channel"', 'model = "abstract"', toml)
 
 
 def fleet_statistics(toml, runs):
@@ -125,7 +120,7 @@ def fleet_variant(scenario, sensors, current, runs):
     """`fleet_statistics` of `onebeacon fleet SCENARIO` with its pings drawn the abstract
     way, `sensors` (TOML keys) as its `[sea.sensors]` and `current` (m/s, text, or None) as
     its `[sea.current]` speed."""
-    toml = abstract_pings(cli("scenarios", "--show", scenario))
+    toml = PRESETS.abstract_pings(cli("scenarios", "--show", scenario))
     if sensors:
         toml += f"\n[sea.sensors]\n{sensors}\n"
     if current:
