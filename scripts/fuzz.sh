@@ -10,7 +10,7 @@ seconds="${1:-60}"
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(scenario log_description log_csv stream wav ping_config partial)
+  targets=(scenario log_description log_csv stream wav ping_config partial log_bag)
 fi
 for t in "${targets[@]}"; do
   corpus="fuzz/corpus/$t"            # grows as the fuzzer learns; not checked in

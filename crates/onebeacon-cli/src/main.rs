@@ -24,6 +24,8 @@ mod plot;
 mod progress;
 mod replay;
 mod report;
+#[cfg(feature = "ros2")]
+mod ros2;
 mod sea_fit;
 mod smooth;
 mod tune;
@@ -333,6 +335,10 @@ enum Command {
         /// state, estimators; its [[source]] tables are ignored.
         config: PathBuf,
     },
+    /// Run the vehicle's computer of CONFIG as a ROS 2 node: its live topics in, per
+    /// estimator nav_msgs/Odometry, the waypoint and diagnostics out (docs/ros2.md).
+    #[cfg(feature = "ros2")]
+    Ros2(ros2::Ros2Args),
     /// Beacon-vehicle guidance tools.
     Guidance {
         #[command(subcommand)]
@@ -541,6 +547,8 @@ fn main() -> ExitCode {
         }
         Command::Twin { log, args } => twin::run(&log, args),
         Command::Stream { config } => replay::stream(&config),
+        #[cfg(feature = "ros2")]
+        Command::Ros2(args) => ros2::run(args),
         Command::Guidance { command: GuidanceCommand::Standoff { speed_m_s, depths_m, period_s, json } } => {
             commands::standoff(speed_m_s, &depths_m, period_s, json)
         }

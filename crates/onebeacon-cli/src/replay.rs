@@ -129,7 +129,8 @@ pub fn replay(path: &Path, args: ReplayArgs) -> Result<()> {
     if args.print_stream {
         let only = beacon_filter(args.beacons, &log.beacon_ids())?;
         let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
-        for item in log.items()? {
+        let mut items = log.items()?;
+        for item in &mut items {
             let item = item?;
             let beacon = match &item.input {
                 onebeacon::nav::session::Input::Measurement(m) => m.beacon().map(|b| b.id),
@@ -142,6 +143,9 @@ pub fn replay(path: &Path, args: ReplayArgs) -> Result<()> {
             writeln!(stdout, "{}", jsonl::item_json(&item))?;
         }
         stdout.flush()?;
+        for d in items.damage() {
+            eprintln!("warning: {d}; what came before it was read");
+        }
         return Ok(());
     }
     let p = Prepared::new(log, args.estimators, args.out, args.beacons, "replay")?;

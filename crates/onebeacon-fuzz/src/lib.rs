@@ -20,7 +20,7 @@ use std::path::PathBuf;
 pub type Target = fn(&[u8]);
 
 /// The targets by name, as `fuzz/fuzz_targets/` and the corpus directories name them.
-pub const TARGETS: [(&str, Target); 7] = [
+pub const TARGETS: &[(&str, Target)] = &[
     ("scenario", scenario),
     ("log_description", log_description),
     ("log_csv", log_csv),
@@ -28,6 +28,8 @@ pub const TARGETS: [(&str, Target); 7] = [
     ("wav", wav),
     ("ping_config", ping_config),
     ("partial", partial),
+    #[cfg(feature = "ros2")]
+    ("log_bag", log_bag),
 ];
 
 /// Longest scenario the target simulates (steps x vehicles): longer ones are only
@@ -149,6 +151,74 @@ pub fn log_csv(data: &[u8]) {
         });
     }
     // kept when a check fails (the panic skips this): the files of the failing input
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The description a bag input is replayed with: plaza's topics as `scripts/ros2_bags.py`
+/// writes them (odometry increments, ranges with the beacon in the frame id, a 2-D pose),
+/// its four beacons; a gated EKF and dead reckoning.
+#[cfg(feature = "ros2")]
+const LOG_BAG: &str = r#"name = "fuzz-bag"
+frame = "enu"
+[[source]]
+kind = "odometry"
+bag = "BAG"
+topic = "/wheel/increment"
+distance = "distance"
+heading_change = "heading_change"
+[[source]]
+kind = "range"
+bag = "BAG"
+topic = "/radio/range"
+beacon = "header.frame_id"
+range = "range"
+time_order = "drop"
+[[source]]
+kind = "ground_truth"
+bag = "BAG"
+topic = "/rtk/pose2d"
+x = "x"
+y = "y"
+heading = "heading"
+time_order = "sort"
+[beacons]
+file = "beacons.csv"
+id = "id"
+x = "x"
+y = "y"
+[initial]
+from = "ground_truth"
+[[estimators]]
+name = "ekf"
+kind = "range-ekf"
+nis_gate = 10.83
+[[estimators]]
+name = "dr"
+kind = "dead-reckoning"
+"#;
+
+/// A ROS 2 bag (SQLite3 when it starts as one, MCAP otherwise) replayed through
+/// [`LOG_BAG`]: an error or a trajectory with finite estimates; never a panic, whatever
+/// the damage.
+#[cfg(feature = "ros2")]
+pub fn log_bag(data: &[u8]) {
+    let dir = scratch();
+    let bag = if data.starts_with(b"SQLite format 3\0") { "bag.db3" } else { "bag.mcap" };
+    std::fs::write(dir.join(bag), data).expect("writable");
+    // plaza1's beacons (data/plaza/plaza1_beacons.csv)
+    let beacons =
+        "id,x,y\n0,-46.623234,11.025549\n1,11.036124,-6.958689\n6,22.053129,23.848482\n5,-17.664893,59.009181\n";
+    std::fs::write(dir.join("beacons.csv"), beacons).expect("writable");
+    let path = dir.join("log.toml");
+    std::fs::write(&path, LOG_BAG.replace("BAG", bag)).expect("writable");
+    if let Ok(log) = Log::load(&path) {
+        let _ = replay(&log, None, |r| {
+            for e in &r.estimates {
+                assert!(e.pos.iter().all(|v| v.is_finite()), "at t = {}: {:?}", r.t_s, e.pos);
+            }
+            Ok::<_, LogError>(())
+        });
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -238,7 +238,12 @@ fn source_rows(log: &Log, which: impl Fn(onebeacon::log::schema::SourceKind) -> 
     use std::io::Read;
     let mut rows = 0u64;
     for s in log.description.sources.iter().filter(|s| which(s.kind)) {
-        let Ok(mut f) = onebeacon::io::file::open_bounded(&log.base().join(&s.file)) else { continue };
+        if let Some(bag) = &s.bag {
+            rows += bag_messages(&log.base().join(bag));
+            continue;
+        }
+        let Some(file) = &s.file else { continue };
+        let Ok(mut f) = onebeacon::io::file::open_bounded(&log.base().join(file)) else { continue };
         let mut buf = vec![0u8; 1 << 16];
         let mut lines = 0u64;
         while let Ok(n) = f.read(&mut buf) {
@@ -250,6 +255,18 @@ fn source_rows(log: &Log, which: impl Fn(onebeacon::log::schema::SourceKind) -> 
         rows += lines.saturating_sub(1);
     }
     rows as f64
+}
+
+/// The messages a ROS 2 bag (a file or a directory of splits) can hold, at most: every
+/// message of every topic takes 48 bytes at least (MCAP's message record is 31 bytes
+/// before its data, a CDR message with a header 16 and more).
+fn bag_messages(path: &std::path::Path) -> u64 {
+    let size = |p: &std::path::Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+    let bytes = match std::fs::read_dir(path) {
+        Ok(dir) => dir.filter_map(|e| e.ok()).map(|e| size(&e.path())).sum(),
+        Err(_) => size(path),
+    };
+    bytes / 48
 }
 
 /// The bytes a Gaussian filter of `n` states keeps per prediction for its

@@ -29,6 +29,8 @@ pub struct Replay {
     pub items: usize,
     /// Rows dropped and kept by sources with `time_order = "drop"`.
     pub dropped: Vec<Dropped>,
+    /// What the sources could not read (a damaged bag), one line each.
+    pub damage: Vec<String>,
     /// Where and when the estimators started (`[initial]`: given, the ground truth or a
     /// fix of the first ranges).
     pub start: InitialStart,
@@ -65,6 +67,7 @@ impl Replay {
                 )
             })
             .collect();
+        w.extend(self.damage.iter().map(|d| format!("{d}; what came before it was read")));
         if has_truth {
             for (name, st) in self.session.names.iter().zip(&self.session.stats) {
                 if st.count < MIN_SCORED_ROWS {
@@ -186,7 +189,7 @@ fn replay_session<E: From<LogError>>(
         record(to_record(&step, session.last_beacon, heard))?;
         heard = false;
     }
-    Ok(Replay { session, items, dropped: stream.dropped(), start, wide_turns })
+    Ok(Replay { session, items, dropped: stream.dropped(), damage: stream.damage(), start, wide_turns })
 }
 
 /// An estimator's entry in a trajectory row (NED) with its error and NEES (NaN: none).

@@ -259,6 +259,9 @@ pub fn step_json(line: usize, step: &Step, names: &[String], frame: Frame) -> Va
                 "heading_rad": frame.heading_from_ned(e.heading_rad()),
                 "sigma_x_m": sx.abs(),
                 "sigma_y_m": sy.abs(),
+                // north-east covariance is x-y covariance in either frame (ENU swaps both axes)
+                "cov_xy_m2": e.horizontal_cov_m2[(0, 1)],
+                "sigma_heading_rad": e.heading_var_rad2.max(0.0).sqrt(),
             });
             for (k, x) in e.calibration.keys() {
                 v[k] = json!(x);

@@ -9,6 +9,8 @@ pub(super) struct Table {
     header: Vec<String>,
     reader: csv::Reader<LineLimited<std::io::Take<std::fs::File>>>,
     record: csv::StringRecord,
+    /// The line of the row in hand.
+    line: u64,
 }
 
 /// Longest CSV line read, bytes: a file that is not a CSV (a device, a binary) is
@@ -36,12 +38,6 @@ impl<R: std::io::Read> std::io::Read for LineLimited<R> {
     }
 }
 
-/// One row of a [`Table`].
-pub(super) struct Row<'a> {
-    pub(super) table: &'a Table,
-    line: u64,
-}
-
 impl Table {
     pub(super) fn open(base: &Path, file: &Path) -> Result<Self, LogError> {
         let path = base.join(file);
@@ -55,7 +51,7 @@ impl Table {
             .iter()
             .map(String::from)
             .collect();
-        Ok(Self { file: name, header, reader, record: csv::StringRecord::new() })
+        Ok(Self { file: name, header, reader, record: csv::StringRecord::new(), line: 0 })
     }
 
     pub(super) fn index(&self, column: &str) -> Result<usize, LogError> {
@@ -75,44 +71,24 @@ impl Table {
         })
     }
 
-    pub(super) fn next_row(&mut self) -> Result<Option<Row<'_>>, LogError> {
+    /// Reads the next row; false at the end of the file.
+    pub(super) fn next_row(&mut self) -> Result<bool, LogError> {
         match self.reader.read_record(&mut self.record) {
-            Ok(false) => Ok(None),
-            Ok(true) => {
-                let line = self.record.position().map_or(0, |p| p.line());
-                Ok(Some(Row { table: self, line }))
+            Ok(more) => {
+                self.line = self.record.position().map_or(0, |p| p.line());
+                Ok(more)
             }
             Err(e) => Err(LogError::File { file: self.file.clone(), message: format!("malformed CSV: {e}") }),
         }
     }
-}
 
-impl Row<'_> {
+    /// An error at the row in hand, in `column`.
     pub(super) fn error(&self, column: usize, message: String) -> LogError {
-        LogError::Cell {
-            file: self.table.file.clone(),
-            line: self.line,
-            column: self.table.header[column].clone(),
-            message,
-        }
+        LogError::Cell { file: self.file.clone(), line: self.line, column: self.header[column].clone(), message }
     }
 
+    /// The cell of the row in hand in `column`.
     pub(super) fn cell(&self, column: usize) -> &str {
-        self.table.record.get(column).unwrap_or("")
-    }
-
-    pub(super) fn number(&self, column: usize) -> Result<f64, LogError> {
-        let cell = self.cell(column);
-        match cell.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
-            Ok(_) => Err(self.error(column, format!("`{cell}` is not finite; a finite number is expected"))),
-            Err(_) => Err(self.error(column, format!("`{cell}` is not a number"))),
-        }
-    }
-
-    pub(super) fn beacon_id(&self, column: usize) -> Result<u32, LogError> {
-        let cell = self.cell(column);
-        cell.parse::<u32>()
-            .map_err(|_| self.error(column, format!("`{cell}` is not a beacon id (a non-negative integer)")))
+        self.record.get(column).unwrap_or("")
     }
 }

@@ -2,12 +2,12 @@
 //! stream. Every error is one line naming the file, the line, the column or key and
 //! what was expected.
 
-use super::csv::Table;
 use super::error::LogError;
 use super::geodesy::{Geodetic, check_latlon};
 use super::merge::{Items, Rows};
 use super::rows::{Site, SourceRows};
 pub use super::schema::*;
+use super::table::Table;
 use crate::config::builder::VehicleModel;
 use crate::config::estimator::{EstimatorKind, EstimatorSpec, Host};
 use crate::config::stream::{Beacon, StreamConfig};
@@ -56,7 +56,13 @@ impl Log {
     /// Every file the log reads: its description, its CSV files and its beacons file.
     pub fn files(&self) -> Vec<PathBuf> {
         let mut files = vec![self.path.clone()];
-        files.extend(self.description.sources.iter().map(|s| self.base.join(&s.file)));
+        files.extend(
+            self.description
+                .sources
+                .iter()
+                .filter_map(|s| s.file.as_ref().or(s.bag.as_ref()))
+                .map(|f| self.base.join(f)),
+        );
         files.extend(self.description.beacons.iter().map(|b| self.base.join(&b.file)));
         files
     }
@@ -67,7 +73,7 @@ impl Log {
         self.description
             .sources
             .iter()
-            .filter_map(|s| std::fs::metadata(self.base.join(&s.file)).ok())
+            .filter_map(|s| std::fs::metadata(self.base.join(s.file.as_ref().or(s.bag.as_ref())?)).ok())
             .map(|m| m.len())
             .sum()
     }
@@ -142,18 +148,20 @@ impl LogDescription {
     fn geodetic(&self, base: &Path) -> Result<Option<Geodetic>, LogError> {
         let deg = std::f64::consts::PI / 180.0;
         let mut first = self.origin.map(|o| (o.lat_deg * deg, o.lon_deg * deg));
-        let first_row = |file: &Path, lat: &str, lon: &str, unit: LatLonUnit| -> Result<Option<(f64, f64)>, LogError> {
-            let mut table = Table::open(base, file)?;
-            let (lat, lon) = (table.index(lat)?, table.index(lon)?);
-            let Some(row) = table.next_row()? else { return Ok(None) };
-            let (lat_rad, lon_rad) = (row.number(lat)? * unit.radians(), row.number(lon)? * unit.radians());
-            check_latlon(lat_rad, lon_rad).map_err(|m| row.error(lat, m))?;
-            Ok(Some((lat_rad, lon_rad)))
-        };
+        let first_row =
+            |mut table: Table, lat: &str, lon: &str, unit: LatLonUnit| -> Result<Option<(f64, f64)>, LogError> {
+                let (lat, lon) = (table.index(lat)?, table.index(lon)?);
+                if !table.next_row()? {
+                    return Ok(None);
+                }
+                let (lat_rad, lon_rad) = (table.number(lat)? * unit.radians(), table.number(lon)? * unit.radians());
+                check_latlon(lat_rad, lon_rad).map_err(|m| table.error(lat, m))?;
+                Ok(Some((lat_rad, lon_rad)))
+            };
         if let Some(t) = self.beacons.as_ref().filter(|_| first.is_none())
             && let (Some(lat), Some(lon)) = (&t.lat, &t.lon)
         {
-            first = first_row(&t.file, lat, lon, t.latlon_unit)?;
+            first = first_row(Table::csv(base, &t.file)?, lat, lon, t.latlon_unit)?;
         }
         if first.is_none() {
             first = self.beacon_list.iter().find_map(|b| Some((b.lat_deg? * deg, b.lon_deg? * deg)));
@@ -162,8 +170,17 @@ impl LogDescription {
             if first.is_some() {
                 break;
             }
-            if let (Some(lat), Some(lon)) = (&s.lat, &s.lon) {
-                first = first_row(&s.file, lat, lon, s.latlon_unit)?;
+            // a live topic cannot be read ahead (its latitudes need [origin]); a CSV
+            // file's are named, a bag's may be a standard message's
+            let live = s.file.is_none() && s.bag.is_none();
+            if live || s.lat.is_none() && (s.bag.is_none() || !s.kind.positioned()) {
+                continue;
+            }
+            // a bag's standard message may hold them (sensor_msgs/NavSatFix)
+            let table = Table::open(base, s)?;
+            let column = |k: &str| s.column(k).cloned().or_else(|| table.default_column(s.kind, k));
+            if let (Some(lat), Some(lon)) = (column("lat"), column("lon")) {
+                first = first_row(table, &lat, &lon, s.latlon_unit)?;
             }
         }
         let frame = Frame::from(self.frame);
@@ -179,16 +196,17 @@ impl LogDescription {
     fn beacons_about(&self, base: &Path, geo: Option<&Geodetic>) -> Result<BTreeMap<u32, Vector3<f64>>, LogError> {
         let mut out = BTreeMap::new();
         if let Some(t) = &self.beacons {
-            let mut table = Table::open(base, &t.file)?;
+            let mut table = Table::csv(base, &t.file)?;
             let id = table.index(&t.id)?;
-            let columns = |a: &Option<String>, b: &Option<String>| match (a, b) {
+            let mut columns = |a: &Option<String>, b: &Option<String>| match (a, b) {
                 (Some(a), Some(b)) => Ok(Some((table.index(a)?, table.index(b)?))),
                 _ => Ok::<_, LogError>(None),
             };
             let (xy, latlon) = (columns(&t.x, &t.y)?, columns(&t.lat, &t.lon)?);
             let z = t.z.as_ref().map(|z| table.index(z)).transpose()?;
             let scale = t.length_unit.metres();
-            while let Some(row) = table.next_row()? {
+            while table.next_row()? {
+                let row = &table;
                 let b = row.beacon_id(id)?;
                 let z = z.map_or(Ok(0.0), |z| row.number(z))? * scale;
                 let (x, y) = match (xy, latlon, geo) {
@@ -250,14 +268,8 @@ impl Log {
     /// and opens every file it names (relative to its directory): headers, columns and
     /// first rows are checked here; a later bad row is an error of [`Log::items`].
     pub fn load(path: &Path) -> Result<Self, LogError> {
-        let description = LogDescription::load(path)?;
-        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        let frame = Frame::from(description.frame);
-        let geodetic = description.geodetic(&base)?;
-        let beacons = description.beacons_about(&base, geodetic.as_ref())?;
+        let mut log = Self::described(path)?;
         // beacon tracks first, so that ranges may name tracked beacons
-        let (tracked, path) = (BTreeSet::new(), path.to_path_buf());
-        let mut log = Self { description, frame, beacons, tracked, geodetic, base, path };
         let mut tracked = BTreeSet::new();
         for s in log.description.sources.iter().filter(|s| s.kind == SourceKind::BeaconTrack) {
             let mut rows = SourceRows::open(log.site(), s)?;
@@ -272,8 +284,19 @@ impl Log {
         Ok(log)
     }
 
+    /// The description at `path` with its fixed beacons and origin; no source opened.
+    pub(super) fn described(path: &Path) -> Result<Self, LogError> {
+        let description = LogDescription::load(path)?;
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let frame = Frame::from(description.frame);
+        let geodetic = description.geodetic(&base)?;
+        let beacons = description.beacons_about(&base, geodetic.as_ref())?;
+        let (tracked, path) = (BTreeSet::new(), path.to_path_buf());
+        Ok(Self { description, frame, beacons, tracked, geodetic, base, path })
+    }
+
     /// What its rows are read against.
-    fn site(&self) -> Site<'_> {
+    pub(super) fn site(&self) -> Site<'_> {
         let (base, frame, beacons, tracked, geodetic) =
             (&self.base, self.frame, &self.beacons, &self.tracked, self.geodetic);
         Site { base, frame, beacons, tracked, geodetic }
@@ -282,18 +305,19 @@ impl Log {
     /// The merged, time-ordered stream of every source. At equal times: beacon
     /// positions, then measurements, then the truth; then in the order of the sources.
     pub fn items(&self) -> Result<Items<'_>, LogError> {
-        let (mut heads, mut rows) = (Vec::new(), Vec::new());
+        let (mut heads, mut rows, mut damaged) = (Vec::new(), Vec::new(), Vec::new());
         for s in &self.description.sources {
             let mut source = SourceRows::open(self.site(), s)?;
             let head = source
                 .next_item()?
-                .ok_or_else(|| LogError::File { file: source.table.file.clone(), message: "no rows".into() })?;
+                .ok_or_else(|| LogError::File { file: source.table.name().to_string(), message: "no rows".into() })?;
             if s.time_order() == TimeOrder::Sort {
                 let mut all = vec![head];
                 while let Some(item) = source.next_item()? {
                     all.push(item);
                 }
                 all.sort_by(|a, b| a.t_s.total_cmp(&b.t_s)); // stable: equal times keep their rows' order
+                damaged.extend(source.table.damage().map(|d| format!("{}: {d}", source.table.name())));
                 let mut all = all.into_iter();
                 heads.push(all.next());
                 rows.push(Rows::Sorted(all));
@@ -308,7 +332,7 @@ impl Log {
             _ => 1,
         };
         let ranks = self.description.sources.iter().map(rank).collect();
-        Ok(Items { heads, rows, ranks, error: None })
+        Ok(Items { heads, rows, ranks, error: None, damaged })
     }
 
     /// Every beacon of the log: fixed ones and those with a track.

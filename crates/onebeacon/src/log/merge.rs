@@ -24,16 +24,28 @@ pub struct Items<'a> {
     pub(super) ranks: Vec<u8>,
     /// A source's error, given after the item in hand.
     pub(super) error: Option<LogError>,
+    /// The damage of sources read whole (sorted) before the merge.
+    pub(super) damaged: Vec<String>,
 }
 
 impl Items<'_> {
+    /// What the sources could not read (a bag's truncation, its messages that did not
+    /// decode), one line each naming the source.
+    pub fn damage(&self) -> Vec<String> {
+        let streamed = self.rows.iter().filter_map(|r| match r {
+            Rows::Streamed(rows) => rows.table.damage().map(|d| format!("{}: {d}", rows.table.name())),
+            Rows::Sorted(_) => None,
+        });
+        self.damaged.iter().cloned().chain(streamed).collect()
+    }
+
     /// The rows dropped and kept so far by sources with `time_order = "drop"`.
     pub fn dropped(&self) -> Vec<Dropped> {
         self.rows
             .iter()
             .filter_map(|r| match r {
                 Rows::Streamed(rows) if rows.order == TimeOrder::Drop => {
-                    Some(Dropped { file: rows.table.file.clone(), dropped: rows.dropped, kept: rows.kept_rows })
+                    Some(Dropped { file: rows.table.name().to_string(), dropped: rows.dropped, kept: rows.kept_rows })
                 }
                 _ => None,
             })

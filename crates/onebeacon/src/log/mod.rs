@@ -6,15 +6,21 @@
 //! this crate alone. The replay, smoother and tuning that run over a log live in the
 //! simulator crate.
 
+mod cell;
 mod csv;
 mod error;
 mod geodesy;
 pub mod load;
 mod merge;
+#[cfg(feature = "ros2")]
+pub mod ros2;
 mod rows;
 pub mod schema;
+mod table;
 #[cfg(any(test, feature = "test-util"))]
 pub mod testing;
+#[cfg(feature = "ros2")]
+pub mod topics;
 mod validate;
 
 pub use error::LogError;

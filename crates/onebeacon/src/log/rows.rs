@@ -1,10 +1,11 @@
 //! One source's rows into stream items: its clock (time cells to seconds), units and
 //! frame to SI and the log's frame, and the rows dropped out of time order.
 
-use super::csv::Table;
+use super::cell::Cell;
 use super::error::LogError;
 use super::geodesy::Geodetic;
 use super::schema::{COLUMN_KEYS, IncrementFrame, Source, SourceKind, TimeOrder};
+use super::table::Table;
 use crate::geo::Frame;
 use crate::nav::Kind;
 use crate::nav::session::{Input, Item, TruthPose, resolve_beacon};
@@ -14,7 +15,7 @@ use std::path::Path;
 
 /// One source read row by row into stream items (the log's frame, SI units).
 pub(super) struct SourceRows<'a> {
-    source: &'a Source,
+    pub(super) source: &'a Source,
     pub(super) table: Table,
     time: usize,
     cols: BTreeMap<&'static str, usize>,
@@ -36,6 +37,9 @@ pub(super) struct SourceRows<'a> {
     pub(super) dropped: usize,
     pub(super) kept_rows: usize,
     error: Option<LogError>,
+    /// A live topic's: a beacon not among the fixed ones is left for the stream to
+    /// resolve (it may be tracked by then).
+    live: bool,
 }
 
 /// The rows of a `time_order = "drop"` source: dropped out of time order, and kept.
@@ -93,7 +97,12 @@ impl Clock {
     }
 
     /// The time of a cell, seconds; an error message when it cannot be read.
-    fn read(&mut self, cell: &str) -> Result<f64, String> {
+    fn read(&mut self, cell: Cell) -> Result<f64, String> {
+        let cell = match (cell, &*self) {
+            (Cell::Number(v), Clock::Number(unit)) if v.is_finite() => return Ok(v * unit),
+            (Cell::Number(v), _) => return Err(format!("{v}: a finite number of seconds is expected")),
+            (Cell::Text(cell), _) => cell,
+        };
         let unix =
             |t: chrono::DateTime<chrono::Utc>| t.timestamp() as f64 + f64::from(t.timestamp_subsec_nanos()) * 1e-9;
         let explain = |format: &str, e: chrono::ParseError| {
@@ -142,12 +151,30 @@ pub(super) struct Site<'a> {
 
 impl<'a> SourceRows<'a> {
     pub(super) fn open(log: Site<'a>, source: &'a Source) -> Result<Self, LogError> {
-        let table = Table::open(log.base, &source.file)?;
-        let time = table.index(&source.time)?;
-        let cols = COLUMN_KEYS
-            .iter()
-            .filter_map(|k| source.column(k).map(|c| table.index(c).map(|c| (*k, c))))
-            .collect::<Result<_, _>>()?;
+        let table = Table::open(log.base, source)?;
+        Self::with_table(log, source, table, false)
+    }
+
+    /// The rows of a live topic (`onebeacon ros2`): one per message handed in; times
+    /// going back are the session's to screen, as on a stream.
+    #[cfg(feature = "ros2")]
+    pub(super) fn open_live(log: Site<'a>, source: &'a Source) -> Result<Self, LogError> {
+        let table = Table::live(log.base, source)?;
+        let mut rows = Self::with_table(log, source, table, true)?;
+        if rows.cols.contains_key("lat") && rows.geodetic.is_none() {
+            return Err(LogError::File {
+                file: rows.table.name().to_string(),
+                message: "latitudes and longitudes on a live topic need the description's [origin] (lat_deg, \
+                          lon_deg): a node cannot wait for its first fix to place the others"
+                    .into(),
+            });
+        }
+        rows.order = TimeOrder::Sort;
+        Ok(rows)
+    }
+
+    fn with_table(log: Site<'a>, source: &'a Source, mut table: Table, live: bool) -> Result<Self, LogError> {
+        let (time, cols) = columns(&mut table, source)?;
         let frame_clockwise = log.frame == Frame::Ned;
         let sense = if source.heading_clockwise.is_some_and(|c| c != frame_clockwise) { -1.0 } else { 1.0 };
         Ok(Self {
@@ -168,6 +195,7 @@ impl<'a> SourceRows<'a> {
             dropped: 0,
             kept_rows: 0,
             error: None,
+            live,
         })
     }
 
@@ -222,7 +250,10 @@ impl<'a> SourceRows<'a> {
         let (s, cols, time) = (self.source, &self.cols, self.time);
         let (beacons, tracked, geodetic, sense) = (self.beacons, self.tracked, self.geodetic, self.sense);
         let previous = self.previous;
-        let Some(row) = self.table.next_row()? else { return Ok(None) };
+        if !self.table.next_row()? {
+            return Ok(None);
+        }
+        let row = &self.table;
         let t = self.clock.read(row.cell(time)).map_err(|m| row.error(time, m))? + s.time_offset_s;
         if let Some(p) = previous.filter(|p| t < *p && self.order == TimeOrder::Refuse) {
             return Err(row.error(
@@ -234,8 +265,12 @@ impl<'a> SourceRows<'a> {
         let num = |k: &str| row.number(cols[k]);
         let heading = |k: &str| Ok::<_, LogError>(sense * num(k)? * ang + s.heading_offset_deg.to_radians());
         let turn = |k: &str| Ok::<_, LogError>(sense * num(k)? * ang);
+        let live = self.live;
         let beacon = || {
             let id = row.beacon_id(cols["beacon"])?;
+            if live && !beacons.contains_key(&id) {
+                return Ok(crate::nav::BeaconFix::fixed(id, Vector3::repeat(f64::NAN)));
+            }
             resolve_beacon(id, beacons, tracked).map_err(|m| row.error(cols["beacon"], m))
         };
         let position = || match (cols.get("x").zip(cols.get("y")), geodetic) {
@@ -307,6 +342,33 @@ impl<'a> SourceRows<'a> {
         self.previous = Some(t);
         Ok(Some((item, second)))
     }
+}
+
+/// The time column and the column of each key of `source` in `table`: the source's
+/// own, or a standard message's (a bag's), every key the kind needs present.
+pub(super) fn columns(table: &mut Table, source: &Source) -> Result<(usize, BTreeMap<&'static str, usize>), LogError> {
+    let time = source.time.clone().or_else(|| table.default_column(source.kind, "time"));
+    let time = table.index(time.as_deref().unwrap_or("time"))?;
+    let mut cols = BTreeMap::new();
+    for k in COLUMN_KEYS {
+        if let Some(c) = source.column(k).cloned().or_else(|| table.default_column(source.kind, k)) {
+            cols.insert(k, table.index(&c)?);
+        }
+    }
+    let (required, _) = source.kind.columns();
+    let position = !source.kind.positioned()
+        || cols.contains_key("x") && cols.contains_key("y")
+        || cols.contains_key("lat") && cols.contains_key("lon");
+    if let Some(k) = required.iter().find(|k| !cols.contains_key(*k)).copied().or((!position).then_some("x")) {
+        return Err(LogError::File {
+            file: table.name().to_string(),
+            message: format!(
+                "a {:?} source needs `{k}`: its messages have no standard field for it; name one (`{k} = \"field.path\"`)",
+                source.kind
+            ),
+        });
+    }
+    Ok((time, cols))
 }
 
 /// A start-frame increment (`increment_frame = "start"`: the translation (d, l) at the

@@ -146,11 +146,24 @@ pub enum IncrementFrame {
 #[serde(deny_unknown_fields)]
 pub struct Source {
     pub kind: SourceKind,
-    /// Relative to the log description's directory.
-    pub file: PathBuf,
+    /// A CSV file, relative to the log description's directory (or `bag`).
+    pub file: Option<PathBuf>,
+    /// A ROS 2 bag (an `.mcap` or `.db3` file, or a rosbag2 directory), relative to the
+    /// description's directory, and the `topic` read from it; the column keys then name
+    /// field paths of its messages (`twist.linear.x`), or take a standard message's.
+    pub bag: Option<PathBuf>,
+    pub topic: Option<String>,
+    /// A live topic's ROS 2 type (`geometry_msgs/msg/TwistStamped`), for `onebeacon
+    /// ros2`: a source with a `topic`, no `file` and no `bag`; a type that is not a
+    /// standard message needs its `definition`, a `.msg` file (relative to the
+    /// description), the types it uses after `MSG: pkg/Type` lines as a bag has them.
+    pub r#type: Option<String>,
+    pub definition: Option<PathBuf>,
     /// The time column: a number (seconds since any origin, or a UNIX epoch) in
-    /// `time_unit`, or text read with `time_format`.
-    pub time: String,
+    /// `time_unit`, or text read with `time_format`. In a bag: a field path
+    /// (`header.stamp` by default when the message has a header) or `log_time`, when
+    /// the recorder received it.
+    pub time: Option<String>,
     #[serde(default)]
     pub time_unit: TimeUnit,
     /// A strftime pattern for times written as text (`%H:%M:%S%.f` with `date`, or

@@ -70,6 +70,40 @@ fn check_time(i: usize, s: &Source) -> Result<(), Violation> {
     check(&at("time_offset_s"), s.time_offset_s, Rule::Finite)
 }
 
+/// Where a source's rows are: a CSV `file` with its `time` column, or a `bag` and its
+/// `topic`.
+fn check_place(i: usize, s: &Source) -> Result<(), Violation> {
+    let at = |k: &str| format!("source[{i}].{k}");
+    let fail = |key: &str, value: &str, allowed: &str| {
+        Err(Violation { key: at(key), value: value.into(), allowed: allowed.into() })
+    };
+    let live = s.file.is_none() && s.bag.is_none();
+    if !live && (s.r#type.is_some() || s.definition.is_some()) {
+        let key = if s.r#type.is_some() { "type" } else { "definition" };
+        return fail(key, "given", "names a live topic's type (onebeacon ros2); a file or a bag says its own");
+    }
+    match (&s.file, &s.bag) {
+        (Some(_), Some(_)) => fail("bag", "given with file", "a source reads a CSV `file` or a ROS 2 `bag`, not both"),
+        (None, None) if s.topic.is_none() || s.r#type.is_none() => fail(
+            if s.topic.is_none() { "file" } else { "type" },
+            "missing",
+            "a source reads a CSV `file`, a ROS 2 `bag` with its `topic`, or (onebeacon ros2) a live `topic` with its `type`",
+        ),
+        (None, None) if s.time_format.is_some() || s.date.is_some() => {
+            fail("time_format", "given", "a topic's times are stamps or the time received; time_format reads CSV text")
+        }
+        (Some(_), None) if s.topic.is_some() => fail("topic", "given", "names a bag's topic: give `bag`, not `file`"),
+        (Some(_), None) if s.time.is_none() => fail("time", "missing", "a CSV source names its time column"),
+        (None, Some(_)) if s.topic.is_none() => {
+            fail("topic", "missing", "a bag source names the topic it reads (\"/dvl/twist\")")
+        }
+        (None, Some(_)) if s.time_format.is_some() || s.date.is_some() => {
+            fail("time_format", "given", "a bag's times are stamps or the recorder's clock; time_format reads CSV text")
+        }
+        _ => Ok(()),
+    }
+}
+
 /// A log description's own keys: each source's column keys, the beacons, the origin.
 pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
     if !d.model.is_planar() && !d.sources.is_empty() {
@@ -89,8 +123,11 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
         });
     }
     for (i, s) in d.sources.iter().enumerate() {
+        check_place(i, s)?;
         let (required, optional) = s.kind.columns();
-        if let Some(key) = required.iter().find(|k| s.column(k).is_none()) {
+        // a topic's standard messages give the keys a source leaves out: checked on opening it
+        let bag = s.file.is_none();
+        if let Some(key) = required.iter().find(|k| s.column(k).is_none() && !bag) {
             return Err(Violation {
                 key: format!("source[{i}].{key}"),
                 value: "missing".into(),
@@ -99,8 +136,8 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
         }
         const POSITION: [&str; 4] = ["x", "y", "lat", "lon"];
         let positioned = s.kind.positioned();
-        if positioned {
-            let has = |k: &str| s.column(k).is_some();
+        let has = |k: &str| s.column(k).is_some();
+        if positioned && !(bag && POSITION.iter().all(|k| !has(k))) {
             check_position(&format!("source[{i}]"), (has("x"), has("y")), (has("lat"), has("lon")), POSITION)?;
         }
         let known = |k: &&str| required.contains(k) || optional.contains(k) || positioned && POSITION.contains(k);
