@@ -69,7 +69,7 @@ impl PyNavigator {
         let mut infos = Vec::new();
         let out = self.lines.push(&mut unit, line.as_bytes(), line.len() > max, |_, note| match note {
             Note::Skipped(m) => skipped = Some(m),
-            Note::Info(m) => infos.push(m),
+            other => infos.push(other.message().to_string()),
         });
         for m in infos {
             user_warning(py, m)?;

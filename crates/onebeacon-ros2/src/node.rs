@@ -95,7 +95,7 @@ pub fn run(
     let node_name = NodeName::new("/", "onebeacon").map_err(|e| ros("node name", &e))?;
     let mut node = context.new_node(node_name, NodeOptions::new().enable_rosout(false)).map_err(|e| ros("node", &e))?;
     let mut subscriptions = Vec::new();
-    let poll = Poll::new()?;
+    let mut poll = Poll::new()?;
     for (i, t) in topics.iter().enumerate() {
         let name = Name::parse(t.topic()).map_err(|e| ros(&format!("topic name {}", t.topic()), &e))?;
         let (pkg, ty) = t.type_name();
@@ -111,7 +111,6 @@ pub fn run(
     let mut lines = Lines::default();
     let mut summary = Summary::default();
     let mut events = Events::with_capacity(64);
-    let mut poll = poll;
     let mut last = None::<Instant>;
     let mut pending = Vec::new();
     loop {
@@ -183,22 +182,14 @@ pub fn run(
             if let Some(r) = record.as_mut() {
                 writeln!(r, "{line}")?;
             }
-            let mut notes = Vec::new();
-            let output = lines.push(&mut unit, line.as_bytes(), false, |n, note| notes.push((n, note)));
-            for (n, note) in notes {
-                match note {
-                    Note::Skipped(m) => {
-                        outputs.skip(&m);
-                        report(n, &m);
-                    }
-                    Note::Info(m) => {
-                        if m.contains("started again") {
-                            outputs.restart(&m);
-                        }
-                        report(n, &m);
-                    }
+            let output = lines.push(&mut unit, line.as_bytes(), false, |n, note| {
+                match &note {
+                    Note::Skipped(m) => outputs.skip(m),
+                    Note::Restarted { estimator, .. } => outputs.restart(estimator),
+                    Note::Info(_) => {}
                 }
-            }
+                report(n, note.message());
+            });
             if let Some(o) = output {
                 writeln!(out, "{o}")?;
                 out.flush()?;
@@ -216,9 +207,7 @@ pub fn run(
     if let Some(mut r) = record {
         r.flush()?;
     }
-    lines.finish(&unit, |n, note| match note {
-        Note::Skipped(m) | Note::Info(m) => report(n, &m),
-    });
+    lines.finish(&unit, |n, note| report(n, note.message()));
     summary.lines = lines.count();
     summary.skipped = outputs.skipped;
     summary.dropped = outputs.dropped;

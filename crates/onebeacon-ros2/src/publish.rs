@@ -104,13 +104,9 @@ impl Outputs {
         self.last_skip = why.to_string();
     }
 
-    /// An estimator started again (the stream's note names it first).
-    pub(crate) fn restart(&mut self, note: &str) {
-        if let Some((name, _)) = note.split_once(':')
-            && let Some(r) = self.records.get_mut(name)
-        {
-            r.restarts += 1;
-        }
+    /// An estimator started again.
+    pub(crate) fn restart(&mut self, estimator: &str) {
+        self.records.entry(estimator.to_string()).or_default().restarts += 1;
     }
 
     /// Publishes what an output line of the stream holds.

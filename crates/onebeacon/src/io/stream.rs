@@ -27,9 +27,20 @@ pub enum Note {
     /// The line was skipped (not UTF-8, too long, not an item) or screened out by the
     /// session: why.
     Skipped(String),
-    /// The line was taken, and something is worth saying (before the start, an
-    /// estimator started again, the controller cannot decide yet).
+    /// The line was taken, and something is worth saying (before the start, the
+    /// controller cannot decide yet).
     Info(String),
+    /// The line was taken, and `estimator` started again from its last sound estimate.
+    Restarted { estimator: String, message: String },
+}
+
+impl Note {
+    /// What it says, in a line.
+    pub fn message(&self) -> &str {
+        match self {
+            Note::Skipped(m) | Note::Info(m) | Note::Restarted { message: m, .. } => m,
+        }
+    }
 }
 
 impl Lines {
@@ -110,9 +121,12 @@ impl Lines {
                             let name = &session.names[i];
                             note(
                                 number,
-                                Note::Info(format!(
-                                    "{name}: its state stopped being finite and positive definite; started again from its last sound estimate"
-                                )),
+                                Note::Restarted {
+                                    estimator: name.clone(),
+                                    message: format!(
+                                        "{name}: its state stopped being finite and positive definite; started again from its last sound estimate"
+                                    ),
+                                },
                             );
                         }
                         let mut out = step_json(number, &step, &session.names, unit.frame);
@@ -182,9 +196,7 @@ pub fn run(
     let max_line = unit.session(0).limits().max_line_bytes;
     let mut lines = Lines::default();
     let mut buf = Vec::new();
-    let mut say = |line: usize, n: Note| match n {
-        Note::Skipped(m) | Note::Info(m) => report(line, &m),
-    };
+    let mut say = |line: usize, n: Note| report(line, n.message());
     loop {
         let (read, too_long) = read_line(&mut input, &mut buf, max_line)?;
         if read == 0 {
