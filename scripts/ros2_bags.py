@@ -19,6 +19,7 @@ import argparse
 import json
 import subprocess
 import sys
+import tempfile
 from decimal import Decimal
 from pathlib import Path
 
@@ -126,7 +127,10 @@ def write_description(log, bag, path):
 
 def summary(onebeacon, description):
     """`replay --json`'s summary without the fields that name the files."""
-    out = subprocess.run([onebeacon, "replay", str(description), "--json"], capture_output=True, text=True)
+    # its files in a directory of their own, not in the working directory
+    with tempfile.TemporaryDirectory() as where:
+        out = subprocess.run([onebeacon, "replay", str(description), "--json", "--out", where], capture_output=True,
+                             text=True)
     if out.returncode != 0:
         raise SystemExit(f"replay {description} failed: {out.stderr.strip()}")
     s = json.loads(out.stdout)

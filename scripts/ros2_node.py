@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """`onebeacon ros2` against an independent DDS: Eclipse Cyclone DDS (the Python package
-`cyclonedds`) publishes plaza's inputs as ROS 2 messages and subscribes to the node's
+`cyclonedds`) publishes plaza's inputs, or what a simulated vehicle's computer heard
+(`onebeacon run SCENARIO --messages`), as ROS 2 messages and subscribes to the node's
 outputs. Used by scripts/ros2_tests/test_node.py, and on its own for the node's latency
 and memory at a rate:
 
@@ -15,6 +16,7 @@ publication to the Odometry it caused, on one clock) and prints both. Needs a
 
 import argparse
 import json
+import math
 import os
 import subprocess
 import sys
@@ -136,6 +138,17 @@ class PoseStamped(IdlStruct, typename="geometry_msgs::msg::dds_::PoseStamped_"):
 
 
 @dataclass
+class Setpoint(IdlStruct, typename="onebeacon_msgs::msg::dds_::Setpoint_"):
+    """crates/onebeacon-ros2/msg/Setpoint.msg."""
+    header: Header
+    heading: float64
+    speed: float64
+    depth: float64
+    mode: int32
+    phase: str
+
+
+@dataclass
 class KeyValue(IdlStruct, typename="diagnostic_msgs::msg::dds_::KeyValue_"):
     key: str
     value: str
@@ -209,17 +222,20 @@ class Graph:
     """A Cyclone DDS participant with writers for the inputs and readers of the node's
     outputs (every message kept, with when it came)."""
 
-    def __init__(self, domain, estimators, namespace="/onebeacon"):
+    def __init__(self, domain, estimators, inputs=None, namespace="/onebeacon"):
+        """`estimators`: the node's odometry topics below `namespace` (`ekf`,
+        `vehicle1/pf`); `inputs`: {topic: DDS type} written to (plaza's by default)."""
         self.dp = DomainParticipant(domain)
         reliable = Qos(Policy.Reliability.Reliable(max_blocking_time=duration(seconds=1)), Policy.History.KeepLast(10000))
+        inputs = inputs or {topic: cls for _, topic, cls, _, _, _ in INPUTS}
         self.writers = {
-            topic: DataWriter(self.dp, Topic(self.dp, "rt" + topic, cls), qos=reliable)
-            for _, topic, cls, _, _, _ in INPUTS
+            topic: DataWriter(self.dp, Topic(self.dp, "rt" + topic, cls), qos=reliable) for topic, cls in inputs.items()
         }
         self.received = {}  # topic -> [(arrival s, message)]
         self.readers = []
         outputs = [(f"{namespace}/{e}/odometry", Odometry) for e in estimators]
-        outputs += [(f"{namespace}/diagnostics", DiagnosticArray), (f"{namespace}/waypoint", PoseStamped)]
+        outputs += [(f"{namespace}/diagnostics", DiagnosticArray), (f"{namespace}/waypoint", PoseStamped),
+                    (f"{namespace}/setpoint", Setpoint)]
         for topic, cls in outputs:
             reader = DataReader(self.dp, Topic(self.dp, "rt" + topic, cls), qos=reliable)
             self.received[topic] = []
@@ -264,6 +280,185 @@ class Graph:
     def close(self):
         self.running = False
         self.thread.join()
+
+
+# A simulated vehicle's computer (`onebeacon run SCENARIO --messages`) on a ROS graph:
+# its stream lines as the messages a vehicle's drivers publish. Fixes, poses, twists and
+# the IMU are standard messages; an acoustic modem's report, a USBL's bearing and an
+# inverted USBL's fix have none, so these are the vehicle's own (their .msg definitions
+# below, given to the node by the description's `definition`).
+@dataclass
+class PointStamped(IdlStruct, typename="geometry_msgs::msg::dds_::PointStamped_"):
+    header: Header
+    point: Point
+
+
+@dataclass
+class TwistStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TwistStamped_"):
+    header: Header
+    twist: Twist
+
+
+@dataclass
+class PoseWithCovarianceStamped(IdlStruct, typename="geometry_msgs::msg::dds_::PoseWithCovarianceStamped_"):
+    header: Header
+    pose: PoseWithCovariance
+
+
+@dataclass
+class Imu(IdlStruct, typename="sensor_msgs::msg::dds_::Imu_"):
+    header: Header
+    orientation: Quaternion
+    orientation_covariance: array[float64, 9]
+    angular_velocity: Vector3
+    angular_velocity_covariance: array[float64, 9]
+    linear_acceleration: Vector3
+    linear_acceleration_covariance: array[float64, 9]
+
+
+@dataclass
+class VehicleReport(IdlStruct, typename="onebeacon_msgs::msg::dds_::VehicleReport_"):
+    header: Header
+    heading: float64
+    speed: float64
+    depth: float64
+
+
+@dataclass
+class UsblBearing(IdlStruct, typename="onebeacon_msgs::msg::dds_::UsblBearing_"):
+    header: Header
+    station: str
+    station_heading: float64
+    azimuth: float64
+    elevation: float64
+
+
+@dataclass
+class ArrayFix(IdlStruct, typename="onebeacon_msgs::msg::dds_::ArrayFix_"):
+    header: Header
+    t_tx: Time
+    beacon_sigma: float64
+    range: float64
+    azimuth: float64
+    inclination: float64
+    mode: uint8
+
+
+# per computer, stream kind -> topic, type, DDS type, its definition (None: a standard
+# message), source keys; in the order of the description's sources
+COMPUTERS = {
+    # hoff2024's surface vehicle: its own fix, the USBL's position, the AUVs' reports
+    # and bearings
+    "asv": {
+        "beacon_position": ("/asv/usbl/position", "geometry_msgs/msg/PointStamped", PointStamped, None,
+                            {"beacon": "header.frame_id"}),
+        "report": ("/asv/modem/report", "onebeacon_msgs/msg/VehicleReport", VehicleReport,
+                   "# what a vehicle says of itself; header.frame_id: the vehicle (auv_1)\n"
+                   "std_msgs/Header header\nfloat64 heading\nfloat64 speed\nfloat64 depth\n",
+                   {"vehicle": "header.frame_id", "heading": "heading", "speed": "speed", "depth": "depth"}),
+        "bearing": ("/asv/usbl/bearing", "onebeacon_msgs/msg/UsblBearing", UsblBearing,
+                    "# a USBL's bearing to a vehicle; header.frame_id: the vehicle heard, station: the USBL\n"
+                    "std_msgs/Header header\nstring station\nfloat64 station_heading\nfloat64 azimuth\n"
+                    "float64 elevation\n",
+                    {"vehicle": "header.frame_id", "beacon": "station", "station_heading": "station_heading",
+                     "azimuth": "azimuth", "elevation": "elevation"}),
+        "own_fix": ("/asv/odometry", "nav_msgs/msg/Odometry", Odometry, None, {}),
+    },
+    # rypkema's AUV: its DVL's speed, its IMU, its depth, and its inverted USBL's fixes
+    # of the beacon (with the beacon's position)
+    "auv": {
+        "beacon_position": ("/auv/beacon/position", "geometry_msgs/msg/PointStamped", PointStamped, None,
+                            {"beacon": "header.frame_id"}),
+        "speed": ("/auv/dvl/twist", "geometry_msgs/msg/TwistStamped", TwistStamped, None,
+                  {"speed": "twist.linear.x"}),
+        "attitude": ("/auv/imu", "sensor_msgs/msg/Imu", Imu, None, {}),
+        "depth": ("/auv/depth", "geometry_msgs/msg/PoseWithCovarianceStamped", PoseWithCovarianceStamped, None,
+                  {"depth": "pose.pose.position.z"}),
+        "array_fix": ("/auv/iusbl/fix", "onebeacon_msgs/msg/ArrayFix", ArrayFix,
+                      "# an inverted USBL's fix of a beacon's ping; header.frame_id: the beacon (beacon_0)\n"
+                      "std_msgs/Header header\nbuiltin_interfaces/Time t_tx\nfloat64 beacon_sigma\n"
+                      "float64 range\nfloat64 azimuth\nfloat64 inclination\nuint8 mode\n",
+                      {"beacon": "header.frame_id", "t_tx": "t_tx", "beacon_sigma": "beacon_sigma",
+                       "range": "range", "azimuth": "azimuth", "inclination": "inclination", "mode": "mode"}),
+    },
+}
+
+
+def computer_inputs(computer):
+    """{topic: DDS type} of a computer's inputs."""
+    return {topic: cls for topic, _, cls, _, _ in COMPUTERS[computer].values()}
+
+
+def computer_description(computer, stream_toml, directory):
+    """A computer's stream configuration `stream_toml` (run --messages's) with its
+    inputs as live topics (COMPUTERS[computer]; the .msg files beside it); returns its
+    path."""
+    sources = []
+    for kind, (topic, msgtype, _, definition, keys) in COMPUTERS[computer].items():
+        lines = ["[[source]]", f'kind = "{kind.replace("beacon_position", "beacon_track")}"', f'topic = "{topic}"',
+                 f'type = "{msgtype}"']
+        if definition:
+            msg = directory / (msgtype.split("/")[-1] + ".msg")
+            msg.write_text(definition)
+            lines.append(f'definition = "{msg.name}"')
+        sources.append("\n".join(lines + [f'{k} = "{v}"' for k, v in keys.items()]))
+    text = Path(stream_toml).read_text()
+    # the sources before the first table, whose keys they would otherwise join
+    cut = text.index("\n[")
+    path = directory / f"{computer}-live.toml"
+    path.write_text(text[:cut] + "\n\n" + "\n\n".join(sources) + "\n" + text[cut:])
+    return path
+
+
+def quaternion(roll, pitch, yaw):
+    """The unit quaternion (x, y, z, w) of ZYX Euler angles."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return Quaternion(x=sr * cp * cy - cr * sp * sy, y=cr * sp * cy + sr * cp * sy, z=cr * cp * sy - sr * sp * cy,
+                      w=cr * cp * cy + sr * sp * sy)
+
+
+def computer_messages(computer, input_jsonl):
+    """The stream lines of `input_jsonl` (run --messages's NAME.input.jsonl) as (t_s,
+    topic, message), in their order; times to the nanosecond, as a stamp holds them."""
+    zero3, zero9, zero36 = Vector3(x=0.0, y=0.0, z=0.0), [0.0] * 9, [0.0] * 36
+    out = []
+    for line in Path(input_jsonl).read_text().splitlines():
+        d = json.loads(line)
+        kind, t = d["kind"], d["t_s"]
+        header = Header(stamp=stamp(repr(t)), frame_id=f"auv_{d.get('vehicle', 0)}")
+        beacon = Header(stamp=header.stamp, frame_id=f"beacon_{d.get('beacon', 0)}")
+        if kind == "own_fix":
+            pose = Pose(position=Point(x=d["x_m"], y=d["y_m"], z=0.0), orientation=quaternion(0, 0, d["heading_rad"]))
+            twist = Twist(linear=Vector3(x=d["speed_m_s"], y=0.0, z=0.0), angular=zero3)
+            m = Odometry(header=Header(stamp=header.stamp, frame_id="map"), child_frame_id="base_link",
+                         pose=PoseWithCovariance(pose=pose, covariance=zero36),
+                         twist=TwistWithCovariance(twist=twist, covariance=zero36))
+        elif kind == "beacon_position":
+            m = PointStamped(header=beacon, point=Point(x=d["x_m"], y=d["y_m"], z=d["z_m"]))
+        elif kind == "report":
+            m = VehicleReport(header=header, heading=d["heading_rad"], speed=d["speed_m_s"], depth=d["depth_m"])
+        elif kind == "bearing":
+            m = UsblBearing(header=header, station=f"beacon_{d['beacon']}", station_heading=d["station_heading_rad"],
+                            azimuth=d["azimuth_rad"], elevation=d["elevation_rad"])
+        elif kind == "speed":
+            m = TwistStamped(header=header, twist=Twist(linear=Vector3(x=d["speed_m_s"], y=0.0, z=0.0), angular=zero3))
+        elif kind == "attitude":
+            m = Imu(header=header, orientation=quaternion(d["roll_rad"], d["pitch_rad"], d["heading_rad"]),
+                    orientation_covariance=zero9, angular_velocity=zero3, angular_velocity_covariance=zero9,
+                    linear_acceleration=zero3, linear_acceleration_covariance=zero9)
+        elif kind == "depth":
+            pose = Pose(position=Point(x=0.0, y=0.0, z=d["depth_m"]), orientation=quaternion(0, 0, 0))
+            m = PoseWithCovarianceStamped(header=header, pose=PoseWithCovariance(pose=pose, covariance=zero36))
+        elif kind == "array_fix":
+            m = ArrayFix(header=beacon, t_tx=stamp(repr(d["t_tx_s"])), beacon_sigma=d.get("beacon_sigma_m", 0.0),
+                         range=d["range_m"], azimuth=d["azimuth_rad"], inclination=d["inclination_rad"],
+                         mode=d["mode"])
+        else:
+            raise ValueError(f"{input_jsonl}: a {kind} line has no message here")
+        out.append((t, COMPUTERS[computer][kind][0], m))
+    return out
 
 
 def start_node(description, domain, out_dir, idle_s=3.0, extra=()):

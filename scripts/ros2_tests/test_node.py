@@ -2,7 +2,9 @@
 `cyclonedds`): it publishes plaza1's inputs as ROS 2 messages on loopback and subscribes
 to the node's outputs. The node's inputs are replay's items, its outputs stream's on
 them, bit for bit; its Odometry carries those estimates; bad messages are screened and
-the node goes on; a bad configuration is one line, exit 2."""
+the node goes on; a bad configuration is one line, exit 2. The simulated vehicles'
+computers (`run --messages`) on topics: a surface vehicle's waypoints are the
+simulator's decisions, an AUV's setpoints its output lines' commands."""
 import json
 import math
 import os
@@ -172,3 +174,127 @@ def test_a_bad_configuration_is_one_line_exit_2(tmp_path):
     # replay refuses a live topic, naming it
     r = subprocess.run([rn.CLI, "replay", str(description)], capture_output=True, text=True)
     assert r.returncode == 2 and "live topic" in r.stderr and "/wheel/increment" in r.stderr
+
+
+def run_computer(tmp_path, computer, run, estimators, name=None, **pace):
+    """A simulated computer of `run` (`run --messages`'s directory; its files NAME.*,
+    NAME the computer's by default) as a node: what it heard published at `pace`
+    (Graph.publish's `rate_hz` or `speed`), every message taken and answered. Returns the
+    graph, the description, the node's output lines, its record and its stderr."""
+    name = name or computer
+    description = rn.computer_description(computer, run / f"{name}.stream.toml", tmp_path)
+    msgs = rn.computer_messages(computer, run / f"{name}.input.jsonl")
+    d = domain()
+    graph = rn.Graph(d, estimators, inputs=rn.computer_inputs(computer))
+    node = rn.start_node(description, d, tmp_path, idle_s=5.0, extra=("--reorder-s", "0.5"))
+    try:
+        assert graph.matched(), "the node's readers never matched Cyclone's writers"
+        graph.publish(msgs, **pace)
+        assert node.wait(timeout=300) == 0, (tmp_path / "node.err").read_text()
+    finally:
+        if node.poll() is None:
+            node.kill()
+        time.sleep(0.5)
+        graph.close()
+    err = (tmp_path / "node.err").read_text()
+    assert f"{len(msgs)} messages, {len(msgs)} lines, 0 skipped" in err, err
+    out = (tmp_path / "node.jsonl").read_text().splitlines()
+    record = (tmp_path / "record.jsonl").read_text().splitlines()
+    return graph, description, out, record, err
+
+
+def test_the_surface_vehicles_computer_decides_on_topics_as_the_simulator(tmp_path):
+    """hoff2024-pair's surface vehicle: what it heard in the simulation (its own fixes,
+    the USBL's position, two AUVs' reports and bearings) published as ROS 2 messages;
+    the node's waypoints on the topic are the simulator's decisions, bit for bit."""
+    run = tmp_path / "run"
+    subprocess.run([rn.CLI, "run", "hoff2024-pair", "--messages", "--out", str(run)], check=True,
+                   capture_output=True)
+    decisions = [json.loads(line) for line in (run / "asv.decisions.jsonl").read_text().splitlines()]
+    names = [f"vehicle{v}/{e}" for v in (0, 1) for e in ("pf", "bearing")]
+    # 150 times the simulation's pace (a 4 s period in 27 ms): the node's particle
+    # filters (100000 particles) keep up on two cores
+    graph, description, out, record, err = run_computer(tmp_path, "asv", run, names, speed=150.0)
+    # the node's inputs are what the simulator's computer heard (in the node's order: at
+    # one time, the beacon's position, then each topic's, the own fix last), the own
+    # fix's heading through its quaternion within 10 ulp of pi (sin, cos, atan2 each
+    # within 1 ulp)
+    key = lambda d: (d["t_s"], d["kind"], d.get("vehicle", -1))  # noqa: E731
+    heard = sorted(map(json.loads, (run / "asv.input.jsonl").read_text().splitlines()), key=key)
+    took = sorted(map(json.loads, record), key=key)
+    assert len(heard) == len(took)
+    for h, t in zip(heard, took):
+        if h["kind"] == "own_fix":
+            assert abs(h.pop("heading_rad") - t.pop("heading_rad")) <= 10 * math.ulp(math.pi)
+        assert h == t
+    # its decisions are the simulator's, and its outputs stream's on its inputs
+    decided = [(line["t_s"], line["command"]) for line in map(json.loads, out) if line.get("decided")]
+    assert [(x["t_s"], x["command"]) for x in decisions] == decided
+    stream = subprocess.run([rn.CLI, "stream", description], input="\n".join(record) + "\n", capture_output=True,
+                            text=True, check=True).stdout.splitlines()
+    assert out == stream
+    # each waypoint on the topic is a decision's: the planner's waypoint, facing it from
+    # the path's start, stamped with its time
+    got = [m for _, m in graph.received["/onebeacon/waypoint"]]
+    assert len(got) == len(decisions)
+    for m, x in zip(got, decisions):
+        c = x["command"]
+        assert m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 == x["t_s"]
+        assert (m.pose.position.x, m.pose.position.y) == (c["waypoint_x_m"], c["waypoint_y_m"])
+        q = m.pose.orientation
+        yaw = math.atan2(2 * q.w * q.z, 1 - 2 * q.z * q.z)
+        want = math.atan2(c["waypoint_y_m"] - c["from_y_m"], c["waypoint_x_m"] - c["from_x_m"])
+        assert abs(math.remainder(yaw - want, 2 * math.pi)) < 1e-12
+    # each AUV's estimates on its own topics
+    for n in names:
+        assert graph.received[f"/onebeacon/{n}/odometry"], n
+
+
+def test_an_auvs_computer_publishes_its_setpoints(tmp_path):
+    """rypkema-m1's AUV platypus (600 s, the abstract signal model): its DVL, IMU,
+    depth and inverted-USBL fixes as ROS 2 messages (sensor_msgs/Imu: the attitude
+    through a quaternion); the node's outputs are stream's on its inputs, and each
+    setpoint on the topic is a decided command of its output lines, bit for bit."""
+    scenario = (REPO / "scenarios" / "rypkema-m1.toml").read_text()
+    scenario = scenario.replace('model = "channel"', 'model = "abstract"', 1)
+    scenario = scenario.replace("duration_s = 3600.0", "duration_s = 600.0", 1)
+    (tmp_path / "fleet.toml").write_text(scenario)
+    run = tmp_path / "run"
+    subprocess.run([rn.CLI, "run", str(tmp_path / "fleet.toml"), "--messages", "--out", str(run)], check=True,
+                   capture_output=True)
+    names = ["iusbl", "iusbl_joint", "dead_reckoning"]
+    graph, description, out, record, err = run_computer(tmp_path, "auv", run, names, name="platypus", rate_hz=2000)
+    # its inputs are what the simulated AUV heard: times to the nanosecond (a stamp's),
+    # roll, pitch and heading through a quaternion within 10 ulp of pi
+    key = lambda x: (round(x["t_s"], 6), x["kind"])  # noqa: E731
+    heard = sorted(map(json.loads, (run / "platypus.input.jsonl").read_text().splitlines()), key=key)
+    took = sorted(map(json.loads, record), key=key)
+    assert len(heard) == len(took)
+    for h, t in zip(heard, took):
+        for k in ("t_s", "t_tx_s"):
+            if k in h:
+                # cut to whole nanoseconds, then a float's rounding of 660 s
+                assert abs(h.pop(k) - t.pop(k)) <= 1e-9 + 1e-12, k
+        for k in ("roll_rad", "pitch_rad", "heading_rad") if h["kind"] == "attitude" else ():
+            assert abs(math.remainder(h.pop(k) - t.pop(k), 2 * math.pi)) <= 10 * math.ulp(math.pi), k
+        assert h == t
+    stream = subprocess.run([rn.CLI, "stream", description], input="\n".join(record) + "\n", capture_output=True,
+                            text=True, check=True).stdout.splitlines()
+    assert out == stream
+    # each setpoint received is the next decided command (a reader too slow loses some,
+    # which the node counts as dropped: together they are all of them)
+    decided = [line for line in map(json.loads, out) if line.get("decided")]
+    got = [m for _, m in graph.received["/onebeacon/setpoint"]]
+    dropped = int(err.rsplit(" skipped, ", 1)[1].split(" outputs dropped")[0])
+    assert len(decided) > 5000 and len(got) + dropped >= len(decided) and len(got) > len(decided) // 2
+    lines = iter(decided)
+    for m in got:
+        stamp_s = m.header.stamp.sec + m.header.stamp.nanosec * 1e-9
+        line = next(x for x in lines if abs(x["t_s"] - stamp_s) <= 1e-9)
+        c = line["command"]
+        assert (m.heading, m.speed, m.depth) == (c["heading_rad"], c["speed_m_s"], c["depth_m"])
+        assert (m.mode, m.phase) == (-1 if c["mode"] is None else c["mode"], c["phase"])
+    # the behaviours' phases all came: waiting, then driving, and the dock's surfacing
+    assert {m.phase for m in got} >= {"waiting", "driving"}
+    for n in names:
+        assert graph.received[f"/onebeacon/{n}/odometry"], n

@@ -1,5 +1,6 @@
 //! The messages the node publishes, as their ROS 2 definitions have them (field order is
-//! wire order): std_msgs/Header, geometry_msgs, nav_msgs/Odometry, diagnostic_msgs.
+//! wire order): std_msgs/Header, geometry_msgs, nav_msgs/Odometry, diagnostic_msgs, and
+//! onebeacon_msgs/Setpoint (msg/Setpoint.msg).
 
 use serde::Serialize;
 use serde::ser::SerializeTuple;
@@ -125,4 +126,16 @@ pub(crate) struct DiagnosticStatus {
 pub(crate) struct DiagnosticArray {
     pub(crate) header: Header,
     pub(crate) status: Vec<DiagnosticStatus>,
+}
+
+/// onebeacon_msgs/Setpoint (msg/Setpoint.msg): a controller's heading, speed and depth,
+/// its confirmed mode (-1: none yet) and phase.
+#[derive(Debug, Clone, Serialize)]
+pub(crate) struct Setpoint {
+    pub(crate) header: Header,
+    pub(crate) heading: f64,
+    pub(crate) speed: f64,
+    pub(crate) depth: f64,
+    pub(crate) mode: i32,
+    pub(crate) phase: String,
 }

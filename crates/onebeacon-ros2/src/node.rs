@@ -1,14 +1,15 @@
 //! The node's loop: its live topics subscribed (best effort, as sensor data go), each
-//! message taken as it comes, turned into the stream lines of its items and pushed
+//! message taken as it comes, turned into stream lines (its items, or an own fix) and pushed
 //! through the stream's loop ([`onebeacon::io::stream::Lines`]); each output line written
 //! (stdout), published ([`crate::publish`]) and, with `record`, its input kept. A bad
 //! message is skipped and said, like a bad stream line; nothing stops the node but a
 //! signal, `idle_exit_s` or an I/O error.
 
 use crate::publish::Outputs;
-use onebeacon::io::jsonl::item_json;
+use onebeacon::io::jsonl::{Line, line_json};
 use onebeacon::io::stream::{Lines, Note};
 use onebeacon::log::{Log, LogError};
+use onebeacon::nav::session::Input;
 use onebeacon::vehicle::unit::Unit;
 use ros2_client::dds::rustdds::mio1::{Events, Interest, Poll, Token};
 use ros2_client::{Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile};
@@ -154,8 +155,8 @@ pub fn run(
                 last = Some(Instant::now());
                 let received_s =
                     SystemTime::now().duration_since(SystemTime::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64());
-                match topics[i].items(message, received_s) {
-                    Ok(items) => pending.extend(items.into_iter().map(|item| (Instant::now(), i, item))),
+                match topics[i].lines(message, received_s) {
+                    Ok(lines) => pending.extend(lines.into_iter().map(|line| (Instant::now(), i, line))),
                     Err(e) => {
                         outputs.skip(&e.to_string());
                         report(lines.count(), &format!("{e}; skipped"));
@@ -164,21 +165,25 @@ pub fn run(
             }
         }
         // as a log's sources merge: by time, then beacon positions, measurements, the
-        // truth, then the sources' order (stable: a topic's own order kept)
-        let rank = |item: &onebeacon::nav::session::Item| match item.input {
-            onebeacon::nav::session::Input::BeaconPosition { .. } => 0,
-            onebeacon::nav::session::Input::Measurement(_) => 1,
-            onebeacon::nav::session::Input::Truth(_) => 2,
+        // truth, then the sources' order (stable: a topic's own order kept); the own fix
+        // a controller decides on last, after what was heard at its time
+        let rank = |line: &Line| match line {
+            Line::Item { item, .. } => match item.input {
+                Input::BeaconPosition { .. } => 0,
+                Input::Measurement(_) => 1,
+                Input::Truth(_) => 2,
+            },
+            Line::OwnFix { .. } => 3,
         };
-        pending.sort_by(|(_, i, a), (_, j, b)| a.t_s.total_cmp(&b.t_s).then(rank(a).cmp(&rank(b))).then(i.cmp(j)));
+        pending.sort_by(|(_, i, a), (_, j, b)| a.t_s().total_cmp(&b.t_s()).then(rank(a).cmp(&rank(b))).then(i.cmp(j)));
         // what has been held long enough goes, with all that is stamped before it
         let due = match ending {
             true => pending.len(),
             false => pending.iter().rposition(|(came, _, _)| came.elapsed() >= hold).map_or(0, |k| k + 1),
         };
         let batch: Vec<_> = pending.drain(..due).map(|(_, i, item)| (i, item)).collect();
-        for (_, item) in batch {
-            let line = item_json(&item).to_string();
+        for (_, line) in batch {
+            let line = line_json(&line).to_string();
             if let Some(r) = record.as_mut() {
                 writeln!(r, "{line}")?;
             }

@@ -1,6 +1,7 @@
 //! The stream's output lines as ROS 2 messages: each estimate a nav_msgs/Odometry on
 //! `NAMESPACE/ESTIMATOR/odometry`, a controller's decided waypoint a
-//! geometry_msgs/PoseStamped on `NAMESPACE/waypoint`, and once a second of the inputs'
+//! geometry_msgs/PoseStamped on `NAMESPACE/waypoint`, a decided setpoint an
+//! onebeacon_msgs/Setpoint on `NAMESPACE/setpoint`, and once a second of the inputs'
 //! time a diagnostic_msgs/DiagnosticArray on `NAMESPACE/diagnostics` (each estimator's
 //! updates, rejections, restarts and its NIS against the band of a consistent filter).
 
@@ -37,6 +38,7 @@ pub(crate) struct Outputs {
     child_frame_id: String,
     odometry: BTreeMap<String, Publisher<Odometry>>,
     waypoint: Publisher<PoseStamped>,
+    setpoint: Publisher<Setpoint>,
     diagnostics: Publisher<DiagnosticArray>,
     records: BTreeMap<String, Record>,
     pub(crate) skipped: u64,
@@ -80,6 +82,7 @@ impl Outputs {
         let namespace = namespace.trim_end_matches('/').to_string();
         Ok(Self {
             waypoint: publisher(node, &format!("{namespace}/waypoint"), "geometry_msgs", "PoseStamped")?,
+            setpoint: publisher(node, &format!("{namespace}/setpoint"), "onebeacon_msgs", "Setpoint")?,
             diagnostics: publisher(node, &format!("{namespace}/diagnostics"), "diagnostic_msgs", "DiagnosticArray")?,
             namespace,
             frame_id: frame_id.into(),
@@ -165,12 +168,24 @@ impl Outputs {
             let sent = self.odometry[&topic].publish(odometry);
             self.sent(&topic, sent);
         }
-        if out["decided"].as_bool() == Some(true)
-            && let Some(pose) = waypoint(&out["command"])
-        {
-            let msg = PoseStamped { header: self.header(t_s), pose };
-            let sent = self.waypoint.publish(msg);
-            self.sent("waypoint", sent);
+        if out["decided"].as_bool() == Some(true) {
+            let command = &out["command"];
+            if let Some(pose) = waypoint(command) {
+                let sent = self.waypoint.publish(PoseStamped { header: self.header(t_s), pose });
+                self.sent("waypoint", sent);
+            } else if command["kind"] == "setpoint" {
+                let f = |k: &str| command[k].as_f64().unwrap_or(f64::NAN);
+                let msg = Setpoint {
+                    header: self.header(t_s),
+                    heading: f("heading_rad"),
+                    speed: f("speed_m_s"),
+                    depth: f("depth_m"),
+                    mode: command["mode"].as_i64().and_then(|m| i32::try_from(m).ok()).unwrap_or(-1),
+                    phase: command["phase"].as_str().unwrap_or_default().to_string(),
+                };
+                let sent = self.setpoint.publish(msg);
+                self.sent("setpoint", sent);
+            }
         }
         if t_s.is_finite() && self.last_diagnostics_s.is_none_or(|last| t_s - last >= 1.0 || t_s < last) {
             self.last_diagnostics_s = Some(t_s);

@@ -11,7 +11,7 @@ use crate::computers::OnBoard;
 use crate::engine::{Observer, Step};
 use nalgebra::Vector3;
 use onebeacon::geo::Frame;
-use onebeacon::io::jsonl::{command_json, item_json, own_fix_json};
+use onebeacon::io::jsonl::{Line, command_json, item_json, line_json};
 use onebeacon::nav::session::{Input, Item};
 use onebeacon::vehicle::unit::Plan;
 use onebeacon::vehicle::{Decided, GuidanceSnapshot, Situation};
@@ -79,11 +79,8 @@ impl Observer for Messages {
                             c.input.push(item_json(&Item { t_s: m.t_s, input }).to_string());
                         }
                     }
-                    let mut line = item_json(&Item { t_s: m.t_s, input: Input::Measurement(m.kind.clone()) });
-                    if several {
-                        line["vehicle"] = json!(i);
-                    }
-                    c.input.push(line.to_string());
+                    let item = Item { t_s: m.t_s, input: Input::Measurement(m.kind.clone()) };
+                    c.input.push(line_json(&Line::Item { vehicle: several.then_some(i), item }).to_string());
                 }
             }
         }
@@ -93,7 +90,7 @@ impl Observer for Messages {
         let h = self.of_helm[helm];
         let c = &mut self.computers[h];
         if let Some(fix) = &situation.fix {
-            c.input.push(own_fix_json(situation.t_s, fix).to_string());
+            c.input.push(line_json(&Line::OwnFix { t_s: situation.t_s, fix: *fix }).to_string());
         }
         if let Some(GuidanceSnapshot::Bearing(b)) = &d.snapshot {
             self.plans[h] = Some(Plan { vehicle: b.vehicle, waypoint: b.waypoint });

@@ -18,7 +18,7 @@ use std::collections::{BTreeMap, BTreeSet};
 pub struct LineError(String);
 
 /// A vehicle's own fix at `t_s` as a JSON line (`own_fix`; its frame as given).
-pub fn own_fix_json(t_s: f64, fix: &OwnFix) -> Value {
+fn own_fix_json(t_s: f64, fix: &OwnFix) -> Value {
     let p = fix.position_m;
     json!({"t_s": t_s, "kind": "own_fix", "x_m": p.x, "y_m": p.y, "heading_rad": fix.heading_rad,
         "speed_m_s": fix.speed_m_s})
@@ -100,6 +100,31 @@ pub use super::{KINDS, kinds};
 pub enum Line {
     Item { vehicle: Option<usize>, item: Item },
     OwnFix { t_s: f64, fix: OwnFix },
+}
+
+impl Line {
+    /// Its time, s.
+    pub fn t_s(&self) -> f64 {
+        match self {
+            Line::Item { item, .. } => item.t_s,
+            Line::OwnFix { t_s, .. } => *t_s,
+        }
+    }
+}
+
+/// A line as JSON: an item with the vehicle it is about (when it names one), or an own
+/// fix.
+pub fn line_json(line: &Line) -> Value {
+    match line {
+        Line::Item { vehicle, item } => {
+            let mut v = item_json(item);
+            if let Some(i) = vehicle {
+                v["vehicle"] = json!(i);
+            }
+            v
+        }
+        Line::OwnFix { t_s, fix } => own_fix_json(*t_s, fix),
+    }
 }
 
 /// Parses one JSON line into an item; `fixed` beacons resolve `beacon` ids, `tracked`

@@ -672,6 +672,98 @@ z_m = 2.0
         assert_abs_diff_eq!(p.heading_rad.unwrap(), PI, epsilon = 1e-12);
     }
 
+    /// The kinds of a vehicle's computer from CSV (attitude, bearing, report, array_fix),
+    /// with a beacon's error and its ping's transmit time, in an ENU log in degrees:
+    /// values worked out by hand. Own fixes and the vehicle a row is about are refused
+    /// in a file, naming the key.
+    #[test]
+    fn a_computers_kinds_are_read_and_its_own_fix_is_a_live_topics() {
+        let body = r#"frame = "enu"
+[[source]]
+kind = "attitude"
+file = "att.csv"
+time = "t"
+roll = "r"
+pitch = "p"
+heading = "h"
+angle_unit = "deg"
+[[source]]
+kind = "bearing"
+file = "usbl.csv"
+time = "t"
+beacon = "id"
+station_heading = "h"
+azimuth = "a"
+elevation = "e"
+beacon_sigma = "s"
+angle_unit = "deg"
+length_unit = "cm"
+[[source]]
+kind = "report"
+file = "report.csv"
+time = "t"
+heading = "h"
+speed = "v"
+depth = "z"
+[[source]]
+kind = "array_fix"
+file = "fix.csv"
+time = "t"
+beacon = "id"
+range = "r"
+azimuth = "a"
+inclination = "i"
+mode = "m"
+t_tx = "tx"
+time_offset_s = 100.0
+[[beacon]]
+id = 3
+x_m = 10.0
+y_m = -5.0
+"#;
+        let files = [
+            ("att.csv", "t,r,p,h\n1.0,10,-20,90\n"),
+            ("usbl.csv", "t,id,h,a,e,s\n2.0,3,45,-30,60,150\n"),
+            ("report.csv", "t,h,v,z\n3.0,0.5,1.5,30\n"),
+            ("fix.csv", "t,id,r,a,i,m,tx\n-96.0,beacon_3,120.5,1.0,2.0,2,-96.08\n"),
+        ];
+        let log = load("computer", body, &files).unwrap();
+        let items = items(&log);
+        assert_eq!(items.iter().map(|i| i.t_s).collect::<Vec<_>>(), [1.0, 2.0, 3.0, 4.0]);
+        // in the log's frame (ENU, counter-clockwise): the stream turns them to NED
+        let Kind::Attitude { roll_rad, pitch_rad, heading_rad } = measurement(&items[0]) else { panic!() };
+        assert_abs_diff_eq!(roll_rad, 10f64.to_radians(), epsilon = 1e-12);
+        assert_abs_diff_eq!(pitch_rad, -20f64.to_radians(), epsilon = 1e-12);
+        assert_abs_diff_eq!(heading_rad, FRAC_PI_2, epsilon = 1e-12);
+        let Kind::Bearing { station, station_heading_rad, azimuth_rad, elevation_rad } = measurement(&items[1]) else {
+            panic!()
+        };
+        assert_eq!((station.id, station.sigma_m, station.t_tx_s), (3, 1.5, None));
+        assert_abs_diff_eq!(station_heading_rad, PI / 4.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(azimuth_rad, -PI / 6.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(elevation_rad, PI / 3.0, epsilon = 1e-12);
+        assert_eq!(measurement(&items[2]), Kind::Report { heading_rad: 0.5, speed_m_s: 1.5, depth_m: 30.0 });
+        // the transmit time on the source's clock, its offset too
+        let Kind::ArrayFix { beacon, range_m, azimuth_rad, inclination_rad, mode } = measurement(&items[3]) else {
+            panic!()
+        };
+        assert_eq!((beacon.id, range_m, azimuth_rad, inclination_rad, mode), (3, 120.5, 1.0, 2.0, 2));
+        assert_abs_diff_eq!(beacon.t_tx_s.unwrap(), 3.92, epsilon = 1e-12);
+        // refused in a file: an own fix, the vehicle of several, a transmit time on a heading
+        let own = "[[source]]\nkind = \"own_fix\"\nfile = \"f.csv\"\ntime = \"t\"\nx = \"x\"\ny = \"y\"\n\
+                   heading = \"h\"\nspeed = \"v\"\n";
+        let vehicle = body.replace("depth = \"z\"", "depth = \"z\"\nvehicle = \"auv\"");
+        let t_tx = "[[source]]\nkind = \"heading\"\nfile = \"h.csv\"\ntime = \"t\"\nheading = \"h\"\nt_tx = \"tx\"\n";
+        for (name, body, key) in [
+            ("own", own, "source[0].kind"),
+            ("vehicle", &vehicle, "source[2].vehicle"),
+            ("ttx", t_tx, "source[0].t_tx"),
+        ] {
+            let e = load(name, body, &files).unwrap_err().to_string();
+            assert!(e.contains(key), "{name}: {e}");
+        }
+    }
+
     /// At equal times: beacon positions, then measurements, then the truth, whatever the
     /// order of the sources; equal ranks in the order of the sources; a sorted source
     /// keeps its rows' order at equal times.

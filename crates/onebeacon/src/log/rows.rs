@@ -7,9 +7,11 @@ use super::geodesy::Geodetic;
 use super::schema::{COLUMN_KEYS, IncrementFrame, Source, SourceKind, TimeOrder};
 use super::table::Table;
 use crate::geo::Frame;
+use crate::io::jsonl::Line;
 use crate::nav::Kind;
 use crate::nav::session::{Input, Item, TruthPose, resolve_beacon};
-use nalgebra::Vector3;
+use crate::vehicle::OwnFix;
+use nalgebra::{Vector2, Vector3};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
@@ -29,7 +31,7 @@ pub(super) struct SourceRows<'a> {
     /// The time of the row above.
     previous: Option<f64>,
     /// The second item of a `speed_heading` row.
-    pending: Option<Item>,
+    pending: Option<Line>,
     /// `time_order = "drop"`: the row read ahead, the time of the last row kept, the rows
     /// dropped, and an error met while reading ahead (given after the row in hand).
     ahead: Option<RowItems>,
@@ -58,8 +60,9 @@ impl Dropped {
     }
 }
 
-/// The one or two items of a row.
-type RowItems = (Item, Option<Item>);
+/// The one or two lines of a row: items (about a vehicle when the row names it), or an
+/// own fix.
+type RowItems = (Line, Option<Line>);
 
 /// How a source's time cells become seconds.
 pub(super) enum Clock {
@@ -199,15 +202,23 @@ impl<'a> SourceRows<'a> {
         })
     }
 
-    /// The next item, None at the end of the file.
+    /// The next item, None at the end of the file: a log's, for one vehicle.
     pub(super) fn next_item(&mut self) -> Result<Option<Item>, LogError> {
-        if let Some(item) = self.pending.take() {
-            return Ok(Some(item));
+        Ok(self.next_line()?.map(|line| match line {
+            Line::Item { vehicle: None, item } => item,
+            _ => unreachable!("validated: own fixes and vehicles are live topics'"),
+        }))
+    }
+
+    /// The next line, None at the end of the file.
+    pub(super) fn next_line(&mut self) -> Result<Option<Line>, LogError> {
+        if let Some(line) = self.pending.take() {
+            return Ok(Some(line));
         }
         let row = if self.order == TimeOrder::Drop { self.next_in_order()? } else { self.read_row()? };
-        Ok(row.map(|(item, second)| {
+        Ok(row.map(|(line, second)| {
             self.pending = second;
-            item
+            line
         }))
     }
 
@@ -225,7 +236,7 @@ impl<'a> SourceRows<'a> {
                     None => return Ok(None),
                 },
             };
-            let t = row.0.t_s;
+            let t = row.0.t_s();
             if self.kept.is_some_and(|k| t < k) {
                 self.dropped += 1; // behind the last row kept
                 continue;
@@ -234,7 +245,7 @@ impl<'a> SourceRows<'a> {
                 Ok(next) => self.ahead = next,
                 Err(e) => self.error = Some(e),
             }
-            let next_t = self.ahead.as_ref().map(|(next, _)| next.t_s);
+            let next_t = self.ahead.as_ref().map(|(next, _)| next.t_s());
             if next_t.is_some_and(|n| n < t && self.kept.is_none_or(|k| n >= k)) {
                 self.dropped += 1; // ahead of both neighbours
                 continue;
@@ -262,16 +273,31 @@ impl<'a> SourceRows<'a> {
             ));
         }
         let (len, ang) = (s.length_unit.metres(), s.angle_unit.radians());
+        // an acoustic measurement's beacon: its error and its ping's transmit time
+        let t_tx = match cols.get("t_tx") {
+            Some(&c) => Some(self.clock.read(row.cell(c)).map_err(|m| row.error(c, m))? + s.time_offset_s),
+            None => None,
+        };
+        let beacon_sigma = match cols.get("beacon_sigma") {
+            Some(&c) => match row.number(c)? * len {
+                v if v >= 0.0 => v,
+                v => return Err(row.error(c, format!("{v}: a beacon's position error, m, is >= 0"))),
+            },
+            None => 0.0,
+        };
         let num = |k: &str| row.number(cols[k]);
         let heading = |k: &str| Ok::<_, LogError>(sense * num(k)? * ang + s.heading_offset_deg.to_radians());
         let turn = |k: &str| Ok::<_, LogError>(sense * num(k)? * ang);
         let live = self.live;
         let beacon = || {
             let id = row.beacon_id(cols["beacon"])?;
-            if live && !beacons.contains_key(&id) {
-                return Ok(crate::nav::BeaconFix::fixed(id, Vector3::repeat(f64::NAN)));
-            }
-            resolve_beacon(id, beacons, tracked).map_err(|m| row.error(cols["beacon"], m))
+            let mut b = if live && !beacons.contains_key(&id) {
+                crate::nav::BeaconFix::fixed(id, Vector3::repeat(f64::NAN))
+            } else {
+                resolve_beacon(id, beacons, tracked).map_err(|m| row.error(cols["beacon"], m))?
+            };
+            (b.sigma_m, b.t_tx_s) = (beacon_sigma, t_tx);
+            Ok::<_, LogError>(b)
         };
         let position = || match (cols.get("x").zip(cols.get("y")), geodetic) {
             (Some((&x, &y)), _) => Ok::<_, LogError>((row.number(x)? * len, row.number(y)? * len)),
@@ -281,9 +307,11 @@ impl<'a> SourceRows<'a> {
             }
             (None, None) => unreachable!("validated: x and y, or lat and lon (which make the origin)"),
         };
-        let measurement = |m: Kind| Item { t_s: t, input: Input::Measurement(m) };
+        let vehicle = cols.get("vehicle").map(|&c| row.id(c, "vehicle")).transpose()?.map(|v| v as usize);
+        let about = |input: Input| Line::Item { vehicle, item: Item { t_s: t, input } };
+        let measurement = |m: Kind| about(Input::Measurement(m));
         let mut second = None;
-        let item = match s.kind {
+        let line = match s.kind {
             SourceKind::Odometry if s.increment_frame == IncrementFrame::Start => {
                 measurement(at_mid_heading(num("distance")? * len, 0.0, turn("heading_change")?))
             }
@@ -321,7 +349,7 @@ impl<'a> SourceRows<'a> {
                 let beacon_id = row.beacon_id(cols["beacon"])?;
                 let z = cols.get("z").map_or(Ok(0.0), |&c| row.number(c))? * len;
                 let (x, y) = position()?;
-                Item { t_s: t, input: Input::BeaconPosition { beacon_id, position: Vector3::new(x, y, z) } }
+                about(Input::BeaconPosition { beacon_id, position: Vector3::new(x, y, z) })
             }
             SourceKind::GroundTruth => {
                 let heading_rad = cols.contains_key("heading").then(|| heading("heading")).transpose()?;
@@ -336,11 +364,44 @@ impl<'a> SourceRows<'a> {
                     }
                     None => s.sigma_m.unwrap_or(0.0),
                 };
-                Item { t_s: t, input: Input::Truth(TruthPose { north_m, east_m, heading_rad, sigma_m }) }
+                about(Input::Truth(TruthPose { north_m, east_m, heading_rad, sigma_m }))
+            }
+            SourceKind::Bearing => measurement(Kind::Bearing {
+                station: beacon()?,
+                station_heading_rad: heading("station_heading")?,
+                azimuth_rad: turn("azimuth")?,
+                elevation_rad: num("elevation")? * ang,
+            }),
+            SourceKind::Report => measurement(Kind::Report {
+                heading_rad: heading("heading")?,
+                speed_m_s: num("speed")? * len,
+                depth_m: num("depth")? * len,
+            }),
+            SourceKind::Attitude => measurement(Kind::Attitude {
+                roll_rad: num("roll")? * ang,
+                pitch_rad: num("pitch")? * ang,
+                heading_rad: heading("heading")?,
+            }),
+            // the array's own frame: no heading sense or offset
+            SourceKind::ArrayFix => measurement(Kind::ArrayFix {
+                beacon: beacon()?,
+                range_m: num("range")? * len,
+                azimuth_rad: num("azimuth")? * ang,
+                inclination_rad: num("inclination")? * ang,
+                mode: row.id(cols["mode"], "mode")? as usize,
+            }),
+            SourceKind::OwnFix => {
+                let (x, y) = position()?;
+                let fix = OwnFix {
+                    position_m: Vector2::new(x, y),
+                    heading_rad: heading("heading")?,
+                    speed_m_s: num("speed")? * len,
+                };
+                Line::OwnFix { t_s: t, fix }
             }
         };
         self.previous = Some(t);
-        Ok(Some((item, second)))
+        Ok(Some((line, second)))
     }
 }
 

@@ -28,6 +28,23 @@ pub enum SourceKind {
     Doppler,
     BeaconTrack,
     GroundTruth,
+    /// A USBL's bearing to a vehicle (hoff2024 sec. 2.1, eq. 1-2): the station's beacon
+    /// id (its position a beacon track), its heading, the azimuth from that heading and
+    /// the elevation from the vertical.
+    Bearing,
+    /// What a vehicle reports of itself in an acoustic message (hoff2024 sec. 2.2): its
+    /// heading, speed over ground and depth.
+    Report,
+    /// Roll, pitch and heading from an AHRS (a 6-dof or an AUV's stream).
+    Attitude,
+    /// One ping reduced by the vehicle's own receiver (rypkema sec. 3.2): the beacon, the
+    /// slant range, the direction toward the beacon in the array frame (azimuth from x
+    /// toward y, inclination from +z down) and the command mode the chirp carries
+    /// (sec. 4.2, an index into the controller's modes).
+    ArrayFix,
+    /// The computer's own vehicle's fix (a surface vehicle's GNSS): its position, heading
+    /// and speed, on which a controller decides; a live topic's only (`onebeacon ros2`).
+    OwnFix,
 }
 
 impl SourceKind {
@@ -45,12 +62,29 @@ impl SourceKind {
             SourceKind::Doppler => (&["beacon", "radial_speed"], &[]),
             SourceKind::BeaconTrack => (&["beacon"], &["z"]),
             SourceKind::GroundTruth => (&[], &["heading", "sigma"]),
+            SourceKind::Bearing => (&["beacon", "station_heading", "azimuth", "elevation"], &[]),
+            SourceKind::Report => (&["heading", "speed", "depth"], &[]),
+            SourceKind::OwnFix => (&["heading", "speed"], &[]),
+            SourceKind::Attitude => (&["roll", "pitch", "heading"], &[]),
+            SourceKind::ArrayFix => (&["beacon", "range", "azimuth", "inclination", "mode"], &[]),
         }
+    }
+
+    /// Whether its rows may name the vehicle they are about (`vehicle`, for a computer
+    /// that tracks several): all but a beacon's track and the computer's own fix.
+    pub(crate) fn about_a_vehicle(self) -> bool {
+        !matches!(self, SourceKind::BeaconTrack | SourceKind::OwnFix)
+    }
+
+    /// Whether it is an acoustic measurement from a beacon, whose rows may give the
+    /// beacon's position error (`beacon_sigma`) and the ping's transmit time (`t_tx`).
+    pub(crate) fn heard(self) -> bool {
+        matches!(self, SourceKind::Range | SourceKind::Doppler | SourceKind::Bearing | SourceKind::ArrayFix)
     }
 
     /// Whether the kind holds a position: `x` and `y`, or `lat` and `lon`.
     pub(crate) fn positioned(self) -> bool {
-        matches!(self, SourceKind::BeaconTrack | SourceKind::GroundTruth)
+        matches!(self, SourceKind::BeaconTrack | SourceKind::GroundTruth | SourceKind::OwnFix)
     }
 }
 
@@ -210,6 +244,25 @@ pub struct Source {
     pub beacon: Option<String>,
     pub range: Option<String>,
     pub radial_speed: Option<String>,
+    /// bearing: the USBL station's heading, the azimuth from it (turning with the
+    /// headings' sense) and the elevation from the vertical (hoff2024 eq. 1-2).
+    pub station_heading: Option<String>,
+    pub azimuth: Option<String>,
+    pub elevation: Option<String>,
+    /// attitude: roll and pitch as the AHRS gives them (the heading as `heading`).
+    pub roll: Option<String>,
+    pub pitch: Option<String>,
+    /// array_fix: the inclination from +z down, and the command mode (an index).
+    pub inclination: Option<String>,
+    pub mode: Option<String>,
+    /// An acoustic measurement's beacon: its position's own error, m (a standard
+    /// deviation on each axis, in `length_unit`), and when it sent the ping (a time read
+    /// as `time` is, a one-way travel time's start).
+    pub beacon_sigma: Option<String>,
+    pub t_tx: Option<String>,
+    /// The vehicle a measurement is about, for a computer that tracks several
+    /// (`[[tracked]]`: its index, or a name ending in it such as `auv_1`); live topics only.
+    pub vehicle: Option<String>,
     pub x: Option<String>,
     pub y: Option<String>,
     pub z: Option<String>,
@@ -244,6 +297,16 @@ impl Source {
             "beacon" => self.beacon.as_ref(),
             "range" => self.range.as_ref(),
             "radial_speed" => self.radial_speed.as_ref(),
+            "station_heading" => self.station_heading.as_ref(),
+            "azimuth" => self.azimuth.as_ref(),
+            "elevation" => self.elevation.as_ref(),
+            "roll" => self.roll.as_ref(),
+            "pitch" => self.pitch.as_ref(),
+            "inclination" => self.inclination.as_ref(),
+            "mode" => self.mode.as_ref(),
+            "vehicle" => self.vehicle.as_ref(),
+            "beacon_sigma" => self.beacon_sigma.as_ref(),
+            "t_tx" => self.t_tx.as_ref(),
             "x" => self.x.as_ref(),
             "y" => self.y.as_ref(),
             "z" => self.z.as_ref(),
@@ -255,7 +318,7 @@ impl Source {
     }
 }
 
-pub(crate) const COLUMN_KEYS: [&str; 19] = [
+pub(crate) const COLUMN_KEYS: [&str; 29] = [
     "distance",
     "heading_change",
     "forward",
@@ -269,6 +332,16 @@ pub(crate) const COLUMN_KEYS: [&str; 19] = [
     "beacon",
     "range",
     "radial_speed",
+    "station_heading",
+    "azimuth",
+    "elevation",
+    "roll",
+    "pitch",
+    "inclination",
+    "mode",
+    "vehicle",
+    "beacon_sigma",
+    "t_tx",
     "x",
     "y",
     "z",

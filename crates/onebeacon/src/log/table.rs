@@ -146,6 +146,12 @@ impl Table {
     /// The beacon id in `column`: a non-negative integer, or a name that ends in one
     /// (a ROS frame id such as `beacon_5`).
     pub(super) fn beacon_id(&self, column: usize) -> Result<u32, LogError> {
+        self.id(column, "beacon")
+    }
+
+    /// The id of a `what` (a beacon, a vehicle) in `column`: a non-negative integer, or a
+    /// name that ends in one (`auv_1`).
+    pub(super) fn id(&self, column: usize, what: &str) -> Result<u32, LogError> {
         let id = match self.cell(column) {
             Cell::Number(v) => (v >= 0.0 && v.fract() == 0.0 && v <= f64::from(u32::MAX)).then_some(v as u32),
             Cell::Text(cell) => {
@@ -163,7 +169,7 @@ impl Table {
             self.error(
                 column,
                 format!(
-                    "`{cell}` is not a beacon id (a non-negative integer, or a name ending in one such as beacon_5)"
+                    "`{cell}` is not a {what} id (a non-negative integer, or a name ending in one such as {what}_5)"
                 ),
             )
         })

@@ -1,16 +1,16 @@
 //! A log description's live topics for a node (`onebeacon ros2`, feature `ros2`): the
 //! description loaded without reading a file, and each topic's messages into the
-//! session's items, as a log's rows become them.
+//! stream's lines (items, own fixes), as a log's rows become them.
 
 use super::error::LogError;
 use super::load::Log;
 use super::ros2::live::{Message, MessageSeed};
 use super::rows::SourceRows;
 use super::table::Table;
-use crate::nav::session::Item;
+use crate::io::jsonl::Line;
 use std::path::Path;
 
-/// One live source: its topic and type, and its messages into items.
+/// One live source: its topic and type, and its messages into lines.
 pub struct TopicRows<'a> {
     rows: SourceRows<'a>,
 }
@@ -38,18 +38,18 @@ impl TopicRows<'_> {
         self.live().seed()
     }
 
-    /// The items of `message`, received at `received_s` (its `log_time`): one, two
+    /// The lines of `message`, received at `received_s` (its `log_time`): one, two
     /// (speed_heading), or an error naming the topic, the message and the field.
-    pub fn items(&mut self, message: Message, received_s: f64) -> Result<Vec<Item>, LogError> {
+    pub fn lines(&mut self, message: Message, received_s: f64) -> Result<Vec<Line>, LogError> {
         match &mut self.rows.table {
             Table::Live(t) => t.hold(message, received_s),
             _ => unreachable!("a TopicRows reads a live topic"),
         }
-        let mut items = Vec::new();
-        while let Some(item) = self.rows.next_item()? {
-            items.push(item);
+        let mut lines = Vec::new();
+        while let Some(line) = self.rows.next_line()? {
+            lines.push(line);
         }
-        Ok(items)
+        Ok(lines)
     }
 }
 
@@ -77,7 +77,7 @@ impl Log {
     }
 
     /// The live topics of a log loaded by [`Log::load_topics`], each turning its
-    /// messages into items.
+    /// messages into lines.
     pub fn topics(&self) -> Result<Vec<TopicRows<'_>>, LogError> {
         let sources = self.description.sources.iter();
         sources.map(|s| SourceRows::open_live(self.site(), s).map(|rows| TopicRows { rows })).collect()

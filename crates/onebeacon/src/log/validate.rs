@@ -104,6 +104,25 @@ fn check_place(i: usize, s: &Source) -> Result<(), Violation> {
     }
 }
 
+/// What only a vehicle's computer on live topics takes: its own fix, and the vehicle of
+/// several (`[[tracked]]`, `tracked` of them) a measurement is about.
+fn check_computer(i: usize, s: &Source, tracked: usize) -> Result<(), Violation> {
+    let live = s.file.is_none() && s.bag.is_none();
+    let (key, value) = match (s.kind, &s.vehicle) {
+        (SourceKind::OwnFix, _) => ("kind", "\"own_fix\"".to_string()),
+        (_, Some(v)) => ("vehicle", format!("{v:?}")),
+        _ => return Ok(()),
+    };
+    let allowed = if !live {
+        "a vehicle's own fix and the vehicle a measurement is about are for a vehicle's computer on live topics (onebeacon ros2); replay estimates one vehicle from files and bags"
+    } else if key == "vehicle" && tracked == 0 {
+        "names which of the [[tracked]] vehicles a measurement is about; this description tracks none"
+    } else {
+        return Ok(());
+    };
+    Err(Violation { key: format!("source[{i}].{key}"), value, allowed: allowed.into() })
+}
+
 /// A log description's own keys: each source's column keys, the beacons, the origin.
 pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
     if !d.model.is_planar() && !d.sources.is_empty() {
@@ -124,6 +143,7 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
     }
     for (i, s) in d.sources.iter().enumerate() {
         check_place(i, s)?;
+        check_computer(i, s, d.tracked.len())?;
         let (required, optional) = s.kind.columns();
         // a topic's standard messages give the keys a source leaves out: checked on opening it
         let bag = s.file.is_none();
@@ -140,7 +160,13 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
         if positioned && !(bag && POSITION.iter().all(|k| !has(k))) {
             check_position(&format!("source[{i}]"), (has("x"), has("y")), (has("lat"), has("lon")), POSITION)?;
         }
-        let known = |k: &&str| required.contains(k) || optional.contains(k) || positioned && POSITION.contains(k);
+        let known = |k: &&str| {
+            required.contains(k)
+                || optional.contains(k)
+                || positioned && POSITION.contains(k)
+                || *k == "vehicle" && s.kind.about_a_vehicle()
+                || ["beacon_sigma", "t_tx"].contains(k) && s.kind.heard()
+        };
         if let Some(key) = COLUMN_KEYS.iter().find(|k| s.column(k).is_some() && !known(k)) {
             let allowed: Vec<&str> = required.iter().chain(optional).copied().collect();
             return Err(Violation {
@@ -169,6 +195,10 @@ pub(crate) fn validate_log(d: &LogDescription) -> Result<(), Violation> {
                 | SourceKind::Heading
                 | SourceKind::SpeedHeading
                 | SourceKind::GroundTruth
+                | SourceKind::Bearing
+                | SourceKind::Report
+                | SourceKind::OwnFix
+                | SourceKind::Attitude
         );
         if s.increment_frame != IncrementFrame::Mid
             && !matches!(s.kind, SourceKind::Odometry | SourceKind::BodyOdometry)

@@ -88,12 +88,17 @@ pub(crate) fn number(value: &Value, leaf: Leaf) -> Option<f64> {
             }
             _ => None,
         },
-        Leaf::Yaw => match value {
+        Leaf::Yaw | Leaf::Roll | Leaf::Pitch => match value {
             Value::List(q) if q.len() == 4 => {
                 let c: Vec<f64> = q.iter().filter_map(scalar).collect();
                 let [x, y, z, w] = c[..] else { return None };
-                // yaw of a unit quaternion (ZYX Euler angles), about the frame's z axis
-                Some((2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z)))
+                // ZYX Euler angles of a unit quaternion: yaw about the frame's z axis,
+                // then pitch, then roll
+                Some(match leaf {
+                    Leaf::Roll => (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y)),
+                    Leaf::Pitch => (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin(),
+                    _ => (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z)),
+                })
             }
             _ => None,
         },
@@ -301,13 +306,21 @@ mod tests {
         assert!(decode(&t, &[0, 7, 0, 0]).unwrap_err().contains("XCDR2"));
     }
 
-    /// The yaw of a quaternion about z by theta is theta (in (-pi, pi]).
+    /// The yaw of a quaternion about z by theta is theta (in (-pi, pi]); roll, pitch and
+    /// yaw come back from nalgebra's quaternion of those ZYX Euler angles.
     #[test]
-    fn a_quaternion_gives_its_yaw() {
+    fn a_quaternion_gives_its_euler_angles() {
         for theta in [-3.0, -1.0, 0.0, 0.5, 2.9] {
             let (s, c) = (theta / 2.0f64).sin_cos();
             let q = Value::List(vec![Value::Float(0.0), Value::Float(0.0), Value::Float(s), Value::Float(c)]);
             assert!((number(&q, Leaf::Yaw).unwrap() - theta).abs() < 1e-12, "{theta}");
+        }
+        for (roll, pitch, yaw) in [(0.3, -0.2, 2.5), (-1.0, 1.2, -0.7), (0.01, -0.4, 3.1)] {
+            let q = nalgebra::UnitQuaternion::from_euler_angles(roll, pitch, yaw);
+            let v = Value::List([q.i, q.j, q.k, q.w].map(Value::Float).to_vec());
+            for (leaf, want) in [(Leaf::Roll, roll), (Leaf::Pitch, pitch), (Leaf::Yaw, yaw)] {
+                assert!((number(&v, leaf).unwrap() - want).abs() < 1e-12, "{leaf:?} {want}");
+            }
         }
     }
 }

@@ -58,8 +58,8 @@ impl Columns {
             if leaf == Leaf::Time && self.units.0 != TimeUnit::S {
                 return Err(self.refuse(path, "a time field gives seconds: remove time_unit".into()));
             }
-            if leaf == Leaf::Yaw && self.units.1 != AngleUnit::Rad {
-                return Err(self.refuse(path, "a quaternion's yaw is in radians: remove angle_unit".into()));
+            if matches!(leaf, Leaf::Yaw | Leaf::Roll | Leaf::Pitch) && self.units.1 != AngleUnit::Rad {
+                return Err(self.refuse(path, "a quaternion's angles are radians: remove angle_unit".into()));
             }
             Column::Field { path: path.to_string(), steps, leaf }
         };

@@ -236,6 +236,18 @@ impl Types {
     /// The field path `path` (`pose.pose.position.x`, `ranges[2]`) of the topic's type:
     /// the steps to take in a decoded message, and the type it ends on.
     pub(crate) fn path(&self, path: &str) -> Result<(Vec<Step>, Leaf), String> {
+        // a quaternion's roll, pitch or yaw (`orientation.roll`): a quaternion has no
+        // field of these names
+        if let Some((head, angle)) = path.rsplit_once('.')
+            && let Ok((steps, Leaf::Yaw)) = self.path(head)
+        {
+            match angle {
+                "roll" => return Ok((steps, Leaf::Roll)),
+                "pitch" => return Ok((steps, Leaf::Pitch)),
+                "yaw" => return Ok((steps, Leaf::Yaw)),
+                _ => {}
+            }
+        }
         let mut steps = Vec::new();
         let mut at = (Elem::Msg(0), Shape::One);
         for part in path.split('.') {
@@ -288,7 +300,7 @@ impl Types {
                     Leaf::Yaw
                 } else {
                     return Err(format!(
-                        "`{path}` is a {} (fields: {}); a number, a text, a time (sec, nanosec) or a quaternion (its yaw) is read",
+                        "`{path}` is a {} (fields: {}); a number, a text, a time (sec, nanosec) or a quaternion (its yaw, or `.roll`, `.pitch`) is read",
                         self.types[t].name,
                         names.join(", ")
                     ));
@@ -328,8 +340,11 @@ pub(crate) enum Leaf {
     Text,
     /// builtin_interfaces/Time or Duration: seconds.
     Time,
-    /// A quaternion: its yaw, rad, about the frame's z axis.
+    /// A quaternion: its yaw, rad, about the frame's z axis; or its roll or pitch (the
+    /// path's `.roll`, `.pitch`): ZYX Euler angles.
     Yaw,
+    Roll,
+    Pitch,
 }
 
 #[cfg(test)]
@@ -361,6 +376,9 @@ mod tests {
         assert_eq!(steps, vec![Step::Field(2), Step::Field(0), Step::Field(0), Step::Field(1)]);
         assert_eq!(leaf, Leaf::Number);
         assert_eq!(t.path("pose.pose.orientation").unwrap().1, Leaf::Yaw);
+        assert_eq!(t.path("pose.pose.orientation.pitch").unwrap().1, Leaf::Pitch);
+        let e = t.path("pose.pose.orientation.tilt").unwrap_err();
+        assert!(e.contains("no field `tilt`"), "{e}");
         assert_eq!(t.path("header.stamp").unwrap().1, Leaf::Time);
         assert_eq!(t.path("header.frame_id").unwrap().1, Leaf::Text);
         assert_eq!(t.path("pose.covariance[35]").unwrap().0.last(), Some(&Step::Index(35)));

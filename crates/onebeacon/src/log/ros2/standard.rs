@@ -68,15 +68,24 @@ pub(crate) fn default_field(type_name: &str, kind: SourceKind, key: &str) -> Opt
     const TWIST_COV: [&str; 3] = ["twist.twist.linear.x", "twist.twist.linear.y", "twist.twist.angular.z"];
     const POINT: [&str; 4] = ["point.x", "point.y", "point.z", ""];
     let field = match (type_name, kind) {
-        ("nav_msgs/Odometry" | "geometry_msgs/PoseWithCovarianceStamped", GroundTruth | BeaconTrack | Heading) => {
-            pose(&POSE_COV)
-        }
-        ("geometry_msgs/PoseStamped", GroundTruth | BeaconTrack | Heading) => pose(&POSE),
-        ("geometry_msgs/PointStamped", GroundTruth | BeaconTrack) => pose(&POINT),
+        // an own fix's speed: the odometry's forward speed in the child (body) frame
+        ("nav_msgs/Odometry", OwnFix) if key == "speed" => Some(TWIST_COV[0]),
+        (
+            "nav_msgs/Odometry" | "geometry_msgs/PoseWithCovarianceStamped",
+            GroundTruth | BeaconTrack | Heading | OwnFix,
+        ) => pose(&POSE_COV),
+        ("geometry_msgs/PoseStamped", GroundTruth | BeaconTrack | Heading | OwnFix) => pose(&POSE),
+        ("geometry_msgs/PointStamped", GroundTruth | BeaconTrack | OwnFix) => pose(&POINT),
         ("nav_msgs/Odometry" | "geometry_msgs/TwistWithCovarianceStamped", BodyVelocity) => twist(&TWIST_COV),
         ("geometry_msgs/TwistStamped", BodyVelocity) => twist(&TWIST),
         ("sensor_msgs/Imu", Heading) => (key == "heading").then_some("orientation"),
-        ("sensor_msgs/NavSatFix", GroundTruth | BeaconTrack) => match key {
+        ("sensor_msgs/Imu", Attitude) => match key {
+            "roll" => Some("orientation.roll"),
+            "pitch" => Some("orientation.pitch"),
+            "heading" => Some("orientation"),
+            _ => None,
+        },
+        ("sensor_msgs/NavSatFix", GroundTruth | BeaconTrack | OwnFix) => match key {
             "lat" => Some("latitude"),
             "lon" => Some("longitude"),
             _ => None,
