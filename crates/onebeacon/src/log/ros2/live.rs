@@ -84,6 +84,15 @@ impl<'de> serde::Deserialize<'de> for Message {
 #[derive(Clone)]
 pub struct MessageSeed(Arc<Types>);
 
+impl MessageSeed {
+    /// A message of the topic from its serialized bytes (CDR with its 4-byte
+    /// encapsulation header, as a DDS sample or a bag holds it): what a transport other
+    /// than a DDS reader hands over.
+    pub fn decode(&self, bytes: &[u8]) -> Result<Message, String> {
+        super::cdr::decode(&self.0, bytes).map(Message)
+    }
+}
+
 impl<'de> serde::de::DeserializeSeed<'de> for MessageSeed {
     type Value = Message;
     fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Message, D::Error> {
