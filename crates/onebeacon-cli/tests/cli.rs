@@ -383,8 +383,8 @@ fn bad_input_exits_2_with_one_line_naming_the_key() {
         ),
         // memory: refused up front, not aborted
         (
-            vec!["mc", &particles, "--runs", "2", "--threads", "2", "--memory-gib", "12", "--out", out],
-            &["particles.toml", "16.9 GB", "memory budget is 12.9 GB", "particles", "--memory-gib"],
+            vec!["mc", &particles, "--runs", "2", "--threads", "2", "--memory-gib", "8", "--out", out],
+            &["particles.toml", "9.7 GB", "memory budget is 8.6 GB", "particles", "--memory-gib"],
         ),
         (vec!["run", &particles, "--memory-gib", "4", "--out", out], &["particles.toml", "memory budget is 4.3 GB"]),
         (vec!["mc", "garin2024", "--memory-gib", "0"], &["--memory-gib", "> 0"]),

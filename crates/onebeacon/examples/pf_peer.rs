@@ -35,9 +35,12 @@ const BLOCK: usize = 256;
 struct Motion;
 
 impl ParticleProcess for Motion {
-    fn propagate(&self, x: &mut [&mut [f64]], dt: f64, rng: &mut Pcg64) {
+    /// A constant-velocity step is the same for offsets from any origin.
+    fn propagate(&self, x: &mut [&mut [f32]], origin: &[f64], dt: f64, rng: &mut Pcg64) {
         let (l11, l21, l22) = cv_factor();
-        let rw = (Q_RW * dt).sqrt();
+        let (l11, l21, l22) = (l11 as f32, l21 as f32, l22 as f32);
+        let rw = (Q_RW * dt).sqrt() as f32;
+        let (dt, v0) = (dt as f32, [origin[1], origin[3], origin[5]].map(|v| (v * dt) as f32));
         let n = x[0].len();
         let mut e = [0.0; 8 * BLOCK];
         for start in (0..n).step_by(BLOCK) {
@@ -48,7 +51,7 @@ impl ParticleProcess for Motion {
                 let (p, v) = x[2 * axis..].split_at_mut(1);
                 let (p, v) = (&mut p[0][start..start + m], &mut v[0][start..start + m]);
                 for j in 0..m {
-                    p[j] += v[j] * dt + l11 * e1[j];
+                    p[j] += (v[j] * dt + v0[axis]) + l11 * e1[j];
                     v[j] += l21 * e1[j] + l22 * e2[j];
                 }
             }
@@ -74,9 +77,11 @@ fn angles(x: f64, y: f64, z: f64) -> (f64, f64) {
 impl ParticleLikelihood for Bearing {
     /// Each residual as one atan2 of the cross and dot products of the measured and the
     /// particle's directions (as hoff2024's likelihood does), in lanes.
-    fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+    fn add_log_likelihood(&self, x: &[&[f32]], origin: &[f64], log_w: &mut [f32]) {
         let (sa, ca) = self.azimuth.sin_cos();
         let (se, ce) = self.elevation.sin_cos();
+        let (sa, ca, se, ce, k) = (sa as f32, ca as f32, se as f32, ce as f32, self.k as f32);
+        let o = [origin[0], origin[2], origin[4]].map(|v| v as f32);
         let n = log_w.len();
         let (mut cross_a, mut dot_a, mut cross_e, mut dot_e) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
         let (mut da, mut de) = ([0.0; BLOCK], [0.0; BLOCK]);
@@ -84,16 +89,17 @@ impl ParticleLikelihood for Bearing {
             let m = BLOCK.min(n - start);
             let (px, py, pz) = (&x[0][start..start + m], &x[2][start..start + m], &x[4][start..start + m]);
             for j in 0..m {
-                let h = (px[j] * px[j] + py[j] * py[j]).sqrt();
-                cross_a[j] = sa * px[j] - ca * py[j];
-                dot_a[j] = ca * px[j] + sa * py[j];
-                cross_e[j] = se * h - ce * pz[j];
-                dot_e[j] = ce * h + se * pz[j];
+                let (px, py, pz) = (o[0] + px[j], o[1] + py[j], o[2] + pz[j]);
+                let h = (px * px + py * py).sqrt();
+                cross_a[j] = sa * px - ca * py;
+                dot_a[j] = ca * px + sa * py;
+                cross_e[j] = se * h - ce * pz;
+                dot_e[j] = ce * h + se * pz;
             }
             lanes::atan2(&cross_a[..m], &dot_a[..m], &mut da[..m]);
             lanes::atan2(&cross_e[..m], &dot_e[..m], &mut de[..m]);
             for (j, lw) in log_w[start..start + m].iter_mut().enumerate() {
-                *lw -= self.k * (da[j] * da[j] + de[j] * de[j]);
+                *lw -= k * (da[j] * da[j] + de[j] * de[j]);
             }
         }
     }

@@ -6,12 +6,14 @@ use super::estimator::{EstimatorKind, EstimatorSpec, IusblKeys};
 use super::stream::StreamConfig;
 
 /// The bytes a particle filter of `n` particles of `d` states holds at most: two copies
-/// of its states (the spare one for resampling) and five per-particle vectors
-/// (log-weights, increments, normalised weights, cumulative weights, ancestors).
-/// Measured: hoff2024's `run` with 5e7 particles peaked at 7.83 GB resident against
-/// 8.47 GB estimated (onebeacon_sim::budget).
+/// of its states in single precision (the spare one for resampling), the log-weights and
+/// the last update's increments (single), and in double the normalised weights (the
+/// cumulative ones in their place), multinomial resampling's sorted draws and the
+/// ancestors. Measured: the `stream` of hoff2024's surface vehicle with 2e6 particles
+/// peaked at 0.165 GiB resident against 0.179 GiB estimated (onebeacon-cli's test
+/// `the_streams_memory_estimate_bounds_its_peak`).
 pub fn particle_filter_bytes(n: usize, d: usize) -> f64 {
-    n as f64 * (2.0 * d as f64 + 5.0) * 8.0
+    n as f64 * (2.0 * 4.0 * d as f64 + 4.0 + 4.0 + 3.0 * 8.0)
 }
 
 /// What a Gaussian filter and its navigator hold, bytes: an upper bound for every
@@ -20,14 +22,15 @@ const GAUSSIAN_BYTES: f64 = 1e5;
 
 impl EstimatorSpec {
     /// An upper bound of the bytes this estimator holds for one vehicle: its particles
-    /// ([`particle_filter_bytes`]; the iUSBL navigator's factored cloud of 4 values a
-    /// particle), else a Gaussian filter's.
+    /// ([`particle_filter_bytes`]; the iUSBL navigator's factored cloud of 4 double-
+    /// precision values a particle, counted as 8 single-precision states), else a
+    /// Gaussian filter's.
     pub fn working_set_bytes(&self) -> f64 {
         match self.kind {
             EstimatorKind::Particle => particle_filter_bytes(self.particle_settings().0, crate::models::hoff::DIM),
             EstimatorKind::Iusbl | EstimatorKind::IusblJoint => particle_filter_bytes(
                 self.iusbl.as_ref().map_or_else(|| IusblKeys::default().particles, |k| k.particles),
-                4,
+                8,
             ),
             _ => GAUSSIAN_BYTES,
         }

@@ -11,11 +11,17 @@
 //! the machine's vector width (the tests compare each level the processor has with the
 //! scalar kernels, bit for bit).
 //!
+//! A particle model writes its own kernels the same way with the [`lanes!`] macro (a
+//! block's whole step or likelihood in one function: hoff2024's are
+//! [`crate::models::hoff`]'s and [`crate::measure::hoff`]'s), over the particles'
+//! single-precision offsets ([`crate::filter::particle`]): 16 particles an instruction
+//! with AVX-512, 8 with AVX2, 4 at the baseline.
+//!
 //! Single precision is far finer than what these values feed: a step of a few metres
 //! (relative error 1e-7: under a micrometre), an angle residual against a noise of
 //! milliradians, a log-likelihood against a spread of units. At N = 5e5 this is what
-//! makes a hoff2024 filter cycle fit its budget (README, Benchmarks): libm's
-//! scalar atan2 and sin_cos cost some 20 ns a call.
+//! makes a hoff2024 filter cycle fit its budget (docs/benchmarks.md): libm's scalar atan2
+//! and sin_cos cost some 20 ns a call.
 
 use rand::Rng;
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
@@ -91,7 +97,7 @@ macro_rules! lanes {
     ($(#[$doc:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block) => {
         $(#[$doc])*
         $vis fn $name($($arg: $ty),*) $(-> $ret)? {
-            $name::at(Level::current(), $($arg),*)
+            $name::at($crate::filter::lanes::Level::current(), $($arg),*)
         }
 
         pub(crate) mod $name {
@@ -117,7 +123,8 @@ macro_rules! lanes {
             ///
             /// # Panics
             /// If the processor does not run `level` ([`Level::available`]).
-            pub fn at(level: Level, $($arg: $ty),*) $(-> $ret)? {
+            pub fn at(level: $crate::filter::lanes::Level, $($arg: $ty),*) $(-> $ret)? {
+                use $crate::filter::lanes::Level;
                 assert!(level <= Level::best(), "{level:?} is beyond this processor");
                 match level {
                     #[cfg(target_arch = "x86_64")]
@@ -132,25 +139,40 @@ macro_rules! lanes {
         }
     };
 }
+/// For a particle model's own kernels (a block's whole step or likelihood in one
+/// function, so that its arithmetic runs at the level's width with no scratch arrays).
+pub(crate) use lanes;
 
-/// x rounded to the nearest integer (|x| < 2^31), as a float and as an integer: added
-/// to and taken from 1.5 2^52, whose last bits then hold the integer (in two's
+/// x rounded to the nearest integer (|x| < 2^22), as a float and as an integer: added
+/// to and taken from 1.5 2^23, whose last bits then hold the integer (in two's
 /// complement). Unlike `as`, which saturates lane by lane, the compiler vectorises it.
 #[inline(always)]
-fn round(x: f64) -> (f64, i32) {
-    const MAGIC: f64 = 6_755_399_441_055_744.0;
+fn round(x: f32) -> (f32, i32) {
+    const MAGIC: f32 = 12_582_912.0;
     let shifted = x + MAGIC;
-    (shifted - MAGIC, shifted.to_bits() as i32)
+    (shifted - MAGIC, (shifted.to_bits() as i32).wrapping_sub(MAGIC.to_bits() as i32))
 }
 
-/// sin x and cos x (|x| below some 1e6): x reduced by pi/2 in double precision (so the
-/// input's own rounding to single precision does not count), then [`sin_cos_reduced`].
+/// sin x and cos x for |x| <= 8192: x reduced by pi/2 in three parts (Cephes' sinf: the
+/// first two short enough that their products with the quadrant are exact), then
+/// [`sin_cos_reduced`].
 #[inline(always)]
-fn sin_cos1(x: f64) -> (f32, f32) {
-    let (q, quadrant) = round(x * std::f64::consts::FRAC_2_PI);
-    // pi / 2 in two parts (the second, what f64 leaves of it)
-    let r = ((x - q * std::f64::consts::FRAC_PI_2) - q * 6.123_233_995_736_766e-17) as f32;
+pub(crate) fn sin_cos1(x: f32) -> (f32, f32) {
+    let (q, quadrant) = round(x * std::f32::consts::FRAC_2_PI);
+    let r = ((x - q * 1.570_312_5) - q * 4.837_513e-4) - q * 7.549_79e-8;
     sin_cos_reduced(r, quadrant)
+}
+
+/// An angle within 3 pi wrapped to (-pi, pi] with one add or subtract.
+#[inline(always)]
+pub(crate) fn wrap_near(a: f32) -> f32 {
+    if a > PI {
+        a - 2.0 * PI
+    } else if a <= -PI {
+        a + 2.0 * PI
+    } else {
+        a
+    }
 }
 
 /// sin and cos of quadrant pi / 2 + r, |r| <= pi / 4: Cephes' polynomials in r, the
@@ -169,7 +191,7 @@ fn sin_cos_reduced(r: f32, quadrant: i32) -> (f32, f32) {
 /// ln x for a positive normal x: x = m 2^e with m in [sqrt(1/2), sqrt(2)), Cephes' logf
 /// polynomial in m - 1, ln 2 in two parts.
 #[inline(always)]
-fn ln1(x: f32) -> f32 {
+pub(crate) fn ln1(x: f32) -> f32 {
     let bits = x.to_bits();
     let mut e = ((bits >> 23) & 0xff) as i32 - 126;
     let mut m = f32::from_bits((bits & 0x007f_ffff) | 0x3f00_0000); // in [1/2, 1)
@@ -202,14 +224,14 @@ fn ln1(x: f32) -> f32 {
 }
 
 /// e^x for x <= 0 (0 below -87, where single precision ends): x = k ln 2 + r with
-/// |r| <= ln 2 / 2, reduced in double precision, Cephes' expf polynomial in r, 2^k from
-/// its bits.
+/// |r| <= ln 2 / 2 (ln 2 in two parts, Cephes' expf), Cephes' expf polynomial in r, 2^k
+/// from its bits.
 #[inline(always)]
-fn exp1(x: f64) -> f32 {
+fn exp1(x: f32) -> f32 {
     let under = x < -87.0;
     let x = x.clamp(-87.0, 0.0);
-    let (k, ki) = round(x * std::f64::consts::LOG2_E);
-    let r = (x - k * std::f64::consts::LN_2) as f32;
+    let (k, ki) = round(x * std::f32::consts::LOG2_E);
+    let r = (x - k * 0.693_359_4) - k * -2.121_944_4e-4;
     let z = r * r;
     let p = 1.987_569_1e-4;
     let p = p * r + 1.398_199_9e-3;
@@ -225,7 +247,7 @@ fn exp1(x: f64) -> f32 {
 /// (in [0, 1], reduced about tan(pi/8)), Cephes' atanf polynomial, the octant applied
 /// by selects; 0 at the origin.
 #[inline(always)]
-fn atan2_1(y: f32, x: f32) -> f32 {
+pub(crate) fn atan2_1(y: f32, x: f32) -> f32 {
     let (ax, ay) = (x.abs(), y.abs());
     let (lo, hi) = (ax.min(ay), ax.max(ay));
     let t = if hi > 0.0 { lo / hi } else { 0.0 };
@@ -239,33 +261,32 @@ fn atan2_1(y: f32, x: f32) -> f32 {
 }
 
 lanes! {
-    /// sin and cos of every angle of `a` (radians, |a| below some 1e6).
-    pub fn sin_cos(a: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    /// sin and cos of every angle of `a` (radians, |a| <= 8192).
+    pub fn sin_cos(a: &[f32], sin: &mut [f32], cos: &mut [f32]) {
         let n = a.len();
         let (sin, cos) = (&mut sin[..n], &mut cos[..n]);
         for i in 0..n {
-            let (s, c) = sin_cos1(a[i]);
-            sin[i] = f64::from(s);
-            cos[i] = f64::from(c);
+            (sin[i], cos[i]) = sin_cos1(a[i]);
         }
     }
 }
 
 lanes! {
     /// atan2(y_i, x_i) for every i, in [-pi, pi].
-    pub fn atan2(y: &[f64], x: &[f64], out: &mut [f64]) {
+    pub fn atan2(y: &[f32], x: &[f32], out: &mut [f32]) {
         let n = out.len();
         let (y, x) = (&y[..n], &x[..n]);
         for i in 0..n {
-            out[i] = f64::from(atan2_1(y[i] as f32, x[i] as f32));
+            out[i] = atan2_1(y[i], x[i]);
         }
     }
 }
 
 lanes! {
     /// exp(x_i - shift) for every i, and their sum (in a fixed order), for log-weights x_i
-    /// at most `shift` (the largest: weights relative to the heaviest).
-    pub fn exp_shifted(x: &[f64], shift: f64, out: &mut [f64]) -> f64 {
+    /// at most `shift` (the largest: weights relative to the heaviest); each to single
+    /// precision, stored and summed in double.
+    pub fn exp_shifted(x: &[f32], shift: f32, out: &mut [f64]) -> f64 {
         let n = out.len();
         let x = &x[..n];
         for i in 0..n {
@@ -285,14 +306,32 @@ lanes! {
 }
 
 lanes! {
+    /// The largest of `x` (-inf if empty), or NaN if one is NaN: sixteen running maxima
+    /// and NaN flags (particle i in lane i mod 16), combined at the end.
+    pub fn max_of(x: &[f32]) -> f32 {
+        let (mut max, mut nan) = ([f32::NEG_INFINITY; 16], [false; 16]);
+        let chunks = x.chunks_exact(16);
+        for v in chunks.remainder() {
+            (max[0], nan[0]) = (if *v > max[0] { *v } else { max[0] }, nan[0] | v.is_nan());
+        }
+        for c in chunks {
+            for j in 0..16 {
+                (max[j], nan[j]) = (if c[j] > max[j] { c[j] } else { max[j] }, nan[j] | c[j].is_nan());
+            }
+        }
+        if nan.iter().any(|n| *n) { f32::NAN } else { max.into_iter().fold(f32::NEG_INFINITY, f32::max) }
+    }
+}
+
+lanes! {
     /// ln x_i for every i: to single precision for x_i within f32's normal range (1.2e-38
-    /// to 3.4e38; a subnormal gives a meaningless result), -inf at 0, +inf above the range,
+    /// to 3.4e38; a subnormal gives a meaningless result), -inf at 0, +inf at infinity,
     /// NaN for a negative or NaN x_i.
-    pub fn ln(x: &[f64], out: &mut [f64]) {
+    pub fn ln(x: &[f32], out: &mut [f32]) {
         let n = out.len();
         let x = &x[..n];
         for i in 0..n {
-            out[i] = f64::from(ln1(x[i] as f32));
+            out[i] = ln1(x[i]);
         }
     }
 }
@@ -305,27 +344,22 @@ lanes! {
     /// uniform angle, as a quadrant (its top two bits) and an offset within it (the other
     /// 30, centred: within +-pi/4), so that no range reduction is needed. The pair gives
     /// draws `out[i]` and `out[n + i]`.
-    fn box_muller(key: u64, out: &mut [f64]) {
-        // the 64-bit hashes, the single-precision arithmetic and the widening each in a
-        // loop of its own, at its own vector width (AVX2 has 4 lanes of u64 or f64, 8 of
-        // f32)
+    fn box_muller(key: u64, out: &mut [f32]) {
+        // the 64-bit hashes and the single-precision arithmetic each in a loop of its
+        // own, at its own vector width (AVX2 has 4 lanes of u64, 8 of f32)
         const PAIRS: usize = 512;
         let n = out.len() / 2;
         let (first, second) = out.split_at_mut(n);
         let second = &mut second[..n];
         let (mut k1, mut k2) = ([0u32; PAIRS], [0u32; PAIRS]);
-        let (mut s, mut c) = ([0f32; PAIRS], [0f32; PAIRS]);
         for start in (0..n).step_by(PAIRS) {
             let m = PAIRS.min(n - start);
             for j in 0..m {
                 (k1[j], k2[j]) = hash1(key, start + j);
             }
+            let (first, second) = (&mut first[start..start + m], &mut second[start..start + m]);
             for j in 0..m {
-                (s[j], c[j]) = pair1(k1[j], k2[j]);
-            }
-            for j in 0..m {
-                first[start + j] = f64::from(s[j]);
-                second[start + j] = f64::from(c[j]);
+                (first[j], second[j]) = pair1(k1[j], k2[j]);
             }
         }
     }
@@ -418,24 +452,26 @@ lanes! {
     /// groups of four (pad with any pair and discard its sum): each group's four sums
     /// advance together, so that no sum waits on its own last addition. `w`'s length is
     /// a multiple of 4 and no component is shorter.
-    pub fn add_products(w: &[f64], x: &[&[f64]], pairs: &[(usize, usize)], products: &mut [[f64; 4]]) {
+    pub fn add_products(w: &[f64], x: &[&[f32]], pairs: &[(usize, usize)], products: &mut [[f64; 4]]) {
         // a block's w x_k stay in the first level of cache for the pairs that read them
         const BLOCK: usize = 128;
         fn quads(s: &[f64], n: usize) -> &[[f64; 4]] {
             &s[..n].as_chunks::<4>().0[..n / 4]
         }
-        let mut wx = vec![0.0; x.len() * BLOCK];
+        // the block's components widened to double precision, and their products by w
+        let (mut wide, mut wx) = (vec![0.0; x.len() * BLOCK], vec![0.0; x.len() * BLOCK]);
         for start in (0..w.len()).step_by(BLOCK) {
             let n = BLOCK.min(w.len() - start);
             let w = &w[start..start + n];
-            for (xk, wxk) in x.iter().zip(wx.chunks_exact_mut(BLOCK)) {
-                for ((wx, w), x) in wxk[..n].iter_mut().zip(w).zip(&xk[start..start + n]) {
-                    *wx = w * x;
+            for ((xk, wk), wxk) in x.iter().zip(wide.chunks_exact_mut(BLOCK)).zip(wx.chunks_exact_mut(BLOCK)) {
+                for (((v, wx), w), x) in wk[..n].iter_mut().zip(&mut wxk[..n]).zip(w).zip(&xk[start..start + n]) {
+                    *v = f64::from(*x);
+                    *wx = w * *v;
                 }
             }
             for (group, acc) in pairs.chunks_exact(4).zip(products.chunks_exact_mut(4)) {
                 let a: [&[[f64; 4]]; 4] = std::array::from_fn(|q| quads(&wx[group[q].0 * BLOCK..], n));
-                let b: [&[[f64; 4]]; 4] = std::array::from_fn(|q| quads(&x[group[q].1][start..], n));
+                let b: [&[[f64; 4]]; 4] = std::array::from_fn(|q| quads(&wide[group[q].1 * BLOCK..], n));
                 let quad = |c: usize| (a.map(|a| a[c]), b.map(|b| b[c]));
                 let mut sum: [[f64; 4]; 4] = std::array::from_fn(|q| acc[q]);
                 for c in 0..n / 4 {
@@ -456,14 +492,7 @@ lanes! {
 #[inline(always)]
 fn angles1(north: f32, east: f32, down: f32, station: [f32; 2], centre: [f32; 2]) -> (f32, f32) {
     let (dx, dy) = (north - station[0], east - station[1]);
-    let a = atan2_1(dy, dx) - centre[0];
-    let a = if a > PI {
-        a - 2.0 * PI
-    } else if a <= -PI {
-        a + 2.0 * PI
-    } else {
-        a
-    };
+    let a = wrap_near(atan2_1(dy, dx) - centre[0]);
     (a, atan2_1((dx * dx + dy * dy).sqrt(), down) - centre[1])
 }
 
@@ -486,13 +515,17 @@ fn add_moments(acc: &mut [[f64; MOMENT_LANES]; 5], j: usize, a: f32, e: f32, w: 
 /// uniforms, so that the radius sqrt(-2 ln u1) reaches 6.77 sigma (the mass beyond it,
 /// 1.3e-11, is what is left out). One 64-bit draw is taken from `rng` per 2048 normals:
 /// the key of a counter-based stream ([`box_muller`]).
-pub fn standard_normals<R: Rng + ?Sized>(rng: &mut R, out: &mut [f64]) {
+pub fn standard_normals<R: Rng + ?Sized>(rng: &mut R, out: &mut [f32]) {
     const BATCH: usize = 2048;
     let mut pairs = [0.0; BATCH];
     for block in out.chunks_mut(BATCH) {
-        let m = block.len() + block.len() % 2;
-        box_muller(rng.next_u64(), &mut pairs[..m]);
-        block.copy_from_slice(&pairs[..block.len()]);
+        let key = rng.next_u64();
+        if block.len() % 2 == 0 {
+            box_muller(key, block);
+        } else {
+            box_muller(key, &mut pairs[..block.len() + 1]);
+            block.copy_from_slice(&pairs[..block.len()]);
+        }
     }
 }
 
@@ -505,36 +538,43 @@ mod tests {
     /// octants, binades): single precision, within a few 1e-7 (relative for ln).
     #[test]
     fn functions_match_std_within_single_precision() {
-        let a: Vec<f64> = (0..2003).map(|i| -20.0 + 0.019_99 * i as f64).collect();
+        let wide = |v: &[f32]| v.iter().map(|x| f64::from(*x)).collect::<Vec<f64>>();
+        // angles to +-20 rad, and one near the 8192 the reduction is exact to
+        let a: Vec<f32> = (0..2003).map(|i| -20.0 + 0.019_99 * i as f32).chain([8191.7, -8000.3]).collect();
         let (mut s, mut c) = (vec![0.0; a.len()], vec![0.0; a.len()]);
         sin_cos(&a, &mut s, &mut c);
         for i in 0..a.len() {
-            assert!((s[i] - a[i].sin()).abs() < 4e-7 && (c[i] - a[i].cos()).abs() < 4e-7, "{}", a[i]);
+            let x = f64::from(a[i]);
+            let (ds, dc) = (f64::from(s[i]) - x.sin(), f64::from(c[i]) - x.cos());
+            assert!(ds.abs() < 4e-7 && dc.abs() < 4e-7, "{x}: {ds} {dc}");
         }
-        let y: Vec<f64> = (0..2003).map(|i| (i as f64 * 0.37).sin() * 10f64.powi(i % 7 - 3)).collect();
-        let x: Vec<f64> = (0..2003).map(|i| (i as f64 * 0.91).cos() * 10f64.powi(i % 5 - 2)).collect();
+        let y: Vec<f32> = (0..2003).map(|i| ((i as f64 * 0.37).sin() * 10f64.powi(i % 7 - 3)) as f32).collect();
+        let x: Vec<f32> = (0..2003).map(|i| ((i as f64 * 0.91).cos() * 10f64.powi(i % 5 - 2)) as f32).collect();
         let mut t = vec![0.0; y.len()];
         atan2(&y, &x, &mut t);
+        let (yw, xw, tw) = (wide(&y), wide(&x), wide(&t));
         for i in 0..y.len() {
-            assert!((t[i] - y[i].atan2(x[i])).abs() < 4e-7, "atan2({}, {})", y[i], x[i]);
+            assert!((tw[i] - yw[i].atan2(xw[i])).abs() < 4e-7, "atan2({}, {})", y[i], x[i]);
         }
         atan2(&[0.0, 0.0, 1.0, -1.0], &[0.0, -1.0, 0.0, 0.0], &mut t[..4]);
         for (t, expected) in t.iter().zip([0.0, 1.0, 0.5, -0.5]) {
-            assert!((t - expected * std::f64::consts::PI).abs() < 4e-7, "{t}");
+            assert!((f64::from(*t) - expected * std::f64::consts::PI).abs() < 4e-7, "{t}");
         }
-        let v: Vec<f64> = (0..2003).map(|i| -100.0 + 0.049_95 * i as f64).collect();
-        let total = exp_shifted(&v, 0.0, &mut t);
+        let v: Vec<f32> = (0..2003).map(|i| -100.0 + 0.049_95 * i as f32).collect();
+        let mut e = vec![0.0; v.len()];
+        let total = exp_shifted(&v, 0.0, &mut e);
         for i in 0..v.len() {
-            let e = v[i].exp();
-            assert!((t[i] - e).abs() <= 3e-7 * e + 2e-38, "exp {}: {} against {e}", v[i], t[i]);
+            let x = f64::from(v[i]).exp();
+            assert!((e[i] - x).abs() <= 3e-7 * x + 2e-38, "exp {}: {} against {x}", v[i], e[i]);
         }
-        assert!((total / t.iter().sum::<f64>() - 1.0).abs() < 1e-12);
-        ln(&[0.0, 1e39, -1.0, f64::NAN], &mut t[..4]);
-        assert!(t[0] == f64::NEG_INFINITY && t[1] == f64::INFINITY && t[2].is_nan() && t[3].is_nan());
-        let v: Vec<f64> = (0..2003).map(|i| 1e-30 * 1.1f64.powi(i % 1400)).collect();
+        assert!((total / e.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        ln(&[0.0, f32::INFINITY, -1.0, f32::NAN], &mut t[..4]);
+        assert!(t[0] == f32::NEG_INFINITY && t[1] == f32::INFINITY && t[2].is_nan() && t[3].is_nan());
+        let v: Vec<f32> = (0..2003).map(|i| (1e-30 * 1.1f64.powi(i % 1200)) as f32).collect();
         ln(&v, &mut t);
         for i in 0..v.len() {
-            assert!((t[i] - v[i].ln()).abs() < 2e-7 * v[i].ln().abs().max(1.0), "ln {}", v[i]);
+            let x = f64::from(v[i]).ln();
+            assert!((f64::from(t[i]) - x).abs() < 2e-7 * x.abs().max(1.0), "ln {}", v[i]);
         }
     }
 
@@ -545,9 +585,10 @@ mod tests {
     fn every_level_matches_the_scalar_kernels_bit_for_bit() {
         use std::hint::black_box;
         let n = 4099;
-        let a: Vec<f64> = (0..n).map(|i| -40.0 + 0.019_53 * i as f64).collect();
-        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.77).cos() * 10f64.powi(i as i32 % 9 - 4)).collect();
-        let positive: Vec<f64> = b.iter().map(|v| v.abs() + 1e-30).collect();
+        let a: Vec<f32> = (0..n).map(|i| -40.0 + 0.019_53 * i as f32).collect();
+        let b: Vec<f32> = (0..n).map(|i| ((i as f64 * 0.77).cos() * 10f64.powi(i as i32 % 9 - 4)) as f32).collect();
+        let positive: Vec<f32> = b.iter().map(|v| v.abs() + 1e-30).collect();
+        let weights: Vec<f64> = positive.iter().map(|v| f64::from(*v)).collect();
         let shift = 3.0;
         // particles about a point, a station 30 m off, angles about the point's
         let col = |f: &dyn Fn(f32) -> f32| (0..n).map(|i| f(i as f32)).collect::<Vec<f32>>();
@@ -562,32 +603,30 @@ mod tests {
             atan2::at(level, &a, &b, &mut t);
             for i in 0..n {
                 let (s1, c1) = black_box(sin_cos1(a[i]));
-                assert_eq!((s[i].to_bits(), c[i].to_bits()), (f64::from(s1).to_bits(), f64::from(c1).to_bits()));
-                let t1 = black_box(atan2_1(a[i] as f32, b[i] as f32));
-                assert_eq!(t[i].to_bits(), f64::from(t1).to_bits(), "{level:?} atan2 {} {}", a[i], b[i]);
+                assert_eq!((s[i].to_bits(), c[i].to_bits()), (s1.to_bits(), c1.to_bits()), "{level:?} sin_cos");
+                let t1 = black_box(atan2_1(a[i], b[i]));
+                assert_eq!(t[i].to_bits(), t1.to_bits(), "{level:?} atan2 {} {}", a[i], b[i]);
             }
             ln::at(level, &positive, &mut t);
             for i in 0..n {
-                assert_eq!(t[i].to_bits(), f64::from(black_box(ln1(positive[i] as f32))).to_bits(), "{level:?} ln");
+                assert_eq!(t[i].to_bits(), black_box(ln1(positive[i])).to_bits(), "{level:?} ln");
             }
-            let total = exp_shifted::at(level, &a, shift, &mut t);
+            let mut wide = vec![0.0; n];
+            let total = exp_shifted::at(level, &a, shift, &mut wide);
             let mut sums = [0.0; 4];
             for i in 0..n {
                 let e = f64::from(black_box(exp1(a[i] - shift)));
-                assert_eq!(t[i].to_bits(), e.to_bits(), "{level:?} exp");
+                assert_eq!(wide[i].to_bits(), e.to_bits(), "{level:?} exp");
                 sums[i % 4] += if i < n / 4 * 4 { e } else { 0.0 };
             }
-            let tail: f64 = t[n / 4 * 4..].iter().sum();
+            let tail: f64 = wide[n / 4 * 4..].iter().sum();
             assert_eq!(total.to_bits(), ((sums[0] + sums[1]) + (sums[2] + sums[3]) + tail).to_bits());
             let mut pairs = vec![0.0; 2 * 1024];
             box_muller::at(level, 0xDEAD_BEEF, &mut pairs);
             for i in 0..1024 {
                 let (k1, k2) = black_box(hash1(0xDEAD_BEEF, i));
                 let (z1, z2) = black_box(pair1(k1, k2));
-                assert_eq!(
-                    (pairs[i].to_bits(), pairs[1024 + i].to_bits()),
-                    (f64::from(z1).to_bits(), f64::from(z2).to_bits())
-                );
+                assert_eq!((pairs[i].to_bits(), pairs[1024 + i].to_bits()), (z1.to_bits(), z2.to_bits()));
             }
             let mut e = vec![0.0; 1001];
             exponentials::at(level, 0xFEED, &mut e);
@@ -595,6 +634,15 @@ mod tests {
                 let k = black_box(hash1(0xFEED, i)).0;
                 assert_eq!(v.to_bits(), f64::from(-black_box(ln_uniform(k))).to_bits());
             }
+            // the maximum, with a NaN planted or not, against a scalar fold
+            let mut v = a.clone();
+            assert_eq!(max_of::at(level, &v).to_bits(), a.iter().fold(f32::NEG_INFINITY, |m, x| m.max(*x)).to_bits());
+            assert_eq!(
+                max_of::at(level, &v[..7]).to_bits(),
+                a[..7].iter().fold(f32::NEG_INFINITY, |m, x| m.max(*x)).to_bits()
+            );
+            v[n - 5] = f32::NAN;
+            assert!(max_of::at(level, &v).is_nan() && max_of::at(level, &v[..n - 5]).is_finite());
             let moments = angle_moments::at(level, &north, &east, &down, &w, station, centre);
             let mut acc = [[0.0; MOMENT_LANES]; 5];
             for i in 0..n {
@@ -608,11 +656,12 @@ mod tests {
             let comps = [&a[..4096], &b[..4096], &ones[..]];
             let pairs = [(0, 2), (1, 2), (0, 0), (0, 1), (1, 1), (1, 0), (0, 0), (0, 0)];
             let mut products = [[0.25; 4]; 8];
-            add_products::at(level, &positive[..4096], &comps, &pairs, &mut products);
+            add_products::at(level, &weights[..4096], &comps, &pairs, &mut products);
             let mut expected = [[0.25; 4]; 8];
             for i in 0..4096 {
                 for (p, &(k, l)) in pairs[..6].iter().enumerate() {
-                    expected[p][i % 4] += black_box(black_box(positive[i] * comps[k][i]) * comps[l][i]);
+                    let (xk, xl) = (f64::from(comps[k][i]), f64::from(comps[l][i]));
+                    expected[p][i % 4] += black_box(black_box(weights[i] * xk) * xl);
                 }
             }
             let bits = |p: &[[f64; 4]]| p.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
@@ -683,8 +732,9 @@ mod tests {
     fn normals_have_the_standard_moments_and_tails() {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
         let n = 1_000_001; // odd, and not a whole number of batches
-        let mut z = vec![0.0; n];
-        standard_normals(&mut rng, &mut z);
+        let mut drawn = vec![0.0f32; n];
+        standard_normals(&mut rng, &mut drawn);
+        let z: Vec<f64> = drawn.iter().map(|v| f64::from(*v)).collect();
         let nf = n as f64;
         let mean = z.iter().sum::<f64>() / nf;
         let var = z.iter().map(|v| v * v).sum::<f64>() / nf;

@@ -10,6 +10,18 @@ use rand_pcg::Pcg64;
 /// Particles per chunk: the unit of parallel work and of random streams.
 pub const CHUNK: usize = 8192;
 
+crate::filter::lanes::lanes! {
+    /// `to[j] = from[picked[j]] - shift`: a component's values copied from the ancestors
+    /// (each index clamped to the last particle, which lets the compiler drop the bounds
+    /// checks and use the level's gathers; every ancestor is below it).
+    pub(super) fn gather(from: &[f32], picked: &[usize], shift: f32, to: &mut [f32]) {
+        let last = from.len() - 1;
+        for (v, &i) in to.iter_mut().zip(picked) {
+            *v = from[i.min(last)] - shift;
+        }
+    }
+}
+
 /// How particles are drawn again in proportion to their weights.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum Resampler {
@@ -157,8 +169,41 @@ pub(super) fn chunk_ancestors(
             walk_from(cum, running[range].iter().map(|s| (before[c] + s) / total))
         }
         (Drawn::Nothing, Resampler::Stratified) => walk_from(cum, range.map(|j| (j as f64 + rng.random::<f64>()) / n)),
-        (Drawn::Nothing, _) => walk_from(cum, range.map(|j| (j as f64 + u0) / n)),
+        (Drawn::Nothing, _) => systematic(cum, range, u0),
     }
+}
+
+/// Systematic resampling's ancestors of new particles `range`, for the points
+/// (j + u0) / N, without a walk's unpredictable branches: the points below C_i number
+/// k_i = ceil(N C_i - u0), so particle i is the ancestor of new particles k_(i-1) to
+/// k_i - 1 and new particle j's is the number of i with k_i <= j. The first of the range
+/// by bisection; then each later particle i is written where its new particles start
+/// (k_(i-1)), in order (one copied no times is overwritten by the next, which starts at
+/// the same place), and a running maximum fills the places between.
+fn systematic(cum: &[f64], range: std::ops::Range<usize>, u0: f64) -> Vec<usize> {
+    let (n, last) = (cum.len() as f64, cum.len() - 1);
+    // ceil(t) for t > -1 by truncation (libm's ceil is a call at the baseline level)
+    let k = |c: f64| {
+        let t = n * c - u0;
+        let i = t as i64;
+        (i + i64::from((i as f64) < t)) as usize
+    };
+    let ancestor = |j: usize| cum.partition_point(|c| k(*c) <= j).min(last);
+    let (lo, len) = (range.start, range.len());
+    let Some(end) = len.checked_sub(1) else { return Vec::new() };
+    let (first, final_) = (ancestor(lo), ancestor(lo + end));
+    let mut out = vec![0; len];
+    out[0] = first;
+    let starts: Vec<usize> = cum[first..final_].iter().map(|c| k(*c) - lo).collect();
+    for (i, s) in (first + 1..).zip(starts) {
+        out[s] = i;
+    }
+    let mut max = first;
+    for a in out.iter_mut() {
+        max = max.max(*a);
+        *a = max;
+    }
+    out
 }
 
 /// `m` independent draws of an index with probabilities `w`: sorted uniforms (from

@@ -367,11 +367,12 @@ mod tests {
         // one bearing from an ASV at (60, 20): weights by azimuth only
         struct Azimuth;
         impl crate::filter::particle::ParticleLikelihood for Azimuth {
-            fn add_log_likelihood(&self, x: &[&[f64]], log_w: &mut [f64]) {
+            fn add_log_likelihood(&self, x: &[&[f32]], origin: &[f64], log_w: &mut [f32]) {
                 for (i, lw) in log_w.iter_mut().enumerate() {
-                    let a = (x[1][i] - 20.0).atan2(x[0][i] - 60.0);
+                    let (n, e) = (origin[0] + f64::from(x[0][i]), origin[1] + f64::from(x[1][i]));
+                    let a = (e - 20.0).atan2(n - 60.0);
                     let d = a - (30.0f64).atan2(40.0);
-                    *lw -= d * d / (2.0 * 0.03 * 0.03);
+                    *lw -= (d * d / (2.0 * 0.03 * 0.03)) as f32;
                 }
             }
         }

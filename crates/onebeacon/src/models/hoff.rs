@@ -5,13 +5,14 @@
 //! the USBL bearing (eq. 6-7) that weigh it are [`crate::measure::hoff`].
 
 use crate::filter::ProcessModel;
-use crate::filter::lanes;
+use crate::filter::lanes::{self, lanes, sin_cos1};
 use crate::filter::particle::ParticleProcess;
 use crate::filter::truncated::truncated_normal;
 use crate::geo::wrap_angle;
 use nalgebra::{SMatrix, SVector};
 use rand_pcg::Pcg64;
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::f32::consts::TAU;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// State dimension.
 pub const DIM: usize = 8;
@@ -94,63 +95,125 @@ impl Default for HoffProcess {
 pub(crate) const BLOCK: usize = 256;
 
 impl ParticleProcess for HoffProcess {
-    /// Block by block: the block's normal draws and its sines and cosines first, eight
-    /// lanes at a time ([`crate::filter::lanes`]), then eq. 4's step. A truncated
-    /// component takes the plain draw when it falls within its bounds and otherwise a
-    /// draw of the truncated law (rejection's first try, then an exact draw: the result
-    /// follows the truncated law).
-    fn propagate(&self, x: &mut [&mut [f64]], dt: f64, rng: &mut Pcg64) {
-        let s = self.sigma.map(|v| v * dt);
-        let keep = 1.0 - dt / self.t_b_s;
+    /// Block by block: the block's normal draws, then eq. 4's step ([`hoff_step`]: the
+    /// sines and cosines in the same pass, the particles' offsets in single precision).
+    /// A truncated component takes the plain draw when it falls within its bounds and
+    /// otherwise a draw of the truncated law (rejection's first try, then an exact draw:
+    /// the result follows the truncated law).
+    fn propagate(&self, x: &mut [&mut [f32]], origin: &[f64], dt: f64, rng: &mut Pcg64) {
         let [px, py, pz, pt, pp, pu, pbt, pbp] = x else { panic!("hoff2024's state has {DIM} components") };
+        let o = |k: usize| origin[k];
+        let step = self.step(origin, dt);
+        // the truncations' bounds (eq. 4) as offsets
+        let z_min = (self.z_min_m - o(idx::Z)) as f32;
+        let theta_bounds = [-FRAC_PI_2 - o(idx::THETA), FRAC_PI_2 - o(idx::THETA)].map(|v| v as f32);
+        let u_min = -o(idx::U) as f32;
         let n = px.len();
-        let mut noise = [0.0; DIM * BLOCK];
-        let (mut st, mut ct, mut sp, mut cp) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+        let mut noise = [0.0f32; DIM * BLOCK];
         for start in (0..n).step_by(BLOCK) {
             let m = BLOCK.min(n - start);
             let r = start..start + m;
-            let (x, y, z, theta, psi) =
-                (&mut px[r.clone()], &mut py[r.clone()], &mut pz[r.clone()], &mut pt[r.clone()], &mut pp[r.clone()]);
-            let (u, b_theta, b_psi) = (&mut pu[r.clone()], &mut pbt[r.clone()], &mut pbp[r]);
-            lanes::standard_normals(rng, &mut noise[..DIM * m]);
-            let (st, ct, sp, cp) = (&mut st[..m], &mut ct[..m], &mut sp[..m], &mut cp[..m]);
-            lanes::sin_cos(theta, st, ct);
-            lanes::sin_cos(psi, sp, cp);
-            let e: [&[f64]; DIM] = std::array::from_fn(|k| &noise[k * m..(k + 1) * m]);
-            // eq. 4: the mean step f(x) dt, noise sigma dt, truncated on z, theta and u
-            for j in 0..m {
-                x[j] += u[j] * ct[j] * cp[j] * dt + s[idx::X] * e[idx::X][j];
-                y[j] += u[j] * ct[j] * sp[j] * dt + s[idx::Y] * e[idx::Y][j];
-                z[j] += -u[j] * st[j] * dt + s[idx::Z] * e[idx::Z][j];
-                theta[j] += b_theta[j] * dt + s[idx::THETA] * e[idx::THETA][j];
-                // a step of the heading is far below a turn: one add or subtract wraps it
-                let p = psi[j] + b_psi[j] * dt + s[idx::PSI] * e[idx::PSI][j];
-                psi[j] = if p > PI {
-                    p - TAU
-                } else if p <= -PI {
-                    p + TAU
-                } else {
-                    p
-                };
-                u[j] += s[idx::U] * e[idx::U][j];
-                b_theta[j] = b_theta[j] * keep + s[idx::B_THETA] * e[idx::B_THETA][j];
-                b_psi[j] = b_psi[j] * keep + s[idx::B_PSI] * e[idx::B_PSI][j];
-            }
+            let e = &mut noise[..DIM * m];
+            lanes::standard_normals(rng, e);
+            let mut block = [
+                &mut px[r.clone()],
+                &mut py[r.clone()],
+                &mut pz[r.clone()],
+                &mut pt[r.clone()],
+                &mut pp[r.clone()],
+                &mut pu[r.clone()],
+                &mut pbt[r.clone()],
+                &mut pbp[r],
+            ];
+            hoff_step(&mut block, e, &step);
+            let [_, _, z, theta, _, u, ..] = block;
+            let s = |k: usize| f64::from(step.sigma[k]);
             // the truncations (eq. 4), rarely needed: drawn again from the step's mean
+            let mut redraw = |v: &mut f32, k: usize, j: usize, lo: f64, hi: f64| {
+                let mean = o(k) + f64::from(*v - step.sigma[k] * e[k * m + j]);
+                *v = (truncated_normal(rng, mean, s(k), lo, hi) - o(k)) as f32;
+            };
             for j in 0..m {
-                if z[j] < self.z_min_m {
-                    let mean = z[j] - s[idx::Z] * e[idx::Z][j];
-                    z[j] = truncated_normal(rng, mean, s[idx::Z], self.z_min_m, f64::INFINITY);
+                if z[j] < z_min {
+                    redraw(&mut z[j], idx::Z, j, self.z_min_m, f64::INFINITY);
                 }
-                if theta[j].abs() > FRAC_PI_2 {
-                    let mean = theta[j] - s[idx::THETA] * e[idx::THETA][j];
-                    theta[j] = truncated_normal(rng, mean, s[idx::THETA], -FRAC_PI_2, FRAC_PI_2);
+                if theta[j] < theta_bounds[0] || theta[j] > theta_bounds[1] {
+                    redraw(&mut theta[j], idx::THETA, j, -FRAC_PI_2, FRAC_PI_2);
                 }
-                if u[j] < 0.0 {
-                    let mean = u[j] - s[idx::U] * e[idx::U][j];
-                    u[j] = truncated_normal(rng, mean, s[idx::U], 0.0, f64::INFINITY);
+                if u[j] < u_min {
+                    redraw(&mut u[j], idx::U, j, 0.0, f64::INFINITY);
                 }
             }
+        }
+    }
+}
+
+/// Eq. 4's step as [`hoff_step`] reads it, in single precision: the step, each
+/// component's noise over it, the biases' decay, the origin of the angles, speed and
+/// biases (whose absolute values the step needs), what the decay takes from a bias's
+/// offset, and the bounds a heading's offset wraps within.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Step {
+    dt: f32,
+    sigma: [f32; DIM],
+    keep: f32,
+    /// theta, psi, u, b_theta, b_psi.
+    origin: [f32; 5],
+    decay: [f32; 2],
+    psi_bounds: [f32; 2],
+}
+
+impl HoffProcess {
+    /// Eq. 4's step over `dt` for particles stored from `origin`, as [`hoff_step`]
+    /// reads it.
+    pub(crate) fn step(&self, origin: &[f64], dt: f64) -> Step {
+        let o = |k: usize| origin[k];
+        let keep = 1.0 - dt / self.t_b_s;
+        Step {
+            dt: dt as f32,
+            sigma: self.sigma.map(|v| (v * dt) as f32),
+            keep: keep as f32,
+            origin: [o(idx::THETA), o(idx::PSI), o(idx::U), o(idx::B_THETA), o(idx::B_PSI)].map(|v| v as f32),
+            // a bias's offset decays toward minus its origin's share
+            decay: [o(idx::B_THETA), o(idx::B_PSI)].map(|b| (b * (1.0 - keep)) as f32),
+            psi_bounds: [-PI - o(idx::PSI), PI - o(idx::PSI)].map(|v| v as f32),
+        }
+    }
+}
+
+lanes! {
+    /// Eq. 4 over a block of particles' offsets: the mean step f(x) dt and the noise
+    /// sigma dt e (e: the block's standard normal draws, component by component), the
+    /// heading wrapped; the truncations are the caller's.
+    pub(crate) fn hoff_step(x: &mut [&mut [f32]; DIM], e: &[f32], p: &Step) {
+        let [px, py, pz, pt, pp, pu, pbt, pbp] = x;
+        let m = px.len();
+        let e: [&[f32]; DIM] = std::array::from_fn(|k| &e[k * m..(k + 1) * m]);
+        let (py, pz, pt, pp, pu, pbt, pbp) =
+            (&mut py[..m], &mut pz[..m], &mut pt[..m], &mut pp[..m], &mut pu[..m], &mut pbt[..m], &mut pbp[..m]);
+        let (s, dt, [t0, p0, u0, bt0, bp0]) = (p.sigma, p.dt, p.origin);
+        for j in 0..m {
+            let (st, ct) = sin_cos1(t0 + pt[j]);
+            let (sp, cp) = sin_cos1(p0 + pp[j]);
+            let u = u0 + pu[j];
+            // eq. 4: the mean step f(x) dt, noise sigma dt
+            px[j] += u * ct * cp * dt + s[idx::X] * e[idx::X][j];
+            py[j] += u * ct * sp * dt + s[idx::Y] * e[idx::Y][j];
+            pz[j] += -u * st * dt + s[idx::Z] * e[idx::Z][j];
+            pt[j] += (bt0 + pbt[j]) * dt + s[idx::THETA] * e[idx::THETA][j];
+            // a step of the heading is far below a turn: one add or subtract wraps it
+            let h = pp[j] + (bp0 + pbp[j]) * dt + s[idx::PSI] * e[idx::PSI][j];
+            pp[j] = if h > p.psi_bounds[1] {
+                h - TAU
+            } else if h <= p.psi_bounds[0] {
+                h + TAU
+            } else {
+                h
+            };
+            pu[j] += s[idx::U] * e[idx::U][j];
+            // b' = b keep + noise, as an offset: b0 + o' = (b0 + o) keep + noise
+            pbt[j] = pbt[j] * p.keep - p.decay[0] + s[idx::B_THETA] * e[idx::B_THETA][j];
+            pbp[j] = pbp[j] * p.keep - p.decay[1] + s[idx::B_PSI] * e[idx::B_PSI][j];
         }
     }
 }
@@ -167,10 +230,10 @@ pub struct MisalignedProcess {
 }
 
 impl ParticleProcess for MisalignedProcess {
-    fn propagate(&self, x: &mut [&mut [f64]], dt: f64, rng: &mut Pcg64) {
-        ParticleProcess::propagate(&self.process, &mut x[..DIM], dt, rng);
+    fn propagate(&self, x: &mut [&mut [f32]], origin: &[f64], dt: f64, rng: &mut Pcg64) {
+        ParticleProcess::propagate(&self.process, &mut x[..DIM], &origin[..DIM], dt, rng);
         let [misalignment] = &mut x[DIM..] else { panic!("the misaligned state has {DIM_MISALIGNED} components") };
-        let s = self.walk_rad_per_sqrt_s * dt.sqrt();
+        let s = (self.walk_rad_per_sqrt_s * dt.sqrt()) as f32;
         let mut noise = [0.0; BLOCK];
         for block in misalignment.chunks_mut(BLOCK) {
             lanes::standard_normals(rng, &mut noise[..block.len()]);
@@ -256,8 +319,9 @@ mod tests {
         assert!((m[idx::X] - u * 0.1f64.cos() * 0.5f64.cos() * dt).abs() < 4e-6);
         assert!((m[idx::Y] - u * 0.1f64.cos() * 0.5f64.sin() * dt).abs() < 4e-6);
         assert!((m[idx::Z] - (30.0 - u * 0.1f64.sin() * dt)).abs() < 4e-6);
-        assert!((m[idx::PSI] - (0.5 + 0.01 * dt)).abs() < 1e-12);
-        assert!((m[idx::B_PSI] - 0.01 * (1.0 - dt / 1000.0)).abs() < 1e-12);
+        // single precision: 6e-8 of the heading, of the bias's offset from its origin
+        assert!((m[idx::PSI] - (0.5 + 0.01 * dt)).abs() < 1e-6);
+        assert!((m[idx::B_PSI] - 0.01 * (1.0 - dt / 1000.0)).abs() < 1e-9);
 
         let shallow = SVector::<f64, DIM>::from([0.0, 0.0, 1.5, 1.5, 0.0, 0.05, 0.0, 0.0]);
         let mut pf =
@@ -285,9 +349,14 @@ mod tests {
                 [10.0 + r * a.cos(), -4.0 + r * a.sin(), 30.0 + 5.0 * (t * 0.11).sin()]
             })
             .collect();
-        let comps: Vec<Vec<f64>> =
-            (0..DIM).map(|k| pts.iter().map(|p| if k < 3 { p[k] } else { 0.0 }).collect()).collect();
-        let view: Vec<&[f64]> = comps.iter().map(|c| &c[..]).collect();
+        // the particles as offsets from an origin near them, and their positions as the
+        // offsets hold them
+        let origin = [12.0, -3.0, 28.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let comps: Vec<Vec<f32>> = (0..DIM)
+            .map(|k| pts.iter().map(|p| if k < 3 { (p[k] - origin[k]) as f32 } else { 0.0 }).collect())
+            .collect();
+        let pts: Vec<[f64; 3]> = (0..n).map(|i| std::array::from_fn(|k| origin[k] + f64::from(comps[k][i]))).collect();
+        let view: Vec<&[f32]> = comps.iter().map(|c| &c[..]).collect();
         for (gps, compass, as_printed) in [(0.0, 0.0, false), (1.0, 0.02, false), (0.0, 0.0, true)] {
             let usbl = Usbl {
                 position_ned_m: Vector3::new(10.0, -4.0, 0.5),
@@ -300,7 +369,7 @@ mod tests {
             };
             let bearing = UsblBearing { usbl, azimuth_rad: 0.2, elevation_rad: 0.9, robust: None };
             let mut got = vec![0.0; n];
-            bearing.add_log_likelihood(&view, &mut got);
+            bearing.add_log_likelihood(&view, &origin, &mut got);
             for (i, p) in pts.iter().enumerate() {
                 let p = Vector3::new(p[0], p[1], p[2]);
                 let (alpha, phi, _) = usbl.angles(&p);
@@ -309,7 +378,7 @@ mod tests {
                 let (da, de) = (wrap_angle(0.2 - alpha), 0.9 - phi);
                 let expected = -da * da / (2.0 * var_a) - de * de / (2.0 * var_e) - 0.5 * (var_a * var_e).ln(); // eq. 6
                 assert!(
-                    (got[i] - expected).abs() < 1e-4 * expected.abs().max(1.0),
+                    (f64::from(got[i]) - expected).abs() < 1e-4 * expected.abs().max(1.0),
                     "{i}: {} against {expected}",
                     got[i]
                 );
@@ -332,17 +401,188 @@ mod tests {
             [50.0 * e.sin() * a.cos(), 50.0 * e.sin() * a.sin(), 50.0 * e.cos()]
         };
         let pts = [at(10.0), at(20.0)];
-        let comps: Vec<Vec<f64>> =
-            (0..DIM).map(|k| pts.iter().map(|p| if k < 3 { p[k] } else { 0.0 }).collect()).collect();
-        let view: Vec<&[f64]> = comps.iter().map(|c| &c[..]).collect();
+        let comps: Vec<Vec<f32>> =
+            (0..DIM).map(|k| pts.iter().map(|p| if k < 3 { p[k] as f32 } else { 0.0 }).collect()).collect();
+        let view: Vec<&[f32]> = comps.iter().map(|c| &c[..]).collect();
         for (robust, expected) in [
             (None, 150.0),
             (Some(Robust::Huber { k: 1.345 }), 13.45),
             (Some(Robust::StudentT { dof: 4.0 }), 2.5 * (101.0f64 / 26.0).ln()),
         ] {
             let mut w = vec![0.0; 2];
-            UsblBearing { usbl, azimuth_rad: 0.0, elevation_rad: 0.9, robust }.add_log_likelihood(&view, &mut w);
-            assert!(((w[0] - w[1]) / expected - 1.0).abs() < 1e-3, "{robust:?}: {} against {expected}", w[0] - w[1]);
+            UsblBearing { usbl, azimuth_rad: 0.0, elevation_rad: 0.9, robust }.add_log_likelihood(
+                &view,
+                &[0.0; DIM],
+                &mut w,
+            );
+            let d = f64::from(w[0] - w[1]);
+            assert!((d / expected - 1.0).abs() < 1e-3, "{robust:?}: {d} against {expected}");
+        }
+    }
+
+    /// The precision argument of particles stored as single-precision offsets from a
+    /// double-precision origin that follows the cloud: the same cloud, model and
+    /// measurements at the frame's origin and translated to a UTM northing of 5e6 m (and
+    /// an easting of 5e5 m, the station with it) hold the same offsets, bit for bit, over
+    /// 30 cycles in which the AUV travels 180 m and the origin moves after it (origins
+    /// on the 2^-10 m grid add exactly below 2^42 m). The estimates then differ by the
+    /// last addition of the origin to the mean alone: half a unit in the last place of
+    /// 5e6 in double precision, 2^-31 m, plus that of 100 m, 2^-47 m; the bound asserted
+    /// is 2^-30 m (4.7e-10 m). Stored whole in single precision, positions near 5e6 m
+    /// would be 0.5 m apart.
+    #[test]
+    fn a_cloud_far_from_the_frame_origin_is_held_as_finely_as_one_near_it() {
+        use crate::filter::particle::ParticleSettings;
+        use crate::measure::hoff::InsReport;
+        use nalgebra::Vector3;
+        let run = |north: f64, east: f64| {
+            let mean = SVector::<f64, DIM>::from([north + 100.25, east + 50.5, 30.0, 0.0, 0.3, 1.5, 0.0, 0.002]);
+            let sigma = SVector::<f64, DIM>::from([10.0, 10.0, 2.0, 0.05, 0.2, 0.3, 0.001, 0.003]);
+            let settings = ParticleSettings {
+                resampler: crate::filter::particle::Resampler::Multinomial,
+                ..ParticleSettings::default()
+            };
+            let mut pf = ParticleFilter::<DIM>::gaussian(20_000, &mean, &sigma, settings, 11);
+            let usbl = Usbl::exact(Vector3::new(north + 80.0, east + 30.0, 0.0), 0.0, 0.022f64.to_radians());
+            let mut estimates = Vec::new();
+            for k in 0..30 {
+                let t = 4.0 * k as f64;
+                pf.predict_resampled(&HoffProcess::default(), 4.0);
+                let ins = InsReport {
+                    heading_rad: 0.3,
+                    speed_m_s: 1.5,
+                    depth_m: 30.0,
+                    sigma_heading_rad: 0.1,
+                    sigma_speed_m_s: 0.2,
+                    sigma_depth_m: 0.4,
+                };
+                // the truth moves along the heading; its bearing from the station
+                let p = Vector3::new(north + 100.25 + 1.43 * t, east + 50.5 + 0.44 * t, 30.0);
+                let (azimuth_rad, elevation_rad, _) = usbl.angles(&p);
+                pf.reweight(&(ins, UsblBearing { usbl, azimuth_rad, elevation_rad, robust: None }));
+                estimates.push(pf.mean_covariance_with_angle(Some(idx::PSI)));
+            }
+            (estimates, pf.origin())
+        };
+        let (near, near_origin) = run(0.0, 0.0);
+        let (far, far_origin) = run(5e6, 5e5);
+        assert!(near_origin[idx::X] > 150.0, "the origin followed the cloud: {near_origin}");
+        assert_eq!((far_origin[idx::X] - 5e6, far_origin[idx::Y] - 5e5), (near_origin[idx::X], near_origin[idx::Y]));
+        let bound = 2f64.powi(-30);
+        for ((m, c), (fm, fc)) in near.iter().zip(&far) {
+            assert!((fm[idx::X] - 5e6 - m[idx::X]).abs() <= bound, "{} against {}", fm[idx::X] - 5e6, m[idx::X]);
+            assert!((fm[idx::Y] - 5e5 - m[idx::Y]).abs() <= bound, "{} against {}", fm[idx::Y] - 5e5, m[idx::Y]);
+            for k in 2..DIM {
+                assert_eq!(fm[k].to_bits(), m[k].to_bits(), "component {k}");
+            }
+            assert_eq!(fc, c);
+        }
+    }
+
+    /// The model's own kernels (eq. 4's step, eq. 8, eq. 6-7 plain, robust and with a
+    /// misalignment) at each level the processor runs give the bits of the scalar
+    /// kernels called one particle at a time (through `black_box`, so not vectorised):
+    /// no result depends on the vector width. A block of 203 particles (vector bodies
+    /// and a tail) spread over headings across +-pi, pitches, speeds and depths.
+    #[test]
+    fn every_level_matches_the_scalar_kernels_bit_for_bit() {
+        use crate::filter::lanes::Level;
+        use crate::measure::hoff::{InsReport, bearing_terms, ins_report, usbl_bearing};
+        use crate::measure::{Robust, Usbl};
+        use nalgebra::Vector3;
+        use std::hint::black_box;
+        let n = 203;
+        let col = |f: &dyn Fn(f32) -> f32| (0..n).map(|i| f(i as f32)).collect::<Vec<f32>>();
+        let state: [Vec<f32>; DIM] = [
+            col(&|t| 40.0 * (t * 0.37).sin()),
+            col(&|t| 30.0 * (t * 0.71).cos()),
+            col(&|t| 2.0 * (t * 0.13).sin()),
+            col(&|t| 0.3 * (t * 0.23).sin()),
+            col(&|t| 3.1 * (t * 0.51).sin()),
+            col(&|t| 0.5 * (t * 0.29).cos()),
+            col(&|t| 0.01 * (t * 0.17).sin()),
+            col(&|t| 0.01 * (t * 0.19).cos()),
+        ];
+        let noise = col(&|t| (t * 1.618).sin() * 2.0);
+        let noise: Vec<f32> = (0..DIM).flat_map(|k| noise.iter().map(move |e| e * (k as f32 + 1.0) * 0.3)).collect();
+        let origin = [1000.0, -200.0, 30.0, 0.05, 0.0, 1.5, 0.0, 0.002];
+        let step = HoffProcess::default().step(&origin, 4.0);
+        let usbl = Usbl {
+            floor_rad: 0.002,
+            position_sigma_m: 1.0,
+            heading_sigma_rad: 0.01,
+            ..Usbl::exact(Vector3::new(990.0, -180.0, 0.5), 0.7, 0.0004)
+        };
+        let bearing = |robust| UsblBearing { usbl, azimuth_rad: 2.9, elevation_rad: 0.8, robust };
+        let mut origin9 = origin.to_vec();
+        origin9.push(0.01);
+        let misalignment = col(&|t| 0.02 * (t * 0.41).sin());
+        let ins = InsReport {
+            heading_rad: 3.0,
+            speed_m_s: 1.4,
+            depth_m: 31.0,
+            sigma_heading_rad: 0.1,
+            sigma_speed_m_s: 0.2,
+            sigma_depth_m: 0.3,
+        };
+        let ins_terms = ins.terms(&origin);
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
+        for level in Level::available() {
+            // eq. 4's step
+            let mut x = state.clone();
+            let [a, b, c, d, e, f, g, h] = &mut x;
+            hoff_step::at(level, &mut [a, b, c, d, e, f, g, h], &noise, &step);
+            for i in 0..n {
+                let mut one: [Vec<f32>; DIM] = std::array::from_fn(|k| vec![state[k][i]]);
+                let e: Vec<f32> = (0..DIM).map(|k| noise[k * n + i]).collect();
+                let [a, b, c, d, f, g, h, j] = &mut one;
+                hoff_step::at(Level::Baseline, black_box(&mut [a, b, c, d, f, g, h, j]), black_box(&e), &step);
+                for k in 0..DIM {
+                    assert_eq!(x[k][i].to_bits(), one[k][0].to_bits(), "{level:?} step {k} {i}");
+                }
+            }
+            // eq. 8 and eq. 6-7
+            let mut w = vec![0.5f32; n];
+            ins_report::at(level, &state[idx::PSI], &state[idx::U], &state[idx::Z], ins_terms, &mut w);
+            let cases = [
+                (bearing(None), &[][..], &origin[..]),
+                (bearing(Some(Robust::Huber { k: 1.345 })), &[][..], &origin[..]),
+                (bearing(None), &misalignment[..], &origin9[..]),
+            ];
+            let mut got = Vec::new();
+            for (b, mis, o) in cases {
+                let mut w = vec![0.25f32; n];
+                let t = bearing_terms(&b, o);
+                for start in (0..n).step_by(BLOCK) {
+                    let r = start..(start + BLOCK).min(n);
+                    let m = if mis.is_empty() { mis } else { &mis[r.clone()] };
+                    usbl_bearing::at(
+                        level,
+                        &state[0][r.clone()],
+                        &state[1][r.clone()],
+                        &state[2][r.clone()],
+                        m,
+                        &t,
+                        &mut w[r],
+                    );
+                }
+                for i in 0..n {
+                    let mut one = [0.25f32];
+                    let m = if mis.is_empty() { mis } else { &mis[i..i + 1] };
+                    let p = |k: usize| black_box(&state[k][i..i + 1]);
+                    usbl_bearing::at(Level::Baseline, p(0), p(1), p(2), m, &t, &mut one);
+                    assert_eq!(w[i].to_bits(), one[0].to_bits(), "{level:?} bearing {i}");
+                }
+                got.push(bits(&w));
+            }
+            for i in 0..n {
+                let mut one = [0.5f32];
+                let p = |k: usize| black_box(&state[k][i..i + 1]);
+                ins_report::at(Level::Baseline, p(idx::PSI), p(idx::U), p(idx::Z), ins_terms, &mut one);
+                assert_eq!(w[i].to_bits(), one[0].to_bits(), "{level:?} report {i}");
+            }
+            assert_ne!(got[0], got[1], "the robust form weighs differently");
+            assert_ne!(got[0], got[2], "the misalignment counts");
         }
     }
 
@@ -369,9 +609,11 @@ mod tests {
             pf.predict(&still, 4.0);
             let (mean, _) = pf.mean_covariance();
             let n = ProcessModel::propagate(&m, &x, 4.0);
-            // single-precision sines in the particles' step (filter::lanes)
+            // the state's offset from its origin (under 2^-11, the origin's grid's half)
+            // held in single precision (2^-35), twice, and single precision in the step
+            // (its sines, filter::lanes): 1e-6 of it
             for i in 0..DIM {
-                assert!((mean[i] - n[i]).abs() < 1e-12 + 1e-6 * (n[i] - x[i]).abs(), "{i}");
+                assert!((mean[i] - n[i]).abs() < 2f64.powi(-34) + 1e-6 * (n[i] - x[i]).abs(), "{i}");
             }
         }
         let q = ProcessModel::noise_covariance(&m, &SVector::zeros(), 4.0);
