@@ -444,48 +444,81 @@ lanes! {
     }
 }
 
+/// Particles whose products [`add_products`] sums in single precision before adding
+/// them in double.
+pub(crate) const PRODUCT_BLOCK: usize = 512;
+
+/// The normalised weight below which [`add_products`] counts a particle as 0: far below
+/// single precision's share of the sums (1e6 such particles weigh 1e-12), and it keeps
+/// the products out of single precision's subnormal range (below 1.2e-38), where each
+/// operation costs a hundred cycles.
+pub(crate) const NEGLIGIBLE_WEIGHT: f64 = 1e-18;
+
 lanes! {
-    /// Adds particles to the weighted products of a particle filter's moments:
-    /// `products[p]` += (w_i x_k,i) x_l,i for the p-th pair (k, l) of `pairs` (a
-    /// component of ones gives the weighted sums), particle i in accumulator i mod 4 (the
-    /// order of a four-way dot product, whatever the vector width). `pairs` comes in
-    /// groups of four (pad with any pair and discard its sum): each group's four sums
-    /// advance together, so that no sum waits on its own last addition. `w`'s length is
-    /// a multiple of 4 and no component is shorter.
-    pub fn add_products(w: &[f64], x: &[&[f32]], pairs: &[(usize, usize)], products: &mut [[f64; 4]]) {
-        // a block's w x_k stay in the first level of cache for the pairs that read them
-        const BLOCK: usize = 128;
-        fn quads(s: &[f64], n: usize) -> &[[f64; 4]] {
-            &s[..n].as_chunks::<4>().0[..n / 4]
-        }
-        // the block's components widened to double precision, and their products by w
-        let (mut wide, mut wx) = (vec![0.0; x.len() * BLOCK], vec![0.0; x.len() * BLOCK]);
-        for start in (0..w.len()).step_by(BLOCK) {
-            let n = BLOCK.min(w.len() - start);
-            let w = &w[start..start + n];
-            for ((xk, wk), wxk) in x.iter().zip(wide.chunks_exact_mut(BLOCK)).zip(wx.chunks_exact_mut(BLOCK)) {
-                for (((v, wx), w), x) in wk[..n].iter_mut().zip(&mut wxk[..n]).zip(w).zip(&xk[start..start + n]) {
-                    *v = f64::from(*x);
-                    *wx = w * *v;
-                }
+    /// Adds particles to the weighted products of a particle filter's moments about a
+    /// centre: with y_k,i = x_k,i - `centre[k]` (wrapped to within pi for the component
+    /// `angle`, if any), `products[p]` += sum_i (w_i y_k,i) y_l,i for the p-th pair (k, l)
+    /// of `pairs` (a component of ones, centred at 0, gives the weighted sums). In single
+    /// precision within each block of [`PRODUCT_BLOCK`] particles (the weight rounded to
+    /// single, or 0 below [`NEGLIGIBLE_WEIGHT`]; particle i of the block in lane i mod 16,
+    /// a last partial block padded with zeros; the 16 lanes summed by halves: 8, 4, 2, 1),
+    /// then each block's sum added in double precision: the same order whatever the
+    /// vector width. No component is shorter than `w`.
+    pub fn add_products(
+        w: &[f64],
+        x: &[&[f32]],
+        centre: &[f32],
+        angle: Option<usize>,
+        pairs: &[(usize, usize)],
+        products: &mut [f64],
+    ) {
+        const B: usize = PRODUCT_BLOCK;
+        let n = w.len();
+        // the block's centred components and their products by w, padded with zeros
+        let (mut yb, mut wy) = (vec![[[0.0f32; 16]; B / 16]; x.len()], vec![[[0.0f32; 16]; B / 16]; x.len()]);
+        let mut wf = [0.0f32; B];
+        for start in (0..n).step_by(B) {
+            let m = B.min(n - start);
+            wf[m..].fill(0.0);
+            for (v, w) in wf[..m].iter_mut().zip(&w[start..start + m]) {
+                *v = if *w < NEGLIGIBLE_WEIGHT { 0.0 } else { *w as f32 };
             }
-            for (group, acc) in pairs.chunks_exact(4).zip(products.chunks_exact_mut(4)) {
-                let a: [&[[f64; 4]]; 4] = std::array::from_fn(|q| quads(&wx[group[q].0 * BLOCK..], n));
-                let b: [&[[f64; 4]]; 4] = std::array::from_fn(|q| quads(&wide[group[q].1 * BLOCK..], n));
-                let quad = |c: usize| (a.map(|a| a[c]), b.map(|b| b[c]));
-                let mut sum: [[f64; 4]; 4] = std::array::from_fn(|q| acc[q]);
-                for c in 0..n / 4 {
-                    let (a, b) = quad(c);
-                    for q in 0..4 {
-                        for j in 0..4 {
-                            sum[q][j] += a[q][j] * b[q][j];
-                        }
+            for (k, ((xk, ybk), wyk)) in x.iter().zip(yb.iter_mut()).zip(wy.iter_mut()).enumerate() {
+                let (ybk, wyk, c) = (ybk.as_flattened_mut(), wyk.as_flattened_mut(), centre[k]);
+                ybk[m..].fill(0.0);
+                if angle == Some(k) {
+                    for (y, x) in ybk[..m].iter_mut().zip(&xk[start..start + m]) {
+                        *y = wrap_near(x - c);
+                    }
+                } else {
+                    for (y, x) in ybk[..m].iter_mut().zip(&xk[start..start + m]) {
+                        *y = x - c;
                     }
                 }
-                acc.copy_from_slice(&sum);
+                for ((v, w), y) in wyk.iter_mut().zip(&wf).zip(ybk.iter()) {
+                    *v = w * y;
+                }
+            }
+            for (&(k, l), total) in pairs.iter().zip(products.iter_mut()) {
+                let (a, b) = (&wy[k], &yb[l]);
+                let mut lanes = [0.0f32; 16];
+                for c in 0..B / 16 {
+                    for j in 0..16 {
+                        lanes[j] += a[c][j] * b[c][j];
+                    }
+                }
+                *total += f64::from(halves(lanes));
             }
         }
     }
+}
+
+/// The sum of 16 lanes by halves: lane j + lane j + 8, then 4, 2, 1.
+#[inline(always)]
+fn halves(v: [f32; 16]) -> f32 {
+    let h8: [f32; 8] = std::array::from_fn(|j| v[j] + v[j + 8]);
+    let h4: [f32; 4] = std::array::from_fn(|j| h8[j] + h8[j + 4]);
+    (h4[0] + h4[2]) + (h4[1] + h4[3])
 }
 
 /// The azimuth and the angle from the vertical of [`angle_moments`] for one particle.
@@ -651,21 +684,36 @@ mod tests {
             }
             let expected = acc.map(|m| ((m[0] + m[1]) + (m[2] + m[3])) + ((m[4] + m[5]) + (m[6] + m[7])));
             assert_eq!(moments.map(f64::to_bits), expected.map(f64::to_bits), "{level:?} angle moments");
-            // three components (ones among them: sums) and six pairs with two of padding
-            let ones = vec![1.0; 4096];
-            let comps = [&a[..4096], &b[..4096], &ones[..]];
-            let pairs = [(0, 2), (1, 2), (0, 0), (0, 1), (1, 1), (1, 0), (0, 0), (0, 0)];
-            let mut products = [[0.25; 4]; 8];
-            add_products::at(level, &weights[..4096], &comps, &pairs, &mut products);
-            let mut expected = [[0.25; 4]; 8];
-            for i in 0..4096 {
-                for (p, &(k, l)) in pairs[..6].iter().enumerate() {
-                    let (xk, xl) = (f64::from(comps[k][i]), f64::from(comps[l][i]));
-                    expected[p][i % 4] += black_box(black_box(weights[i] * xk) * xl);
+            // three components (ones among them: sums; the second an angle), six pairs,
+            // two blocks and a part
+            let m = 2 * PRODUCT_BLOCK + 37;
+            let ones = vec![1.0; m];
+            let comps = [&a[..m], &b[..m], &ones[..]];
+            let (centre, angle) = ([0.5, -3.0, 0.0], Some(1));
+            let pairs = [(0, 2), (1, 2), (0, 0), (0, 1), (1, 1), (1, 0)];
+            let mut products = [0.25; 6];
+            add_products::at(level, &weights[..m], &comps, &centre, angle, &pairs, &mut products);
+            let mut expected = [0.25; 6];
+            let y = |k: usize, i: usize| {
+                let d = comps[k][i] - centre[k];
+                if Some(k) == angle { black_box(wrap_near(d)) } else { d }
+            };
+            for start in (0..m).step_by(PRODUCT_BLOCK) {
+                let end = (start + PRODUCT_BLOCK).min(m);
+                for (p, &(k, l)) in pairs.iter().enumerate() {
+                    let mut lanes = [0.0f32; 16];
+                    let wf = |i: usize| if weights[i] < NEGLIGIBLE_WEIGHT { 0.0 } else { weights[i] as f32 };
+                    let term = |i: usize| black_box(black_box(wf(i) * y(k, i)) * y(l, i));
+                    for i in start..end {
+                        lanes[(i - start) % 16] += term(i);
+                    }
+                    let h8: Vec<f32> = (0..8).map(|j| black_box(lanes[j] + lanes[j + 8])).collect();
+                    let h4: Vec<f32> = (0..4).map(|j| black_box(h8[j] + h8[j + 4])).collect();
+                    expected[p] += f64::from((h4[0] + h4[2]) + (h4[1] + h4[3]));
                 }
             }
-            let bits = |p: &[[f64; 4]]| p.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&products[..6]), bits(&expected[..6]), "{level:?} products");
+            let bits = |p: &[f64]| p.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&products), bits(&expected), "{level:?} products");
         }
     }
 

@@ -424,38 +424,27 @@ impl<const D: usize> ParticleFilter<D> {
     pub fn mean_covariance_with_angle(&self, angle: Option<usize>) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
         let w = self.normalised();
         let x = &self.x;
-        let reference = angle.map_or(0.0, |k| {
-            let heaviest = w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b });
-            x[k][heaviest.0]
-        });
-        // per chunk: sum w x_k (w x_k times a component of ones) and sum w x_k x_l
-        // (k <= l), each a four-way dot product over the chunk (in the lanes, the pairs in
-        // groups of four), reduced in chunk order
-        let mut pairs: Vec<(usize, usize)> =
+        // the moments are taken about the heaviest particle (in single precision a cloud
+        // off the origin by more than its spread would otherwise lose its covariance to
+        // E[x x'] - m m')
+        let heaviest = w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b }).0;
+        let centre: Vec<f32> = (0..D).map(|k| x[k].get(heaviest).copied().unwrap_or(0.0)).chain([0.0]).collect();
+        // per chunk: sum w y_k (w y_k times a component of ones) and sum w y_k y_l
+        // (k <= l), y the offsets less the centre, in the lanes (single precision within
+        // blocks, double across them), reduced in chunk order
+        let pairs: Vec<(usize, usize)> =
             (0..D).map(|k| (k, D)).chain((0..D).flat_map(|k| (k..D).map(move |l| (k, l)))).collect();
-        let used = pairs.len();
-        pairs.resize(used.next_multiple_of(4), (0, 0));
         let ones = vec![1.0f32; CHUNK.min(w.len())];
         let partial: Vec<(SVector<f64, D>, SMatrix<f64, D, D>)> = (0..w.len().div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
                 let (start, end) = (c * CHUNK, ((c + 1) * CHUNK).min(w.len()));
                 let w = &w[start..end];
-                let wrapped: Vec<f32> = angle.map_or_else(Vec::new, |k| {
-                    x[k][start..end].iter().map(|a| crate::filter::lanes::wrap_near(a - reference)).collect()
-                });
-                let comp = |k: usize| if Some(k) == angle { &wrapped[..] } else { &x[k][start..end] };
-                let comps: Vec<&[f32]> = (0..D).map(comp).chain([&ones[..w.len()]]).collect();
-                let whole = w.len() / 4 * 4;
-                let mut products = vec![[0.0; 4]; pairs.len()];
-                crate::filter::lanes::add_products(&w[..whole], &comps, &pairs, &mut products);
-                // the tail of fewer than four particles apart, as a four-way dot product
-                // sums it, then the four accumulators pairwise
+                let comps: Vec<&[f32]> = x.iter().map(|xk| &xk[start..end]).chain([&ones[..w.len()]]).collect();
+                let mut products = vec![0.0; pairs.len()];
+                crate::filter::lanes::add_products(w, &comps, &centre, angle, &pairs, &mut products);
                 let (mut s, mut ss) = (SVector::<f64, D>::zeros(), SMatrix::<f64, D, D>::zeros());
-                let at = |k: usize, i: usize| f64::from(comps[k][i]);
-                for (&(k, l), a) in pairs[..used].iter().zip(&products) {
-                    let tail: f64 = (whole..w.len()).map(|i| w[i] * at(k, i) * at(l, i)).sum();
-                    let total = (a[0] + a[1]) + (a[2] + a[3]) + tail;
+                for (&(k, l), total) in pairs.iter().zip(products) {
                     if l == D {
                         s[k] = total;
                     } else {
@@ -471,9 +460,11 @@ impl<const D: usize> ParticleFilter<D> {
             second += ss;
         }
         let cov = second - mean * mean.transpose();
-        mean += SVector::from(self.origin);
+        for k in 0..D {
+            mean[k] += self.origin[k] + f64::from(centre[k]);
+        }
         if let Some(k) = angle {
-            mean[k] = crate::geo::wrap_angle(mean[k] + f64::from(reference));
+            mean[k] = crate::geo::wrap_angle(mean[k]);
         }
         (mean, cov)
     }
@@ -537,7 +528,7 @@ impl<const D: usize> ParticleFilter<D> {
             )
         };
         // the new particle 0: the first chunk's first ancestor
-        let first = ancestors(0, CHUNK.min(self.log_w.len())).first().copied();
+        let first = (!self.log_w.is_empty()).then(|| ancestors(0, CHUNK.min(self.log_w.len()))[0]);
         let shift = recentring::<D>(|k| first.map(|i| self.x[k][i]));
         self.move_origin(shift);
         let (from, origin) = (&self.x, self.origin);
@@ -648,14 +639,7 @@ mod tests {
         use crate::models::hoff::{DIM, HoffProcess};
         let mean = SVector::<f64, DIM>::from([100.0, 50.0, 30.0, 0.0, 0.3, 1.5, 0.0, 0.002]);
         let sigma = SVector::<f64, DIM>::from([10.0, 10.0, 2.0, 0.05, 0.2, 0.3, 0.001, 0.003]);
-        let report = InsReport {
-            heading_rad: 0.3,
-            speed_m_s: 1.5,
-            depth_m: 30.0,
-            sigma_heading_rad: 0.1,
-            sigma_speed_m_s: 0.2,
-            sigma_depth_m: 0.4,
-        };
+        let report = InsReport::example();
         for ess_fraction in [0.5, 1e-9] {
             let settings = ParticleSettings { ess_fraction, ..ParticleSettings::default() };
             let mut a = ParticleFilter::<DIM>::gaussian(3 * CHUNK + 77, &mean, &sigma, settings, 9);
@@ -922,24 +906,14 @@ mod tests {
         }
     }
 
-    /// sum a_i b_i with four accumulators, the tail apart: the reference order.
-    fn dot(a: &[f64], b: &[f64]) -> f64 {
-        let mut acc = [0.0; 4];
-        let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-        let tail: f64 = a4.remainder().iter().zip(b4.remainder()).map(|(a, b)| a * b).sum();
-        for (a, b) in a4.zip(b4) {
-            for j in 0..4 {
-                acc[j] += a[j] * b[j];
-            }
-        }
-        (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
-    }
-
-    /// The mean and covariance equal, to the bit, the chunk-by-chunk four-way dot
-    /// products written out pair by pair (8 components, an angle among them, a chunk and
-    /// a part with a tail of 3).
+    /// The mean and covariance against the weighted sums in double precision over the
+    /// same offsets less the heaviest particle's (8 components, an angle among them, two
+    /// chunks and a part): within the single-precision share, each product w y_k y_l
+    /// rounded three times, then 32 additions in its lane and 4 across the lanes (39
+    /// roundings of 2^-24 of the sum of |w y_k y_l|), the covariance's bound carried
+    /// through E[y y'] - m m'.
     #[test]
-    fn mean_and_covariance_are_the_dot_products_of_each_chunk() {
+    fn mean_and_covariance_match_double_precision_sums() {
         let n = 2 * CHUNK + 4099;
         let mean = SVector::<f64, 8>::from([0.5, 50.0, 30.0, 0.0, 3.0, 1.5, 0.0, 0.002]);
         let sigma = SVector::<f64, 8>::from([2.0, 10.0, 2.0, 0.05, 0.5, 0.3, 0.001, 0.003]);
@@ -947,33 +921,53 @@ mod tests {
         pf.update(&Tilt);
         let (m, c) = pf.mean_covariance_with_angle(Some(4));
         let w = pf.normalised();
-        let reference =
-            pf.x[4][w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b }).0];
+        let heaviest = w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b }).0;
+        let centre: Vec<f32> = (0..8).map(|k| pf.x[k][heaviest]).collect();
+        // the offsets less the heaviest particle's, in double precision
+        let comps: Vec<Vec<f64>> = (0..8)
+            .map(|k| {
+                let centred =
+                    |a: &f32| if k == 4 { crate::filter::lanes::wrap_near(a - centre[k]) } else { a - centre[k] };
+                pf.x[k].iter().map(|a| f64::from(centred(a))).collect()
+            })
+            .collect();
+        // a product's three roundings, 32 additions in its lane, 4 across the lanes
+        let eps = 39.0 * 2f64.powi(-24);
         let (mut mean, mut second) = (SVector::<f64, 8>::zeros(), SMatrix::<f64, 8, 8>::zeros());
-        for start in (0..n).step_by(CHUNK) {
-            let end = (start + CHUNK).min(n);
-            let w = &w[start..end];
-            let comps: Vec<Vec<f64>> = (0..8)
-                .map(|k| {
-                    let x = pf.x[k][start..end].iter();
-                    let wrapped = |a: &f32| if k == 4 { crate::filter::lanes::wrap_near(a - reference) } else { *a };
-                    x.map(|a| f64::from(wrapped(a))).collect()
-                })
-                .collect();
+        let (mut mean_bound, mut second_bound) = (SVector::<f64, 8>::zeros(), SMatrix::<f64, 8, 8>::zeros());
+        for i in 0..n {
             for k in 0..8 {
-                mean[k] += dot(w, &comps[k]);
-                let wx: Vec<f64> = w.iter().zip(&comps[k]).map(|(w, x)| w * x).collect();
-                for l in k..8 {
-                    second[(k, l)] += dot(&wx, &comps[l]);
-                    second[(l, k)] = second[(k, l)];
+                mean[k] += w[i] * comps[k][i];
+                mean_bound[k] += eps * (w[i] * comps[k][i]).abs();
+                for l in 0..8 {
+                    second[(k, l)] += w[i] * comps[k][i] * comps[l][i];
+                    second_bound[(k, l)] += eps * (w[i] * comps[k][i] * comps[l][i]).abs();
                 }
             }
         }
         let cov = second - mean * mean.transpose();
-        mean += pf.origin();
-        mean[4] = crate::geo::wrap_angle(mean[4] + f64::from(reference));
-        assert!(m.iter().zip(mean.iter()).all(|(a, b)| a.to_bits() == b.to_bits()), "{m} {mean}");
-        assert!(c.iter().zip(cov.iter()).all(|(a, b)| a.to_bits() == b.to_bits()), "{c} {cov}");
+        for k in 0..8 {
+            for l in 0..8 {
+                let bound = second_bound[(k, l)]
+                    + mean[k].abs() * mean_bound[l]
+                    + mean[l].abs() * mean_bound[k]
+                    + mean_bound[k] * mean_bound[l]
+                    + 1e-15;
+                assert!(
+                    (c[(k, l)] - cov[(k, l)]).abs() <= bound,
+                    "cov ({k}, {l}): {} against {}",
+                    c[(k, l)],
+                    cov[(k, l)]
+                );
+            }
+        }
+        for k in 0..8 {
+            mean[k] += pf.origin()[k] + f64::from(centre[k]);
+        }
+        mean[4] = crate::geo::wrap_angle(mean[4]);
+        for k in 0..8 {
+            assert!((m[k] - mean[k]).abs() <= mean_bound[k] + 1e-12, "mean {k}: {} against {}", m[k], mean[k]);
+        }
     }
 
     /// An angle component across +-pi: the mean where the particles are (pi, not 0) and

@@ -181,7 +181,7 @@ pub(super) fn chunk_ancestors(
 /// (k_(i-1)), in order (one copied no times is overwritten by the next, which starts at
 /// the same place), and a running maximum fills the places between.
 fn systematic(cum: &[f64], range: std::ops::Range<usize>, u0: f64) -> Vec<usize> {
-    let (n, last) = (cum.len() as f64, cum.len() - 1);
+    let (n, last) = (cum.len() as f64, cum.len().saturating_sub(1));
     // ceil(t) for t > -1 by truncation (libm's ceil is a call at the baseline level)
     let k = |c: f64| {
         let t = n * c - u0;

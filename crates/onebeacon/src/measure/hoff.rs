@@ -40,6 +40,21 @@ impl InsReport {
     }
 }
 
+#[cfg(test)]
+impl InsReport {
+    /// A report the tests weigh particles by: heading 0.3 rad, 1.5 m/s, 30 m deep.
+    pub(crate) fn example() -> Self {
+        Self {
+            heading_rad: 0.3,
+            speed_m_s: 1.5,
+            depth_m: 30.0,
+            sigma_heading_rad: 0.1,
+            sigma_speed_m_s: 0.2,
+            sigma_depth_m: 0.4,
+        }
+    }
+}
+
 impl ParticleLikelihood for InsReport {
     fn add_log_likelihood(&self, x: &[&[f32]], origin: &[f64], log_w: &mut [f32]) {
         let n = log_w.len();

@@ -448,14 +448,7 @@ mod tests {
             for k in 0..30 {
                 let t = 4.0 * k as f64;
                 pf.predict_resampled(&HoffProcess::default(), 4.0);
-                let ins = InsReport {
-                    heading_rad: 0.3,
-                    speed_m_s: 1.5,
-                    depth_m: 30.0,
-                    sigma_heading_rad: 0.1,
-                    sigma_speed_m_s: 0.2,
-                    sigma_depth_m: 0.4,
-                };
+                let ins = InsReport::example();
                 // the truth moves along the heading; its bearing from the station
                 let p = Vector3::new(north + 100.25 + 1.43 * t, east + 50.5 + 0.44 * t, 30.0);
                 let (azimuth_rad, elevation_rad, _) = usbl.angles(&p);
