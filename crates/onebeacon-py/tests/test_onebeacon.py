@@ -368,13 +368,14 @@ def test_memory_budget_refuses_before_any_work(monkeypatch):
 
 
 def test_the_navigators_memory_budget_refuses_before_any_filter(monkeypatch, tmp_path):
-    # 1000 tracked AUVs with a 5e5-particle filter each: about 84 GB, refused in the
-    # constructor (cfb7f93 built them and the kernel killed the interpreter)
+    # 1000 tracked AUVs with a 5e5-particle filter each: about 48 GB (single-precision
+    # particles, issue 57), refused in the constructor (cfb7f93 built them and the kernel
+    # killed the interpreter)
     tracked = '[[tracked]]\nfrom = "given"\nt0_s = 0.0\nx_m = 50.0\ny_m = 0.0\nheading_deg = 90.0\n' * 1000
     config = tmp_path / "fleet.toml"
     config.write_text('name = "asv"\nframe = "ned"\n' + tracked + '[[estimators]]\nkind = "pf"\nparticles = 500000\n')
     monkeypatch.setenv("ONEBEACON_MEMORY_GIB", "16")
-    with pytest.raises(onebeacon.InputError, match="would hold about 84.1 GB.*for 1000 vehicle"):
+    with pytest.raises(onebeacon.InputError, match="would hold about 48.1 GB.*for 1000 vehicle"):
         onebeacon.Navigator(config)
     monkeypatch.setenv("ONEBEACON_MEMORY_GIB", "0.01")
     with pytest.raises(onebeacon.InputError, match="memory budget is 0.0 GB"):
