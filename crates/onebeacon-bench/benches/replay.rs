@@ -8,8 +8,6 @@
 //! checks and every estimator's update, the output line): a range, an odometry item.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use onebeacon::io::jsonl::item_json;
-use onebeacon::io::stream::Lines;
 use onebeacon::log::{Log, LogError, stream_setup};
 use onebeacon_sim::replay::replay;
 use std::hint::black_box;
@@ -38,13 +36,7 @@ fn bench(c: &mut Criterion) {
     // a started stream: plaza1's first 2000 items
     let mut unit =
         stream_setup(&path, |s| onebeacon_sim::budget::Budget::resolve(None).unwrap().check_stream(s)).unwrap();
-    let mut lines = Lines::default();
-    let mut t0 = 0.0;
-    for item in full.items().unwrap().take(2000) {
-        let item = item.unwrap();
-        t0 = item.t_s;
-        lines.push(&mut unit, item_json(&item).to_string().as_bytes(), false, |_, _| {});
-    }
+    let (mut lines, mut t0) = onebeacon::log::feed_items(&mut unit, &full, 2000).unwrap();
     assert!(unit.session(0).started());
     let names = unit.session(0).names.len();
     for (label, line) in [

@@ -5,9 +5,8 @@
 //! alone (`stream`'s cost, onebeacon-bench's "stream line: range").
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use onebeacon::io::jsonl::{item_json, line_json};
-use onebeacon::io::stream::Lines;
-use onebeacon::log::{Log, stream_setup};
+use onebeacon::io::jsonl::line_json;
+use onebeacon::log::{Log, feed_items, stream_setup};
 use std::hint::black_box;
 use std::path::PathBuf;
 
@@ -36,14 +35,8 @@ fn bench(c: &mut Criterion) {
     let plaza1 = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/plaza/plaza1.toml");
     let full = Log::load(&plaza1).unwrap();
     let mut unit = stream_setup(&plaza1, |_| Ok::<_, String>(())).unwrap();
-    let mut lines = Lines::default();
-    let mut t0 = 0.0;
     // a started stream: plaza1's first 2000 items
-    for item in full.items().unwrap().take(2000) {
-        let item = item.unwrap();
-        t0 = item.t_s;
-        lines.push(&mut unit, item_json(&item).to_string().as_bytes(), false, |_, _| {});
-    }
+    let (mut lines, mut t0) = feed_items(&mut unit, &full, 2000).unwrap();
     assert!(unit.session(0).started());
     // the range topic of a live description (sensor_msgs/Range: its fields are known)
     let dir = std::env::temp_dir().join(format!("onebeacon-bench-node-{}", std::process::id()));

@@ -48,6 +48,19 @@ pub fn stream_setup<E: std::fmt::Display>(
     stream.unit().map_err(|v| LogError::File { file, message: v.to_string() })
 }
 
+/// `unit` fed the first `items` items of `log` as stream lines (a started stream, for a
+/// benchmark of the next line): the lines read so far and the last item's time.
+pub fn feed_items(unit: &mut Unit, log: &Log, items: usize) -> Result<(crate::io::stream::Lines, f64), LogError> {
+    let mut lines = crate::io::stream::Lines::default();
+    let mut t0 = 0.0;
+    for item in log.items()?.take(items) {
+        let item = item?;
+        t0 = item.t_s;
+        lines.push(unit, crate::io::jsonl::item_json(&item).to_string().as_bytes(), false, |_, _| {});
+    }
+    Ok((lines, t0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
