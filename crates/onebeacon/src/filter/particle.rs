@@ -500,7 +500,7 @@ fn add_log_likelihood(x: &[Vec<f32>], origin: &[f64], log_w: &mut [f32], likelih
             crate::filter::lanes::max_of(lw)
         })
         .collect();
-    maxima.into_iter().fold(f32::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f32::NAN } else { a.max(b) })
+    crate::filter::lanes::max_of(&maxima)
 }
 
 /// The effective sample size of log-weights `log_w + lambda inc`, summed by chunks in
@@ -524,7 +524,7 @@ fn ess_tempered(log_w: &[f32], inc: &[f32], lambda: f64) -> f64 {
 /// The largest log-weight (exact in any order; NaN if one is).
 fn max_log_weight(log_w: &[f32]) -> f32 {
     let maxima: Vec<f32> = log_w.par_chunks(CHUNK).map(crate::filter::lanes::max_of).collect();
-    maxima.into_iter().fold(f32::NEG_INFINITY, |a, b| if a.is_nan() || b.is_nan() { f32::NAN } else { a.max(b) })
+    crate::filter::lanes::max_of(&maxima)
 }
 
 #[cfg(test)]
