@@ -9,8 +9,11 @@ a tie at this run count.
 Usage:
   scripts/paired.py MC_JSON --vary guidance --base circle [--estimator range-ekf]
   scripts/paired.py MC_JSON --vary estimator --base range-ekf
+  scripts/paired.py MC_JSON --before OLD_MC_JSON
 Every other entry of the varied key is compared with --base within each cell; negative
-means lower error than the base.
+means lower error than the base. With --before, every cell of MC_JSON against the same
+cell of OLD_MC_JSON: the same scenario, seed and runs from another build (what a change
+that moves the bits does to each figure); negative means lower error than before.
 """
 import argparse
 import json
@@ -68,13 +71,78 @@ def verdict(mean: float, half: float) -> str:
     return "tie" if not abs(mean) > half else ("lower" if mean < 0 else "higher")
 
 
+def cell_key(c) -> tuple:
+    """A cell's place in a campaign: its sweep values, vehicle and estimator."""
+    return (json.dumps(c["sweep"], sort_keys=True), c["vehicle"], c["estimator"])
+
+
+def before_and_after(new: dict, old: dict) -> list:
+    """Every cell of the campaign `new` against the same cell of `old` (two builds' `mc`
+    JSON of one scenario, seed and run count), paired by run: (cell key, new mean error,
+    old mean error, mean difference, its 95 % half-width, n, new NEES, old NEES, whether
+    the runs are the same to the bit, the NEES's paired (difference, half-width, n) or
+    None when a campaign has no run_nees). A ValueError names what does not match."""
+    for field in ("scenario", "seed", "runs"):
+        if new.get(field) != old.get(field):
+            raise ValueError(f"the two campaigns differ in {field}: {new.get(field)!r} and {old.get(field)!r}")
+    before = {cell_key(c): c for c in old["cells"]}
+    missing = [k for k in map(cell_key, new["cells"]) if k not in before]
+    if missing or len(before) != len(new["cells"]):
+        raise ValueError(f"the two campaigns hold different cells (first not in both: {(missing or list(before))[0]})")
+    rows = []
+    for c in new["cells"]:
+        o = before[cell_key(c)]
+        m, h, n = paired(c["run_mean_errors_m"], o["run_mean_errors_m"])
+        nees = paired(c["run_nees"], o["run_nees"]) if "run_nees" in c and "run_nees" in o else None
+        rows.append((cell_key(c), c["mean_error_m"], o["mean_error_m"], m, h, n, c["nees_mean"], o["nees_mean"],
+                     c["run_mean_errors_m"] == o["run_mean_errors_m"], nees))
+    return rows
+
+
+def print_before_and_after(path: str, before_path: str) -> None:
+    """`before_and_after` as a Markdown table."""
+    new, old = json.load(open(path)), json.load(open(before_path))
+    try:
+        rows = before_and_after(new, old)
+    except ValueError as e:
+        print(f"paired.py: {path} against {before_path}: {e}", file=sys.stderr)
+        sys.exit(2)
+    print(f"{new['scenario']}, {new['runs']} runs per cell, seed {new['seed']}: this build - the one before, paired by run")
+    print("| cell | vehicle | estimator | mean error, m (before) | difference, m [95 %] | verdict | NEES (before) "
+          "| NEES difference [95 %] |")
+    print("|---|---|---|---|---|---|---|---|")
+    for (sweep, vehicle, est), m_new, m_old, m, h, n, nees_new, nees_old, same, nees in rows:
+        label = " ".join(f"{k}={x}" for k, x in json.loads(sweep).items()) or "-"
+        if same:
+            diff, word = "same, to the bit", "same"
+        elif n < 2:
+            diff, word = f"{m_new - m_old:+.4f} (no interval: {n} run)", "-"
+        else:
+            diff, word = f"{m:+.4f} [{m - h:+.4f}, {m + h:+.4f}]", verdict(m, h)
+        nees_diff = "-" if nees is None or not nees[2] > 1 else f"{nees[0]:+.3f} [{nees[0] - nees[1]:+.3f}, {nees[0] + nees[1]:+.3f}]"
+        print(f"| {label} | {vehicle} | {est} | {m_new:.4f} ({m_old:.4f}) | {diff} | {word} "
+              f"| {figure(nees_new)} ({figure(nees_old)}) | {nees_diff} |")
+
+
+def figure(x) -> str:
+    """A NEES, or '-' where an estimator has none (null in the JSON)."""
+    return "-" if x is None else f"{x:.2f}"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("mc_json")
-    ap.add_argument("--vary", required=True, help="a sweep key, or 'estimator'")
-    ap.add_argument("--base", required=True, help="the value of the varied key compared against")
+    ap.add_argument("--vary", help="a sweep key, or 'estimator'")
+    ap.add_argument("--base", help="the value of the varied key compared against")
     ap.add_argument("--estimator", help="only this estimator (when varying a sweep key)")
+    ap.add_argument("--before", metavar="OLD_MC_JSON", help="the same campaign from another build")
     args = ap.parse_args()
+    if args.before is not None:
+        if args.vary or args.base or args.estimator:
+            ap.error("--before compares every cell: drop --vary, --base and --estimator")
+        return print_before_and_after(args.mc_json, args.before)
+    if not (args.vary and args.base):
+        ap.error("give --vary and --base (or --before OLD_MC_JSON)")
     cells = json.load(open(args.mc_json))["cells"]
     if any("run_mean_errors_m" not in c for c in cells):
         sys.exit(f"{args.mc_json}: no run_mean_errors_m (written by onebeacon from issue 29 on); re-run mc")

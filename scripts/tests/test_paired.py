@@ -44,3 +44,38 @@ def test_the_binomial_upper_bound_meets_its_closed_forms():
     tail = lambda p: sum(math.comb(n, i) * p ** i * (1 - p) ** (n - i) for i in range(k + 1))
     scan = next(j / 1e5 for j in range(1, 100000) if tail(j / 1e5) <= 0.05)
     assert abs(paired.binomial_upper(k, n) - scan) <= 1e-5
+
+
+def campaign(errors, seed=1, scenario="s", nees=2.0):
+    """An `mc` JSON of one cell per estimator: its run mean errors, their mean, every
+    run's NEES `nees`."""
+    return {"scenario": scenario, "seed": seed, "runs": len(next(iter(errors.values()))),
+            "cells": [{"sweep": {"guidance": "det"}, "vehicle": "auv", "estimator": e, "run_mean_errors_m": r,
+                       "mean_error_m": sum(r) / len(r), "nees_mean": nees, "run_nees": [nees] * len(r)}
+                      for e, r in errors.items()]}
+
+
+def test_a_build_against_the_one_before_pairs_the_same_cells_run_by_run():
+    old = campaign({"pf": [1.0, 2.0, 3.0, 4.0], "ekf": [5.0, 6.0, 7.0, 8.0]})
+    # pf: every run 0.25 m lower, the differences 0.2, 0.3, 0.2, 0.3 (mean 0.25, sd
+    # sqrt(1/300)): half-width t(0.975, 3) sd / 2 = 3.182 x 0.02887; ekf unchanged
+    new = campaign({"ekf": [5.0, 6.0, 7.0, 8.0], "pf": [0.8, 1.7, 2.8, 3.7]}, nees=2.5)
+    rows = {key[2]: row for key, *row in paired.before_and_after(new, old)}
+    _, _, m, h, n, _, _, same, nees = rows["pf"]
+    assert abs(m + 0.25) < 1e-12 and n == 4 and not same
+    assert abs(h - 3.182 * math.sqrt(1 / 300) / 2) < 1e-12
+    assert paired.verdict(m, h) == "lower"
+    assert nees == (0.5, 0.0, 4)  # every run's NEES 0.5 higher: no spread
+    assert rows["ekf"][-2] and rows["ekf"][2] == 0.0
+
+
+def test_two_campaigns_that_differ_in_seed_runs_or_cells_are_refused():
+    old = campaign({"pf": [1.0, 2.0]})
+    for new, what in ((campaign({"pf": [1.0, 2.0]}, seed=2), "seed"), (campaign({"pf": [1.0, 2.0, 3.0]}), "runs"),
+                      (campaign({"ekf": [1.0, 2.0]}), "cells")):
+        try:
+            paired.before_and_after(new, old)
+        except ValueError as e:
+            assert what in str(e), e
+        else:
+            raise AssertionError(f"a campaign of another {what} was compared")

@@ -53,6 +53,7 @@ pub fn mc(s: &Scenario, r: &McResult, wall_s: f64) -> Value {
                     "mean_error_second_half_m": num(m.mean_error_second_half_m),
                     "failed_updates": m.failed_updates,
                     "run_mean_errors_m": m.run_mean_errors_m.iter().map(|&e| num(e)).collect::<Vec<_>>(),
+                    "run_nees": m.run_nees.iter().map(|&e| num(e)).collect::<Vec<_>>(),
                 })
             })
         })

@@ -150,6 +150,9 @@ pub struct CellSummary {
     /// Every run's mean error in run order, outliers included, m: what paired
     /// comparisons between estimators or cells of the same runs are made of.
     pub run_mean_errors_m: Vec<f64>,
+    /// Every run's mean position NEES in run order, outliers included (NaN without a
+    /// covariance): the spread behind `nees_mean`, and what pairs two builds' NEES.
+    pub run_nees: Vec<f64>,
 }
 
 /// Aggregates runs (in run order) into a cell summary.
@@ -185,6 +188,7 @@ pub fn summarise(runs: &[RunMetrics]) -> CellSummary {
         mean_error_first_half_m: avg(&|r| r.mean_error_first_half_m),
         mean_error_second_half_m: avg(&|r| r.mean_error_second_half_m),
         run_mean_errors_m: runs.iter().map(|r| r.mean_error_m).collect(),
+        run_nees: runs.iter().map(|r| r.nees_mean).collect(),
     }
 }
 
@@ -227,6 +231,7 @@ mod tests {
         assert_relative_eq!(s.mean_error_m, 6.0); // mean of 2..=10
         assert_relative_eq!(s.nees_mean, 2.0);
         assert_eq!(s.nees_band, chi_square_band(9, 2));
+        assert_eq!(s.run_nees, vec![2.0; 10]); // every run's, the outlier's too
         // a diverged run is an outlier; NEES over all runs sees it
         let mut acc = ErrorStats::with_half(1);
         acc.push(f64::NAN, None);
