@@ -31,7 +31,7 @@ def hoff2024_cells(scenario, quick, vehicle="auv"):
 
 def hoff2024(quick):
     """docs/reproductions/hoff2024.md: `onebeacon mc hoff2024` and `mc hoff2024-kinematic`
-    (20 runs per cell, 1 h, 5e5 particles; 42 min and more): per guidance the particle
+    (20 runs per cell, 1 h, 5e5 particles; 18 and 17 min on 2 cores): per guidance the particle
     filter's mean error (RMSE / PCRB), mean NEES (95 % band) and second-half / first-half
     error, the EKF's and UKF's mean error (NEES), and the kinematic world's."""
     dynamic, kinematic = hoff2024_cells("hoff2024", quick), hoff2024_cells("hoff2024-kinematic", quick)
@@ -83,7 +83,7 @@ def hoff2024_dynamics(quick):
 
 def hoff2024_consistency(quick):
     """docs/reproductions/hoff2024.md: `onebeacon mc hoff2024-consistency` (10 runs, 1 h, 5e4
-    particles, det; 10 min): each filter's mean error, mean NEES (the particle filter's 95 %
+    particles, det; 97 s): each filter's mean error, mean NEES (the particle filter's 95 %
     band), and its run mean error against the matched particle filter's, paired by run."""
     by = {e: c for (_, e), c in hoff2024_cells("hoff2024-consistency", quick).items()}
     lo, hi = by["pf"]["nees_band"]
@@ -114,7 +114,7 @@ def hoff2024_current(quick):
 
 def hoff2024_pair(quick):
     """docs/reproductions/hoff2024.md: `onebeacon mc hoff2024-pair` (two AUVs 100 m apart,
-    1e5 particles, 10 runs; 18 min): per guidance and AUV the particle filter's mean error,
+    1e5 particles, 10 runs; 2 min): per guidance and AUV the particle filter's mean error,
     NEES and h2/h1, and its error against the static ASV's, paired by run."""
     rows = header("guidance", "AUV", "pf mean error, m", "pf NEES", "pf h2/h1", "pf: this guidance - static, m")
     for g in ("det", "max-eig", "static"):
