@@ -13,7 +13,8 @@ Usage:
 Every other entry of the varied key is compared with --base within each cell; negative
 means lower error than the base. With --before, every cell of MC_JSON against the same
 cell of OLD_MC_JSON: the same scenario, seed and runs from another build (what a change
-that moves the bits does to each figure); negative means lower error than before.
+that moves the bits does to each figure), the mean error and (where both campaigns carry
+run_nees) the NEES paired by run; negative means lower than before.
 """
 import argparse
 import json
