@@ -57,14 +57,28 @@ impl<const D: usize> ParticleFilter<D> {
     /// in (-pi, pi]: taken as its difference from the heaviest particle's, wrapped, so
     /// that a cloud across +-pi has its mean and spread where they are (for a spread
     /// well below pi). The mean angle is wrapped. The moments are those of the offsets
-    /// (summed in double precision), the origin added to the mean.
+    /// less the heaviest particle's (single precision within blocks of
+    /// [`crate::filter::lanes::PRODUCT_BLOCK`], double across them), the origin and that
+    /// particle added to the mean.
     pub fn mean_covariance_with_angle(&self, angle: Option<usize>) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
         let w = self.normalised();
         let x = &self.x;
         // the moments are taken about the heaviest particle (in single precision a cloud
         // off the origin by more than its spread would otherwise lose its covariance to
         // E[x x'] - m m')
-        let heaviest = w.iter().enumerate().fold((0, f64::MIN), |b, (i, v)| if *v > b.1 { (i, *v) } else { b }).0;
+        // the first of the largest weights: each chunk's first, then the first of those
+        let first_largest = |b: (usize, f64), (i, v): (usize, f64)| if v > b.1 { (i, v) } else { b };
+        let heaviest = (0..w.len().div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let start = c * CHUNK;
+                let chunk = &w[start..(start + CHUNK).min(w.len())];
+                chunk.iter().enumerate().map(|(i, v)| (start + i, *v)).fold((start, f64::MIN), first_largest)
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .fold((0, f64::MIN), first_largest)
+            .0;
         let centre: Vec<f32> = (0..D).map(|k| x[k].get(heaviest).copied().unwrap_or(0.0)).chain([0.0]).collect();
         // per chunk: sum w y_k (w y_k times a component of ones) and sum w y_k y_l
         // (k <= l), y the offsets less the centre, in the lanes (single precision within
